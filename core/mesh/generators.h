@@ -1,0 +1,53 @@
+#pragma once
+
+// Meshes generated in code, for tests and benchmarks that must not depend on
+// data files. Every generator is deterministic and returns a valid Mesh
+// (it aborts on a programming error in its own parameters).
+
+#include <cstdint>
+
+#include "core/mesh/mesh.h"
+
+namespace geodex::mesh::gen {
+
+// Flat grid in the z=0 plane covering [0,width]x[0,height], nx by ny cells,
+// each cell split in two triangles (diagonals alternate). `jitter` (fraction of
+// a cell, < 0.5) moves interior vertices in the plane, pseudo-randomly from
+// `seed`. Geodesic distance = Euclidean distance (the domain is convex).
+Mesh Grid(int nx, int ny, double width, double height, double jitter = 0.0, uint32_t seed = 1);
+
+// L-shaped flat domain: the square [0,2]x[0,2] minus [1,2]x[1,2], scaled by
+// `size`/2, with `n` cells per unit of the scaled half-size. The re-entrant
+// corner is the vertex at (size/2, size/2, 0).
+Mesh LShape(int n, double size);
+
+// Flat square [0,size]^2 with a square hole [size/3, 2size/3]^2, n cells a side
+// (n divisible by 3).
+Mesh SquareWithHole(int n, double size);
+
+// Grid(nx, ny, width, height) folded along the line x = width/2 by
+// `fold_angle` radians (0 = flat): developable, so geodesic distances equal
+// the distances in the unfolded plane. nx must be even.
+Mesh FoldedSheet(int nx, int ny, double width, double height, double fold_angle);
+
+// Open cylinder of `radius` around the z axis, z in [0, length], n_around
+// segments around and n_along along. Developable.
+Mesh Cylinder(int n_around, int n_along, double radius, double length);
+
+// Closed cube surface [0,size]^3, n cells per face side.
+Mesh Cube(int n, double size);
+
+// Icosphere of `radius` with `subdivisions` loop subdivisions (vertices
+// projected to the sphere): 20*4^subdivisions faces.
+Mesh Sphere(int subdivisions, double radius);
+
+// Torus around the z axis: major radius R, minor radius r.
+Mesh Torus(int n_major, int n_minor, double major_radius, double minor_radius);
+
+// Closed genus-2 surface (two tori joined), roughly `size` across.
+Mesh DoubleTorus(int resolution, double size);
+
+// Two disjoint unit grids (n by n cells), the second shifted by 2 along x.
+Mesh TwoComponents(int n);
+
+}  // namespace geodex::mesh::gen

@@ -1,0 +1,297 @@
+#include "core/mesh/mesh.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+
+#include "absl/strings/str_cat.h"
+#include "absl/strings/str_format.h"
+#include "core/common/status_macros.h"
+
+namespace geodex::mesh {
+namespace {
+
+// Faces whose doubled area is below this fraction of their longest squared
+// edge are degenerate to double precision (collinear corners).
+constexpr double kDegenerateAreaRatio = 1e-14;
+
+double CornerAngle(const Vec3& at, const Vec3& a, const Vec3& b) {
+  const Vec3 u = a - at;
+  const Vec3 w = b - at;
+  return std::atan2(u.cross(w).norm(), u.dot(w));
+}
+
+int32_t FindRoot(std::vector<int32_t>& parent, int32_t x) {
+  while (parent[x] != x) {
+    parent[x] = parent[parent[x]];
+    x = parent[x];
+  }
+  return x;
+}
+
+}  // namespace
+
+absl::StatusOr<Mesh> Mesh::Create(std::vector<Vec3> positions, std::vector<Triangle> faces,
+                                  std::string name) {
+  Mesh mesh;
+  mesh.name_ = std::move(name);
+  if (faces.empty()) {
+    return absl::InvalidArgumentError(absl::StrCat(mesh.name_, ": mesh has no faces"));
+  }
+  if (positions.size() >= static_cast<size_t>(INT32_MAX) || faces.size() >= INT32_MAX / 3) {
+    return absl::InvalidArgumentError(absl::StrCat(mesh.name_, ": mesh too large"));
+  }
+  for (size_t v = 0; v < positions.size(); ++v) {
+    if (!positions[v].allFinite()) {
+      return absl::InvalidArgumentError(absl::StrFormat(
+          "%s: vertex %d has a non-finite coordinate (%g, %g, %g)", mesh.name_, v, positions[v].x(),
+          positions[v].y(), positions[v].z()));
+    }
+  }
+  const int64_t n = static_cast<int64_t>(positions.size());
+  for (size_t f = 0; f < faces.size(); ++f) {
+    const Triangle& t = faces[f];
+    for (int i = 0; i < 3; ++i) {
+      if (t[i] < 0 || t[i] >= n) {
+        return absl::InvalidArgumentError(
+            absl::StrFormat("%s: face %d references vertex %d, out of range [0, %d)", mesh.name_, f,
+                            t[i], n));
+      }
+    }
+    if (t[0] == t[1] || t[1] == t[2] || t[0] == t[2]) {
+      return absl::InvalidArgumentError(absl::StrFormat(
+          "%s: face %d repeats a vertex (%d %d %d)", mesh.name_, f, t[0], t[1], t[2]));
+    }
+    const Vec3& a = positions[t[0]];
+    const Vec3& b = positions[t[1]];
+    const Vec3& c = positions[t[2]];
+    const double twice_area = (b - a).cross(c - a).norm();
+    const double longest2 =
+        std::max({(b - a).squaredNorm(), (c - b).squaredNorm(), (a - c).squaredNorm()});
+    if (!(twice_area > kDegenerateAreaRatio * longest2)) {
+      return absl::InvalidArgumentError(absl::StrFormat(
+          "%s: face %d (%d %d %d) has zero area (its corners are collinear or coincide)",
+          mesh.name_, f, t[0], t[1], t[2]));
+    }
+  }
+  // Duplicate faces: the same vertex set, in any order.
+  {
+    std::vector<std::pair<Triangle, int32_t>> sorted(faces.size());
+    for (size_t f = 0; f < faces.size(); ++f) {
+      Triangle t = faces[f];
+      std::sort(t.begin(), t.end());
+      sorted[f] = {t, static_cast<int32_t>(f)};
+    }
+    std::sort(sorted.begin(), sorted.end());
+    for (size_t i = 1; i < sorted.size(); ++i) {
+      if (sorted[i].first == sorted[i - 1].first) {
+        return absl::InvalidArgumentError(absl::StrFormat(
+            "%s: faces %d and %d are duplicates (vertices %d %d %d)", mesh.name_,
+            sorted[i - 1].second, sorted[i].second, sorted[i].first[0], sorted[i].first[1],
+            sorted[i].first[2]));
+      }
+    }
+  }
+  mesh.positions_ = std::move(positions);
+  mesh.faces_ = std::move(faces);
+  GEODEX_RETURN_IF_ERROR(mesh.BuildAdjacency());
+  return mesh;
+}
+
+absl::Status Mesh::BuildAdjacency() {
+  const int32_t nv = num_vertices();
+  const int32_t nf = num_faces();
+  const int32_t nh = 3 * nf;
+
+  length_.resize(nh);
+  for (int32_t h = 0; h < nh; ++h) length_[h] = (position(Dest(h)) - position(Origin(h))).norm();
+
+  // Pair half-edges by their undirected edge.
+  std::vector<int32_t> order(nh);
+  std::iota(order.begin(), order.end(), 0);
+  auto key = [&](int32_t h) {
+    const int64_t a = Origin(h), b = Dest(h);
+    return std::pair<int64_t, int64_t>(std::min(a, b), std::max(a, b));
+  };
+  std::sort(order.begin(), order.end(), [&](int32_t x, int32_t y) {
+    const auto kx = key(x), ky = key(y);
+    return kx != ky ? kx < ky : x < y;
+  });
+  twin_.assign(nh, kNone);
+  num_boundary_edges_ = 0;
+  for (int32_t i = 0; i < nh;) {
+    int32_t j = i + 1;
+    while (j < nh && key(order[j]) == key(order[i])) ++j;
+    const int32_t count = j - i;
+    const auto [a, b] = key(order[i]);
+    if (count > 2) {
+      std::string list;
+      for (int32_t k = i; k < j; ++k) absl::StrAppend(&list, k > i ? ", " : "", FaceOf(order[k]));
+      return absl::InvalidArgumentError(absl::StrFormat(
+          "%s: non-manifold edge (%d, %d) is shared by %d faces (%s)", name_, a, b, count, list));
+    }
+    if (count == 2) {
+      const int32_t h0 = order[i], h1 = order[i + 1];
+      if (Origin(h0) == Origin(h1)) {
+        return absl::InvalidArgumentError(absl::StrFormat(
+            "%s: faces %d and %d traverse edge (%d, %d) in the same direction (inconsistent "
+            "orientation or a non-orientable surface)",
+            name_, FaceOf(h0), FaceOf(h1), a, b));
+      }
+      twin_[h0] = h1;
+      twin_[h1] = h0;
+    } else {
+      ++num_boundary_edges_;
+    }
+    i = j;
+  }
+
+  // Outgoing half-edges per vertex, then order each fan counter-clockwise.
+  outgoing_offset_.assign(nv + 1, 0);
+  for (int32_t h = 0; h < nh; ++h) ++outgoing_offset_[Origin(h) + 1];
+  for (int32_t v = 0; v < nv; ++v) outgoing_offset_[v + 1] += outgoing_offset_[v];
+  std::vector<int32_t> unordered(nh);
+  {
+    std::vector<int32_t> fill(outgoing_offset_.begin(), outgoing_offset_.end() - 1);
+    for (int32_t h = 0; h < nh; ++h) unordered[fill[Origin(h)]++] = h;
+  }
+  outgoing_.assign(nh, kNone);
+  is_boundary_.assign(nv, 0);
+  angle_sum_.assign(nv, 0.0);
+  for (int32_t v = 0; v < nv; ++v) {
+    const int32_t begin = outgoing_offset_[v], end = outgoing_offset_[v + 1];
+    if (begin == end) continue;
+    // Start at a half-edge with no clockwise neighbour (a boundary), if any.
+    int32_t start = unordered[begin];
+    for (int32_t k = begin; k < end; ++k) {
+      if (twin_[unordered[k]] == kNone) {
+        start = unordered[k];
+        is_boundary_[v] = 1;
+        break;
+      }
+    }
+    int32_t count = 0;
+    int32_t h = start;
+    do {
+      outgoing_[begin + count++] = h;
+      const int32_t back = twin_[Prev(h)];  // counter-clockwise neighbour
+      if (back == kNone) {
+        is_boundary_[v] = 1;
+        break;
+      }
+      h = back;
+    } while (h != start && count < end - begin);
+    if (count != end - begin) {
+      return absl::InvalidArgumentError(absl::StrFormat(
+          "%s: non-manifold vertex %d: its %d faces form more than one fan", name_, v,
+          end - begin));
+    }
+    for (int32_t k = begin; k < end; ++k) {
+      const int32_t o = outgoing_[k];
+      angle_sum_[v] += CornerAngle(position(v), position(Dest(o)), position(Opposite(o)));
+    }
+  }
+
+  // Connected components over faces.
+  std::vector<int32_t> parent(nf);
+  std::iota(parent.begin(), parent.end(), 0);
+  for (int32_t h = 0; h < nh; ++h) {
+    if (twin_[h] == kNone) continue;
+    const int32_t a = FindRoot(parent, FaceOf(h)), b = FindRoot(parent, FaceOf(twin_[h]));
+    if (a != b) parent[std::max(a, b)] = std::min(a, b);
+  }
+  face_component_.assign(nf, kNone);
+  std::vector<int32_t> root_id(nf, kNone);
+  num_components_ = 0;
+  for (int32_t f = 0; f < nf; ++f) {
+    const int32_t r = FindRoot(parent, f);
+    if (root_id[r] == kNone) root_id[r] = num_components_++;
+    face_component_[f] = root_id[r];
+  }
+  vertex_component_.assign(nv, kNone);
+  for (int32_t f = 0; f < nf; ++f) {
+    for (int32_t v : faces_[f]) vertex_component_[v] = face_component_[f];
+  }
+  return absl::OkStatus();
+}
+
+double Mesh::Area(int32_t f) const {
+  const Triangle& t = faces_[f];
+  return 0.5 * (positions_[t[1]] - positions_[t[0]])
+                   .cross(positions_[t[2]] - positions_[t[0]])
+                   .norm();
+}
+
+double Mesh::TotalArea() const {
+  double total = 0;
+  for (int32_t f = 0; f < num_faces(); ++f) total += Area(f);
+  return total;
+}
+
+Vec3 Mesh::BoundingBoxMin() const {
+  Vec3 lo = Vec3::Constant(std::numeric_limits<double>::infinity());
+  for (int32_t v = 0; v < num_vertices(); ++v) {
+    if (IsReferenced(v)) lo = lo.cwiseMin(positions_[v]);
+  }
+  return lo;
+}
+
+Vec3 Mesh::BoundingBoxMax() const {
+  Vec3 hi = Vec3::Constant(-std::numeric_limits<double>::infinity());
+  for (int32_t v = 0; v < num_vertices(); ++v) {
+    if (IsReferenced(v)) hi = hi.cwiseMax(positions_[v]);
+  }
+  return hi;
+}
+
+double Mesh::BoundingBoxDiagonal() const { return (BoundingBoxMax() - BoundingBoxMin()).norm(); }
+
+Vec3 PositionOf(const Mesh& mesh, const SurfacePoint& p) {
+  const Triangle& t = mesh.face(p.face);
+  return p.w[0] * mesh.position(t[0]) + p.w[1] * mesh.position(t[1]) +
+         p.w[2] * mesh.position(t[2]);
+}
+
+absl::Status ValidateSurfacePoint(const Mesh& mesh, const SurfacePoint& p, double tolerance) {
+  if (p.face < 0 || p.face >= mesh.num_faces()) {
+    return absl::OutOfRangeError(
+        absl::StrFormat("face id %d out of range [0, %d)", p.face, mesh.num_faces()));
+  }
+  double sum = 0;
+  for (int i = 0; i < 3; ++i) {
+    if (!std::isfinite(p.w[i])) {
+      return absl::InvalidArgumentError(
+          absl::StrFormat("barycentric weight %d of face %d is not finite", i, p.face));
+    }
+    if (p.w[i] < -tolerance) {
+      return absl::InvalidArgumentError(
+          absl::StrFormat("barycentric weight %d of face %d is negative (%g)", i, p.face, p.w[i]));
+    }
+    sum += p.w[i];
+  }
+  if (std::abs(sum - 1.0) > tolerance) {
+    return absl::InvalidArgumentError(absl::StrFormat(
+        "barycentric weights of face %d sum to %.17g, not 1 (tolerance %g)", p.face, sum,
+        tolerance));
+  }
+  return absl::OkStatus();
+}
+
+absl::StatusOr<SurfacePoint> VertexPoint(const Mesh& mesh, int32_t v) {
+  if (v < 0 || v >= mesh.num_vertices()) {
+    return absl::OutOfRangeError(
+        absl::StrFormat("vertex id %d out of range [0, %d)", v, mesh.num_vertices()));
+  }
+  if (!mesh.IsReferenced(v)) {
+    return absl::FailedPreconditionError(
+        absl::StrFormat("vertex %d is not referenced by any face", v));
+  }
+  const int32_t h = mesh.Outgoing(v)[0];
+  SurfacePoint p;
+  p.face = Mesh::FaceOf(h);
+  p.w = {0, 0, 0};
+  p.w[h % 3] = 1.0;
+  return p;
+}
+
+}  // namespace geodex::mesh

@@ -1,0 +1,45 @@
+#pragma once
+
+// Loading triangle meshes from OBJ, PLY (ASCII, binary little- and big-endian)
+// and OFF files.
+//
+// Ids: vertex ids are the file's vertex order (0-based). Faces are numbered in
+// file order; a polygon with k > 3 corners (c0, c1, ..., c{k-1}) is
+// fan-triangulated into k-2 triangles (c0, c{i}, c{i+1}), i = 1..k-2, that take
+// consecutive triangle ids. For a file of triangles only, triangle id = face id
+// of the file. `LoadedMesh::input_face` maps triangle ids back to file faces.
+//
+// Errors: NotFound if the file cannot be opened; InvalidArgument for a
+// malformed, truncated or garbage file (naming file and line or element) and
+// for anything Mesh::Create rejects.
+
+#include <cstdint>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "absl/status/statusor.h"
+#include "core/mesh/mesh.h"
+
+namespace geodex::mesh {
+
+struct LoadedMesh {
+  Mesh mesh;
+  // input_face[t] = index of the file face that triangle t came from.
+  std::vector<int32_t> input_face;
+};
+
+// Loads by extension (.obj, .ply, .off; case-insensitive).
+absl::StatusOr<LoadedMesh> LoadMeshFile(const std::string& path);
+absl::StatusOr<Mesh> LoadMesh(const std::string& path);
+
+// Parse in-memory file contents; `name` is used in error messages.
+absl::StatusOr<LoadedMesh> ParseObj(std::string_view contents, const std::string& name);
+absl::StatusOr<LoadedMesh> ParsePly(std::string_view contents, const std::string& name);
+absl::StatusOr<LoadedMesh> ParseOff(std::string_view contents, const std::string& name);
+
+// Writes an ASCII OBJ (v and f lines) / binary little-endian PLY.
+absl::Status WriteObj(const Mesh& mesh, const std::string& path);
+absl::Status WritePly(const Mesh& mesh, const std::string& path);
+
+}  // namespace geodex::mesh
