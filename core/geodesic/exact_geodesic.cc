@@ -1,0 +1,586 @@
+#include "core/geodesic/exact_geodesic.h"
+
+#include <algorithm>
+#include <cmath>
+#include <functional>
+#include <numbers>
+
+#include "absl/strings/str_format.h"
+#include "core/common/status_macros.h"
+
+namespace geodex::geodesic {
+namespace {
+
+using mesh::kNone;
+using mesh::Vec3;
+
+// A window is discarded only when a vertex offers a path shorter by more than
+// this fraction of the window's own distances, so rounding never discards a
+// window that carries a shortest path.
+constexpr double kFilterSlack = 1e-12;
+// Barycentric weights below this count as zero when classifying sources.
+constexpr double kSnap = 1e-12;
+// Vertices whose angle sum reaches 2*pi minus this are treated as saddles
+// (pseudo-sources): it keeps flat vertices exact despite rounding.
+constexpr double kSaddleSlack = 1e-9;
+
+// sqrt(x^2 + y^2): distances here never approach overflow, and std::hypot's
+// overflow care costs a third of the propagation time.
+inline double Hypot(double x, double y) { return std::sqrt(x * x + y * y); }
+
+}  // namespace
+
+ExactGeodesicSolver::ExactGeodesicSolver(const Mesh& mesh) : mesh_(mesh) {
+  const int32_t nh = mesh.num_halfedges();
+  frame_.resize(nh);
+  for (int32_t h = 0; h < nh; ++h) {
+    // From positions rather than edge lengths: the law of cosines loses half
+    // the digits of cy on sliver triangles, the cross product does not.
+    const Vec3& a = mesh.position(mesh.Origin(h));
+    const Vec3 ab = mesh.position(mesh.Dest(h)) - a;
+    const Vec3 ac = mesh.position(mesh.Opposite(h)) - a;
+    const double l = mesh.Length(h);
+    frame_[h] = {l, ab.dot(ac) / l, std::max(ab.cross(ac).norm() / l, 1e-300)};
+  }
+  corner_angle_.resize(nh);
+  for (int32_t h = 0; h < nh; ++h) corner_angle_[h] = std::atan2(frame_[h].cy, frame_[h].cx);
+  emits_.resize(mesh.num_vertices());
+  for (int32_t v = 0; v < mesh.num_vertices(); ++v) {
+    emits_[v] = mesh.IsReferenced(v) &&
+                (mesh.IsBoundaryVertex(v) ||
+                 mesh.AngleSum(v) >= 2 * std::numbers::pi - kSaddleSlack);
+  }
+}
+
+void ExactGeodesicSolver::Reset() {
+  dist_.assign(mesh_.num_vertices(), kInfinity);
+  nearest_.assign(mesh_.num_vertices(), kNone);
+  origin_.assign(mesh_.num_vertices(), VertexOrigin{});
+  windows_.clear();
+  edge_head_.assign(mesh_.num_halfedges(), kNone);
+  split_.assign(mesh_.num_halfedges(), Split{});
+  heap_.clear();
+  face_sources_.clear();
+  sources_.clear();
+  stats_ = {};
+}
+
+absl::Status ExactGeodesicSolver::Propagate(std::span<const SurfacePoint> sources,
+                                            const GeodesicOptions& options) {
+  Reset();
+  if (sources.empty()) return absl::InvalidArgumentError("no sources given");
+  for (const SurfacePoint& s : sources) {
+    GEODEX_RETURN_IF_ERROR(mesh::ValidateSurfacePoint(mesh_, s));
+  }
+  if (!options.initial_distance.empty()) {
+    if (options.initial_distance.size() != static_cast<size_t>(mesh_.num_vertices())) {
+      return absl::InvalidArgumentError(
+          absl::StrFormat("initial_distance has %d entries, the mesh %d vertices",
+                          options.initial_distance.size(), mesh_.num_vertices()));
+    }
+    for (int32_t v = 0; v < mesh_.num_vertices(); ++v) {
+      const double d = options.initial_distance[v];
+      if (std::isnan(d) || d < 0) {
+        return absl::InvalidArgumentError(
+            absl::StrFormat("initial_distance[%d] = %g is not a distance", v, d));
+      }
+      if (d < kInfinity) {
+        dist_[v] = d;
+        origin_[v] = {Via::kInitial, kNone};
+      }
+    }
+  }
+  for (const SurfacePoint& p : options.stop_points) {
+    GEODEX_RETURN_IF_ERROR(mesh::ValidateSurfacePoint(mesh_, p));
+  }
+  for (int32_t v : options.stop_vertices) {
+    if (v < 0 || v >= mesh_.num_vertices()) {
+      return absl::OutOfRangeError(absl::StrFormat("stop vertex %d out of range", v));
+    }
+  }
+  stop_radius_ = options.stop_radius;
+  stop_vertices_ = options.stop_vertices;
+  stop_points_ = options.stop_points;
+  max_windows_ = options.max_windows > 0 ? options.max_windows
+                                         : 400 * int64_t{mesh_.num_halfedges()} + 1'000'000;
+
+  sources_.assign(sources.begin(), sources.end());
+  for (int32_t s = 0; s < static_cast<int32_t>(sources.size()); ++s) {
+    GEODEX_RETURN_IF_ERROR(AddSource(sources[s], s));
+  }
+
+  const bool has_targets = !stop_vertices_.empty() || !stop_points_.empty();
+  int64_t pops = 0;
+  while (!heap_.empty()) {
+    std::pop_heap(heap_.begin(), heap_.end(), std::greater<>());
+    const QueueEntry top = heap_.back();
+    heap_.pop_back();
+    if (top.key > stop_radius_) break;
+    if (has_targets && (++pops & 63) == 0 && TargetsSettled(top.key)) break;
+    if (top.id < 0) {
+      const int32_t v = ~top.id;
+      if (top.key != dist_[v]) continue;  // superseded by a shorter path
+      ++stats_.vertex_events;
+      EmitFromVertex(v);
+    } else {
+      if (IsUseless(windows_[top.id])) continue;
+      ++stats_.windows_propagated;
+      PropagateWindow(top.id);
+    }
+    if (static_cast<int64_t>(windows_.size()) > max_windows_) {
+      return absl::ResourceExhaustedError(absl::StrFormat(
+          "geodesic propagation on %s exceeded %d windows", mesh_.name(), max_windows_));
+    }
+  }
+  heap_.clear();
+  heap_.shrink_to_fit();
+  return absl::OkStatus();
+}
+
+absl::Status ExactGeodesicSolver::AddSource(const SurfacePoint& p, int32_t source) {
+  const mesh::Triangle& t = mesh_.face(p.face);
+  int zeros = 0;
+  int nonzero = 0;
+  for (int i = 0; i < 3; ++i) {
+    if (p.w[i] <= kSnap) {
+      ++zeros;
+    } else {
+      nonzero = i;
+    }
+  }
+  if (zeros >= 2) {  // at a vertex
+    const int32_t v = t[nonzero];
+    if (dist_[v] > 0 || origin_[v].via == Via::kInitial) {
+      dist_[v] = 0;
+      nearest_[v] = source;
+      origin_[v] = {Via::kSource, source};
+      EmitFromVertex(v);
+    }
+    return absl::OkStatus();
+  }
+  std::array<double, 3> w = p.w;
+  const double sum = w[0] + w[1] + w[2];
+  for (double& x : w) x /= sum;
+  if (zeros == 1) {  // on an edge: both faces hold the source
+    int zero = 0;
+    for (int i = 0; i < 3; ++i) {
+      if (w[i] <= kSnap) zero = i;
+    }
+    w[zero] = 0;
+    const int32_t h = 3 * p.face + (zero + 1) % 3;  // the edge opposite the zero weight
+    AddFaceSource(p.face, w, source, h);
+    const int32_t g = mesh_.Twin(h);
+    if (g != kNone) {
+      std::array<double, 3> wg = {0, 0, 0};
+      wg[g % 3] = w[(h + 1) % 3];  // Origin(g) = Dest(h)
+      wg[(g + 1) % 3] = w[h % 3];
+      AddFaceSource(Mesh::FaceOf(g), wg, source, g);
+    }
+  } else {
+    AddFaceSource(p.face, w, source, kNone);
+  }
+  return absl::OkStatus();
+}
+
+void ExactGeodesicSolver::AddFaceSource(int32_t face, const std::array<double, 3>& w,
+                                        int32_t source, int32_t skip_halfedge) {
+  const SurfacePoint p{face, w};
+  const Vec3 x = mesh::PositionOf(mesh_, p);
+  face_sources_.push_back({face, source, x});
+  for (int i = 0; i < 3; ++i) {
+    const int32_t v = mesh_.face(face)[i];
+    UpdateVertex(v, (mesh_.position(v) - x).norm(), source, Via::kSource, source);
+  }
+  for (int i = 0; i < 3; ++i) {
+    const int32_t h = 3 * face + i;
+    const int32_t t = mesh_.Twin(h);
+    if (h == skip_halfedge || t == kNone) continue;
+    const auto [px, py] = InFrame(h, p);
+    const double l = frame_[h].length;
+    Window win{};
+    win.b0 = 0;
+    win.b1 = l;
+    win.sx = l - px;  // mirror into the twin's frame
+    win.sy = -py;
+    win.sigma = 0;
+    win.h = t;
+    win.parent = kNone;
+    win.pseudo = kNone;
+    win.source = source;
+    PushWindow(win);
+  }
+}
+
+double ExactGeodesicSolver::BackAngle(int32_t v) const {
+  // Angles around v are measured counter-clockwise from the first outgoing
+  // half-edge; corner k spans [phi_k, phi_k + angle of corner k].
+  const VertexOrigin& o = origin_[v];
+  const auto fan = mesh_.Outgoing(v);
+  if (o.via == Via::kWindow) {
+    const Window& w = windows_[o.id];
+    const Frame& f = frame_[w.h];
+    // v = C of the window's face; its corner there starts at C->A.
+    const int32_t corner = Mesh::Prev(w.h);
+    const double ax = -f.cx, ay = -f.cy;                  // A - C
+    const double sx = w.sx - f.cx, sy = w.sy - f.cy;      // S - C
+    const double beta = std::atan2(ax * sy - ay * sx, ax * sx + ay * sy);
+    double phi = 0;
+    for (const int32_t h : fan) {
+      if (h == corner) return phi + std::clamp(beta, 0.0, corner_angle_[h]);
+      phi += corner_angle_[h];
+    }
+  } else if (o.via == Via::kVertex) {
+    double phi = 0;
+    for (const int32_t h : fan) {
+      if (mesh_.Dest(h) == o.id) return phi;
+      phi += corner_angle_[h];
+    }
+    if (mesh_.Opposite(fan.back()) == o.id) return phi;  // end of a boundary fan
+  }
+  return -1;  // no single incoming direction: emit everywhere
+}
+
+void ExactGeodesicSolver::EmitFromVertex(int32_t v) {
+  const double d = dist_[v];
+  const int32_t source = nearest_[v];
+  const auto fan = mesh_.Outgoing(v);
+  for (const int32_t o : fan) {
+    UpdateVertex(mesh_.Dest(o), d + mesh_.Length(o), source, Via::kVertex, v);
+    UpdateVertex(mesh_.Opposite(o), d + mesh_.Length(Mesh::Prev(o)), source, Via::kVertex, v);
+  }
+  // A shortest path continues through a saddle or boundary vertex only into
+  // its shadow: directions at least pi away, both ways round, from the
+  // direction it came from (Mitchell, Mount & Papadimitriou 1987).
+  double total = 0;
+  for (const int32_t o : fan) total += corner_angle_[o];
+  const double back = BackAngle(v);
+  std::array<std::pair<double, double>, 3> shadow;
+  int num_shadow = 0;
+  constexpr double kMargin = 1e-9;
+  if (back < 0) {
+    shadow[num_shadow++] = {-1, total + 1};
+  } else if (mesh_.IsBoundaryVertex(v)) {
+    if (back - std::numbers::pi > 0) shadow[num_shadow++] = {-1, back - std::numbers::pi + kMargin};
+    if (back + std::numbers::pi < total) {
+      shadow[num_shadow++] = {back + std::numbers::pi - kMargin, total + 1};
+    }
+  } else {
+    const double lo = back + std::numbers::pi - kMargin;
+    const double hi = back + total - std::numbers::pi + kMargin;
+    if (hi > lo) {
+      // The range may wrap around the fan: also test it shifted by -total.
+      shadow[num_shadow++] = {lo, hi};
+      shadow[num_shadow++] = {lo - total, hi - total};
+    }
+  }
+  double phi = 0;
+  for (const int32_t o : fan) {
+    const double theta = corner_angle_[o];
+    const int32_t g = Mesh::Next(o);  // the edge opposite v in this face
+    const int32_t t = mesh_.Twin(g);
+    for (int k = 0; k < num_shadow && t != kNone; ++k) {
+      const double a0 = std::max(shadow[k].first - phi, 0.0);
+      const double a1 = std::min(shadow[k].second - phi, theta);
+      if (!(a1 > a0)) continue;
+      // Fraction along Dest(o) -> Opposite(o) hit by the ray at angle a.
+      const Frame& fo = frame_[o];
+      auto hit = [&](double a) {
+        if (a <= 0) return 0.0;
+        if (a >= theta) return 1.0;
+        const double c = std::cos(a), s = std::sin(a);
+        const double den = c * fo.cy - s * (fo.cx - fo.length);
+        return den > 0 ? std::clamp(fo.length * s / den, 0.0, 1.0) : 1.0;
+      };
+      const Frame& fg = frame_[g];
+      Window win{};
+      win.b0 = (1 - hit(a1)) * fg.length;
+      win.b1 = (1 - hit(a0)) * fg.length;
+      win.sx = fg.length - fg.cx;
+      win.sy = -fg.cy;
+      win.sigma = d;
+      win.h = t;
+      win.parent = kNone;
+      win.pseudo = v;
+      win.source = source;
+      PushWindow(win);
+    }
+    phi += theta;
+  }
+}
+
+void ExactGeodesicSolver::UpdateVertex(int32_t v, double d, int32_t source, Via via,
+                                       int32_t id) {
+  if (!(d < dist_[v])) return;
+  dist_[v] = d;
+  nearest_[v] = source;
+  origin_[v] = {via, id};
+  if (emits_[v] && d <= stop_radius_) {
+    heap_.push_back({d, ~v});
+    std::push_heap(heap_.begin(), heap_.end(), std::greater<>());
+  }
+}
+
+double ExactGeodesicSolver::MinDistance(const Window& w) const {
+  const double dx = w.sx < w.b0 ? w.b0 - w.sx : (w.sx > w.b1 ? w.sx - w.b1 : 0.0);
+  return w.sigma + Hypot(dx, w.sy);
+}
+
+bool ExactGeodesicSolver::IsUseless(const Window& w) const {
+  const Frame& f = frame_[w.h];
+  const double d0 = w.sigma + Hypot(w.b0 - w.sx, w.sy);
+  const double d1 = w.sigma + Hypot(w.b1 - w.sx, w.sy);
+  const double slack = kFilterSlack * std::max(d0, d1);
+  // Paper (Xin & Wang 2009) filter. The origin A offers d(A) + |A P| to every
+  // point P of [b0,b1]; compared with the window's sigma + |S P| the
+  // difference only grows with P, so checking the far end b1 suffices.
+  const double da = dist_[mesh_.Origin(w.h)];
+  if (da + w.b1 + slack < d1) return true;
+  const double db = dist_[mesh_.Dest(w.h)];
+  if (db + (f.length - w.b0) + slack < d0) return true;
+  // The opposite vertex C: where d(C) >= sigma the set of points that C
+  // reaches sooner is convex (bounded by a hyperbola branch around C), so
+  // both interval ends inside it put the whole interval inside.
+  const double dc = dist_[mesh_.Opposite(w.h)];
+  if (dc >= w.sigma && dc + Hypot(w.b0 - f.cx, f.cy) + slack < d0 &&
+      dc + Hypot(w.b1 - f.cx, f.cy) + slack < d1) {
+    return true;
+  }
+  return false;
+}
+
+void ExactGeodesicSolver::PushWindow(const Window& w) {
+  if (!(w.b1 - w.b0 > 1e-14 * frame_[w.h].length)) return;
+  const double key = MinDistance(w);
+  if (key > stop_radius_) return;
+  if (IsUseless(w)) return;
+  const int32_t index = static_cast<int32_t>(windows_.size());
+  windows_.push_back(w);
+  windows_.back().next_on_edge = edge_head_[w.h];
+  edge_head_[w.h] = index;
+  ++stats_.windows_created;
+  heap_.push_back({key, index});
+  std::push_heap(heap_.begin(), heap_.end(), std::greater<>());
+}
+
+void ExactGeodesicSolver::PropagateWindow(int32_t index) {
+  const Window w = windows_[index];
+  const int32_t h = w.h;
+  const Frame& f = frame_[h];
+  // Where the ray from the pseudo-source through C crosses this edge.
+  const double xc = w.sx + (f.cx - w.sx) * (-w.sy) / (f.cy - w.sy);
+  const double eps = 1e-12 * f.length;
+  if (xc >= w.b0 - eps && xc <= w.b1 + eps) {
+    UpdateVertex(mesh_.Opposite(h), w.sigma + Hypot(f.cx - w.sx, f.cy - w.sy), w.source,
+                 Via::kWindow, index);
+  }
+
+  // ICH's "one angle, one split" (Xin & Wang 2009, after Chen & Han): keep,
+  // per face angle, the shortest segment P*->C seen through this edge. A ray
+  // of this window that crosses that segment reaches the crossing point later
+  // than the segment's own path whenever sigma + |S C| exceeds d*(C): such
+  // rays are trimmed from the children.
+  const double dc_here = w.sigma + Hypot(f.cx - w.sx, f.cy - w.sy);
+  double left_end = std::min(w.b1, xc);     // rays through [b0, left_end] go left
+  double right_begin = std::max(w.b0, xc);  // rays through [right_begin, b1] go right
+  Split& split = split_[h];
+  if (split.dc + kFilterSlack * dc_here < dc_here) {
+    if (split.x < xc) {
+      left_end = std::min(left_end, split.x);
+    } else {
+      right_begin = std::max(right_begin, split.x);
+    }
+  }
+  if (xc >= w.b0 && xc <= w.b1 && dc_here < split.dc) split = {dc_here, xc};
+
+  Window child{};
+  child.sigma = w.sigma;
+  child.parent = index;
+  child.pseudo = kNone;
+  child.source = w.source;
+
+  // Rays through [b0, left_end] leave through edge A->C (A = origin).
+  if (w.b0 < left_end) {
+    const int32_t t = mesh_.Twin(Mesh::Prev(h));
+    if (t != kNone) {
+      auto hit = [&](double b) {  // fraction along A->C hit by the ray through (b,0)
+        if (b >= xc) return 1.0;
+        const double den = f.cy * (b - w.sx) + f.cx * w.sy;
+        if (!(std::abs(den) > 0)) return 0.0;
+        return std::clamp(w.sy * b / den, 0.0, 1.0);
+      };
+      const double l = frame_[t].length;
+      child.b0 = hit(w.b0) * l;
+      child.b1 = hit(left_end) * l;
+      const double ux = f.cx / l, uy = f.cy / l;
+      child.sx = ux * w.sx + uy * w.sy;
+      child.sy = std::min(ux * w.sy - uy * w.sx, 0.0);
+      child.h = t;
+      PushWindow(child);
+    }
+  }
+  // Rays through [right_begin, b1] leave through edge C->B.
+  if (right_begin < w.b1) {
+    const int32_t t = mesh_.Twin(Mesh::Next(h));
+    if (t != kNone) {
+      const double bx = f.length - f.cx, by = -f.cy;  // B - C
+      auto hit = [&](double b) {  // fraction along C->B
+        if (b <= xc) return 0.0;
+        const double dx = b - w.sx, dy = -w.sy;
+        const double num = (w.sx - f.cx) * dy - (w.sy - f.cy) * dx;
+        const double den = bx * dy - by * dx;
+        if (!(std::abs(den) > 0)) return 1.0;
+        return std::clamp(num / den, 0.0, 1.0);
+      };
+      const double l = frame_[t].length;
+      child.b0 = hit(right_begin) * l;
+      child.b1 = hit(w.b1) * l;
+      const double ux = bx / l, uy = by / l;
+      const double rx = w.sx - f.cx, ry = w.sy - f.cy;
+      child.sx = ux * rx + uy * ry;
+      child.sy = std::min(ux * ry - uy * rx, 0.0);
+      child.h = t;
+      PushWindow(child);
+    }
+  }
+}
+
+bool ExactGeodesicSolver::TargetsSettled(double key) const {
+  for (int32_t v : stop_vertices_) {
+    if (dist_[v] > key) return false;
+  }
+  for (const SurfacePoint& p : stop_points_) {
+    if (UpperBoundAt(p) > key) return false;
+  }
+  return true;
+}
+
+std::array<double, 2> ExactGeodesicSolver::InFrame(int32_t h, const SurfacePoint& p) const {
+  const Frame& f = frame_[h];
+  const int i = h % 3;
+  const double wb = p.w[(i + 1) % 3], wc = p.w[(i + 2) % 3];
+  return {wb * f.length + wc * f.cx, wc * f.cy};
+}
+
+double ExactGeodesicSolver::UpperBoundAt(const SurfacePoint& p) const {
+  return BestAt(p).distance;
+}
+
+ExactGeodesicSolver::Candidate ExactGeodesicSolver::BestAt(const SurfacePoint& p) const {
+  Candidate best;
+  const Vec3 x = mesh::PositionOf(mesh_, p);
+  for (int i = 0; i < 3; ++i) {
+    const int32_t v = mesh_.face(p.face)[i];
+    const double d = dist_[v] + (mesh_.position(v) - x).norm();
+    if (d < best.distance) best = {d, Via::kVertex, v};
+  }
+  for (const SourceInFace& s : face_sources_) {
+    if (s.face != p.face) continue;
+    const double d = (s.position - x).norm();
+    if (d < best.distance) best = {d, Via::kSource, s.source};
+  }
+  for (int i = 0; i < 3; ++i) {
+    const int32_t h = 3 * p.face + i;
+    const auto [px, py] = InFrame(h, p);
+    const double eps = 1e-12 * frame_[h].length;
+    for (int32_t k = edge_head_[h]; k != kNone; k = windows_[k].next_on_edge) {
+      const Window& w = windows_[k];
+      const double den = py - w.sy;
+      if (!(den > 0)) continue;
+      const double cross = w.sx + (px - w.sx) * (-w.sy) / den;
+      if (cross < w.b0 - eps || cross > w.b1 + eps) continue;
+      const double d = w.sigma + Hypot(px - w.sx, py - w.sy);
+      if (d < best.distance) best = {d, Via::kWindow, k};
+    }
+  }
+  return best;
+}
+
+double ExactGeodesicSolver::DistanceAt(const SurfacePoint& p) const {
+  return BestAt(p).distance;
+}
+
+absl::StatusOr<std::vector<SurfacePoint>> ExactGeodesicSolver::PathTo(
+    const SurfacePoint& p) const {
+  GEODEX_RETURN_IF_ERROR(mesh::ValidateSurfacePoint(mesh_, p));
+  std::vector<SurfacePoint> path = {p};
+  Candidate c = BestAt(p);
+  if (!(c.distance < kInfinity)) {
+    return absl::NotFoundError("the point is not reachable from any source");
+  }
+  auto vertex_point = [&](int32_t v) { return *mesh::VertexPoint(mesh_, v); };
+  // Current position, as a point of a face, while following windows back.
+  SurfacePoint here = p;
+  const int64_t max_steps = 4 * int64_t{mesh_.num_halfedges()} + 16;
+  for (int64_t step = 0; step < max_steps; ++step) {
+    switch (c.via) {
+      case Via::kSource:
+        path.push_back(sources_[c.id]);
+        return path;
+      case Via::kInitial:
+        return absl::FailedPreconditionError(
+            "the path reaches a vertex whose distance was given as initial_distance");
+      case Via::kNone:
+        return absl::InternalError("path tracing lost its way");
+      case Via::kVertex: {
+        const int32_t v = c.id;
+        const SurfacePoint vp = vertex_point(v);
+        path.push_back(vp);
+        here = vp;
+        c = {dist_[v], origin_[v].via, origin_[v].id};
+        if (c.via == Via::kWindow) {
+          // The vertex is the opposite corner of the window's face.
+          const int32_t h = windows_[c.id].h;
+          here.face = Mesh::FaceOf(h);
+          here.w = {0, 0, 0};
+          here.w[(h + 2) % 3] = 1.0;
+        } else if (c.via == Via::kSource) {
+          // A vertex source, or a vertex of a face holding the source.
+          const SurfacePoint& s = sources_[c.id];
+          const bool same = (PositionOf(mesh_, s) - mesh_.position(v)).norm() == 0;
+          if (!same) path.push_back(s);
+          return path;
+        }
+        break;
+      }
+      case Via::kWindow: {
+        const Window& w = windows_[c.id];
+        const auto [px, py] = InFrame(w.h, here);
+        const double den = py - w.sy;
+        double cross = den > 0 ? w.sx + (px - w.sx) * (-w.sy) / den : w.sx;
+        cross = std::clamp(cross, w.b0, w.b1);
+        const double l = frame_[w.h].length;
+        SurfacePoint q;
+        q.face = Mesh::FaceOf(w.h);
+        q.w = {0, 0, 0};
+        q.w[w.h % 3] = 1.0 - cross / l;
+        q.w[(w.h + 1) % 3] = cross / l;
+        path.push_back(q);
+        if (w.parent != kNone) {
+          // Continue in the parent's face, where this edge is twin(w.h).
+          const int32_t g = mesh_.Twin(w.h);
+          here.face = Mesh::FaceOf(g);
+          here.w = {0, 0, 0};
+          here.w[g % 3] = cross / l;  // Origin(g) = Dest(w.h)
+          here.w[(g + 1) % 3] = 1.0 - cross / l;
+          c = {0, Via::kWindow, w.parent};
+        } else if (w.pseudo != kNone) {
+          c = {0, Via::kVertex, w.pseudo};
+        } else {
+          c = {0, Via::kSource, w.source};
+        }
+        break;
+      }
+    }
+  }
+  return absl::InternalError("path tracing did not terminate");
+}
+
+absl::StatusOr<std::vector<double>> ExactGeodesicDistances(const Mesh& mesh,
+                                                           std::span<const SurfacePoint> sources,
+                                                           const GeodesicOptions& options) {
+  ExactGeodesicSolver solver(mesh);
+  GEODEX_RETURN_IF_ERROR(solver.Propagate(sources, options));
+  return solver.VertexDistances();
+}
+
+}  // namespace geodex::geodesic

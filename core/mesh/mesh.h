@@ -25,6 +25,7 @@
 #include <vector>
 
 #include "Eigen/Core"
+#include "Eigen/Geometry"
 #include "absl/status/statusor.h"
 
 namespace geodex::mesh {
