@@ -6,7 +6,7 @@ set -euo pipefail
 PACKAGES=(
   build-essential cmake ninja-build pkg-config git
   libabsl-dev libeigen3-dev libspdlog-dev libfmt-dev
-  libtinyobjloader-dev libcli11-dev libtbb-dev
+  libtinyobjloader-dev libcli11-dev libtbb-dev libxxhash-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   libprotobuf-dev protobuf-compiler libgrpc++-dev protobuf-compiler-grpc
   prometheus-cpp-dev

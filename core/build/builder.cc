@@ -1,0 +1,340 @@
+#include "core/build/builder.h"
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <mutex>
+#include <thread>
+
+#include "absl/strings/str_cat.h"
+#include "absl/strings/str_format.h"
+#include "core/common/status_macros.h"
+#include "core/geodesic/exact_geodesic.h"
+#include "core/query/point_locator.h"
+#include "core/sampling/farthest_point_sampling.h"
+
+namespace geodex::build {
+namespace {
+
+using mesh::kNone;
+using mesh::Mesh;
+
+double SecondsSince(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+int ThreadCount(const BuildOptions& options) {
+  if (options.threads > 0) return options.threads;
+  return std::max(1u, std::thread::hardware_concurrency());
+}
+
+// Vertices whose cell is `a` or one of its neighbours, in increasing order.
+std::vector<int32_t> CellVertices(const Plan& plan, const std::vector<int32_t>& neighbors_of_a,
+                                  int32_t a) {
+  std::vector<uint8_t> member(plan.num_samples(), 0);
+  member[a] = 1;
+  for (int32_t b : neighbors_of_a) member[b] = 1;
+  std::vector<int32_t> out;
+  for (int32_t v = 0; v < static_cast<int32_t>(plan.nearest.size()); ++v) {
+    if (plan.nearest[v] != kNone && member[plan.nearest[v]]) out.push_back(v);
+  }
+  return out;
+}
+
+// Barycentric coordinates, in the unfolded geodesic triangle (a, b, c), of
+// the point at distances (da, db, dc) from its corners. The point is placed
+// from da and db on the side of ab that best matches dc (paper §5.1
+// unfolding); side lengths that break the triangle inequality are clamped.
+std::array<double, 3> UnfoldedBarycentric(double ab, double bc, double ca, double da, double db,
+                                          double dc) {
+  if (!(ab > 0)) return {1, 0, 0};
+  const double cx = (ab * ab + ca * ca - bc * bc) / (2 * ab);
+  const double cy = std::sqrt(std::max(ca * ca - cx * cx, 0.0));
+  const double px = (ab * ab + da * da - db * db) / (2 * ab);
+  const double h = std::sqrt(std::max(da * da - px * px, 0.0));
+  const double up = std::abs(std::hypot(px - cx, h - cy) - dc);
+  const double down = std::abs(std::hypot(px - cx, -h - cy) - dc);
+  const double py = up <= down ? h : -h;
+  const double area = ab * cy;  // twice the signed area of (a, b, c)
+  if (!(area > 1e-300)) return {1, 0, 0};
+  const double lc = py / cy;
+  const double lb = (px * cy - py * cx) / area;
+  return {1 - lb - lc, lb, lc};
+}
+
+}  // namespace
+
+uint64_t HashMesh(const Mesh& mesh) {
+  std::vector<double> positions;
+  positions.reserve(3 * mesh.num_vertices());
+  for (const auto& p : mesh.positions()) positions.insert(positions.end(), {p.x(), p.y(), p.z()});
+  std::vector<int32_t> faces;
+  faces.reserve(3 * mesh.num_faces());
+  for (const auto& f : mesh.faces()) faces.insert(faces.end(), f.begin(), f.end());
+  return index::MeshHash(positions, faces);
+}
+
+std::vector<std::vector<int32_t>> Plan::SampleNeighbors() const {
+  std::vector<std::vector<int32_t>> out(num_samples());
+  for (const auto& t : triangles) {
+    for (int i = 0; i < 3; ++i) {
+      out[t[i]].push_back(t[(i + 1) % 3]);
+      out[t[i]].push_back(t[(i + 2) % 3]);
+    }
+  }
+  for (auto& list : out) {
+    std::sort(list.begin(), list.end());
+    list.erase(std::unique(list.begin(), list.end()), list.end());
+  }
+  return out;
+}
+
+std::string BuildSummary::ToText() const {
+  return absl::StrFormat(
+      "requested_samples = %d\nsamples = %d\nrepair = %s\ntriangles = %d\n"
+      "referenced_vertices = %d\nunassigned_vertices = %d\nshare_outside_triangle = %.6g\n"
+      "longest_edge = %.9g\nbbox_diagonal = %.9g\n",
+      requested_samples, num_samples, repair, num_triangles, referenced_vertices,
+      unassigned_vertices, share_outside, longest_edge, bbox_diagonal);
+}
+
+absl::StatusOr<Plan> MakePlan(const Mesh& mesh, const BuildOptions& options) {
+  Plan plan;
+  plan.mesh_hash = HashMesh(mesh);
+  plan.requested_samples = options.num_samples;
+  plan.seed = options.seed;
+  auto start = std::chrono::steady_clock::now();
+  if (options.progress) options.progress({"sampling", 0, options.num_samples});
+  GEODEX_ASSIGN_OR_RETURN(sampling::SampleSet set,
+                          sampling::FarthestPointSampling(mesh, options.num_samples, options.seed));
+  plan.sampling_seconds = SecondsSince(start);
+  if (options.progress) options.progress({"sampling", options.num_samples, options.num_samples});
+
+  start = std::chrono::steady_clock::now();
+  if (options.progress) options.progress({"repair", 0, 1});
+  const int32_t max_samples = std::max<int32_t>(4 * options.num_samples + 64, 256);
+  GEODEX_ASSIGN_OR_RETURN(
+      triangulation::DualComplex dual,
+      triangulation::RepairTriangulation(mesh, &set, options.max_repair_rounds,
+                                         std::min<int32_t>(max_samples, mesh.num_vertices()),
+                                         &plan.repair));
+  plan.triangulation_seconds = SecondsSince(start);
+  if (options.progress) options.progress({"repair", 1, 1});
+  plan.samples = std::move(set.samples);
+  plan.nearest = std::move(set.nearest);
+  plan.triangles = std::move(dual.triangles);
+  plan.neighbors = std::move(dual.neighbors);
+  return plan;
+}
+
+absl::StatusOr<std::vector<SampleRow>> ComputeRows(const Mesh& mesh, const Plan& plan,
+                                                   std::span<const int32_t> sample_ids,
+                                                   const BuildOptions& options) {
+  const int32_t m = plan.num_samples();
+  for (int32_t id : sample_ids) {
+    if (id < 0 || id >= m) {
+      return absl::InvalidArgumentError(absl::StrFormat("sample %d out of range [0, %d)", id, m));
+    }
+  }
+  const std::vector<std::vector<int32_t>> neighbors = plan.SampleNeighbors();
+  std::vector<SampleRow> rows(sample_ids.size());
+  std::atomic<size_t> next{0};
+  std::atomic<int64_t> done{0};
+  std::mutex progress_mutex;
+  const int threads = std::min<int>(ThreadCount(options), std::max<size_t>(1, sample_ids.size()));
+  std::vector<absl::Status> errors(threads);
+  auto worker = [&](int id) {
+    geodesic::ExactGeodesicSolver solver(mesh);
+    for (size_t k; (k = next.fetch_add(1)) < sample_ids.size();) {
+      const int32_t a = sample_ids[k];
+      absl::StatusOr<mesh::SurfacePoint> source = mesh::VertexPoint(mesh, plan.samples[a]);
+      absl::Status status = source.status();
+      if (status.ok()) status = solver.Propagate({*source});
+      if (!status.ok()) {
+        errors[id] = status;
+        return;
+      }
+      SampleRow& row = rows[k];
+      row.sample = a;
+      row.to_samples.resize(m);
+      for (int32_t b = 0; b < m; ++b) row.to_samples[b] = solver.VertexDistance(plan.samples[b]);
+      for (int32_t v : CellVertices(plan, neighbors[a], a)) {
+        row.to_cell_vertices.push_back(solver.VertexDistance(v));
+      }
+      const int64_t finished = ++done;
+      if (options.progress) {
+        std::lock_guard<std::mutex> lock(progress_mutex);
+        options.progress({"rows", finished, static_cast<int64_t>(sample_ids.size())});
+      }
+    }
+  };
+  std::vector<std::thread> pool;
+  for (int t = 0; t < threads; ++t) pool.emplace_back(worker, t);
+  for (std::thread& t : pool) t.join();
+  for (const absl::Status& status : errors) GEODEX_RETURN_IF_ERROR(status);
+  return rows;
+}
+
+absl::StatusOr<index::IndexData> Merge(const Mesh& mesh, const Plan& plan,
+                                       std::vector<SampleRow> rows, BuildSummary* summary) {
+  const auto start = std::chrono::steady_clock::now();
+  const int32_t m = plan.num_samples();
+  const int32_t nv = mesh.num_vertices();
+  if (static_cast<int32_t>(rows.size()) != m) {
+    return absl::InvalidArgumentError(
+        absl::StrFormat("merge needs the rows of all %d samples, got %d", m, rows.size()));
+  }
+  std::sort(rows.begin(), rows.end(),
+            [](const SampleRow& x, const SampleRow& y) { return x.sample < y.sample; });
+  const std::vector<std::vector<int32_t>> neighbors = plan.SampleNeighbors();
+  for (int32_t a = 0; a < m; ++a) {
+    if (rows[a].sample != a) {
+      return absl::InvalidArgumentError(absl::StrFormat("row of sample %d missing or repeated", a));
+    }
+    if (static_cast<int32_t>(rows[a].to_samples.size()) != m) {
+      return absl::InvalidArgumentError(absl::StrFormat("row of sample %d has the wrong size", a));
+    }
+  }
+
+  // Symmetric matrix: the two propagations agree to rounding; keep the
+  // shorter (both are lengths of real paths).
+  index::IndexData data;
+  data.sample_distances.resize(static_cast<size_t>(m) * m);
+  auto matrix = [&](int32_t a, int32_t b) {
+    return std::min(rows[a].to_samples[b], rows[b].to_samples[a]);
+  };
+  for (int32_t a = 0; a < m; ++a) {
+    for (int32_t b = 0; b < m; ++b) {
+      data.sample_distances[static_cast<size_t>(a) * m + b] =
+          a == b ? 0.0f : static_cast<float>(matrix(a, b));
+    }
+  }
+
+  // Per vertex: distances to the samples of its cell and the neighbours.
+  std::vector<int32_t> slot_offset(nv + 1, 0);
+  for (int32_t v = 0; v < nv; ++v) {
+    const int32_t a = plan.nearest[v];
+    slot_offset[v + 1] = slot_offset[v] + (a == kNone ? 0 : 1 + neighbors[a].size());
+  }
+  std::vector<double> slots(slot_offset[nv], geodesic::kInfinity);
+  auto slot_index = [&](int32_t v, int32_t b) -> int32_t {
+    const int32_t a = plan.nearest[v];
+    if (b == a) return slot_offset[v];
+    const auto& list = neighbors[a];
+    const auto it = std::lower_bound(list.begin(), list.end(), b);
+    if (it == list.end() || *it != b) return kNone;
+    return slot_offset[v] + 1 + static_cast<int32_t>(it - list.begin());
+  };
+  for (int32_t a = 0; a < m; ++a) {
+    const std::vector<int32_t> vertices = CellVertices(plan, neighbors[a], a);
+    if (vertices.size() != rows[a].to_cell_vertices.size()) {
+      return absl::InvalidArgumentError(
+          absl::StrFormat("row of sample %d has %d cell distances, expected %d", a,
+                          rows[a].to_cell_vertices.size(), vertices.size()));
+    }
+    for (size_t k = 0; k < vertices.size(); ++k) {
+      const int32_t slot = slot_index(vertices[k], a);
+      if (slot != kNone) slots[slot] = rows[a].to_cell_vertices[k];
+    }
+  }
+
+  // Triangles around each sample.
+  std::vector<std::vector<int32_t>> incident(m);
+  for (int32_t t = 0; t < static_cast<int32_t>(plan.triangles.size()); ++t) {
+    for (int32_t a : plan.triangles[t]) incident[a].push_back(t);
+  }
+
+  data.vertices.resize(nv);
+  int64_t referenced = 0, unassigned = 0, outside = 0;
+  for (int32_t v = 0; v < nv; ++v) {
+    index::VertexRecord& record = data.vertices[v];
+    record = {kNone, {kNone, kNone, kNone}, {0, 0, 0}, 0};
+    const int32_t a = plan.nearest[v];
+    if (!mesh.IsReferenced(v) || a == kNone) continue;
+    ++referenced;
+    double best_score = -geodesic::kInfinity;
+    double best_max = 0;
+    for (int32_t t : incident[a]) {
+      const auto& corners = plan.triangles[t];
+      std::array<double, 3> d;
+      for (int i = 0; i < 3; ++i) d[i] = slots[slot_index(v, corners[i])];
+      const auto lambda =
+          UnfoldedBarycentric(matrix(corners[0], corners[1]), matrix(corners[1], corners[2]),
+                              matrix(corners[2], corners[0]), d[0], d[1], d[2]);
+      const double score = std::min({lambda[0], lambda[1], lambda[2]});
+      if (score > best_score) {
+        best_score = score;
+        best_max = std::max({lambda[0], lambda[1], lambda[2]});
+        record.triangle = t;
+        for (int i = 0; i < 3; ++i) {
+          record.corner[i] = corners[i];
+          record.distance[i] = static_cast<float>(d[i]);
+        }
+      }
+    }
+    if (record.triangle == kNone) {
+      ++unassigned;
+    } else if (best_score < -0.01 || best_max > 1.01) {
+      ++outside;
+    }
+  }
+
+  data.builder_version = kBuilderVersion;
+  data.mesh_hash = plan.mesh_hash;
+  data.params.requested_samples = plan.requested_samples;
+  data.params.num_samples = m;
+  data.params.seed = plan.seed;
+  data.params.samples_added_by_repair = plan.repair.samples_added;
+  for (const auto& p : mesh.positions()) data.positions.insert(data.positions.end(), {p.x(), p.y(), p.z()});
+  for (const auto& f : mesh.faces()) data.faces.insert(data.faces.end(), f.begin(), f.end());
+  for (int32_t h = 0; h < mesh.num_halfedges(); ++h) data.twins.push_back(mesh.Twin(h));
+  data.samples = plan.samples;
+  for (size_t t = 0; t < plan.triangles.size(); ++t) {
+    index::GeodesicTriangle tri;
+    for (int i = 0; i < 3; ++i) {
+      tri.corner[i] = plan.triangles[t][i];
+      tri.neighbor[i] = plan.neighbors[t][i];
+    }
+    data.triangles.push_back(tri);
+  }
+  query::BuildFaceBvh(data.positions, data.faces, &data.bvh_nodes, &data.bvh_faces);
+
+  double longest = 0;
+  for (const auto& t : plan.triangles) {
+    for (int i = 0; i < 3; ++i) longest = std::max(longest, matrix(t[i], t[(i + 1) % 3]));
+  }
+  summary->sampling_seconds = plan.sampling_seconds;
+  summary->triangulation_seconds = plan.triangulation_seconds;
+  summary->requested_samples = plan.requested_samples;
+  summary->num_samples = m;
+  summary->repair = plan.repair.Summary();
+  summary->num_triangles = static_cast<int32_t>(plan.triangles.size());
+  summary->referenced_vertices = referenced;
+  summary->unassigned_vertices = unassigned;
+  summary->share_outside = referenced > 0 ? static_cast<double>(outside) / referenced : 0;
+  summary->longest_edge = longest;
+  summary->bbox_diagonal = mesh.BoundingBoxDiagonal();
+  summary->merge_seconds = SecondsSince(start);
+  if (unassigned > 0) {
+    return absl::InternalError(absl::StrFormat(
+        "%d referenced vertices have no geodesic triangle (a cell without triangles)", unassigned));
+  }
+  data.report = summary->ToText();
+  return data;
+}
+
+absl::StatusOr<index::IndexData> BuildIndex(const Mesh& mesh, const BuildOptions& options,
+                                            BuildSummary* summary) {
+  GEODEX_ASSIGN_OR_RETURN(const Plan plan, MakePlan(mesh, options));
+  std::vector<int32_t> all(plan.num_samples());
+  for (int32_t a = 0; a < plan.num_samples(); ++a) all[a] = a;
+  const auto start = std::chrono::steady_clock::now();
+  GEODEX_ASSIGN_OR_RETURN(std::vector<SampleRow> rows, ComputeRows(mesh, plan, all, options));
+  const double rows_seconds = SecondsSince(start);
+  GEODEX_ASSIGN_OR_RETURN(index::IndexData data, Merge(mesh, plan, std::move(rows), summary));
+  summary->rows_seconds = rows_seconds;
+  return data;
+}
+
+}  // namespace geodex::build

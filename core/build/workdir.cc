@@ -1,0 +1,213 @@
+#include "core/build/workdir.h"
+
+#include <xxhash.h>
+
+#include <algorithm>
+#include <cstring>
+#include <filesystem>
+#include <regex>
+
+#include "absl/strings/str_format.h"
+#include "core/common/file_util.h"
+#include "core/common/status_macros.h"
+#include "core/mesh/mesh_io.h"
+
+namespace geodex::build {
+namespace {
+
+constexpr char kPlanMagic[8] = {'G', 'D', 'X', 'P', 'L', 'A', 'N', '1'};
+constexpr char kRowsMagic[8] = {'G', 'D', 'X', 'R', 'O', 'W', 'S', '1'};
+
+std::string PlanPath(const std::string& workdir) { return workdir + "/plan.bin"; }
+
+std::string RowsPath(const std::string& workdir, int32_t shard, int32_t num_shards) {
+  return absl::StrFormat("%s/rows-%05d-of-%05d.bin", workdir, shard, num_shards);
+}
+
+// Appends the checksum of everything written so far.
+void Seal(ByteWriter& writer) {
+  writer.Put<uint64_t>(XXH64(writer.bytes().data(), writer.bytes().size(), 0));
+}
+
+// Checks magic and trailing checksum; returns the payload after the magic.
+absl::StatusOr<std::string_view> Unseal(const std::string& bytes, const char (&magic)[8],
+                                        const std::string& path) {
+  if (bytes.size() < sizeof(magic) + sizeof(uint64_t) ||
+      std::memcmp(bytes.data(), magic, sizeof(magic)) != 0) {
+    return absl::DataLossError(absl::StrFormat("%s is not a geodex work file", path));
+  }
+  uint64_t stored;
+  std::memcpy(&stored, bytes.data() + bytes.size() - sizeof(stored), sizeof(stored));
+  if (XXH64(bytes.data(), bytes.size() - sizeof(stored), 0) != stored) {
+    return absl::DataLossError(absl::StrFormat("%s: checksum mismatch", path));
+  }
+  return std::string_view(bytes).substr(sizeof(magic),
+                                        bytes.size() - sizeof(magic) - sizeof(stored));
+}
+
+}  // namespace
+
+std::string PlanMeshPath(const std::string& workdir) { return workdir + "/mesh.ply"; }
+
+std::vector<int32_t> ShardSamples(int32_t num_samples, int32_t shard, int32_t num_shards) {
+  std::vector<int32_t> out;
+  for (int32_t a = shard; a < num_samples; a += num_shards) out.push_back(a);
+  return out;
+}
+
+absl::Status SavePlan(const mesh::Mesh& mesh, const Plan& plan, const std::string& workdir) {
+  std::error_code error;
+  std::filesystem::create_directories(workdir, error);
+  if (error) {
+    return absl::InternalError(
+        absl::StrFormat("cannot create %s: %s", workdir, error.message()));
+  }
+  GEODEX_RETURN_IF_ERROR(mesh::WritePly(mesh, PlanMeshPath(workdir)));
+  ByteWriter w;
+  w.bytes().append(kPlanMagic, sizeof(kPlanMagic));
+  w.Put(plan.mesh_hash);
+  w.Put(plan.requested_samples);
+  w.Put(plan.seed);
+  w.PutVector(plan.samples);
+  w.PutVector(plan.nearest);
+  w.PutVector(plan.triangles);
+  w.PutVector(plan.neighbors);
+  w.Put(plan.repair.rounds);
+  w.Put(plan.repair.samples_added);
+  w.Put(plan.repair.added_for);
+  w.Put(plan.sampling_seconds);
+  w.Put(plan.triangulation_seconds);
+  Seal(w);
+  return AtomicWriteFile(PlanPath(workdir), w.bytes());
+}
+
+absl::StatusOr<std::pair<mesh::Mesh, Plan>> LoadPlan(const std::string& workdir) {
+  GEODEX_ASSIGN_OR_RETURN(mesh::Mesh mesh, mesh::LoadMesh(PlanMeshPath(workdir)));
+  const std::string path = PlanPath(workdir);
+  GEODEX_ASSIGN_OR_RETURN(const std::string bytes, ReadWholeFile(path));
+  GEODEX_ASSIGN_OR_RETURN(const std::string_view payload, Unseal(bytes, kPlanMagic, path));
+  ByteReader r(payload, path);
+  Plan plan;
+  GEODEX_RETURN_IF_ERROR(r.Get(&plan.mesh_hash));
+  GEODEX_RETURN_IF_ERROR(r.Get(&plan.requested_samples));
+  GEODEX_RETURN_IF_ERROR(r.Get(&plan.seed));
+  GEODEX_RETURN_IF_ERROR(r.GetVector(&plan.samples));
+  GEODEX_RETURN_IF_ERROR(r.GetVector(&plan.nearest));
+  GEODEX_RETURN_IF_ERROR(r.GetVector(&plan.triangles));
+  GEODEX_RETURN_IF_ERROR(r.GetVector(&plan.neighbors));
+  GEODEX_RETURN_IF_ERROR(r.Get(&plan.repair.rounds));
+  GEODEX_RETURN_IF_ERROR(r.Get(&plan.repair.samples_added));
+  GEODEX_RETURN_IF_ERROR(r.Get(&plan.repair.added_for));
+  GEODEX_RETURN_IF_ERROR(r.Get(&plan.sampling_seconds));
+  GEODEX_RETURN_IF_ERROR(r.Get(&plan.triangulation_seconds));
+  if (!r.AtEnd()) return absl::DataLossError(absl::StrFormat("%s has trailing bytes", path));
+  if (HashMesh(mesh) != plan.mesh_hash) {
+    return absl::FailedPreconditionError(
+        absl::StrFormat("%s does not belong to %s", path, PlanMeshPath(workdir)));
+  }
+  const int32_t m = plan.num_samples();
+  bool valid = static_cast<int32_t>(plan.nearest.size()) == mesh.num_vertices() &&
+               plan.neighbors.size() == plan.triangles.size();
+  for (int32_t v : plan.samples) valid &= v >= 0 && v < mesh.num_vertices();
+  for (int32_t a : plan.nearest) valid &= a >= mesh::kNone && a < m;
+  for (const auto& t : plan.triangles) {
+    for (int32_t a : t) valid &= a >= 0 && a < m;
+  }
+  for (const auto& n : plan.neighbors) {
+    for (int32_t t : n) valid &= t >= mesh::kNone && t < static_cast<int32_t>(plan.triangles.size());
+  }
+  if (!valid) return absl::DataLossError(absl::StrFormat("%s holds inconsistent data", path));
+  return std::make_pair(std::move(mesh), std::move(plan));
+}
+
+absl::Status SaveRows(const Plan& plan, const std::vector<SampleRow>& rows, int32_t shard,
+                      int32_t num_shards, const std::string& workdir) {
+  ByteWriter w;
+  w.bytes().append(kRowsMagic, sizeof(kRowsMagic));
+  w.Put(plan.mesh_hash);
+  w.Put(plan.num_samples());
+  w.Put(shard);
+  w.Put(num_shards);
+  w.Put<uint64_t>(rows.size());
+  for (const SampleRow& row : rows) {
+    w.Put(row.sample);
+    w.PutVector(row.to_samples);
+    w.PutVector(row.to_cell_vertices);
+  }
+  Seal(w);
+  return AtomicWriteFile(RowsPath(workdir, shard, num_shards), w.bytes());
+}
+
+absl::StatusOr<std::vector<SampleRow>> LoadAllRows(const Plan& plan, const std::string& workdir) {
+  const std::regex pattern(R"(rows-(\d{5})-of-(\d{5})\.bin)");
+  std::vector<std::pair<int32_t, int32_t>> found;
+  std::error_code error;
+  for (const auto& entry : std::filesystem::directory_iterator(workdir, error)) {
+    std::smatch match;
+    const std::string name = entry.path().filename().string();
+    if (std::regex_match(name, match, pattern)) {
+      found.push_back({std::stoi(match[1]), std::stoi(match[2])});
+    }
+  }
+  if (error) {
+    return absl::NotFoundError(absl::StrFormat("cannot list %s: %s", workdir, error.message()));
+  }
+  if (found.empty()) return absl::NotFoundError(absl::StrFormat("no rows files in %s", workdir));
+  std::sort(found.begin(), found.end());
+  const int32_t num_shards = found.front().second;
+  for (const auto& [shard, count] : found) {
+    if (count != num_shards) {
+      return absl::InvalidArgumentError(absl::StrFormat(
+          "%s mixes shardings (%d and %d shards)", workdir, num_shards, count));
+    }
+  }
+  if (static_cast<int32_t>(found.size()) != num_shards) {
+    std::string missing;
+    for (int32_t s = 0, k = 0; s < num_shards; ++s) {
+      if (k < static_cast<int32_t>(found.size()) && found[k].first == s) {
+        ++k;
+      } else {
+        missing += absl::StrFormat(" %d", s);
+      }
+    }
+    return absl::NotFoundError(
+        absl::StrFormat("%s: shards missing of %d:%s", workdir, num_shards, missing));
+  }
+  std::vector<SampleRow> rows;
+  for (int32_t shard = 0; shard < num_shards; ++shard) {
+    const std::string path = RowsPath(workdir, shard, num_shards);
+    GEODEX_ASSIGN_OR_RETURN(const std::string bytes, ReadWholeFile(path));
+    GEODEX_ASSIGN_OR_RETURN(const std::string_view payload, Unseal(bytes, kRowsMagic, path));
+    ByteReader r(payload, path);
+    uint64_t hash = 0, count = 0;
+    int32_t m = 0, s = 0, n = 0;
+    GEODEX_RETURN_IF_ERROR(r.Get(&hash));
+    GEODEX_RETURN_IF_ERROR(r.Get(&m));
+    GEODEX_RETURN_IF_ERROR(r.Get(&s));
+    GEODEX_RETURN_IF_ERROR(r.Get(&n));
+    GEODEX_RETURN_IF_ERROR(r.Get(&count));
+    if (hash != plan.mesh_hash || m != plan.num_samples() || s != shard || n != num_shards) {
+      return absl::FailedPreconditionError(
+          absl::StrFormat("%s was computed for another plan", path));
+    }
+    const std::vector<int32_t> expected = ShardSamples(m, shard, num_shards);
+    if (count != expected.size()) {
+      return absl::DataLossError(absl::StrFormat("%s holds %d rows, expected %d", path, count,
+                                                 expected.size()));
+    }
+    for (uint64_t k = 0; k < count; ++k) {
+      SampleRow row;
+      GEODEX_RETURN_IF_ERROR(r.Get(&row.sample));
+      GEODEX_RETURN_IF_ERROR(r.GetVector(&row.to_samples));
+      GEODEX_RETURN_IF_ERROR(r.GetVector(&row.to_cell_vertices));
+      if (row.sample != expected[k]) {
+        return absl::DataLossError(absl::StrFormat("%s: unexpected sample %d", path, row.sample));
+      }
+      rows.push_back(std::move(row));
+    }
+    if (!r.AtEnd()) return absl::DataLossError(absl::StrFormat("%s has trailing bytes", path));
+  }
+  return rows;
+}
+
+}  // namespace geodex::build

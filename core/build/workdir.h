@@ -1,0 +1,40 @@
+#pragma once
+
+// The shared work directory of a distributed build:
+//
+//   geodex-build plan MESH --samples M -o WORKDIR   writes mesh.ply, plan.bin
+//   geodex-build rows WORKDIR --shard I/N           writes rows-I-of-N.bin
+//   geodex-build merge WORKDIR -o OUT.gdx           reads them all
+//
+// Every file is written atomically and carries a magic, a version, the mesh
+// hash and an XXH64 checksum, so a half-copied or stale file is rejected
+// (DataLoss / FailedPrecondition) instead of merged.
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "absl/status/statusor.h"
+#include "core/build/builder.h"
+#include "core/mesh/mesh.h"
+
+namespace geodex::build {
+
+std::string PlanMeshPath(const std::string& workdir);
+
+// Samples of shard `shard` of `num_shards`: a with a % num_shards == shard.
+std::vector<int32_t> ShardSamples(int32_t num_samples, int32_t shard, int32_t num_shards);
+
+absl::Status SavePlan(const mesh::Mesh& mesh, const Plan& plan, const std::string& workdir);
+// Loads the mesh and plan of a work directory.
+absl::StatusOr<std::pair<mesh::Mesh, Plan>> LoadPlan(const std::string& workdir);
+
+absl::Status SaveRows(const Plan& plan, const std::vector<SampleRow>& rows, int32_t shard,
+                      int32_t num_shards, const std::string& workdir);
+// Loads the rows of every shard. Errors: NotFound / InvalidArgument if shards
+// are missing, mixed (different shard counts) or do not cover every sample
+// exactly once; DataLoss for corrupt files; FailedPrecondition for rows of
+// another plan.
+absl::StatusOr<std::vector<SampleRow>> LoadAllRows(const Plan& plan, const std::string& workdir);
+
+}  // namespace geodex::build

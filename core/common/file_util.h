@@ -1,0 +1,79 @@
+#pragma once
+
+// Small file helpers shared by the builder and the index writer.
+
+#include <cstdint>
+#include <cstring>
+#include <string>
+#include <string_view>
+#include <type_traits>
+#include <vector>
+
+#include "absl/status/status.h"
+#include "absl/status/statusor.h"
+
+namespace geodex {
+
+// Writes `bytes` to `path` atomically: a temporary file in the same directory,
+// fsync, rename over `path`, fsync of the directory. Readers see the old file
+// or the new one, never a partial one. Errors name the path and the reason.
+absl::Status AtomicWriteFile(const std::string& path, std::string_view bytes);
+
+// Reads a whole file. Errors: NotFound, or Internal on read failure.
+absl::StatusOr<std::string> ReadWholeFile(const std::string& path);
+
+// Appends plain values and arrays to a byte string (host byte order, which the
+// readers check through their own headers).
+class ByteWriter {
+ public:
+  template <typename T>
+  void Put(const T& value) {
+    static_assert(std::is_trivially_copyable_v<T>);
+    bytes_.append(reinterpret_cast<const char*>(&value), sizeof(T));
+  }
+  template <typename T>
+  void PutVector(const std::vector<T>& values) {
+    Put<uint64_t>(values.size());
+    bytes_.append(reinterpret_cast<const char*>(values.data()), values.size() * sizeof(T));
+  }
+  std::string& bytes() { return bytes_; }
+
+ private:
+  std::string bytes_;
+};
+
+// Reads what ByteWriter wrote, with bounds checks: every failure is DataLoss
+// naming `what`.
+class ByteReader {
+ public:
+  ByteReader(std::string_view bytes, std::string what) : bytes_(bytes), what_(std::move(what)) {}
+
+  template <typename T>
+  absl::Status Get(T* value) {
+    static_assert(std::is_trivially_copyable_v<T>);
+    if (bytes_.size() - pos_ < sizeof(T)) return Truncated();
+    std::memcpy(value, bytes_.data() + pos_, sizeof(T));
+    pos_ += sizeof(T);
+    return absl::OkStatus();
+  }
+  template <typename T>
+  absl::Status GetVector(std::vector<T>* values) {
+    uint64_t n = 0;
+    if (absl::Status s = Get(&n); !s.ok()) return s;
+    if (n > (bytes_.size() - pos_) / sizeof(T)) return Truncated();
+    values->resize(n);
+    std::memcpy(values->data(), bytes_.data() + pos_, n * sizeof(T));
+    pos_ += n * sizeof(T);
+    return absl::OkStatus();
+  }
+  bool AtEnd() const { return pos_ == bytes_.size(); }
+
+ private:
+  absl::Status Truncated() const;
+
+  std::string_view bytes_;
+  size_t pos_ = 0;
+  std::string what_;
+};
+
+}  // namespace geodex

@@ -1,0 +1,169 @@
+#pragma once
+
+// Constant-time approximate geodesic queries over a loaded index (Xin, Ying
+// & He 2012, §5): distances between any two surface points, geodesic paths
+// by tracing the gradient of the approximate distance field (§6.2), distance
+// fields from several sources (§6.2), and point location.
+//
+// How a distance is answered. Each query point is first "lifted" to a
+// geodesic triangle T and its distances to T's three corner samples: exact
+// for a vertex (its index record); for a point inside a mesh face, by
+// two-side unfolding across the face's edges (§5.1) from the face vertices'
+// distances, which are exact when a vertex lies in T and come from case 2.2
+// otherwise. Two lifted points are then combined as two vertices are in
+// §5.2: one-side unfolding when they share T (case 3.1), otherwise the
+// distances from p to q's corners by case 2.2 and a final case 2.2 (3.2).
+// This visits the same unfoldings as the paper's cases 4-5 but computes each
+// distance once.
+//
+// Near pairs (the same or adjacent geodesic triangles, §6.5) are the method's
+// weak spot; with QueryOptions::exact_near_pairs they are answered by a local
+// exact propagation that stops as soon as the second point is reached.
+//
+// Thread safety: a QueryEngine is immutable; all const methods are safe from
+// any number of threads. Methods that need scratch space take a QueryScratch,
+// one per thread.
+
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <span>
+#include <vector>
+
+#include "absl/status/statusor.h"
+#include "core/geodesic/exact_geodesic.h"
+#include "core/index/index.h"
+#include "core/mesh/mesh.h"
+#include "core/query/point_locator.h"
+
+namespace geodex::query {
+
+using mesh::SurfacePoint;
+
+struct QueryOptions {
+  // Answer pairs in the same or adjacent geodesic triangles exactly, by a
+  // local propagation (not O(1); needs a QueryScratch). Off: pure O(1).
+  bool exact_near_pairs = false;
+  // Barycentric tolerance for validation (weights >= -tol, |sum - 1| <= tol).
+  double weight_tolerance = 1e-6;
+};
+
+// Per-thread working memory for exact near pairs.
+class QueryScratch {
+ public:
+  QueryScratch() = default;
+
+ private:
+  friend class QueryEngine;
+  std::unique_ptr<geodesic::ExactGeodesicSolver> solver_;
+  const mesh::Mesh* mesh_ = nullptr;
+};
+
+// A point lifted into a geodesic triangle (see the header comment).
+struct LiftedPoint {
+  int32_t triangle = -1;
+  std::array<int32_t, 3> corner = {-1, -1, -1};
+  std::array<double, 3> distance = {0, 0, 0};
+};
+
+struct PathPoint {
+  SurfacePoint point;
+  mesh::Vec3 position;
+};
+
+// An unfolded geodesic triangle seen from one of its edges: corner i at the
+// origin, corner i+1 at (l, 0), the third corner at (cx, cy), cy >= 0.
+struct EdgeFrame {
+  double l, cx, cy;
+};
+
+struct DistanceField {
+  std::vector<double> distance;  // per vertex; +inf when unreachable or unreferenced
+  std::vector<int32_t> nearest;  // per vertex: index of the nearest source (-1 if none)
+};
+
+class QueryEngine {
+ public:
+  // Errors: FailedPrecondition if the index has no triangles; errors of
+  // mesh::Mesh::Create when exact_near_pairs needs the mesh.
+  static absl::StatusOr<std::shared_ptr<const QueryEngine>> Create(
+      std::shared_ptr<const index::Index> index, QueryOptions options = {});
+
+  const index::Index& index() const { return *index_; }
+  const QueryOptions& options() const { return options_; }
+
+  // Validates a point: OutOfRange for a face id past the end,
+  // InvalidArgument for NaN/Inf/negative weights or weights not summing to 1.
+  absl::Status Validate(const SurfacePoint& p) const;
+
+  // Approximate geodesic distance; +inf between components. Validates both
+  // points. Symmetric: Distance(p, q) == Distance(q, p) exactly.
+  absl::StatusOr<double> Distance(const SurfacePoint& p, const SurfacePoint& q,
+                                  QueryScratch* scratch = nullptr) const;
+
+  // Batch: out[i] = Distance(a[i], b[i]). Validates everything first (the
+  // error names the pair index) and allocates nothing in the O(1) mode.
+  absl::Status DistanceBatch(std::span<const SurfacePoint> a, std::span<const SurfacePoint> b,
+                             std::span<double> out, QueryScratch* scratch = nullptr) const;
+
+  // The pure O(1) distance for valid points (no checks, no near-pair fix).
+  double DistanceUnchecked(const SurfacePoint& p, const SurfacePoint& q) const;
+
+  // True when the points lift into the same or adjacent geodesic triangles.
+  bool IsNearPair(const SurfacePoint& p, const SurfacePoint& q) const;
+
+  // The paper's linear-interpolation baseline (§6.3), for comparisons.
+  double LinearInterpolationDistance(const SurfacePoint& p, const SurfacePoint& q) const;
+
+  // Geodesic path from `from` to `to` by tracing the gradient of the
+  // approximate distance field of `from` backwards from `to` (§6.2). The
+  // first point is `from`, the last `to`, exactly; consecutive points share
+  // a mesh face. Errors: as Validate; NotFound between components.
+  absl::StatusOr<std::vector<PathPoint>> Path(const SurfacePoint& from,
+                                              const SurfacePoint& to) const;
+
+  // Distance from the nearest of `sources` to every vertex, O(l n).
+  // Errors: as Validate (naming the source index); InvalidArgument if empty.
+  absl::StatusOr<DistanceField> Field(std::span<const SurfacePoint> sources) const;
+
+  // Closest surface point to a 3D position.
+  absl::StatusOr<LocatedPoint> Locate(const mesh::Vec3& x) const;
+
+  // Building blocks, exposed for tests and benchmarks.
+  LiftedPoint Lift(const SurfacePoint& p) const;
+  double LiftedDistance(const LiftedPoint& p, const LiftedPoint& q) const;
+
+ private:
+  QueryEngine(std::shared_ptr<const index::Index> index, QueryOptions options);
+  double Matrix(int32_t a, int32_t b) const {
+    return static_cast<double>(matrix_[static_cast<size_t>(a) * num_samples_ + b]);
+  }
+  mesh::Vec3 Position(int32_t v) const {
+    return {positions_[3 * v], positions_[3 * v + 1], positions_[3 * v + 2]};
+  }
+  // Approximate distance from a lifted point to sample `s` (case 2.1/2.2).
+  double ToSample(const LiftedPoint& p, int32_t s) const;
+  double VertexToSample(int32_t v, int32_t s) const;
+  // Smallest squared distance between two points given by their distances
+  // to the corners of `triangle`, over the triangle's three edge unfoldings.
+  double UnfoldedDistance2(int32_t triangle, const double* p, const double* q) const;
+  double ExactNearDistance(const SurfacePoint& p, const SurfacePoint& q,
+                           QueryScratch* scratch) const;
+  SurfacePoint Canonical(const SurfacePoint& p) const;
+
+  std::shared_ptr<const index::Index> index_;
+  QueryOptions options_;
+  std::span<const double> positions_;
+  std::span<const int32_t> faces_;
+  std::span<const int32_t> twins_;
+  std::span<const float> matrix_;
+  std::span<const index::VertexRecord> records_;
+  std::span<const index::GeodesicTriangle> triangles_;
+  int32_t num_samples_ = 0;
+  PointLocator locator_;
+  std::vector<EdgeFrame> frames_;     // 3 per geodesic triangle, derived at load
+  std::unique_ptr<mesh::Mesh> mesh_;  // only with exact_near_pairs
+};
+
+}  // namespace geodex::query

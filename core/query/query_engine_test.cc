@@ -1,0 +1,245 @@
+#include "core/query/query_engine.h"
+
+#include <cmath>
+#include <random>
+
+#include "core/build/builder.h"
+#include "core/mesh/generators.h"
+#include "gmock/gmock.h"
+#include "gtest/gtest.h"
+
+namespace geodex::query {
+namespace {
+
+namespace gen = mesh::gen;
+using mesh::Mesh;
+using ::testing::HasSubstr;
+
+std::shared_ptr<const QueryEngine> MakeEngine(const Mesh& m, int32_t samples,
+                                              QueryOptions options = {}) {
+  build::BuildOptions build_options;
+  build_options.num_samples = samples;
+  build_options.threads = 2;
+  build::BuildSummary summary;
+  auto data = build::BuildIndex(m, build_options, &summary);
+  EXPECT_TRUE(data.ok()) << data.status();
+  auto bytes = index::SerializeIndex(*data);
+  EXPECT_TRUE(bytes.ok());
+  auto index = index::Index::FromBytes(*bytes);
+  EXPECT_TRUE(index.ok()) << index.status();
+  auto engine = QueryEngine::Create(*index, options);
+  EXPECT_TRUE(engine.ok()) << engine.status();
+  return *engine;
+}
+
+// Area-uniform random surface points.
+std::vector<SurfacePoint> RandomPoints(const Mesh& m, int count, uint32_t seed) {
+  std::vector<double> cumulative(m.num_faces());
+  double total = 0;
+  for (int32_t f = 0; f < m.num_faces(); ++f) cumulative[f] = total += m.Area(f);
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> u(0, 1);
+  std::vector<SurfacePoint> out;
+  for (int k = 0; k < count; ++k) {
+    const int32_t f = static_cast<int32_t>(
+        std::lower_bound(cumulative.begin(), cumulative.end(), u(rng) * total) -
+        cumulative.begin());
+    double a = u(rng), b = u(rng);
+    if (a + b > 1) a = 1 - a, b = 1 - b;
+    out.push_back({std::min(f, m.num_faces() - 1), {a, b, 1 - a - b}});
+  }
+  return out;
+}
+
+double Exact(const Mesh& m, const SurfacePoint& p, const SurfacePoint& q) {
+  geodesic::ExactGeodesicSolver solver(m);
+  EXPECT_TRUE(solver.Propagate({p}).ok());
+  return solver.DistanceAt(q);
+}
+
+TEST(QueryEngineTest, DevelopableSurfacesAreExactToFloatPrecision) {
+  for (const Mesh& m : {gen::FoldedSheet(24, 16, 2.0, 1.0, 1.1), gen::Cylinder(48, 16, 1.0, 3.0)}) {
+    SCOPED_TRACE(m.name());
+    auto engine = MakeEngine(m, 40);
+    const auto points = RandomPoints(m, 60, 11);
+    double max_rel = 0;
+    for (size_t i = 0; i + 1 < points.size(); i += 2) {
+      geodesic::ExactGeodesicSolver solver(m);
+      ASSERT_TRUE(solver.Propagate({points[i]}).ok());
+      for (size_t j = 0; j < points.size(); j += 3) {
+        const double exact = solver.DistanceAt(points[j]);
+        if (exact < 1e-3) continue;
+        const double approx = *engine->Distance(points[i], points[j]);
+        max_rel = std::max(max_rel, std::abs(approx - exact) / exact);
+      }
+    }
+    EXPECT_LT(max_rel, 1e-5);
+  }
+}
+
+TEST(QueryEngineTest, SphereRelativeErrorIsSmallAndFallsWithSamples) {
+  const Mesh m = gen::Sphere(4, 1.0);
+  const auto points = RandomPoints(m, 40, 5);
+  double previous = 1;
+  for (int32_t samples : {40, 160}) {
+    auto engine = MakeEngine(m, samples);
+    double sum2 = 0;
+    int count = 0;
+    for (size_t i = 0; i < 8; ++i) {
+      geodesic::ExactGeodesicSolver solver(m);
+      ASSERT_TRUE(solver.Propagate({points[i]}).ok());
+      for (size_t j = 8; j < points.size(); ++j) {
+        const double exact = solver.DistanceAt(points[j]);
+        const double rel = (*engine->Distance(points[i], points[j]) - exact) / exact;
+        sum2 += rel * rel;
+        ++count;
+      }
+    }
+    const double rms = std::sqrt(sum2 / count);
+    EXPECT_LT(rms, previous);
+    previous = rms;
+  }
+  EXPECT_LT(previous, 0.01);
+}
+
+TEST(QueryEngineTest, SymmetricZeroOnTheDiagonalAndInfiniteAcrossComponents) {
+  const Mesh m = gen::Torus(48, 24, 2.0, 0.7);
+  auto engine = MakeEngine(m, 60);
+  const auto points = RandomPoints(m, 50, 3);
+  for (size_t i = 0; i < points.size(); ++i) {
+    EXPECT_EQ(*engine->Distance(points[i], points[i]), 0.0);
+    for (size_t j = 0; j < points.size(); j += 7) {
+      EXPECT_EQ(*engine->Distance(points[i], points[j]), *engine->Distance(points[j], points[i]));
+    }
+  }
+  // A point on an edge, described from either face, is the same point.
+  const int32_t h = 5, g = m.Twin(h);
+  const SurfacePoint on_h{Mesh::FaceOf(h), {0, 0, 0}};
+  SurfacePoint a = on_h, b{Mesh::FaceOf(g), {0, 0, 0}};
+  a.w[h % 3] = 0.3;
+  a.w[(h + 1) % 3] = 0.7;
+  b.w[g % 3] = 0.7;  // Origin(g) = Dest(h)
+  b.w[(g + 1) % 3] = 0.3;
+  EXPECT_EQ(*engine->Distance(a, b), 0.0);
+  EXPECT_EQ(*engine->Distance(a, points[0]), *engine->Distance(b, points[0]));
+
+  const Mesh two = gen::TwoComponents(10);
+  auto split = MakeEngine(two, 20);
+  int32_t far = 0;
+  while (two.FaceComponent(far) == two.FaceComponent(0)) ++far;
+  EXPECT_EQ(*split->Distance({0, {0.2, 0.3, 0.5}}, {far, {0.2, 0.3, 0.5}}),
+            std::numeric_limits<double>::infinity());
+  EXPECT_EQ(split->Path({0, {0.2, 0.3, 0.5}}, {far, {0.2, 0.3, 0.5}}).status().code(),
+            absl::StatusCode::kNotFound);
+}
+
+TEST(QueryEngineTest, BatchEqualsSingleAndValidatesEveryPoint) {
+  const Mesh m = gen::Sphere(3, 1.0);
+  auto engine = MakeEngine(m, 40);
+  const auto a = RandomPoints(m, 100, 1), b = RandomPoints(m, 100, 2);
+  std::vector<double> out(a.size());
+  ASSERT_TRUE(engine->DistanceBatch(a, b, out).ok());
+  for (size_t i = 0; i < a.size(); ++i) EXPECT_EQ(out[i], *engine->Distance(a[i], b[i]));
+
+  auto bad = b;
+  bad[42] = {m.num_faces(), {1, 0, 0}};
+  absl::Status status = engine->DistanceBatch(a, bad, out);
+  EXPECT_EQ(status.code(), absl::StatusCode::kOutOfRange);
+  EXPECT_THAT(status.message(), HasSubstr("pair 42, point B"));
+  bad[42] = {0, {NAN, 0.5, 0.5}};
+  EXPECT_EQ(engine->DistanceBatch(a, bad, out).code(), absl::StatusCode::kInvalidArgument);
+  bad[42] = {0, {-0.5, 1.0, 0.5}};
+  EXPECT_THAT(engine->DistanceBatch(a, bad, out).message(), HasSubstr("negative"));
+  bad[42] = {0, {0.5, 0.5, 0.5}};
+  EXPECT_THAT(engine->DistanceBatch(a, bad, out).message(), HasSubstr("sum"));
+  EXPECT_EQ(engine->Distance({-1, {1, 0, 0}}, a[0]).status().code(),
+            absl::StatusCode::kOutOfRange);
+}
+
+TEST(QueryEngineTest, ExactNearPairsMatchTheExactEngine) {
+  const Mesh m = gen::Sphere(4, 1.0);
+  QueryOptions options;
+  options.exact_near_pairs = true;
+  auto engine = MakeEngine(m, 60, options);
+  QueryScratch scratch;
+  const auto points = RandomPoints(m, 400, 9);
+  int near = 0;
+  for (size_t i = 0; i + 1 < points.size(); i += 2) {
+    if (!engine->IsNearPair(points[i], points[i + 1])) continue;
+    ++near;
+    const double exact = Exact(m, points[i], points[i + 1]);
+    EXPECT_NEAR(*engine->Distance(points[i], points[i + 1], &scratch), exact, 1e-9 * (1 + exact));
+  }
+  EXPECT_GT(near, 0);
+}
+
+TEST(QueryEngineTest, PathsStayOnTheSurfaceAndAreNearlyGeodesic) {
+  const Mesh m = gen::Grid(30, 30, 1.0, 1.0, 0.2, 4);
+  auto engine = MakeEngine(m, 40);
+  const auto points = RandomPoints(m, 40, 8);
+  for (size_t i = 0; i + 1 < points.size(); i += 2) {
+    auto path = engine->Path(points[i], points[i + 1]);
+    ASSERT_TRUE(path.ok()) << path.status();
+    ASSERT_GE(path->size(), 2u);
+    const mesh::Vec3 a = PositionOf(m, points[i]), b = PositionOf(m, points[i + 1]);
+    EXPECT_EQ(path->front().position, a);
+    EXPECT_EQ(path->back().position, b);
+    double length = 0;
+    for (size_t k = 1; k < path->size(); ++k) {
+      length += ((*path)[k].position - (*path)[k - 1].position).norm();
+      EXPECT_LT(std::abs((*path)[k].position.z()), 1e-12);  // on the plane
+    }
+    EXPECT_LE(length, (a - b).norm() * 1.01 + 1e-9);
+  }
+}
+
+TEST(QueryEngineTest, FieldIsTheMinimumOverSources) {
+  const Mesh m = gen::Sphere(3, 1.0);
+  auto engine = MakeEngine(m, 40);
+  const auto sources = RandomPoints(m, 3, 6);
+  auto field = engine->Field(sources);
+  ASSERT_TRUE(field.ok());
+  for (int32_t v = 0; v < m.num_vertices(); v += 13) {
+    const SurfacePoint p = *mesh::VertexPoint(m, v);
+    double best = 1e300;
+    int32_t nearest = -1;
+    for (int32_t s = 0; s < 3; ++s) {
+      const double d = *engine->Distance(sources[s], p);
+      if (d < best) best = d, nearest = s;
+    }
+    EXPECT_NEAR(field->distance[v], best, 1e-12);
+    EXPECT_EQ(field->nearest[v], nearest);
+  }
+  EXPECT_EQ(engine->Field({}).status().code(), absl::StatusCode::kInvalidArgument);
+}
+
+TEST(QueryEngineTest, LocateFindsSurfacePoints) {
+  const Mesh m = gen::Sphere(3, 1.0);
+  auto engine = MakeEngine(m, 30);
+  for (const SurfacePoint& p : RandomPoints(m, 50, 2)) {
+    const mesh::Vec3 x = PositionOf(m, p);
+    auto located = engine->Locate(x * 1.0);
+    ASSERT_TRUE(located.ok());
+    EXPECT_LT((PositionOf(m, located->point) - x).norm(), 1e-12);
+  }
+}
+
+TEST(QueryEngineTest, LinearBaselineIsWorseThanUnfolding) {
+  const Mesh m = gen::Sphere(4, 1.0);
+  auto engine = MakeEngine(m, 60);
+  const auto points = RandomPoints(m, 30, 4);
+  double unfold2 = 0, linear2 = 0;
+  for (size_t i = 0; i < 5; ++i) {
+    geodesic::ExactGeodesicSolver solver(m);
+    ASSERT_TRUE(solver.Propagate({points[i]}).ok());
+    for (size_t j = 5; j < points.size(); ++j) {
+      const double exact = solver.DistanceAt(points[j]);
+      unfold2 += std::pow((*engine->Distance(points[i], points[j]) - exact) / exact, 2);
+      linear2 += std::pow((engine->LinearInterpolationDistance(points[i], points[j]) - exact) / exact, 2);
+    }
+  }
+  EXPECT_LT(unfold2, linear2);
+}
+
+}  // namespace
+}  // namespace geodex::query

@@ -1,0 +1,242 @@
+// Geodesic paths by tracing the gradient of the approximate distance field
+// (paper §6.2): QueryEngine::Path.
+
+#include <algorithm>
+#include <cmath>
+#include <queue>
+#include <unordered_map>
+
+#include "absl/strings/str_format.h"
+#include "core/common/status_macros.h"
+#include "core/query/query_engine.h"
+
+namespace geodex::query {
+namespace {
+
+using mesh::Vec3;
+
+struct Tracer {
+  const QueryEngine& engine;
+  std::span<const double> positions;
+  std::span<const int32_t> faces;
+  std::span<const int32_t> twins;
+  LiftedPoint source;
+  std::unordered_map<int32_t, double> cache;
+
+  Vec3 P(int32_t v) const { return {positions[3 * v], positions[3 * v + 1], positions[3 * v + 2]}; }
+  int32_t V(int32_t f, int i) const { return faces[3 * f + i]; }
+
+  // Approximate distance from the source to vertex v (O(1), memoised).
+  double D(int32_t v) {
+    auto [it, inserted] = cache.try_emplace(v, 0.0);
+    if (inserted) {
+      const index::VertexRecord& r = engine.index().vertices()[v];
+      LiftedPoint x;
+      x.triangle = r.triangle;
+      for (int c = 0; c < 3; ++c) {
+        x.corner[c] = r.corner[c];
+        x.distance[c] = r.distance[c];
+      }
+      it->second = engine.LiftedDistance(source, x);
+    }
+    return it->second;
+  }
+
+  // Steepest descent of the linear interpolant of D over face f, as
+  // barycentric velocities (sum 0), and the gradient's length.
+  std::array<double, 3> Descent(int32_t f, double* magnitude) {
+    const Vec3 v[3] = {P(V(f, 0)), P(V(f, 1)), P(V(f, 2))};
+    const double d[3] = {D(V(f, 0)), D(V(f, 1)), D(V(f, 2))};
+    const Vec3 n = (v[1] - v[0]).cross(v[2] - v[0]);
+    const double area2 = n.squaredNorm();
+    // grad b_i = n x (v_{i+2} - v_{i+1}) / |n|^2
+    Vec3 grad_b[3];
+    for (int i = 0; i < 3; ++i) grad_b[i] = n.cross(v[(i + 2) % 3] - v[(i + 1) % 3]) / area2;
+    const Vec3 g = d[0] * grad_b[0] + d[1] * grad_b[1] + d[2] * grad_b[2];
+    *magnitude = g.norm();
+    return {-grad_b[0].dot(g), -grad_b[1].dot(g), -grad_b[2].dot(g)};
+  }
+
+  // Faces around vertex v, starting from face f.
+  std::vector<int32_t> FacesAround(int32_t v, int32_t f) const {
+    std::vector<int32_t> out = {f};
+    for (int dir = 0; dir < 2; ++dir) {
+      int32_t g = f;
+      for (size_t guard = 0; guard < 1024; ++guard) {
+        int k = 0;
+        while (V(g, k) != v) ++k;
+        const int32_t h = dir == 0 ? 3 * g + k : 3 * g + (k + 2) % 3;
+        const int32_t t = twins[h];
+        if (t < 0) break;
+        g = t / 3;
+        if (g == f) return out;
+        out.push_back(g);
+      }
+    }
+    return out;
+  }
+};
+
+int LocalIndex(std::span<const int32_t> faces, int32_t f, int32_t v) {
+  for (int i = 0; i < 3; ++i) {
+    if (faces[3 * f + i] == v) return i;
+  }
+  return -1;
+}
+
+}  // namespace
+
+absl::StatusOr<std::vector<PathPoint>> QueryEngine::Path(const SurfacePoint& from_in,
+                                                         const SurfacePoint& to_in) const {
+  GEODEX_RETURN_IF_ERROR(Validate(from_in));
+  GEODEX_RETURN_IF_ERROR(Validate(to_in));
+  const SurfacePoint from = Canonical(from_in), to = Canonical(to_in);
+  Tracer tr{*this, positions_, faces_, twins_, Lift(from), {}};
+  if (!(LiftedDistance(tr.source, Lift(to)) < std::numeric_limits<double>::infinity())) {
+    return absl::NotFoundError("the two points lie on different connected components");
+  }
+  // The source's support: the vertices with non-zero weight.
+  std::vector<int32_t> support;
+  for (int i = 0; i < 3; ++i) {
+    if (from.w[i] > 0) support.push_back(faces_[3 * from.face + i]);
+  }
+  auto contains_source = [&](int32_t f) {
+    if (f == from.face) return true;
+    for (int32_t v : support) {
+      if (LocalIndex(faces_, f, v) < 0) return false;
+    }
+    return true;  // the source is a vertex or edge point of f
+  };
+  auto point_at = [&](int32_t f, const std::array<double, 3>& b) {
+    SurfacePoint p{f, b};
+    return PathPoint{p, b[0] * Position(faces_[3 * f]) + b[1] * Position(faces_[3 * f + 1]) +
+                            b[2] * Position(faces_[3 * f + 2])};
+  };
+  auto vertex_point = [&](int32_t f, int32_t v) {
+    std::array<double, 3> b = {0, 0, 0};
+    b[LocalIndex(faces_, f, v)] = 1;
+    return point_at(f, b);
+  };
+
+  std::vector<PathPoint> path = {point_at(to.face, to.w)};
+  int32_t f = to.face;
+  std::array<double, 3> b = to.w;
+  int32_t at_vertex = -1;  // set while the path sits on a vertex
+  for (int i = 0; i < 3; ++i) {
+    if (b[i] >= 1) at_vertex = faces_[3 * f + i];
+  }
+  const int64_t max_steps = 8 * int64_t{index_->num_faces()} + 64;
+  for (int64_t step = 0; step < max_steps; ++step) {
+    if (contains_source(f)) {
+      path.push_back(point_at(from.face, from.w));
+      std::reverse(path.begin(), path.end());
+      return path;
+    }
+    if (at_vertex >= 0) {
+      // Leave the vertex into the face where the descent points inside.
+      const int32_t v = at_vertex;
+      int32_t best_face = -1;
+      double best_slope = 0;
+      for (int32_t g : tr.FacesAround(v, f)) {
+        if (contains_source(g)) {
+          best_face = g;
+          break;
+        }
+        double magnitude;
+        const auto beta = tr.Descent(g, &magnitude);
+        const int k = LocalIndex(faces_, g, v);
+        const double e = 1e-12 * (std::abs(beta[0]) + std::abs(beta[1]) + std::abs(beta[2]));
+        if (beta[(k + 1) % 3] >= -e && beta[(k + 2) % 3] >= -e && beta[k] < -e &&
+            magnitude > best_slope) {
+          best_slope = magnitude;
+          best_face = g;
+        }
+      }
+      if (best_face >= 0) {
+        f = best_face;
+        b = {0, 0, 0};
+        b[LocalIndex(faces_, f, v)] = 1;
+        if (contains_source(f)) continue;
+        at_vertex = -1;
+        // Fall through to the face step below from the vertex.
+      } else {
+        // Walk along the edge to the lowest neighbour, if lower.
+        int32_t next = -1, next_face = -1;
+        double lowest = tr.D(v);
+        for (int32_t g : tr.FacesAround(v, f)) {
+          for (int i = 0; i < 3; ++i) {
+            const int32_t u = faces_[3 * g + i];
+            if (u != v && tr.D(u) < lowest) {
+              lowest = tr.D(u);
+              next = u;
+              next_face = g;
+            }
+          }
+        }
+        if (next < 0) {
+          return absl::InternalError(absl::StrFormat(
+              "path tracing reached a local minimum of the approximate field at vertex %d", v));
+        }
+        f = next_face;
+        at_vertex = next;
+        path.push_back(vertex_point(f, next));
+        continue;
+      }
+    }
+    // Face step: follow the descent to the face's boundary.
+    double magnitude;
+    const auto beta = tr.Descent(f, &magnitude);
+    double t = std::numeric_limits<double>::infinity();
+    int exit = -1;
+    const double eps = 1e-12 * (std::abs(beta[0]) + std::abs(beta[1]) + std::abs(beta[2]));
+    for (int i = 0; i < 3; ++i) {
+      if (beta[i] < -eps) {
+        const double ti = -b[i] / beta[i];
+        if (ti < t) {
+          t = ti;
+          exit = i;
+        }
+      }
+    }
+    if (exit < 0 || !(t > 1e-14) || !(magnitude > 0)) {
+      // No way forward inside this face: go to its lowest vertex.
+      int k = 0;
+      for (int i = 1; i < 3; ++i) {
+        if (tr.D(faces_[3 * f + i]) < tr.D(faces_[3 * f + k])) k = i;
+      }
+      at_vertex = faces_[3 * f + k];
+      path.push_back(vertex_point(f, at_vertex));
+      continue;
+    }
+    for (int i = 0; i < 3; ++i) b[i] = std::max(b[i] + t * beta[i], 0.0);
+    b[exit] = 0;
+    const double sum = b[0] + b[1] + b[2];
+    for (double& x : b) x /= sum;
+    path.push_back(point_at(f, b));
+    for (int i = 0; i < 3; ++i) {
+      if (b[i] >= 1 - 1e-12) at_vertex = faces_[3 * f + i];
+    }
+    if (at_vertex >= 0) {
+      path.back() = vertex_point(f, at_vertex);
+      continue;
+    }
+    // Cross the edge opposite `exit` into the neighbouring face.
+    const int32_t h = 3 * f + (exit + 1) % 3;
+    const int32_t g = twins_[h];
+    if (g < 0) {
+      // A boundary edge: slide to its lower end.
+      const int32_t a = faces_[3 * f + (exit + 1) % 3], c = faces_[3 * f + (exit + 2) % 3];
+      at_vertex = tr.D(a) <= tr.D(c) ? a : c;
+      path.push_back(vertex_point(f, at_vertex));
+      continue;
+    }
+    std::array<double, 3> nb = {0, 0, 0};
+    nb[g % 3] = b[(exit + 2) % 3];            // Origin(g) = Dest(h)
+    nb[(g % 3 + 1) % 3] = b[(exit + 1) % 3];  // Dest(g) = Origin(h)
+    f = g / 3;
+    b = nb;
+  }
+  return absl::InternalError("path tracing did not reach the source");
+}
+
+}  // namespace geodex::query

@@ -1,0 +1,186 @@
+// geodex-query: answers queries offline from an index file, without a server.
+//
+//   geodex-query INDEX --pairs FILE [--exact-near-pairs] [--linear-baseline]
+//   geodex-query INDEX --paths FILE [--format xyz|json]
+//   geodex-query INDEX --field SOURCES [--nearest]
+//   geodex-query INDEX --locate POINTS
+//
+// FILE holds lines "fa a0 a1 a2 fb b0 b1 b2" (core/mesh/pairs_io.h); SOURCES
+// lines "f w0 w1 w2"; POINTS lines "x y z". "-" reads standard input. Output
+// goes to standard output in input order; on a bad line nothing is printed and
+// the error names the line. Exit codes: 0 ok, 2 bad input, 1 other errors.
+
+#include <cstdio>
+#include <string>
+
+#include "CLI/CLI.hpp"
+#include "absl/strings/str_format.h"
+#include "core/common/status_macros.h"
+#include "core/mesh/pairs_io.h"
+#include "core/query/query_engine.h"
+
+namespace geodex {
+namespace {
+
+// Lines of `width` numbers; errors name the line.
+absl::StatusOr<std::vector<std::vector<double>>> ReadNumberLines(const std::string& path,
+                                                                 size_t width) {
+  GEODEX_ASSIGN_OR_RETURN(const std::string text, mesh::ReadFileOrStdin(path));
+  std::vector<std::vector<double>> lines;
+  size_t begin = 0;
+  int64_t number = 0;
+  while (begin < text.size()) {
+    size_t end = text.find('\n', begin);
+    if (end == std::string::npos) end = text.size();
+    const std::string line = text.substr(begin, end - begin);
+    begin = end + 1;
+    ++number;
+    if (line.find_first_not_of(" \t\r") == std::string::npos || line[line.find_first_not_of(" \t")] == '#') {
+      continue;
+    }
+    std::vector<double> values;
+    const char* p = line.c_str();
+    char* next = nullptr;
+    while (true) {
+      const double v = std::strtod(p, &next);
+      if (next == p) break;
+      values.push_back(v);
+      p = next;
+    }
+    while (*p == ' ' || *p == '\t' || *p == '\r') ++p;
+    if (*p != '\0' || values.size() != width) {
+      return absl::InvalidArgumentError(
+          absl::StrFormat("line %d: expected %d numbers", number, width));
+    }
+    for (double v : values) {
+      if (!std::isfinite(v)) {
+        return absl::InvalidArgumentError(absl::StrFormat("line %d: non-finite number", number));
+      }
+    }
+    lines.push_back(std::move(values));
+  }
+  return lines;
+}
+
+absl::Status CheckPairs(const query::QueryEngine& engine, const std::vector<mesh::PointPair>& pairs) {
+  for (const mesh::PointPair& pair : pairs) {
+    for (const mesh::SurfacePoint* p : {&pair.a, &pair.b}) {
+      const absl::Status status = engine.Validate(*p);
+      if (!status.ok()) {
+        return absl::Status(status.code(),
+                            absl::StrFormat("line %d: %s", pair.line, status.message()));
+      }
+    }
+  }
+  return absl::OkStatus();
+}
+
+struct Args {
+  std::string index, pairs, paths, field, locate, format = "xyz";
+  bool exact_near = false, baseline = false, nearest = false;
+};
+
+absl::Status Run(const Args& args) {
+  GEODEX_ASSIGN_OR_RETURN(auto index, index::Index::Open(args.index));
+  query::QueryOptions options;
+  options.exact_near_pairs = args.exact_near;
+  GEODEX_ASSIGN_OR_RETURN(auto engine, query::QueryEngine::Create(index, options));
+  std::string out;
+  if (!args.pairs.empty() || !args.paths.empty()) {
+    const bool paths = args.pairs.empty();
+    GEODEX_ASSIGN_OR_RETURN(const std::string text,
+                            mesh::ReadFileOrStdin(paths ? args.paths : args.pairs));
+    GEODEX_ASSIGN_OR_RETURN(const auto pairs, mesh::ParsePairs(text));
+    GEODEX_RETURN_IF_ERROR(CheckPairs(*engine, pairs));
+    query::QueryScratch scratch;
+    if (paths && args.format == "json") out += "[\n";
+    for (size_t i = 0; i < pairs.size(); ++i) {
+      const mesh::PointPair& pair = pairs[i];
+      if (!paths) {
+        double d;
+        if (args.baseline) {
+          d = engine->LinearInterpolationDistance(pair.a, pair.b);
+        } else {
+          GEODEX_ASSIGN_OR_RETURN(d, engine->Distance(pair.a, pair.b, &scratch));
+        }
+        out += mesh::FormatDistance(d) + "\n";
+        continue;
+      }
+      auto path = engine->Path(pair.a, pair.b);
+      if (!path.ok()) {
+        return absl::Status(path.status().code(),
+                            absl::StrFormat("line %d: %s", pair.line, path.status().message()));
+      }
+      if (args.format == "json") {
+        out += "  [";
+        for (size_t k = 0; k < path->size(); ++k) {
+          const auto& p = (*path)[k];
+          out += absl::StrFormat("%s{\"face\": %d, \"w\": [%.17g, %.17g, %.17g], \"xyz\": [%.17g, %.17g, %.17g]}",
+                                 k ? ", " : "", p.point.face, p.point.w[0], p.point.w[1],
+                                 p.point.w[2], p.position.x(), p.position.y(), p.position.z());
+        }
+        out += i + 1 < pairs.size() ? "],\n" : "]\n";
+      } else {
+        for (const auto& p : *path) {
+          out += absl::StrFormat("%.17g %.17g %.17g\n", p.position.x(), p.position.y(), p.position.z());
+        }
+        out += "\n";
+      }
+    }
+    if (paths && args.format == "json") out += "]\n";
+  } else if (!args.field.empty()) {
+    GEODEX_ASSIGN_OR_RETURN(const auto lines, ReadNumberLines(args.field, 4));
+    std::vector<mesh::SurfacePoint> sources;
+    for (const auto& l : lines) sources.push_back({static_cast<int32_t>(l[0]), {l[1], l[2], l[3]}});
+    GEODEX_ASSIGN_OR_RETURN(const auto field, engine->Field(sources));
+    for (size_t v = 0; v < field.distance.size(); ++v) {
+      out += mesh::FormatDistance(field.distance[v]);
+      if (args.nearest) out += absl::StrFormat(" %d", field.nearest[v]);
+      out += "\n";
+    }
+  } else if (!args.locate.empty()) {
+    GEODEX_ASSIGN_OR_RETURN(const auto lines, ReadNumberLines(args.locate, 3));
+    for (const auto& l : lines) {
+      GEODEX_ASSIGN_OR_RETURN(const auto located, engine->Locate({l[0], l[1], l[2]}));
+      out += absl::StrFormat("%d %.17g %.17g %.17g %.17g\n", located.point.face, located.point.w[0],
+                             located.point.w[1], located.point.w[2], located.distance);
+    }
+  } else {
+    return absl::InvalidArgumentError("give one of --pairs, --paths, --field, --locate");
+  }
+  std::fwrite(out.data(), 1, out.size(), stdout);
+  return absl::OkStatus();
+}
+
+}  // namespace
+}  // namespace geodex
+
+int main(int argc, char** argv) {
+  geodex::Args args;
+  CLI::App app{"geodex-query: geodesic queries from an index file, offline."};
+  app.add_option("index", args.index, "Index file (.gdx)")->required();
+  auto* pairs = app.add_option("--pairs", args.pairs, "Distances for lines 'fa a0 a1 a2 fb b0 b1 b2'");
+  auto* paths = app.add_option("--paths", args.paths, "Paths for lines 'fa a0 a1 a2 fb b0 b1 b2'");
+  auto* field = app.add_option("--field", args.field, "Distance field from lines 'f w0 w1 w2'");
+  auto* locate = app.add_option("--locate", args.locate, "Closest surface points to lines 'x y z'");
+  pairs->excludes(paths)->excludes(field)->excludes(locate);
+  paths->excludes(field)->excludes(locate);
+  field->excludes(locate);
+  app.add_flag("--exact-near-pairs", args.exact_near,
+               "Answer pairs in the same or adjacent geodesic triangles exactly (not O(1))");
+  app.add_flag("--linear-baseline", args.baseline, "The paper's linear interpolation (§6.3)");
+  app.add_flag("--nearest", args.nearest, "With --field: also print the nearest source");
+  app.add_option("--format", args.format, "Path output: xyz (blank line between paths) or json")
+      ->check(CLI::IsMember({"xyz", "json"}));
+  CLI11_PARSE(app, argc, argv);
+  const absl::Status status = geodex::Run(args);
+  if (!status.ok()) {
+    std::fprintf(stderr, "geodex-query: %s\n", status.ToString().c_str());
+    return status.code() == absl::StatusCode::kInvalidArgument ||
+                   status.code() == absl::StatusCode::kOutOfRange ||
+                   status.code() == absl::StatusCode::kNotFound
+               ? 2
+               : 1;
+  }
+  return 0;
+}

@@ -1,0 +1,326 @@
+#include "core/triangulation/geodesic_triangulation.h"
+
+#include <algorithm>
+#include <map>
+#include <numeric>
+
+#include "absl/strings/str_cat.h"
+#include "absl/strings/str_format.h"
+#include "absl/strings/str_join.h"
+#include "core/common/status_macros.h"
+
+namespace geodex::triangulation {
+namespace {
+
+using mesh::kNone;
+using mesh::Mesh;
+
+int32_t Find(std::vector<int32_t>& parent, int32_t x) {
+  while (parent[x] != x) x = parent[x] = parent[parent[x]];
+  return x;
+}
+
+// Rotates an oriented triple so its smallest entry comes first.
+std::array<int32_t, 3> Canonical(std::array<int32_t, 3> t) {
+  const int i = static_cast<int>(std::min_element(t.begin(), t.end()) - t.begin());
+  return {t[i], t[(i + 1) % 3], t[(i + 2) % 3]};
+}
+
+}  // namespace
+
+const char* ViolationName(ViolationKind kind) {
+  switch (kind) {
+    case ViolationKind::kRepeatedVoronoiVertex:
+      return "three cells meeting more than once";
+    case ViolationKind::kOrientation:
+      return "inconsistent orientation";
+    case ViolationKind::kArcWithoutVertex:
+      return "cell boundary arc without a Voronoi vertex";
+    case ViolationKind::kEdgeInManyTriangles:
+      return "two cells sharing several arcs";
+    case ViolationKind::kOpenEdgeInside:
+      return "open dual edge away from the boundary";
+    case ViolationKind::kCellNotDisk:
+      return "cell not a disk";
+    case ViolationKind::kCellDisconnected:
+      return "cell in several pieces";
+    case ViolationKind::kEulerCharacteristic:
+      return "wrong Euler characteristic";
+  }
+  return "?";
+}
+
+std::string RepairReport::Summary() const {
+  std::string out = absl::StrFormat("%d samples added in %d rounds", samples_added, rounds);
+  for (int k = 0; k < static_cast<int>(added_for.size()); ++k) {
+    if (added_for[k] > 0) {
+      absl::StrAppend(&out, "; ", added_for[k], " for ",
+                      ViolationName(static_cast<ViolationKind>(k)));
+    }
+  }
+  return out;
+}
+
+DualComplex CheckDual(const Mesh& mesh, const std::vector<int32_t>& nearest,
+                      int32_t num_samples) {
+  DualComplex out;
+  auto violate = [&](ViolationKind kind, std::vector<int32_t> cells) {
+    out.violations.push_back({kind, std::move(cells)});
+  };
+  const int32_t nf = mesh.num_faces();
+
+  // 1. Voronoi vertices: faces with three different labels.
+  std::vector<std::pair<std::array<int32_t, 3>, int32_t>> keyed;  // (sorted labels, face)
+  for (int32_t f = 0; f < nf; ++f) {
+    const auto& t = mesh.face(f);
+    std::array<int32_t, 3> l = {nearest[t[0]], nearest[t[1]], nearest[t[2]]};
+    if (l[0] == kNone || l[1] == kNone || l[2] == kNone) continue;
+    if (l[0] == l[1] || l[1] == l[2] || l[0] == l[2]) continue;
+    std::sort(l.begin(), l.end());
+    keyed.push_back({l, f});
+  }
+  std::sort(keyed.begin(), keyed.end());
+  for (size_t i = 0; i < keyed.size();) {
+    size_t j = i;
+    while (j < keyed.size() && keyed[j].first == keyed[i].first) ++j;
+    const std::array<int32_t, 3> key = keyed[i].first;
+    // Faces of this triple must form one edge-connected cluster.
+    std::vector<int32_t> group;
+    for (size_t k = i; k < j; ++k) group.push_back(keyed[k].second);
+    std::vector<int32_t> parent(group.size());
+    std::iota(parent.begin(), parent.end(), 0);
+    for (size_t k = 0; k < group.size(); ++k) {
+      for (int e = 0; e < 3; ++e) {
+        const int32_t twin = mesh.Twin(3 * group[k] + e);
+        if (twin == kNone) continue;
+        const auto it = std::lower_bound(group.begin(), group.end(), Mesh::FaceOf(twin));
+        if (it != group.end() && *it == Mesh::FaceOf(twin)) {
+          parent[Find(parent, static_cast<int32_t>(k))] =
+              Find(parent, static_cast<int32_t>(it - group.begin()));
+        }
+      }
+    }
+    int clusters = 0;
+    for (size_t k = 0; k < group.size(); ++k) clusters += Find(parent, k) == static_cast<int32_t>(k);
+    if (clusters > 1) violate(ViolationKind::kRepeatedVoronoiVertex, {key[0], key[1], key[2]});
+    // Orientation of each face's labels.
+    std::array<int32_t, 3> oriented{};
+    bool consistent = true;
+    for (size_t k = 0; k < group.size(); ++k) {
+      const auto& t = mesh.face(group[k]);
+      const auto c = Canonical({nearest[t[0]], nearest[t[1]], nearest[t[2]]});
+      if (k == 0) {
+        oriented = c;
+      } else if (c != oriented) {
+        consistent = false;
+      }
+    }
+    if (!consistent) violate(ViolationKind::kOrientation, {key[0], key[1], key[2]});
+    out.triangles.push_back(oriented);
+    i = j;
+  }
+  std::sort(out.triangles.begin(), out.triangles.end());
+  const int32_t nt = static_cast<int32_t>(out.triangles.size());
+
+  // Cells on the mesh boundary.
+  std::vector<uint8_t> on_boundary(num_samples, 0);
+  for (int32_t v = 0; v < mesh.num_vertices(); ++v) {
+    if (mesh.IsBoundaryVertex(v) && nearest[v] != kNone) on_boundary[nearest[v]] = 1;
+  }
+
+  // 2. Dual edges: every pair of touching cells must be an edge of one or two
+  // triangles, used in opposite directions.
+  struct Side {
+    int32_t a, b;  // a < b
+    int32_t triangle;
+    int8_t side;
+    bool forward;  // the triangle runs a -> b
+    bool operator<(const Side& o) const {
+      return std::tie(a, b, triangle, side) < std::tie(o.a, o.b, o.triangle, o.side);
+    }
+  };
+  std::vector<Side> sides;
+  sides.reserve(3 * nt);
+  for (int32_t t = 0; t < nt; ++t) {
+    for (int8_t s = 0; s < 3; ++s) {
+      const int32_t x = out.triangles[t][s], y = out.triangles[t][(s + 1) % 3];
+      sides.push_back({std::min(x, y), std::max(x, y), t, s, x < y});
+    }
+  }
+  std::sort(sides.begin(), sides.end());
+  out.neighbors.assign(nt, {kNone, kNone, kNone});
+  std::vector<std::pair<int32_t, int32_t>> touching;
+  for (int32_t h = 0; h < mesh.num_halfedges(); ++h) {
+    const int32_t twin = mesh.Twin(h);
+    if (twin != kNone && twin < h) continue;
+    const int32_t a = nearest[mesh.Origin(h)], b = nearest[mesh.Dest(h)];
+    if (a == kNone || b == kNone || a == b) continue;
+    touching.push_back({std::min(a, b), std::max(a, b)});
+  }
+  std::sort(touching.begin(), touching.end());
+  touching.erase(std::unique(touching.begin(), touching.end()), touching.end());
+  for (const auto& [a, b] : touching) {
+    const auto it = std::lower_bound(sides.begin(), sides.end(), Side{a, b, -1, -1, false});
+    if (it == sides.end() || it->a != a || it->b != b) {
+      violate(ViolationKind::kArcWithoutVertex, {a, b});
+    }
+  }
+  for (size_t i = 0; i < sides.size();) {
+    size_t j = i;
+    while (j < sides.size() && sides[j].a == sides[i].a && sides[j].b == sides[i].b) ++j;
+    const int32_t a = sides[i].a, b = sides[i].b;
+    if (j - i > 2) {
+      violate(ViolationKind::kEdgeInManyTriangles, {a, b});
+    } else if (j - i == 2) {
+      if (sides[i].forward == sides[i + 1].forward) {
+        violate(ViolationKind::kOrientation, {a, b});
+      }
+      out.neighbors[sides[i].triangle][sides[i].side] = sides[i + 1].triangle;
+      out.neighbors[sides[i + 1].triangle][sides[i + 1].side] = sides[i].triangle;
+    } else if (!(on_boundary[a] && on_boundary[b])) {
+      violate(ViolationKind::kOpenEdgeInside, {a, b});
+    }
+    i = j;
+  }
+
+  // 3. The triangles around each sample must form one fan: a cycle inside,
+  // a path for a cell on the boundary.
+  std::vector<std::vector<std::pair<int32_t, int32_t>>> link(num_samples);
+  for (const auto& t : out.triangles) {
+    for (int s = 0; s < 3; ++s) link[t[s]].push_back({t[(s + 1) % 3], t[(s + 2) % 3]});
+  }
+  for (int32_t a = 0; a < num_samples; ++a) {
+    auto& edges = link[a];
+    bool disk = !edges.empty();
+    std::map<int32_t, int32_t> next;
+    std::map<int32_t, int> in_degree;
+    for (const auto& [x, y] : edges) {
+      if (!next.emplace(x, y).second) disk = false;
+      if (++in_degree[y] > 1) disk = false;
+    }
+    if (disk) {
+      int32_t start = edges.front().first;
+      int starts = 0;
+      for (const auto& [x, y] : edges) {
+        if (!in_degree.count(x)) {
+          start = x;
+          ++starts;
+        }
+      }
+      size_t walked = 0;
+      int32_t x = start;
+      for (auto it = next.find(x); it != next.end() && walked <= edges.size();
+           it = next.find(x)) {
+        x = it->second;
+        ++walked;
+        if (x == start) break;
+      }
+      disk = walked == edges.size() && starts <= 1 && (starts == 1) == (on_boundary[a] != 0);
+    }
+    if (!disk) violate(ViolationKind::kCellNotDisk, {a});
+  }
+
+  // 4. Each cell must be connected.
+  std::vector<int32_t> parent(mesh.num_vertices());
+  std::iota(parent.begin(), parent.end(), 0);
+  for (int32_t h = 0; h < mesh.num_halfedges(); ++h) {
+    const int32_t u = mesh.Origin(h), v = mesh.Dest(h);
+    if (nearest[u] == nearest[v]) parent[Find(parent, u)] = Find(parent, v);
+  }
+  std::vector<int32_t> pieces(num_samples, 0);
+  for (int32_t v = 0; v < mesh.num_vertices(); ++v) {
+    if (mesh.IsReferenced(v) && nearest[v] != kNone && Find(parent, v) == v) ++pieces[nearest[v]];
+  }
+  for (int32_t a = 0; a < num_samples; ++a) {
+    if (pieces[a] > 1) violate(ViolationKind::kCellDisconnected, {a});
+  }
+
+  // 5. Same Euler characteristic as the mesh, component by component.
+  if (out.violations.empty()) {
+    const int32_t nc = mesh.num_components();
+    std::vector<int64_t> mesh_chi(nc, 0), dual_chi(nc, 0);
+    for (int32_t v = 0; v < mesh.num_vertices(); ++v) {
+      if (mesh.IsReferenced(v)) ++mesh_chi[mesh.VertexComponent(v)];
+    }
+    for (int32_t h = 0; h < mesh.num_halfedges(); ++h) {
+      if (mesh.Twin(h) == kNone || mesh.Twin(h) > h) --mesh_chi[mesh.FaceComponent(Mesh::FaceOf(h))];
+    }
+    for (int32_t f = 0; f < nf; ++f) ++mesh_chi[mesh.FaceComponent(f)];
+    std::vector<int32_t> sample_component(num_samples, kNone);
+    for (int32_t v = 0; v < mesh.num_vertices(); ++v) {
+      if (nearest[v] != kNone) sample_component[nearest[v]] = mesh.VertexComponent(v);
+    }
+    for (int32_t a = 0; a < num_samples; ++a) {
+      if (sample_component[a] != kNone) ++dual_chi[sample_component[a]];
+    }
+    for (size_t i = 0; i < sides.size(); ++i) {
+      if (i == 0 || sides[i].a != sides[i - 1].a || sides[i].b != sides[i - 1].b) {
+        --dual_chi[sample_component[sides[i].a]];
+      }
+    }
+    for (const auto& t : out.triangles) ++dual_chi[sample_component[t[0]]];
+    for (int32_t c = 0; c < nc; ++c) {
+      if (mesh_chi[c] != dual_chi[c]) {
+        std::vector<int32_t> cells;
+        for (int32_t a = 0; a < num_samples; ++a) {
+          if (sample_component[a] == c) cells.push_back(a);
+        }
+        violate(ViolationKind::kEulerCharacteristic, std::move(cells));
+      }
+    }
+  }
+  return out;
+}
+
+absl::StatusOr<DualComplex> RepairTriangulation(const Mesh& mesh, sampling::SampleSet* set,
+                                                int32_t max_rounds, int32_t max_samples,
+                                                RepairReport* report) {
+  geodesic::ExactGeodesicSolver solver(mesh);
+  for (int32_t round = 0;; ++round) {
+    const int32_t m = static_cast<int32_t>(set->samples.size());
+    DualComplex dual = CheckDual(mesh, set->nearest, m);
+    report->rounds = round;
+    if (dual.violations.empty()) return dual;
+    if (round >= max_rounds || m >= max_samples) {
+      const Violation& v = dual.violations.front();
+      return absl::FailedPreconditionError(absl::StrFormat(
+          "no valid geodesic triangulation after %d repair rounds and %d samples: %d violations "
+          "left, e.g. %s at samples %s",
+          round, m, dual.violations.size(), ViolationName(v.kind),
+          absl::StrJoin(v.cells, ",")));
+    }
+    // The farthest vertex of each cell.
+    std::vector<int32_t> far(m, kNone);
+    for (int32_t v = 0; v < mesh.num_vertices(); ++v) {
+      const int32_t a = set->nearest[v];
+      if (a == kNone || !mesh.IsReferenced(v)) continue;
+      if (far[a] == kNone || set->distance[v] > set->distance[far[a]]) far[a] = v;
+    }
+    std::vector<std::pair<int32_t, ViolationKind>> insert;  // (vertex, reason)
+    for (const Violation& v : dual.violations) {
+      int32_t best = kNone;
+      for (int32_t a : v.cells) {
+        if (far[a] != kNone && (best == kNone || set->distance[far[a]] > set->distance[best])) {
+          best = far[a];
+        }
+      }
+      if (best != kNone && set->distance[best] > 0) insert.push_back({best, v.kind});
+    }
+    std::sort(insert.begin(), insert.end());
+    insert.erase(std::unique(insert.begin(), insert.end(),
+                             [](const auto& x, const auto& y) { return x.first == y.first; }),
+                 insert.end());
+    if (insert.empty()) {
+      return absl::FailedPreconditionError(
+          "geodesic triangulation is invalid and no sample can be added to repair it");
+    }
+    for (const auto& [vertex, kind] : insert) {
+      if (set->distance[vertex] == 0) continue;
+      GEODEX_RETURN_IF_ERROR(sampling::AddSample(solver, vertex, set));
+      ++report->samples_added;
+      ++report->added_for[static_cast<int>(kind)];
+    }
+  }
+}
+
+}  // namespace geodex::triangulation

@@ -1,0 +1,73 @@
+#pragma once
+
+// The geodesic Delaunay triangulation of a set of samples, as the dual of
+// their geodesic Voronoi diagram at vertex resolution (paper §4.1, Xin & Wang
+// 2010), with validity checks and repair by sample insertion.
+//
+// A face whose three vertices lie in three different Voronoi cells holds a
+// Voronoi vertex and gives a Delaunay triangle, oriented like the face. The
+// dual is a valid triangulation of the surface only when the samples are dense
+// enough: CheckDual finds every way it can fail, and RepairTriangulation adds
+// samples (the farthest vertex of an offending cell) until none is left.
+//
+// Thread safety: the functions are reentrant.
+
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "absl/status/statusor.h"
+#include "core/geodesic/exact_geodesic.h"
+#include "core/mesh/mesh.h"
+#include "core/sampling/farthest_point_sampling.h"
+
+namespace geodex::triangulation {
+
+enum class ViolationKind {
+  kRepeatedVoronoiVertex,  // three cells meet at more than one place
+  kOrientation,            // a Voronoi vertex whose faces disagree on orientation
+  kArcWithoutVertex,       // two cells touch along an arc that has no Voronoi vertex
+  kEdgeInManyTriangles,    // two cells share more than one arc
+  kOpenEdgeInside,         // a dual edge with one triangle away from the boundary
+  kCellNotDisk,            // the triangles around a sample do not form one fan
+  kCellDisconnected,       // a Voronoi cell in several pieces
+  kEulerCharacteristic,    // right locally, wrong globally (e.g. a missed handle)
+};
+
+const char* ViolationName(ViolationKind kind);
+
+struct Violation {
+  ViolationKind kind;
+  std::vector<int32_t> cells;  // samples involved
+};
+
+struct DualComplex {
+  // Oriented triangles (sample indices), sorted; for each side (corner i,
+  // corner i+1) the neighbouring triangle or -1.
+  std::vector<std::array<int32_t, 3>> triangles;
+  std::vector<std::array<int32_t, 3>> neighbors;
+  std::vector<Violation> violations;
+};
+
+// Builds the dual of the Voronoi labels (`nearest` per vertex, sample count
+// `num_samples`) and lists every violation.
+DualComplex CheckDual(const mesh::Mesh& mesh, const std::vector<int32_t>& nearest,
+                      int32_t num_samples);
+
+struct RepairReport {
+  int32_t rounds = 0;
+  int32_t samples_added = 0;
+  // How many samples were added for each kind of violation.
+  std::array<int32_t, 8> added_for = {};
+  std::string Summary() const;
+};
+
+// Adds samples to `set` until CheckDual finds no violation, and returns the
+// valid dual. Errors: FailedPrecondition when no valid triangulation is found
+// within `max_rounds` rounds or once samples exceed `max_samples`.
+absl::StatusOr<DualComplex> RepairTriangulation(const mesh::Mesh& mesh,
+                                                sampling::SampleSet* set, int32_t max_rounds,
+                                                int32_t max_samples, RepairReport* report);
+
+}  // namespace geodex::triangulation

@@ -1,0 +1,112 @@
+#include "core/triangulation/geodesic_triangulation.h"
+
+#include "core/mesh/generators.h"
+#include "gtest/gtest.h"
+
+namespace geodex::triangulation {
+namespace {
+
+namespace gen = mesh::gen;
+
+struct Shape {
+  const char* name;
+  mesh::Mesh mesh;
+  int32_t samples;
+};
+
+std::vector<Shape> Shapes() {
+  std::vector<Shape> shapes;
+  shapes.push_back({"sphere", gen::Sphere(4, 1.0), 60});
+  shapes.push_back({"torus", gen::Torus(64, 32, 2.0, 0.7), 60});
+  shapes.push_back({"cube", gen::Cube(12, 2.0), 50});
+  shapes.push_back({"double_torus", gen::DoubleTorus(12, 4.0), 80});
+  shapes.push_back({"square_with_hole", gen::SquareWithHole(24, 3.0), 40});
+  shapes.push_back({"two_components", gen::TwoComponents(16), 30});
+  shapes.push_back({"folded_sheet", gen::FoldedSheet(20, 12, 2.0, 1.0, 1.0), 20});
+  return shapes;
+}
+
+TEST(GeodesicTriangulationTest, RepairReachesAValidTriangulationOnEveryShape) {
+  for (Shape& shape : Shapes()) {
+    SCOPED_TRACE(shape.name);
+    auto set = sampling::FarthestPointSampling(shape.mesh, shape.samples, 1);
+    ASSERT_TRUE(set.ok());
+    RepairReport report;
+    auto dual = RepairTriangulation(shape.mesh, &*set, 200, 2000, &report);
+    ASSERT_TRUE(dual.ok()) << dual.status();
+    EXPECT_TRUE(dual->violations.empty());
+    EXPECT_FALSE(dual->triangles.empty());
+    // Independent re-check of the final labels.
+    const DualComplex again =
+        CheckDual(shape.mesh, set->nearest, static_cast<int32_t>(set->samples.size()));
+    EXPECT_TRUE(again.violations.empty());
+    EXPECT_EQ(again.triangles, dual->triangles);
+    // Closed surfaces: every triangle has three neighbours.
+    if (shape.mesh.num_boundary_edges() == 0) {
+      for (const auto& n : dual->neighbors) {
+        for (int32_t t : n) EXPECT_GE(t, 0);
+      }
+      // Euler: V - E + F with E = 3F/2.
+      const int64_t f = dual->triangles.size();
+      const int64_t v = set->samples.size();
+      int64_t chi_mesh = 0;
+      chi_mesh = shape.mesh.num_vertices() - shape.mesh.num_halfedges() / 2 + shape.mesh.num_faces();
+      EXPECT_EQ(v - 3 * f / 2 + f, chi_mesh);
+    }
+    std::printf("%-18s %4zu samples (%s), %zu triangles\n", shape.name, set->samples.size(),
+                report.Summary().c_str(), dual->triangles.size());
+  }
+}
+
+TEST(GeodesicTriangulationTest, SparseSamplesOnATorusAreDetectedAndRepaired) {
+  const mesh::Mesh torus = gen::Torus(64, 32, 2.0, 0.7);
+  auto set = sampling::FarthestPointSampling(torus, 4, 1);
+  ASSERT_TRUE(set.ok());
+  const DualComplex sparse = CheckDual(torus, set->nearest, 4);
+  EXPECT_FALSE(sparse.violations.empty());
+  RepairReport report;
+  auto dual = RepairTriangulation(torus, &*set, 200, 2000, &report);
+  ASSERT_TRUE(dual.ok()) << dual.status();
+  EXPECT_GT(report.samples_added, 0);
+  EXPECT_GT(set->samples.size(), 4u);
+}
+
+TEST(GeodesicTriangulationTest, ReportsEachViolationKind) {
+  // Two samples on a sphere: two cells touching along one closed arc with no
+  // Voronoi vertex, and no triangle at all.
+  const mesh::Mesh sphere = gen::Sphere(3, 1.0);
+  auto set = sampling::FarthestPointSampling(sphere, 2, 1);
+  ASSERT_TRUE(set.ok());
+  const DualComplex dual = CheckDual(sphere, set->nearest, 2);
+  bool arc = false, not_disk = false;
+  for (const Violation& v : dual.violations) {
+    arc |= v.kind == ViolationKind::kArcWithoutVertex;
+    not_disk |= v.kind == ViolationKind::kCellNotDisk;
+  }
+  EXPECT_TRUE(arc);
+  EXPECT_TRUE(not_disk);
+  // A disconnected cell: relabel a far vertex.
+  std::vector<int32_t> labels = set->nearest;
+  int32_t far = 0;
+  for (int32_t v = 0; v < sphere.num_vertices(); ++v) {
+    if (labels[v] == 1) far = v;
+  }
+  labels[far] = 0;
+  bool disconnected = false;
+  for (const Violation& v : CheckDual(sphere, labels, 2).violations) {
+    disconnected |= v.kind == ViolationKind::kCellDisconnected;
+  }
+  EXPECT_TRUE(disconnected);
+}
+
+TEST(GeodesicTriangulationTest, FailsCleanlyWhenRepairIsCapped) {
+  const mesh::Mesh torus = gen::Torus(64, 32, 2.0, 0.7);
+  auto set = sampling::FarthestPointSampling(torus, 3, 1);
+  ASSERT_TRUE(set.ok());
+  RepairReport report;
+  auto dual = RepairTriangulation(torus, &*set, 1, 4, &report);
+  EXPECT_EQ(dual.status().code(), absl::StatusCode::kFailedPrecondition);
+}
+
+}  // namespace
+}  // namespace geodex::triangulation
