@@ -1,0 +1,682 @@
+#include "core/index/index.h"
+
+#include <fcntl.h>
+#include <sys/mman.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <bit>
+#include <cerrno>
+#include <cmath>
+#include <cstddef>
+#include <cstring>
+#include <limits>
+#include <optional>
+#include <random>
+#include <type_traits>
+#include <utility>
+
+#include "absl/strings/str_cat.h"
+#include "absl/strings/str_format.h"
+#include "core/common/status_macros.h"
+
+#define XXH_STATIC_LINKING_ONLY  // XXH64_state_t on the stack
+#include "xxhash.h"
+
+namespace geodex::index {
+
+// The format is little-endian and the server uses the sections in place, so
+// the host must be little-endian too (x86-64, arm64). Were this assert removed
+// on a big-endian host, every file would still be rejected, not misread: the
+// byte-order mark would read 0x04030201 (FailedPrecondition).
+static_assert(std::endian::native == std::endian::little,
+              "geodex index files are little-endian and used in place");
+
+// The on-disk structs have no implicit padding (builders still memset them, so
+// that a future field added with padding stays deterministic).
+static_assert(sizeof(FileHeader) == 144);
+static_assert(sizeof(SectionEntry) == 32);
+static_assert(sizeof(BuildParams) == 24);
+static_assert(std::is_trivially_copyable_v<FileHeader> &&
+              std::is_trivially_copyable_v<SectionEntry> &&
+              std::is_trivially_copyable_v<VertexRecord> &&
+              std::is_trivially_copyable_v<GeodesicTriangle> &&
+              std::is_trivially_copyable_v<BvhNode>);
+
+namespace {
+
+constexpr uint64_t kInt32Max = std::numeric_limits<int32_t>::max();
+
+// What a reader of this version knows about each section. Element sizes are
+// those of the scalar or record type (positions: one double, not a vertex).
+struct SectionSpec {
+  SectionId id;
+  uint32_t element_size;
+  const char* name;
+  bool required;  // must be present (possibly empty) in every file
+};
+
+constexpr SectionSpec kSpecs[] = {
+    {SectionId::kPositions, sizeof(double), "positions", true},
+    {SectionId::kFaces, sizeof(int32_t), "faces", true},
+    {SectionId::kTwins, sizeof(int32_t), "twins", true},
+    {SectionId::kSamples, sizeof(int32_t), "samples", true},
+    {SectionId::kSampleDistances, sizeof(float), "sample distances", true},
+    {SectionId::kVertexRecords, sizeof(VertexRecord), "vertex records", true},
+    {SectionId::kTriangles, sizeof(GeodesicTriangle), "geodesic triangles", true},
+    {SectionId::kFaceBvh, sizeof(BvhNode), "face BVH", false},
+    {SectionId::kBvhFaces, sizeof(int32_t), "BVH faces", false},
+    {SectionId::kReport, 1, "report", false},
+};
+constexpr size_t kNumSpecs = std::size(kSpecs);
+
+// Index of `id` in kSpecs, or -1 for an id this reader does not know.
+int SpecIndex(uint32_t id) {
+  for (size_t i = 0; i < kNumSpecs; ++i) {
+    if (static_cast<uint32_t>(kSpecs[i].id) == id) return static_cast<int>(i);
+  }
+  return -1;
+}
+
+struct Counts {
+  uint64_t num_vertices = 0;
+  uint64_t num_faces = 0;
+  uint64_t num_samples = 0;
+  uint64_t num_triangles = 0;
+  uint64_t num_bvh_nodes = 0;
+};
+
+// Elements a known section must hold; nullopt when any number is fine. Every
+// product fits in uint64_t (the counts are at most 2^31).
+std::optional<uint64_t> ExpectedCount(SectionId id, const Counts& c) {
+  switch (id) {
+    case SectionId::kPositions:
+      return 3 * c.num_vertices;
+    case SectionId::kFaces:
+    case SectionId::kTwins:
+      return 3 * c.num_faces;
+    case SectionId::kSamples:
+      return c.num_samples;
+    case SectionId::kSampleDistances:
+      return c.num_samples * c.num_samples;
+    case SectionId::kVertexRecords:
+      return c.num_vertices;
+    case SectionId::kTriangles:
+      return c.num_triangles;
+    case SectionId::kFaceBvh:
+      return c.num_bvh_nodes;
+    case SectionId::kBvhFaces:
+      return c.num_bvh_nodes > 0 ? c.num_faces : 0;
+    case SectionId::kReport:
+      return std::nullopt;
+  }
+  return std::nullopt;
+}
+
+uint64_t AlignUp(uint64_t x) { return (x + kAlignment - 1) / kAlignment * kAlignment; }
+
+uint64_t Checksum(const void* data, size_t size) { return XXH64(data, size, 0); }
+
+// XXH64 of the first `header_size` bytes with the header_checksum field read
+// as zero. `header_size` >= sizeof(FileHeader) (a later minor version may
+// append fields; they are covered too).
+uint64_t HeaderChecksum(const uint8_t* p, size_t header_size) {
+  constexpr size_t kField = offsetof(FileHeader, header_checksum);
+  constexpr uint64_t kZero = 0;
+  XXH64_state_t state;
+  XXH64_reset(&state, 0);
+  XXH64_update(&state, p, kField);
+  XXH64_update(&state, &kZero, sizeof(kZero));
+  XXH64_update(&state, p + kField + sizeof(kZero), header_size - kField - sizeof(kZero));
+  return XXH64_digest(&state);
+}
+
+// The arrays of an index, wherever they live: checked the same way by the
+// writer (InvalidArgument) and the reader (DataLoss), so that the writer never
+// produces a file the reader rejects. Sizes are already consistent.
+struct Contents {
+  Counts counts;
+  std::span<const double> positions;
+  std::span<const int32_t> faces;
+  std::span<const int32_t> twins;
+  std::span<const int32_t> samples;
+  std::span<const float> sample_distances;
+  std::span<const VertexRecord> vertices;
+  std::span<const GeodesicTriangle> triangles;
+  std::span<const BvhNode> bvh_nodes;
+  std::span<const int32_t> bvh_faces;
+};
+
+bool InRange(int64_t x, int64_t lo, int64_t hi) { return x >= lo && x < hi; }
+// Non-negative and not NaN; +inf allowed.
+bool NonNegative(float x) { return x >= 0; }
+
+absl::Status CheckContents(const Contents& c, absl::StatusCode code) {
+  auto fail = [code](std::string message) { return absl::Status(code, message); };
+  const int64_t nv = static_cast<int64_t>(c.counts.num_vertices);
+  const int64_t nf = static_cast<int64_t>(c.counts.num_faces);
+  const int64_t m = static_cast<int64_t>(c.counts.num_samples);
+  const int64_t nt = static_cast<int64_t>(c.counts.num_triangles);
+  const int64_t nb = static_cast<int64_t>(c.bvh_nodes.size());
+
+  for (size_t i = 0; i < c.positions.size(); ++i) {
+    if (!std::isfinite(c.positions[i])) {
+      return fail(absl::StrFormat("vertex %d: coordinate %d is not finite (%g)", i / 3, i % 3,
+                                  c.positions[i]));
+    }
+  }
+  for (size_t i = 0; i < c.faces.size(); ++i) {
+    if (!InRange(c.faces[i], 0, nv)) {
+      return fail(
+          absl::StrFormat("face %d: vertex id %d out of range [0, %d)", i / 3, c.faces[i], nv));
+    }
+  }
+  for (size_t i = 0; i < c.twins.size(); ++i) {
+    if (!InRange(c.twins[i], -1, 3 * nf)) {
+      return fail(
+          absl::StrFormat("half-edge %d: twin %d out of range [-1, %d)", i, c.twins[i], 3 * nf));
+    }
+  }
+  for (size_t i = 0; i < c.samples.size(); ++i) {
+    if (!InRange(c.samples[i], 0, nv)) {
+      return fail(
+          absl::StrFormat("sample %d: vertex id %d out of range [0, %d)", i, c.samples[i], nv));
+    }
+  }
+  // +inf is a legitimate distance between samples on different components.
+  for (size_t i = 0; i < c.sample_distances.size(); ++i) {
+    if (!NonNegative(c.sample_distances[i])) {
+      return fail(absl::StrFormat("sample distance (%d, %d) is negative or NaN (%g)", i / m, i % m,
+                                  c.sample_distances[i]));
+    }
+  }
+  for (size_t v = 0; v < c.vertices.size(); ++v) {
+    const VertexRecord& r = c.vertices[v];
+    if (!InRange(r.triangle, -1, nt)) {
+      return fail(absl::StrFormat("vertex record %d: geodesic triangle %d out of range [-1, %d)", v,
+                                  r.triangle, nt));
+    }
+    for (int k = 0; k < 3; ++k) {
+      if (r.triangle == -1 ? r.corner[k] != -1 : !InRange(r.corner[k], 0, m)) {
+        return fail(absl::StrFormat(
+            "vertex record %d: corner %d is %d, expected %s", v, k, r.corner[k],
+            r.triangle == -1 ? "-1 (no triangle)" : absl::StrFormat("a sample in [0, %d)", m)));
+      }
+      // Vertices without a triangle may carry +inf; the others need real values.
+      const bool ok = r.triangle == -1 ? NonNegative(r.distance[k])
+                                       : std::isfinite(r.distance[k]) && r.distance[k] >= 0;
+      if (!ok) {
+        return fail(
+            absl::StrFormat("vertex record %d: distance %d is invalid (%g)", v, k, r.distance[k]));
+      }
+    }
+  }
+  for (size_t t = 0; t < c.triangles.size(); ++t) {
+    const GeodesicTriangle& g = c.triangles[t];
+    for (int k = 0; k < 3; ++k) {
+      if (!InRange(g.corner[k], 0, m)) {
+        return fail(absl::StrFormat("geodesic triangle %d: corner %d is %d, out of range [0, %d)",
+                                    t, k, g.corner[k], m));
+      }
+      if (!InRange(g.neighbor[k], -1, nt)) {
+        return fail(
+            absl::StrFormat("geodesic triangle %d: neighbour %d is %d, out of range [-1, %d)", t, k,
+                            g.neighbor[k], nt));
+      }
+    }
+  }
+  // Children after their parent: every traversal terminates.
+  for (int64_t i = 0; i < nb; ++i) {
+    const BvhNode& b = c.bvh_nodes[i];
+    for (int k = 0; k < 3; ++k) {
+      if (!(b.lo[k] <= b.hi[k])) {
+        return fail(
+            absl::StrFormat("BVH node %d: bad box on axis %d [%g, %g]", i, k, b.lo[k], b.hi[k]));
+      }
+    }
+    const bool ok = b.count > 0 ? b.first >= 0 && int64_t{b.first} + b.count <= nf
+                                : b.count == 0 && b.first > i && int64_t{b.first} + 1 < nb;
+    if (!ok) {
+      return fail(
+          absl::StrFormat("BVH node %d: first %d, count %d out of range (%d nodes, %d "
+                          "faces)",
+                          i, b.first, b.count, nb, nf));
+    }
+  }
+  if (!c.bvh_faces.empty()) {
+    std::vector<bool> seen(nf, false);
+    for (size_t i = 0; i < c.bvh_faces.size(); ++i) {
+      const int32_t f = c.bvh_faces[i];
+      if (!InRange(f, 0, nf) || seen[f]) {
+        return fail(
+            absl::StrFormat("BVH face %d: face %d out of range [0, %d) or repeated", i, f, nf));
+      }
+      seen[f] = true;
+    }
+  }
+  return absl::OkStatus();
+}
+
+// A typed view of a present, validated section; empty when absent.
+template <typename T>
+std::span<const T> SectionView(const uint8_t* base, const std::optional<SectionEntry>& e) {
+  if (!e.has_value() || e->size == 0) return {};
+  return std::span<const T>(reinterpret_cast<const T*>(base + e->offset), e->size / sizeof(T));
+}
+
+absl::Status ErrnoStatus(int err, const std::string& what, const std::string& path) {
+  const std::string message = absl::StrCat(what, " ", path, ": ", std::strerror(err));
+  switch (err) {
+    case ENOENT:
+    case ENOTDIR:
+      return absl::NotFoundError(message);
+    case EACCES:
+    case EPERM:
+    case EROFS:
+      return absl::PermissionDeniedError(message);
+    default:
+      return absl::InternalError(message);
+  }
+}
+
+absl::Status WithPath(const absl::Status& status, const std::string& path) {
+  if (status.ok()) return status;
+  return absl::Status(status.code(), absl::StrCat(path, ": ", status.message()));
+}
+
+}  // namespace
+
+uint64_t MeshHash(std::span<const double> positions, std::span<const int32_t> faces) {
+  XXH64_state_t state;
+  XXH64_reset(&state, 0);
+  XXH64_update(&state, positions.data(), positions.size_bytes());
+  XXH64_update(&state, faces.data(), faces.size_bytes());
+  return XXH64_digest(&state);
+}
+
+absl::StatusOr<std::string> SerializeIndex(const IndexData& d) {
+  auto bad = [](std::string message) { return absl::InvalidArgumentError(message); };
+  if (d.positions.size() % 3 != 0) {
+    return bad(absl::StrFormat("positions: %d values, not a multiple of 3", d.positions.size()));
+  }
+  if (d.faces.size() % 3 != 0) {
+    return bad(absl::StrFormat("faces: %d values, not a multiple of 3", d.faces.size()));
+  }
+  Counts counts;
+  counts.num_vertices = d.positions.size() / 3;
+  counts.num_faces = d.faces.size() / 3;
+  counts.num_samples = d.samples.size();
+  counts.num_triangles = d.triangles.size();
+  counts.num_bvh_nodes = d.bvh_nodes.size();
+  if (counts.num_vertices > kInt32Max || 3 * counts.num_faces > kInt32Max ||
+      counts.num_samples > kInt32Max || counts.num_triangles > kInt32Max ||
+      counts.num_bvh_nodes > kInt32Max) {
+    return bad("too many vertices, faces, samples, triangles or BVH nodes for int32 ids");
+  }
+  if (d.twins.size() != d.faces.size()) {
+    return bad(absl::StrFormat("twins: %d values, expected %d (3 per face)", d.twins.size(),
+                               d.faces.size()));
+  }
+  if (d.sample_distances.size() != counts.num_samples * counts.num_samples) {
+    return bad(absl::StrFormat("sample_distances: %d values, expected %d (num_samples^2)",
+                               d.sample_distances.size(), counts.num_samples * counts.num_samples));
+  }
+  if (d.vertices.size() != counts.num_vertices) {
+    return bad(absl::StrFormat("vertices: %d records, expected %d (one per vertex)",
+                               d.vertices.size(), counts.num_vertices));
+  }
+  const uint64_t expected_bvh_faces = counts.num_bvh_nodes > 0 ? counts.num_faces : 0;
+  if (d.bvh_faces.size() != expected_bvh_faces) {
+    return bad(absl::StrFormat("bvh_faces: %d values, expected %d", d.bvh_faces.size(),
+                               expected_bvh_faces));
+  }
+  if (d.params.num_samples != counts.num_samples) {
+    return bad(absl::StrFormat("params.num_samples is %d but there are %d samples",
+                               d.params.num_samples, counts.num_samples));
+  }
+  if (d.builder_version.size() >= sizeof(FileHeader::builder_version) ||
+      d.builder_version.find('\0') != std::string::npos) {
+    return bad(absl::StrFormat("builder_version must be under %d bytes without NULs: \"%s\"",
+                               sizeof(FileHeader::builder_version), d.builder_version));
+  }
+  GEODEX_RETURN_IF_ERROR(
+      CheckContents(Contents{counts, d.positions, d.faces, d.twins, d.samples, d.sample_distances,
+                             d.vertices, d.triangles, d.bvh_nodes, d.bvh_faces},
+                    absl::StatusCode::kInvalidArgument));
+
+  // Every section is written, empty ones with size 0, in kSpecs order.
+  struct Piece {
+    const void* data;
+    uint64_t size;
+  };
+  const Piece pieces[kNumSpecs] = {
+      {d.positions.data(), d.positions.size() * sizeof(double)},
+      {d.faces.data(), d.faces.size() * sizeof(int32_t)},
+      {d.twins.data(), d.twins.size() * sizeof(int32_t)},
+      {d.samples.data(), d.samples.size() * sizeof(int32_t)},
+      {d.sample_distances.data(), d.sample_distances.size() * sizeof(float)},
+      {d.vertices.data(), d.vertices.size() * sizeof(VertexRecord)},
+      {d.triangles.data(), d.triangles.size() * sizeof(GeodesicTriangle)},
+      {d.bvh_nodes.data(), d.bvh_nodes.size() * sizeof(BvhNode)},
+      {d.bvh_faces.data(), d.bvh_faces.size() * sizeof(int32_t)},
+      {d.report.data(), d.report.size()},
+  };
+  SectionEntry entries[kNumSpecs];
+  std::memset(entries, 0, sizeof(entries));
+  const uint64_t table_offset = sizeof(FileHeader);
+  uint64_t cursor = table_offset + sizeof(entries);
+  for (size_t i = 0; i < kNumSpecs; ++i) {
+    cursor = AlignUp(cursor);
+    entries[i].id = static_cast<uint32_t>(kSpecs[i].id);
+    entries[i].element_size = kSpecs[i].element_size;
+    entries[i].offset = cursor;
+    entries[i].size = pieces[i].size;
+    entries[i].checksum = Checksum(pieces[i].data, pieces[i].size);
+    cursor += pieces[i].size;
+  }
+  const uint64_t file_size = cursor;
+
+  FileHeader h;
+  std::memset(static_cast<void*>(&h), 0, sizeof(h));  // padding included
+  std::memcpy(h.magic, kMagic, sizeof(kMagic));
+  h.format_major = kFormatMajor;
+  h.format_minor = kFormatMinor;
+  h.byte_order_mark = kByteOrderMark;
+  h.header_size = sizeof(FileHeader);
+  std::memcpy(h.builder_version, d.builder_version.data(), d.builder_version.size());
+  h.mesh_hash = d.mesh_hash;
+  h.params = d.params;
+  h.num_vertices = static_cast<uint32_t>(counts.num_vertices);
+  h.num_faces = static_cast<uint32_t>(counts.num_faces);
+  h.num_samples = static_cast<uint32_t>(counts.num_samples);
+  h.num_triangles = static_cast<uint32_t>(counts.num_triangles);
+  h.num_bvh_nodes = static_cast<uint32_t>(counts.num_bvh_nodes);
+  h.num_sections = kNumSpecs;
+  h.section_table_offset = table_offset;
+  h.file_size = file_size;
+  h.table_checksum = Checksum(entries, sizeof(entries));
+  h.header_checksum = 0;
+  h.header_checksum = HeaderChecksum(reinterpret_cast<const uint8_t*>(&h), sizeof(h));
+
+  std::string out(file_size, '\0');  // zero padding everywhere
+  std::memcpy(out.data(), &h, sizeof(h));
+  std::memcpy(out.data() + table_offset, entries, sizeof(entries));
+  for (size_t i = 0; i < kNumSpecs; ++i) {
+    if (pieces[i].size > 0) {
+      std::memcpy(out.data() + entries[i].offset, pieces[i].data, pieces[i].size);
+    }
+  }
+  return out;
+}
+
+absl::Status WriteIndexFile(const IndexData& data, const std::string& path) {
+  GEODEX_ASSIGN_OR_RETURN(const std::string bytes, SerializeIndex(data));
+
+  const size_t slash = path.rfind('/');
+  const std::string dir =
+      slash == std::string::npos ? "." : (slash == 0 ? "/" : path.substr(0, slash));
+  std::random_device random;
+  const uint64_t nonce = (uint64_t{random()} << 32) ^ random();
+  const std::string tmp = absl::StrFormat("%s.tmp.%d.%016x", path, ::getpid(), nonce);
+
+  int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
+  if (fd < 0) return ErrnoStatus(errno, "cannot create temporary file", tmp);
+  // On any failure before the rename: close and remove the temporary file.
+  auto abandon = [&](int err, const std::string& what) {
+    if (fd >= 0) ::close(fd);
+    ::unlink(tmp.c_str());
+    return ErrnoStatus(err, what, tmp);
+  };
+  size_t written = 0;
+  while (written < bytes.size()) {
+    const size_t chunk = std::min<size_t>(bytes.size() - written, size_t{1} << 30);
+    const ssize_t n = ::write(fd, bytes.data() + written, chunk);
+    if (n < 0) {
+      if (errno == EINTR) continue;
+      return abandon(errno, "cannot write");
+    }
+    written += static_cast<size_t>(n);
+  }
+  if (::fsync(fd) != 0) return abandon(errno, "cannot fsync");
+  const int close_result = ::close(fd);
+  fd = -1;
+  if (close_result != 0) return abandon(errno, "cannot close");
+  if (::rename(tmp.c_str(), path.c_str()) != 0) {
+    const int err = errno;
+    ::unlink(tmp.c_str());
+    return ErrnoStatus(err, absl::StrCat("cannot rename ", tmp, " to"), path);
+  }
+  // The rename is durable only once the directory entry is. A failure here
+  // leaves the new file in place (complete) but reports the error.
+  const int dir_fd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (dir_fd < 0) return ErrnoStatus(errno, "cannot open the directory of", path);
+  const int sync_result = ::fsync(dir_fd);
+  const int sync_errno = errno;
+  ::close(dir_fd);
+  if (sync_result != 0) return ErrnoStatus(sync_errno, "cannot fsync the directory of", path);
+  return absl::OkStatus();
+}
+
+// The file must not shrink while mapped (SIGBUS): writers replace files by
+// rename (WriteIndexFile), which leaves this mapping on the old inode.
+absl::StatusOr<std::shared_ptr<const Index>> Index::Open(const std::string& path) {
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd < 0) return ErrnoStatus(errno, "cannot open", path);
+  struct stat st;
+  if (::fstat(fd, &st) != 0) {
+    const int err = errno;
+    ::close(fd);
+    return ErrnoStatus(err, "cannot stat", path);
+  }
+  if (!S_ISREG(st.st_mode)) {
+    ::close(fd);
+    return absl::FailedPreconditionError(absl::StrCat(path, ": not a regular file"));
+  }
+  std::shared_ptr<Index> index(new Index());
+  index->size_ = static_cast<size_t>(st.st_size);
+  if (index->size_ > 0) {  // mmap rejects length 0; an empty file fails validation below
+    void* map = ::mmap(nullptr, index->size_, PROT_READ, MAP_SHARED, fd, 0);
+    if (map == MAP_FAILED) {
+      const int err = errno;
+      ::close(fd);
+      return ErrnoStatus(err, "cannot mmap", path);
+    }
+    index->base_ = static_cast<const uint8_t*>(map);
+    index->mapped_ = true;
+    ::madvise(map, index->size_, MADV_WILLNEED);  // advisory; failure is harmless
+  }
+  ::close(fd);  // the mapping keeps the file open
+  GEODEX_RETURN_IF_ERROR(WithPath(index->Validate(), path));
+  return std::shared_ptr<const Index>(std::move(index));
+}
+
+absl::StatusOr<std::shared_ptr<const Index>> Index::FromBytes(std::string bytes) {
+  std::shared_ptr<Index> index(new Index());
+  index->size_ = bytes.size();
+  index->owned_.reset(new uint8_t[bytes.size() + kAlignment]);
+  const uintptr_t raw = reinterpret_cast<uintptr_t>(index->owned_.get());
+  uint8_t* aligned = index->owned_.get() + (AlignUp(raw) - raw);
+  if (!bytes.empty()) std::memcpy(aligned, bytes.data(), bytes.size());
+  index->base_ = aligned;
+  GEODEX_RETURN_IF_ERROR(index->Validate());
+  return std::shared_ptr<const Index>(std::move(index));
+}
+
+Index::~Index() {
+  if (mapped_) ::munmap(const_cast<uint8_t*>(base_), size_);
+}
+
+std::string Index::builder_version() const {
+  const char* v = header_->builder_version;
+  return std::string(v, strnlen(v, sizeof(header_->builder_version)));
+}
+
+// Every check happens before the bytes it guards are used; sizes are compared
+// by subtraction so that no sum can overflow. Every byte of a valid file is
+// covered by a checksum or must be zero padding, so any corruption is seen.
+absl::Status Index::Validate() {
+  const uint8_t* p = base_;
+  const size_t n = size_;
+  constexpr size_t kHeaderSize = sizeof(FileHeader);
+  if (n < kHeaderSize) {
+    const size_t k = std::min(n, sizeof(kMagic));
+    if (k == 0 || std::memcmp(p, kMagic, k) == 0) {
+      return absl::DataLossError(absl::StrFormat(
+          "truncated: expected at least %d bytes (the header), found %d", kHeaderSize, n));
+    }
+    return absl::FailedPreconditionError("not a geodex index (bad magic)");
+  }
+  FileHeader h;
+  std::memcpy(&h, p, sizeof(h));
+  if (std::memcmp(h.magic, kMagic, sizeof(kMagic)) != 0) {
+    return absl::FailedPreconditionError("not a geodex index (bad magic)");
+  }
+  if (h.byte_order_mark != kByteOrderMark) {
+    if (h.byte_order_mark == __builtin_bswap32(kByteOrderMark)) {
+      return absl::FailedPreconditionError(
+          "byte order mismatch: the file was written on a host of the other byte order");
+    }
+    return absl::FailedPreconditionError(
+        absl::StrFormat("bad byte order mark 0x%08x", h.byte_order_mark));
+  }
+  if (h.format_major != kFormatMajor) {
+    return absl::FailedPreconditionError(absl::StrFormat(
+        "index format version %d.%d is not supported by this reader (version %d.%d)",
+        h.format_major, h.format_minor, kFormatMajor, kFormatMinor));
+  }
+  if (h.header_size < kHeaderSize || h.header_size % 8 != 0) {
+    return absl::DataLossError(absl::StrFormat("bad header size %d", h.header_size));
+  }
+  if (h.header_size > n) {
+    return absl::DataLossError(absl::StrFormat(
+        "truncated: expected at least %d bytes (the header), found %d", h.header_size, n));
+  }
+  if (HeaderChecksum(p, h.header_size) != h.header_checksum) {
+    return absl::DataLossError("header checksum mismatch");
+  }
+  if (h.file_size != n) {
+    if (h.file_size > n) {
+      return absl::DataLossError(
+          absl::StrFormat("truncated: expected %d bytes, found %d", h.file_size, n));
+    }
+    return absl::DataLossError(absl::StrFormat(
+        "size mismatch: expected %d bytes, found %d (trailing data)", h.file_size, n));
+  }
+
+  Counts counts;
+  counts.num_vertices = h.num_vertices;
+  counts.num_faces = h.num_faces;
+  counts.num_samples = h.num_samples;
+  counts.num_triangles = h.num_triangles;
+  counts.num_bvh_nodes = h.num_bvh_nodes;
+  if (counts.num_vertices > kInt32Max || 3 * counts.num_faces > kInt32Max ||
+      counts.num_samples > kInt32Max || counts.num_triangles > kInt32Max ||
+      counts.num_bvh_nodes > kInt32Max) {
+    return absl::DataLossError("header counts exceed the int32 id range");
+  }
+  if (h.params.num_samples != h.num_samples) {
+    return absl::DataLossError(absl::StrFormat("header: params.num_samples %d != num_samples %d",
+                                               h.params.num_samples, h.num_samples));
+  }
+
+  // Section table.
+  const uint64_t table_offset = h.section_table_offset;
+  const uint64_t table_bytes = uint64_t{h.num_sections} * sizeof(SectionEntry);
+  if (table_offset < h.header_size || table_offset % alignof(SectionEntry) != 0) {
+    return absl::DataLossError(absl::StrFormat("bad section table offset %d", table_offset));
+  }
+  if (table_offset > n || table_bytes > n - table_offset) {
+    return absl::DataLossError(
+        absl::StrFormat("section table (%d entries at offset %d) does not fit in %d bytes",
+                        h.num_sections, table_offset, n));
+  }
+  if (Checksum(p + table_offset, table_bytes) != h.table_checksum) {
+    return absl::DataLossError("section table checksum mismatch");
+  }
+  std::vector<SectionEntry> entries(h.num_sections);
+  if (table_bytes > 0) std::memcpy(entries.data(), p + table_offset, table_bytes);
+
+  // Byte ranges in use, to check that everything else is zero padding.
+  std::vector<std::pair<uint64_t, uint64_t>> used = {{0, h.header_size},
+                                                     {table_offset, table_bytes}};
+  std::optional<SectionEntry> found[kNumSpecs];
+  for (size_t i = 0; i < entries.size(); ++i) {
+    const SectionEntry& e = entries[i];
+    const int spec = SpecIndex(e.id);
+    const std::string name = spec >= 0 ? kSpecs[spec].name : absl::StrCat("with id ", e.id);
+    if (e.offset % kAlignment != 0) {
+      return absl::DataLossError(
+          absl::StrFormat("section %s: offset %d is not 64-byte aligned", name, e.offset));
+    }
+    if (e.offset > n || e.size > n - e.offset) {
+      return absl::DataLossError(
+          absl::StrFormat("section %s: %d bytes at offset %d do not fit in the file (%d bytes)",
+                          name, e.size, e.offset, n));
+    }
+    if (Checksum(p + e.offset, e.size) != e.checksum) {
+      return absl::DataLossError(absl::StrFormat("section %s: checksum mismatch", name));
+    }
+    if (e.size > 0) used.emplace_back(e.offset, e.size);
+    if (spec < 0) continue;  // from a later minor version: ignored
+    if (found[spec].has_value()) {
+      return absl::DataLossError(absl::StrFormat("section %s appears twice", name));
+    }
+    if (e.element_size != kSpecs[spec].element_size) {
+      return absl::DataLossError(absl::StrFormat("section %s: element size %d, expected %d", name,
+                                                 e.element_size, kSpecs[spec].element_size));
+    }
+    const std::optional<uint64_t> count = ExpectedCount(kSpecs[spec].id, counts);
+    if (count.has_value() && e.size != *count * e.element_size) {
+      return absl::DataLossError(
+          absl::StrFormat("section %s: %d bytes, expected %d (%d elements of %d bytes)", name,
+                          e.size, *count * e.element_size, *count, e.element_size));
+    }
+    found[spec] = e;
+  }
+  for (size_t s = 0; s < kNumSpecs; ++s) {
+    const std::optional<uint64_t> count = ExpectedCount(kSpecs[s].id, counts);
+    if (!found[s].has_value() && (kSpecs[s].required || count.value_or(0) > 0)) {
+      return absl::DataLossError(absl::StrFormat("missing section: %s", kSpecs[s].name));
+    }
+  }
+
+  std::sort(used.begin(), used.end());
+  uint64_t end = 0;
+  for (const auto& [offset, size] : used) {
+    if (offset < end) {
+      return absl::DataLossError(absl::StrFormat("overlapping sections at byte %d", offset));
+    }
+    for (uint64_t b = end; b < offset; ++b) {
+      if (p[b] != 0) return absl::DataLossError(absl::StrFormat("non-zero padding at byte %d", b));
+    }
+    end = offset + size;
+  }
+  for (uint64_t b = end; b < n; ++b) {
+    if (p[b] != 0) return absl::DataLossError(absl::StrFormat("non-zero padding at byte %d", b));
+  }
+
+  // Sections are 64-byte aligned in a 64-byte aligned image: typed views are
+  // properly aligned.
+  auto entry = [&found](SectionId id) -> const std::optional<SectionEntry>& {
+    return found[SpecIndex(static_cast<uint32_t>(id))];
+  };
+  header_ = reinterpret_cast<const FileHeader*>(p);
+  positions_ = SectionView<double>(p, entry(SectionId::kPositions));
+  faces_ = SectionView<int32_t>(p, entry(SectionId::kFaces));
+  twins_ = SectionView<int32_t>(p, entry(SectionId::kTwins));
+  samples_ = SectionView<int32_t>(p, entry(SectionId::kSamples));
+  sample_distances_ = SectionView<float>(p, entry(SectionId::kSampleDistances));
+  vertices_ = SectionView<VertexRecord>(p, entry(SectionId::kVertexRecords));
+  triangles_ = SectionView<GeodesicTriangle>(p, entry(SectionId::kTriangles));
+  bvh_nodes_ = SectionView<BvhNode>(p, entry(SectionId::kFaceBvh));
+  bvh_faces_ = SectionView<int32_t>(p, entry(SectionId::kBvhFaces));
+  const std::span<const char> report = SectionView<char>(p, entry(SectionId::kReport));
+  report_ = std::string_view(report.data(), report.size());
+
+  return CheckContents(Contents{counts, positions_, faces_, twins_, samples_, sample_distances_,
+                                vertices_, triangles_, bvh_nodes_, bvh_faces_},
+                       absl::StatusCode::kDataLoss);
+}
+
+}  // namespace geodex::index

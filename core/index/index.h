@@ -1,0 +1,128 @@
+#pragma once
+
+// Reading and writing geodex index files (format: core/index/index_format.h).
+//
+// IndexData owns its arrays (the builder fills it); Index is a read-only view
+// of a validated file image, either memory-mapped (the server) or held in
+// memory (tests). Both expose the same spans, so code that queries an index
+// never knows where the bytes live.
+//
+// Thread safety: Index is immutable after Open; every method is const and safe
+// from any number of threads. Share it as std::shared_ptr<const Index>.
+
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "absl/status/status.h"
+#include "absl/status/statusor.h"
+#include "core/index/index_format.h"
+
+namespace geodex::index {
+
+// Everything a builder writes into an index.
+struct IndexData {
+  std::string builder_version;
+  uint64_t mesh_hash = 0;
+  BuildParams params;
+  std::vector<double> positions;        // 3 per vertex
+  std::vector<int32_t> faces;           // 3 per face
+  std::vector<int32_t> twins;           // 3 per face
+  std::vector<int32_t> samples;         // vertex of each sample
+  std::vector<float> sample_distances;  // num_samples^2, row-major
+  std::vector<VertexRecord> vertices;
+  std::vector<GeodesicTriangle> triangles;
+  std::vector<BvhNode> bvh_nodes;
+  std::vector<int32_t> bvh_faces;
+  std::string report;
+};
+
+// XXH64 of the positions and faces: identifies the source mesh.
+uint64_t MeshHash(std::span<const double> positions, std::span<const int32_t> faces);
+
+// Serialises `data` to the exact bytes of an index file. Deterministic: the
+// same data gives the same bytes. Errors: InvalidArgument if array sizes are
+// inconsistent (e.g. sample_distances not num_samples^2, bvh_faces not one per
+// face when there is a BVH, params.num_samples != samples.size()), if
+// builder_version has 32 bytes or more, or if the contents fail the checks
+// Index applies on reading (ids out of range, NaN or negative distances, ...):
+// the writer never produces a file the reader rejects.
+absl::StatusOr<std::string> SerializeIndex(const IndexData& data);
+
+// Writes atomically: a temporary file in the same directory, fsync, rename,
+// fsync of the directory. A reader never sees a half-written file. Errors:
+// InvalidArgument as SerializeIndex; Internal / PermissionDenied / NotFound on
+// I/O failures (naming the path).
+absl::Status WriteIndexFile(const IndexData& data, const std::string& path);
+
+class Index {
+ public:
+  // Maps `path` read-only (MAP_SHARED, so processes share the page cache) and
+  // validates it. Errors: NotFound (no file), PermissionDenied, FailedPrecondition
+  // (not a regular file, wrong magic, byte order or major version), DataLoss
+  // (checksum mismatch, truncation, counts, sizes or offsets that do not fit,
+  // non-zero padding, indices out of range, NaN or negative distances).
+  // An image shorter than the header is DataLoss ("truncated") when its bytes
+  // are a prefix of the magic (including an empty file), FailedPrecondition
+  // ("not a geodex index") otherwise. Messages name the path.
+  static absl::StatusOr<std::shared_ptr<const Index>> Open(const std::string& path);
+  // Validates an in-memory file image (copied into the Index). Same errors.
+  static absl::StatusOr<std::shared_ptr<const Index>> FromBytes(std::string bytes);
+
+  ~Index();
+  Index(const Index&) = delete;
+  Index& operator=(const Index&) = delete;
+
+  const FileHeader& header() const { return *header_; }
+  std::string builder_version() const;
+  int32_t num_vertices() const { return static_cast<int32_t>(header_->num_vertices); }
+  int32_t num_faces() const { return static_cast<int32_t>(header_->num_faces); }
+  int32_t num_samples() const { return static_cast<int32_t>(header_->num_samples); }
+  int32_t num_triangles() const { return static_cast<int32_t>(header_->num_triangles); }
+
+  std::span<const double> positions() const { return positions_; }
+  std::span<const int32_t> faces() const { return faces_; }
+  std::span<const int32_t> twins() const { return twins_; }
+  std::span<const int32_t> samples() const { return samples_; }
+  std::span<const float> sample_distances() const { return sample_distances_; }
+  std::span<const VertexRecord> vertices() const { return vertices_; }
+  std::span<const GeodesicTriangle> triangles() const { return triangles_; }
+  std::span<const BvhNode> bvh_nodes() const { return bvh_nodes_; }
+  std::span<const int32_t> bvh_faces() const { return bvh_faces_; }
+  std::string_view report() const { return report_; }
+
+  // d(sample i, sample j) from the matrix.
+  float SampleDistance(int32_t i, int32_t j) const {
+    return sample_distances_[static_cast<size_t>(i) * header_->num_samples + j];
+  }
+  // Bytes of the file image (mapped or owned).
+  size_t size_bytes() const { return size_; }
+  bool is_mapped() const { return mapped_; }
+
+ private:
+  Index() = default;
+  absl::Status Validate();
+
+  const uint8_t* base_ = nullptr;  // 64-byte aligned (page-aligned when mapped)
+  size_t size_ = 0;
+  bool mapped_ = false;
+  // FromBytes: the image copied into an over-allocated buffer; base_ points
+  // at its first 64-byte aligned byte (std::string only guarantees 16).
+  std::unique_ptr<uint8_t[]> owned_;
+  const FileHeader* header_ = nullptr;
+  std::span<const double> positions_;
+  std::span<const int32_t> faces_;
+  std::span<const int32_t> twins_;
+  std::span<const int32_t> samples_;
+  std::span<const float> sample_distances_;
+  std::span<const VertexRecord> vertices_;
+  std::span<const GeodesicTriangle> triangles_;
+  std::span<const BvhNode> bvh_nodes_;
+  std::span<const int32_t> bvh_faces_;
+  std::string_view report_;
+};
+
+}  // namespace geodex::index

@@ -1,0 +1,116 @@
+#pragma once
+
+// The geodex index file (.gdx): one file per mesh, written by the builder and
+// memory-mapped read-only by the server, which uses every section in place.
+//
+// Layout (all integers and floats little-endian; every section starts at a
+// multiple of 64 bytes):
+//
+//   FileHeader            fixed size, at offset 0
+//   SectionEntry[n]       the section table, right after the header
+//   sections...           each 64-byte aligned, in table order
+//
+// The header carries the fingerprint (magic, format version, byte-order mark,
+// builder version, a hash of the source mesh, the build parameters) and a
+// checksum of itself and of the section table; each section has its own
+// checksum (XXH64 of its bytes).
+//
+// Version log (bump kFormatMinor for additive changes that old readers can
+// ignore, kFormatMajor for anything else):
+//   1.0  first version: mesh, samples, full float32 distance matrix, vertex
+//        records, geodesic triangles with adjacency, face BVH, build report.
+
+#include <cstdint>
+
+namespace geodex::index {
+
+inline constexpr char kMagic[8] = {'G', 'E', 'O', 'D', 'E', 'X', 'I', 'X'};
+inline constexpr uint32_t kFormatMajor = 1;
+inline constexpr uint32_t kFormatMinor = 0;
+inline constexpr uint32_t kByteOrderMark = 0x01020304;  // reads 0x04030201 when swapped
+inline constexpr uint64_t kAlignment = 64;
+
+// Section ids. A reader ignores ids it does not know (minor-version additions).
+enum class SectionId : uint32_t {
+  kPositions = 1,        // double[num_vertices][3]
+  kFaces = 2,            // int32[num_faces][3]
+  kTwins = 3,            // int32[num_faces * 3]: twin half-edge or -1
+  kSamples = 4,          // int32[num_samples]: the vertex of each sample
+  kSampleDistances = 5,  // float[num_samples][num_samples], row-major, symmetric
+  kVertexRecords = 6,    // VertexRecord[num_vertices]
+  kTriangles = 7,        // GeodesicTriangle[num_triangles]
+  kFaceBvh = 8,          // BvhNode[num_bvh_nodes]
+  kBvhFaces = 9,         // int32[num_faces]: faces in BVH leaf order
+  kReport = 10,          // UTF-8 text: the builder's summary (key = value lines)
+};
+
+// Build parameters recorded in the header.
+struct BuildParams {
+  uint32_t requested_samples = 0;
+  uint32_t num_samples = 0;  // after repair insertions
+  uint64_t seed = 0;
+  uint32_t samples_added_by_repair = 0;
+  uint32_t reserved = 0;
+};
+
+struct FileHeader {
+  char magic[8];
+  uint32_t format_major;
+  uint32_t format_minor;
+  uint32_t byte_order_mark;
+  uint32_t header_size;      // sizeof(FileHeader)
+  char builder_version[32];  // NUL-padded
+  uint64_t mesh_hash;        // XXH64 of positions and faces
+  BuildParams params;
+  uint32_t num_vertices;
+  uint32_t num_faces;
+  uint32_t num_samples;
+  uint32_t num_triangles;
+  uint32_t num_bvh_nodes;
+  uint32_t num_sections;
+  uint64_t section_table_offset;
+  uint64_t file_size;
+  uint64_t table_checksum;   // XXH64 of the section table
+  uint64_t header_checksum;  // XXH64 of this header with header_checksum = 0
+};
+
+struct SectionEntry {
+  uint32_t id;  // SectionId
+  uint32_t element_size;
+  uint64_t offset;
+  uint64_t size;  // bytes
+  uint64_t checksum;
+};
+
+// What the index stores for each mesh vertex: the geodesic triangle that
+// contains it, the triangle's three corner samples (copied here so a query
+// needs one cache line per vertex), and the exact geodesic distances from the
+// vertex to those corners. Unreferenced vertices have triangle = -1.
+struct VertexRecord {
+  int32_t triangle;
+  int32_t corner[3];  // sample indices
+  float distance[3];  // d(v, sample corner[i])
+  uint32_t flags;     // reserved, 0
+};
+static_assert(sizeof(VertexRecord) == 32);
+
+// A geodesic triangle: three samples and, across each side (corner[i],
+// corner[i+1]), the neighbouring triangle or -1.
+struct GeodesicTriangle {
+  int32_t corner[3];
+  int32_t neighbor[3];
+};
+static_assert(sizeof(GeodesicTriangle) == 24);
+
+// Axis-aligned bounding-box hierarchy over the mesh faces. A leaf has
+// count > 0 and covers bvh_faces[first, first+count); an inner node has
+// count == 0 and children at `first` and `first + 1`.
+struct BvhNode {
+  float lo[3];
+  float hi[3];
+  int32_t first;
+  int32_t count;
+};
+static_assert(sizeof(BvhNode) == 32);
+
+}  // namespace geodex::index
