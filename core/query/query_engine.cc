@@ -13,6 +13,10 @@ namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
+// sqrt(x^2 + y^2) without std::hypot's overflow care, which costs more than
+// the rest of a query.
+inline double Norm2(double x, double y) { return std::sqrt(x * x + y * y); }
+
 // Paper §5.1. Places a point at distances (da, db) from the ends of an edge of
 // length l lying on the x axis: x along the edge, y >= 0 its height. Distances
 // that break the triangle inequality (numerically, or because geodesic
@@ -51,6 +55,57 @@ inline void PlaceSigned(const EdgeFrame& e, double da, double db, double dc, dou
   // 4 y cy; pick the side whose value is nearer dc^2.
   const double dx = *x - e.cx;
   if (dc * dc > dx * dx + *y * *y + e.cy * e.cy) *y = -*y;
+}
+
+// A point of a geodesic triangle placed in the triangle's three edge frames.
+struct Placed {
+  double x[3], y[3];
+};
+
+inline Placed PlaceInTriangle(const EdgeFrame* frames, const double* d) {
+  Placed out;
+  for (int i = 0; i < 3; ++i) {
+    PlaceSigned(frames[i], d[i], d[(i + 1) % 3], d[(i + 2) % 3], &out.x[i], &out.y[i]);
+  }
+  return out;
+}
+
+// Paper §5.2, case 2.2: the squared distance from a placed point to a point
+// outside its triangle at distances e[] from the corners, unfolded on the far
+// side of each edge (two-side unfolding); the smallest over the edges. On a
+// developable surface the edge the geodesic crosses gives the exact answer
+// and the others overestimate.
+inline double TwoSideToOutside2(const EdgeFrame* frames, const Placed& p, const double* e) {
+  // Placements of the other point almost on an edge's line lose most digits
+  // of their height to cancellation (distances are stored as float32); they
+  // only count when every edge is like that.
+  double best = kInf, best_collinear = kInf;
+  for (int i = 0; i < 3; ++i) {
+    double xs, ys;
+    if (!(frames[i].l > 0)) continue;
+    if (p.y[i] >= 0) {
+      Place(frames[i].l, e[i], e[(i + 1) % 3], &xs, &ys);
+      // Mirror across the edge (two-side) unless the third distance says
+      // clearly that the other point is on this side: closer to the third
+      // corner than even the same-side placement.
+      const double dx = xs - frames[i].cx, dy = ys - frames[i].cy;
+      const double ek = e[(i + 2) % 3];
+      if (!(ek * ek < dx * dx + dy * dy)) ys = -ys;
+    } else {
+      // The point itself lies beyond this edge (outside its triangle, as near
+      // mesh boundaries): mirroring the other point here would bring it
+      // closer, so place it on the side its distances say.
+      PlaceSigned(frames[i], e[i], e[(i + 1) % 3], e[(i + 2) % 3], &xs, &ys);
+    }
+    const double dx = p.x[i] - xs, dy = p.y[i] - ys;
+    const double d2 = dx * dx + dy * dy;
+    if (ys * ys < 1e-6 * e[i] * e[i]) {
+      best_collinear = std::min(best_collinear, d2);
+    } else {
+      best = std::min(best, d2);
+    }
+  }
+  return best < kInf ? best : best_collinear;
 }
 
 // Barycentric coordinates of the point at distances d from the corners of the
@@ -176,40 +231,13 @@ SurfacePoint QueryEngine::Canonical(const SurfacePoint& p) const {
   return c;
 }
 
-double QueryEngine::VertexToSample(int32_t v, int32_t s) const {
-  const index::VertexRecord& r = records_[v];
-  LiftedPoint p;
-  p.triangle = r.triangle;
-  for (int i = 0; i < 3; ++i) {
-    p.corner[i] = r.corner[i];
-    p.distance[i] = r.distance[i];
-  }
-  return ToSample(p, s);
-}
-
 double QueryEngine::ToSample(const LiftedPoint& p, int32_t s) const {
   for (int i = 0; i < 3; ++i) {
     if (p.corner[i] == s) return p.distance[i];  // paper §5.2, case 2.1
   }
-  // Case 2.2: unfold the sample and the point about each edge of the point's
-  // triangle, each on the side its distances say.
-  const double to_corner[3] = {Matrix(s, p.corner[0]), Matrix(s, p.corner[1]),
-                               Matrix(s, p.corner[2])};
-  return std::sqrt(UnfoldedDistance2(p.triangle, p.distance.data(), to_corner));
-}
-
-double QueryEngine::UnfoldedDistance2(int32_t triangle, const double* p, const double* q) const {
-  const EdgeFrame* frames = &frames_[3 * triangle];
-  double best = kInf;
-  for (int i = 0; i < 3; ++i) {
-    const int j = (i + 1) % 3, k = (i + 2) % 3;
-    double xp, yp, xq, yq;
-    PlaceSigned(frames[i], p[i], p[j], p[k], &xp, &yp);
-    PlaceSigned(frames[i], q[i], q[j], q[k], &xq, &yq);
-    const double dx = xp - xq, dy = yp - yq;
-    best = std::min(best, dx * dx + dy * dy);
-  }
-  return best;
+  const EdgeFrame* frames = &frames_[3 * p.triangle];
+  const double e[3] = {Matrix(s, p.corner[0]), Matrix(s, p.corner[1]), Matrix(s, p.corner[2])};
+  return std::sqrt(TwoSideToOutside2(frames, PlaceInTriangle(frames, p.distance.data()), e));
 }
 
 LiftedPoint QueryEngine::Lift(const SurfacePoint& p) const {
@@ -218,29 +246,64 @@ LiftedPoint QueryEngine::Lift(const SurfacePoint& p) const {
   for (int i = 1; i < 3; ++i) {
     if (p.w[i] > p.w[k]) k = i;
   }
-  const index::VertexRecord& anchor = records_[f[k]];
-  LiftedPoint out;
-  out.triangle = anchor.triangle;
-  for (int c = 0; c < 3; ++c) {
-    out.corner[c] = anchor.corner[c];
-    out.distance[c] = anchor.distance[c];
+  if (p.w[k] >= 1.0) return VertexLift(f[k]);  // at a vertex: its record is exact
+  // Anchor on the geodesic triangle most of the face's vertices share (fewer
+  // approximate distances), else on the vertex with the largest weight.
+  const int32_t t0 = records_[f[0]].triangle, t1 = records_[f[1]].triangle,
+                t2 = records_[f[2]].triangle;
+  if (t0 == t1 || t0 == t2) {
+    k = 0;
+  } else if (t1 == t2) {
+    k = 1;
   }
-  if (p.w[k] >= 1.0) return out;  // at a vertex: its record is exact
+  LiftedPoint out = VertexLift(f[k]);
 
-  // Distances from the face's vertices to the corners of the anchor's triangle.
+  // Distances from the face's vertices to the anchor triangle's corners:
+  // exact for vertices of that triangle, case 2.2 for the others.
   double d[3][3];
+  bool exact = true;
   for (int i = 0; i < 3; ++i) {
     const index::VertexRecord& r = records_[f[i]];
+    if (r.triangle == out.triangle) {
+      for (int c = 0; c < 3; ++c) d[i][c] = r.distance[c];
+      continue;
+    }
+    exact = false;
+    const LiftedPoint vi = VertexLift(f[i]);
+    const EdgeFrame* frames = &frames_[3 * vi.triangle];
+    const Placed placed = PlaceInTriangle(frames, vi.distance.data());
     for (int c = 0; c < 3; ++c) {
-      d[i][c] = r.triangle == out.triangle ? r.distance[c] : VertexToSample(f[i], out.corner[c]);
+      const int32_t s = out.corner[c];
+      d[i][c] = -1;
+      for (int j = 0; j < 3; ++j) {
+        if (vi.corner[j] == s) d[i][c] = vi.distance[j];
+      }
+      if (d[i][c] < 0) {
+        const double e[3] = {Matrix(s, vi.corner[0]), Matrix(s, vi.corner[1]),
+                             Matrix(s, vi.corner[2])};
+        d[i][c] = std::sqrt(TwoSideToOutside2(frames, placed, e));
+      }
     }
   }
-  // Paper §5.2, case 4: unfold the face about each of its edges.
-  const mesh::Vec3 v[3] = {Position(f[0]), Position(f[1]), Position(f[2])};
-  const mesh::Vec3 x = p.w[0] * v[0] + p.w[1] * v[1] + p.w[2] * v[2];
-  const double to_vertex[3] = {(x - v[0]).norm(), (x - v[1]).norm(), (x - v[2]).norm()};
-  const double edge[3] = {(v[1] - v[0]).norm(), (v[2] - v[1]).norm(), (v[0] - v[2]).norm()};
+  // The face in its own plane: v0 at the origin, v1 on the x axis.
+  const mesh::Vec3 v0 = Position(f[0]), e1 = Position(f[1]) - v0, e2 = Position(f[2]) - v0;
+  const double l = e1.norm();
+  const double cx = e1.dot(e2) / l, cy = e1.cross(e2).norm() / l;
+  const double px = p.w[1] * l + p.w[2] * cx, py = p.w[2] * cy;
   for (int c = 0; c < 3; ++c) {
+    if (exact && cy > 1e-3 * l) {
+      // Exact distances of one field at the three corners of a face fix the
+      // unfolded source: trilaterate it (linear, no square roots) and measure.
+      const double sx = (l * l + d[0][c] * d[0][c] - d[1][c] * d[1][c]) / (2 * l);
+      const double sy = (cx * cx + cy * cy - 2 * sx * cx + d[0][c] * d[0][c] - d[2][c] * d[2][c]) /
+                        (2 * cy);
+      out.distance[c] = Norm2(px - sx, py - sy);
+      continue;
+    }
+    // Paper §5.2, case 4: two-side unfolding about each edge of the face.
+    const double to_vertex[3] = {Norm2(px, py), Norm2(px - l, py),
+                                 Norm2(px - cx, py - cy)};
+    const double edge[3] = {l, Norm2(cx - l, cy), Norm2(cx, cy)};
     double best = kInf;
     for (int i = 0; i < 3; ++i) {
       const int j = (i + 1) % 3;
@@ -253,16 +316,42 @@ LiftedPoint QueryEngine::Lift(const SurfacePoint& p) const {
 
 double QueryEngine::LiftedDistance(const LiftedPoint& p0, const LiftedPoint& q0) const {
   if (!(Matrix(p0.corner[0], q0.corner[0]) < kInf)) return kInf;  // different components
-  if (p0.triangle == q0.triangle) {  // case 3.1
-    return std::sqrt(UnfoldedDistance2(p0.triangle, p0.distance.data(), q0.distance.data()));
+  if (p0.triangle == q0.triangle) {
+    // Case 3.1: both placed in the triangle (each on the side its distances
+    // say, which for points inside is the one-side unfolding).
+    const EdgeFrame* frames = &frames_[3 * p0.triangle];
+    const Placed p = PlaceInTriangle(frames, p0.distance.data());
+    const Placed q = PlaceInTriangle(frames, q0.distance.data());
+    double best = kInf;
+    for (int i = 0; i < 3; ++i) {
+      const double dx = p.x[i] - q.x[i], dy = p.y[i] - q.y[i];
+      best = std::min(best, dx * dx + dy * dy);
+    }
+    return std::sqrt(best);
   }
-  // Case 3.2, in a fixed order so that the result is symmetric.
+  // Case 3.2, in a fixed order so that the result is symmetric: p's
+  // distances to q's corners by case 2.2, then case 2.2 again in q's triangle.
   const bool swap = p0.triangle > q0.triangle;
   const LiftedPoint& p = swap ? q0 : p0;
   const LiftedPoint& q = swap ? p0 : q0;
-  const double to_corner[3] = {ToSample(p, q.corner[0]), ToSample(p, q.corner[1]),
-                               ToSample(p, q.corner[2])};
-  return std::sqrt(UnfoldedDistance2(q.triangle, to_corner, q.distance.data()));
+  const EdgeFrame* p_frames = &frames_[3 * p.triangle];
+  const Placed p_placed = PlaceInTriangle(p_frames, p.distance.data());
+  double to_corner[3];
+  for (int j = 0; j < 3; ++j) {
+    const int32_t s = q.corner[j];
+    to_corner[j] = -1;
+    for (int i = 0; i < 3; ++i) {
+      if (p.corner[i] == s) to_corner[j] = p.distance[i];  // case 2.1
+    }
+    if (to_corner[j] < 0) {
+      const double e[3] = {Matrix(s, p.corner[0]), Matrix(s, p.corner[1]),
+                           Matrix(s, p.corner[2])};
+      to_corner[j] = std::sqrt(TwoSideToOutside2(p_frames, p_placed, e));
+    }
+  }
+  const EdgeFrame* q_frames = &frames_[3 * q.triangle];
+  return std::sqrt(
+      TwoSideToOutside2(q_frames, PlaceInTriangle(q_frames, q.distance.data()), to_corner));
 }
 
 double QueryEngine::DistanceUnchecked(const SurfacePoint& p, const SurfacePoint& q) const {

@@ -144,10 +144,11 @@ class QueryEngine {
   }
   // Approximate distance from a lifted point to sample `s` (case 2.1/2.2).
   double ToSample(const LiftedPoint& p, int32_t s) const;
-  double VertexToSample(int32_t v, int32_t s) const;
-  // Smallest squared distance between two points given by their distances
-  // to the corners of `triangle`, over the triangle's three edge unfoldings.
-  double UnfoldedDistance2(int32_t triangle, const double* p, const double* q) const;
+  LiftedPoint VertexLift(int32_t v) const {
+    const index::VertexRecord& r = records_[v];
+    return {r.triangle, {r.corner[0], r.corner[1], r.corner[2]},
+            {r.distance[0], r.distance[1], r.distance[2]}};
+  }
   double ExactNearDistance(const SurfacePoint& p, const SurfacePoint& q,
                            QueryScratch* scratch) const;
   SurfacePoint Canonical(const SurfacePoint& p) const;

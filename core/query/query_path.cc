@@ -42,19 +42,42 @@ struct Tracer {
     return it->second;
   }
 
-  // Steepest descent of the linear interpolant of D over face f, as
-  // barycentric velocities (sum 0), and the gradient's length.
-  std::array<double, 3> Descent(int32_t f, double* magnitude) {
+  // Direction of descent of the distance field in face f at barycentric
+  // position b, as barycentric velocities (sum 0), and its slope. The three
+  // vertex distances fix an unfolded source in the face's plane
+  // (trilateration); the path heads straight for it, which is exact where the
+  // field is planar. When the distances do not fit a point (|residual| large)
+  // the gradient of their linear interpolant is used instead.
+  std::array<double, 3> Descent(int32_t f, const std::array<double, 3>& b, double* magnitude) {
     const Vec3 v[3] = {P(V(f, 0)), P(V(f, 1)), P(V(f, 2))};
     const double d[3] = {D(V(f, 0)), D(V(f, 1)), D(V(f, 2))};
-    const Vec3 n = (v[1] - v[0]).cross(v[2] - v[0]);
+    const Vec3 e1 = v[1] - v[0], e2 = v[2] - v[0];
+    const Vec3 n = e1.cross(e2);
     const double area2 = n.squaredNorm();
-    // grad b_i = n x (v_{i+2} - v_{i+1}) / |n|^2
     Vec3 grad_b[3];
     for (int i = 0; i < 3; ++i) grad_b[i] = n.cross(v[(i + 2) % 3] - v[(i + 1) % 3]) / area2;
-    const Vec3 g = d[0] * grad_b[0] + d[1] * grad_b[1] + d[2] * grad_b[2];
-    *magnitude = g.norm();
-    return {-grad_b[0].dot(g), -grad_b[1].dot(g), -grad_b[2].dot(g)};
+    Vec3 dir;
+    const double l = e1.norm();
+    const Vec3 ux = e1 / l;
+    const Vec3 uy = n.cross(e1).normalized();
+    const double cx = e2.dot(ux), cy = e2.dot(uy);
+    bool planar = false;
+    if (cy > 1e-6 * l) {
+      const double sx = (l * l + d[0] * d[0] - d[1] * d[1]) / (2 * l);
+      const double sy = (cx * cx + cy * cy - 2 * sx * cx + d[0] * d[0] - d[2] * d[2]) / (2 * cy);
+      const double r0 = std::sqrt(sx * sx + sy * sy);
+      planar = std::abs(r0 - d[0]) < 1e-3 * (d[0] + l);
+      if (planar) {
+        const Vec3 source = v[0] + sx * ux + sy * uy;
+        const Vec3 x = b[0] * v[0] + b[1] * v[1] + b[2] * v[2];
+        dir = source - x;
+      }
+    }
+    if (!planar) {
+      dir = -(d[0] * grad_b[0] + d[1] * grad_b[1] + d[2] * grad_b[2]);
+    }
+    *magnitude = dir.norm();
+    return {grad_b[0].dot(dir), grad_b[1].dot(dir), grad_b[2].dot(dir)};
   }
 
   // Faces around vertex v, starting from face f.
@@ -143,8 +166,10 @@ absl::StatusOr<std::vector<PathPoint>> QueryEngine::Path(const SurfacePoint& fro
           break;
         }
         double magnitude;
-        const auto beta = tr.Descent(g, &magnitude);
         const int k = LocalIndex(faces_, g, v);
+        std::array<double, 3> at = {0, 0, 0};
+        at[k] = 1;
+        const auto beta = tr.Descent(g, at, &magnitude);
         const double e = 1e-12 * (std::abs(beta[0]) + std::abs(beta[1]) + std::abs(beta[2]));
         if (beta[(k + 1) % 3] >= -e && beta[(k + 2) % 3] >= -e && beta[k] < -e &&
             magnitude > best_slope) {
@@ -185,7 +210,7 @@ absl::StatusOr<std::vector<PathPoint>> QueryEngine::Path(const SurfacePoint& fro
     }
     // Face step: follow the descent to the face's boundary.
     double magnitude;
-    const auto beta = tr.Descent(f, &magnitude);
+    const auto beta = tr.Descent(f, b, &magnitude);
     double t = std::numeric_limits<double>::infinity();
     int exit = -1;
     const double eps = 1e-12 * (std::abs(beta[0]) + std::abs(beta[1]) + std::abs(beta[2]));

@@ -1,0 +1,115 @@
+#include "tests/accuracy/accuracy.h"
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+
+#include "absl/strings/str_format.h"
+#include "core/geodesic/exact_geodesic.h"
+
+namespace geodex::accuracy {
+
+ErrorStats ErrorStats::Of(std::vector<double> errors) {
+  ErrorStats s;
+  s.count = static_cast<int64_t>(errors.size());
+  if (errors.empty()) return s;
+  double sum2 = 0, sum = 0;
+  for (double& e : errors) {
+    sum2 += e * e;
+    e = std::abs(e);
+    sum += e;
+  }
+  std::sort(errors.begin(), errors.end());
+  s.rms = std::sqrt(sum2 / errors.size());
+  s.mean = sum / errors.size();
+  s.p99 = errors[std::min(errors.size() - 1, static_cast<size_t>(0.99 * errors.size()))];
+  s.max = errors.back();
+  return s;
+}
+
+std::string AccuracyReport::MarkdownHeader() {
+  return "| case | pairs | RMS | mean | p99 | max | far p99 | near pairs | near RMS | near p99 | "
+         "near p99 (exact mode) | RMS (exact mode) | baseline RMS | path/exact p99 |\n"
+         "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+}
+
+std::string AccuracyReport::ToMarkdownRow(const std::string& label) const {
+  auto pct = [](double x) { return absl::StrFormat("%.3f%%", 100 * x); };
+  return absl::StrFormat("| %s | %d | %s | %s | %s | %s | %s | %d | %s | %s | %s | %s | %s | %.4f |\n",
+                         label, all.count, pct(all.rms), pct(all.mean), pct(all.p99),
+                         pct(all.max), pct(far.p99), near.count, pct(near.rms), pct(near.p99),
+                         pct(near_exact_mode.p99), pct(all_exact_mode.rms), pct(baseline.rms),
+                         path_ratio.count ? 1 + path_ratio.p99 : 0.0);
+}
+
+std::vector<mesh::SurfacePoint> RandomSurfacePoints(const mesh::Mesh& mesh, int32_t count,
+                                                    uint64_t seed) {
+  std::vector<double> cumulative(mesh.num_faces());
+  double total = 0;
+  for (int32_t f = 0; f < mesh.num_faces(); ++f) cumulative[f] = total += mesh.Area(f);
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> u(0, 1);
+  std::vector<mesh::SurfacePoint> points;
+  for (int32_t k = 0; k < count; ++k) {
+    const auto it = std::lower_bound(cumulative.begin(), cumulative.end(), u(rng) * total);
+    const int32_t f = std::min<int32_t>(it - cumulative.begin(), mesh.num_faces() - 1);
+    double a = u(rng), b = u(rng);
+    if (a + b > 1) a = 1 - a, b = 1 - b;  // uniform on the triangle
+    points.push_back({f, {1 - a - b, a, b}});
+  }
+  return points;
+}
+
+AccuracyReport MeasureAccuracy(const mesh::Mesh& mesh, const query::QueryEngine& engine,
+                               const query::QueryEngine* exact_engine,
+                               const AccuracyOptions& options) {
+  const auto points = RandomSurfacePoints(mesh, options.num_points, options.seed);
+  const int32_t sources = std::min(options.num_sources, options.num_points);
+  std::vector<double> all, far, near, near_exact, all_exact, baseline, path_ratio;
+  geodesic::ExactGeodesicSolver solver(mesh);
+  query::QueryScratch scratch;
+  const double tiny = 1e-9 * mesh.BoundingBoxDiagonal();
+  int32_t paths_left = options.num_paths;
+  for (int32_t s = 0; s < sources; ++s) {
+    if (!solver.Propagate({points[s]}).ok()) continue;
+    for (int32_t k = sources; k < options.num_points; ++k) {
+      const double exact = solver.DistanceAt(points[k]);
+      if (!(exact > tiny) || !std::isfinite(exact)) continue;
+      const double approx = *engine.Distance(points[s], points[k]);
+      const double e = (approx - exact) / exact;
+      all.push_back(e);
+      const bool is_near = engine.IsNearPair(points[s], points[k]);
+      (is_near ? near : far).push_back(e);
+      baseline.push_back((engine.LinearInterpolationDistance(points[s], points[k]) - exact) / exact);
+      if (exact_engine != nullptr) {
+        const double fixed = *exact_engine->Distance(points[s], points[k], &scratch);
+        all_exact.push_back((fixed - exact) / exact);
+        if (is_near) near_exact.push_back((fixed - exact) / exact);
+      }
+      if (paths_left > 0 && (k % 3 == 0)) {
+        auto path = engine.Path(points[s], points[k]);
+        if (path.ok()) {
+          double length = 0;
+          for (size_t i = 1; i < path->size(); ++i) {
+            length += ((*path)[i].position - (*path)[i - 1].position).norm();
+          }
+          path_ratio.push_back(length / exact - 1);
+          --paths_left;
+        }
+      }
+    }
+  }
+  AccuracyReport report;
+  report.all = ErrorStats::Of(all);
+  report.far = ErrorStats::Of(far);
+  report.near = ErrorStats::Of(near);
+  report.near_exact_mode = ErrorStats::Of(near_exact);
+  report.all_exact_mode = ErrorStats::Of(all_exact);
+  report.baseline = ErrorStats::Of(baseline);
+  // Path ratio: keep the signed excess so p99 reads as ratio - 1.
+  ErrorStats paths = ErrorStats::Of(path_ratio);
+  report.path_ratio = paths;
+  return report;
+}
+
+}  // namespace geodex::accuracy

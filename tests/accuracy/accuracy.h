@@ -1,0 +1,50 @@
+#pragma once
+
+// Accuracy measurement of the query engine against the exact geodesic engine
+// on area-uniform random surface point pairs.
+//
+// Relative error e = (approx - exact) / exact per pair; reported as relative
+// RMS = sqrt(mean(e^2)), mean |e|, p99 |e| and max |e|, separately for far
+// pairs and near pairs (the same or adjacent geodesic triangles), for the
+// pure O(1) mode, the exact-near-pairs mode and the paper's linear
+// interpolation baseline (§6.3); and path length / exact distance.
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "core/mesh/mesh.h"
+#include "core/query/query_engine.h"
+
+namespace geodex::accuracy {
+
+struct ErrorStats {
+  int64_t count = 0;
+  double rms = 0, mean = 0, p99 = 0, max = 0;
+  static ErrorStats Of(std::vector<double> errors);  // relative errors (signed)
+};
+
+struct AccuracyReport {
+  ErrorStats all, far, near, near_exact_mode, all_exact_mode, baseline, path_ratio;
+  std::string ToMarkdownRow(const std::string& label) const;
+  static std::string MarkdownHeader();
+};
+
+struct AccuracyOptions {
+  int32_t num_points = 400;  // random points; pairs are (source, point)
+  int32_t num_sources = 20;  // exact propagations
+  int32_t num_paths = 100;   // pairs whose path length is measured
+  uint64_t seed = 1;
+};
+
+// Area-uniform random surface points.
+std::vector<mesh::SurfacePoint> RandomSurfacePoints(const mesh::Mesh& mesh, int32_t count,
+                                                    uint64_t seed);
+
+// `engine` must be built from `mesh`; `exact_engine`, built with
+// exact_near_pairs, may be null (then the exact-mode rows stay empty).
+AccuracyReport MeasureAccuracy(const mesh::Mesh& mesh, const query::QueryEngine& engine,
+                               const query::QueryEngine* exact_engine,
+                               const AccuracyOptions& options);
+
+}  // namespace geodex::accuracy

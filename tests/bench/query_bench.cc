@@ -1,0 +1,150 @@
+// Query throughput: single-thread queries per second of the constant-time
+// engine, next to (a) a gather-only loop that performs just the memory loads a
+// query needs (the practical limit) and (b) the paper's linear-interpolation
+// baseline (§6.3), all in the same run on the same pairs.
+//
+//   query_bench [--index FILE.gdx]... [--pairs N]
+//
+// Without --index it builds an index of a generated sphere (a note says so).
+
+#include <chrono>
+#include <cstdio>
+#include <random>
+
+#include "CLI/CLI.hpp"
+#include "absl/strings/str_format.h"
+#include "core/build/builder.h"
+#include "core/mesh/generators.h"
+#include "core/query/query_engine.h"
+
+namespace geodex {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+std::vector<mesh::SurfacePoint> InteriorPoints(const index::Index& ix, int n, uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> u(0, 1);
+  std::vector<mesh::SurfacePoint> out;
+  while (static_cast<int>(out.size()) < n) {
+    const int32_t f = static_cast<int32_t>(rng() % ix.num_faces());
+    double a = u(rng), b = u(rng);
+    if (a + b > 1) a = 1 - a, b = 1 - b;
+    out.push_back({f, {1 - a - b, a, b}});
+  }
+  return out;
+}
+
+std::vector<mesh::SurfacePoint> VertexPoints(const index::Index& ix, int n, uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  std::vector<mesh::SurfacePoint> out;
+  while (static_cast<int>(out.size()) < n) {
+    const int32_t f = static_cast<int32_t>(rng() % ix.num_faces());
+    mesh::SurfacePoint p{f, {0, 0, 0}};
+    p.w[rng() % 3] = 1;
+    out.push_back(p);
+  }
+  return out;
+}
+
+template <typename F>
+double Rate(int64_t n, F&& body) {
+  double best = 0;
+  for (int rep = 0; rep < 3; ++rep) {
+    const auto start = Clock::now();
+    body();
+    const double seconds = std::chrono::duration<double>(Clock::now() - start).count();
+    best = std::max(best, n / seconds);
+  }
+  return best;
+}
+
+// The loads of a query: the records and positions of both faces' vertices and
+// the 3x3 block of the sample matrix between the two anchors' corners.
+double Gather(const index::Index& ix, const mesh::SurfacePoint& p, const mesh::SurfacePoint& q) {
+  const auto faces = ix.faces();
+  const auto records = ix.vertices();
+  const auto positions = ix.positions();
+  double acc = 0;
+  const index::VertexRecord* anchor[2];
+  const mesh::SurfacePoint* pts[2] = {&p, &q};
+  for (int k = 0; k < 2; ++k) {
+    const int32_t* f = &faces[3 * pts[k]->face];
+    for (int i = 0; i < 3; ++i) {
+      acc += records[f[i]].distance[0] + positions[3 * f[i]];
+    }
+    anchor[k] = &records[f[0]];
+  }
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) acc += ix.SampleDistance(anchor[0]->corner[i], anchor[1]->corner[j]);
+  }
+  return acc;
+}
+
+void Bench(const std::string& label, std::shared_ptr<const index::Index> ix, int n) {
+  auto engine = *query::QueryEngine::Create(ix);
+  const auto a = InteriorPoints(*ix, n, 1), b = InteriorPoints(*ix, n, 2);
+  const auto va = VertexPoints(*ix, n, 3), vb = VertexPoints(*ix, n, 4);
+  std::vector<double> out(n);
+  volatile double sink = 0;
+  const double vertex_rate = Rate(n, [&] {
+    for (int i = 0; i < n; ++i) out[i] = engine->DistanceUnchecked(va[i], vb[i]);
+    sink = sink + out[n - 1];
+  });
+  const double interior_rate = Rate(n, [&] {
+    for (int i = 0; i < n; ++i) out[i] = engine->DistanceUnchecked(a[i], b[i]);
+    sink = sink + out[n - 1];
+  });
+  const double batch_rate = Rate(n, [&] {
+    (void)engine->DistanceBatch(a, b, out);
+    sink = sink + out[n - 1];
+  });
+  const double gather_rate = Rate(n, [&] {
+    double acc = 0;
+    for (int i = 0; i < n; ++i) acc += Gather(*ix, a[i], b[i]);
+    sink = sink + acc;
+  });
+  const double linear_rate = Rate(n, [&] {
+    double acc = 0;
+    for (int i = 0; i < n; ++i) acc += engine->LinearInterpolationDistance(a[i], b[i]);
+    sink = sink + acc;
+  });
+  std::printf("| %s | %d | %d | %.2fM | %.2fM | %.2fM | %.2fM | %.2f | %.2fM |\n", label.c_str(),
+              ix->num_vertices(), ix->num_samples(), vertex_rate / 1e6, interior_rate / 1e6,
+              batch_rate / 1e6, gather_rate / 1e6, gather_rate / interior_rate,
+              linear_rate / 1e6);
+}
+
+}  // namespace
+}  // namespace geodex
+
+int main(int argc, char** argv) {
+  CLI::App app{"query_bench: constant-time query throughput, one thread."};
+  std::vector<std::string> indexes;
+  int pairs = 1'000'000;
+  app.add_option("--index", indexes, "Index files to measure");
+  app.add_option("--pairs", pairs, "Pairs per measurement");
+  CLI11_PARSE(app, argc, argv);
+  std::printf(
+      "| index | vertices | m | vertex pairs/s | interior pairs/s | batch (validated) pairs/s | "
+      "gather-only/s | gather/query | linear baseline/s |\n|---|---|---|---|---|---|---|---|---|\n");
+  if (indexes.empty()) {
+    std::printf("(no --index given: a generated sphere, m = 500)\n");
+    geodex::build::BuildOptions options;
+    options.num_samples = 500;
+    geodex::build::BuildSummary summary;
+    auto data = geodex::build::BuildIndex(geodex::mesh::gen::Sphere(5, 1.0), options, &summary);
+    auto ix = geodex::index::Index::FromBytes(*geodex::index::SerializeIndex(*data));
+    geodex::Bench("sphere(5)", *ix, pairs);
+    return 0;
+  }
+  for (const std::string& path : indexes) {
+    auto ix = geodex::index::Index::Open(path);
+    if (!ix.ok()) {
+      std::fprintf(stderr, "%s: %s\n", path.c_str(), ix.status().ToString().c_str());
+      return 1;
+    }
+    geodex::Bench(path, *ix, pairs);
+  }
+  return 0;
+}
