@@ -1,0 +1,53 @@
+#pragma once
+
+// Output formats of the `geodex` CLI.
+
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "geodex/client/types.h"
+
+namespace geodex::client::cli {
+
+// Paths as Wavefront OBJ: all points as `v` lines, one `l` polyline per path
+// (a path of a single point gets a `p` point element).
+std::string PathsToObj(const std::vector<GeodesicPath>& paths);
+
+// Paths as ASCII PLY: vertices (x, y, z, path index) and edges between
+// consecutive points of a path.
+std::string PathsToPly(const std::vector<GeodesicPath>& paths);
+
+// Paths as JSON: [{"length": L, "points": [{"face": f, "w": [..], "xyz": [..]}, ...]}, ...].
+std::string PathsToJson(const std::vector<GeodesicPath>& paths);
+
+// A distance field as text: one line per vertex, "distance" or, with
+// nearest sources, "distance nearest_source".
+std::string FieldToText(const VertexDistances& field);
+
+// A triangle mesh's geometry: positions (#V) and vertex-index triples (#F).
+struct MeshGeometry {
+  std::vector<Position> positions;
+  std::vector<std::array<int32_t, 3>> faces;
+};
+
+// An ASCII PLY of `mesh` with per-vertex colors (a blue-to-yellow ramp over
+// [0, largest finite distance]; unreachable vertices gray) and the distance as
+// the vertex `quality`, which MeshLab shows and filters on. Requires
+// distances.size() == mesh.positions.size().
+std::string FieldToPly(const MeshGeometry& mesh, const std::vector<double>& distances);
+
+// The color of t in [0, 1] on the ramp FieldToPly uses.
+std::array<uint8_t, 3> RampColor(double t);
+
+// One line per model: name, version, state, vertices, faces, samples.
+std::string ModelsTable(const std::vector<ModelInfo>& models);
+
+// A model's full description as JSON.
+std::string ModelToJson(const ModelInfo& model);
+
+// `s` as a JSON string literal, quotes included.
+std::string JsonString(const std::string& s);
+
+}  // namespace geodex::client::cli

@@ -1,0 +1,197 @@
+#include "client/cli/text_io.h"
+
+#include <charconv>
+#include <cmath>
+#include <cstdint>
+#include <fstream>
+#include <iostream>
+#include <iterator>
+#include <sstream>
+
+#include "absl/strings/str_format.h"
+
+namespace geodex::client::cli {
+namespace {
+
+// Splits on spaces, tabs, commas and carriage returns, dropping empty fields.
+std::vector<std::string_view> Fields(std::string_view line) {
+  std::vector<std::string_view> fields;
+  size_t i = 0;
+  auto separator = [](char c) { return c == ' ' || c == '\t' || c == ',' || c == '\r'; };
+  while (i < line.size()) {
+    while (i < line.size() && separator(line[i])) ++i;
+    const size_t start = i;
+    while (i < line.size() && !separator(line[i])) ++i;
+    if (i > start) fields.push_back(line.substr(start, i - start));
+  }
+  return fields;
+}
+
+// Calls on_line(number, fields) for every line that is not blank or a comment.
+template <typename F>
+absl::Status ForEachLine(std::string_view text, F&& on_line) {
+  int64_t number = 0;
+  size_t begin = 0;
+  while (begin < text.size()) {
+    size_t end = text.find('\n', begin);
+    if (end == std::string_view::npos) end = text.size();
+    const std::string_view line = text.substr(begin, end - begin);
+    begin = end + 1;
+    ++number;
+    const std::vector<std::string_view> fields = Fields(line);
+    if (fields.empty() || fields[0][0] == '#') continue;
+    if (absl::Status s = on_line(number, fields); !s.ok()) return s;
+  }
+  return absl::OkStatus();
+}
+
+absl::Status ParseDouble(std::string_view text, int64_t line, size_t field, double* out) {
+  const auto [ptr, ec] = std::from_chars(text.data(), text.data() + text.size(), *out);
+  if (ec != std::errc() || ptr != text.data() + text.size() || !std::isfinite(*out)) {
+    return absl::InvalidArgumentError(absl::StrFormat(
+        "line %d: field %d ('%s') is not a finite number", line, field + 1, std::string(text)));
+  }
+  return absl::OkStatus();
+}
+
+absl::Status ParseFace(std::string_view text, int64_t line, size_t field, int32_t* out) {
+  int64_t face = 0;
+  const auto [ptr, ec] = std::from_chars(text.data(), text.data() + text.size(), face);
+  if (ec != std::errc() || ptr != text.data() + text.size() || face < 0 || face > INT32_MAX) {
+    return absl::InvalidArgumentError(absl::StrFormat("line %d: field %d ('%s') is not a face id",
+                                                      line, field + 1, std::string(text)));
+  }
+  *out = static_cast<int32_t>(face);
+  return absl::OkStatus();
+}
+
+absl::Status CheckCount(const std::vector<std::string_view>& fields, size_t expected,
+                        const char* format, int64_t line) {
+  if (fields.size() == expected) return absl::OkStatus();
+  return absl::InvalidArgumentError(absl::StrFormat("line %d: expected %d fields '%s', found %d",
+                                                    line, expected, format, fields.size()));
+}
+
+// Fields [first, first + 4) as a surface point.
+absl::Status ParsePoint(const std::vector<std::string_view>& fields, size_t first, int64_t line,
+                        SurfacePoint* p) {
+  if (absl::Status s = ParseFace(fields[first], line, first, &p->face); !s.ok()) return s;
+  for (size_t i = 0; i < 3; ++i) {
+    if (absl::Status s = ParseDouble(fields[first + 1 + i], line, first + 1 + i, &p->w[i]);
+        !s.ok()) {
+      return s;
+    }
+  }
+  return absl::OkStatus();
+}
+
+absl::Status ParsePosition(const std::vector<std::string_view>& fields, size_t first, int64_t line,
+                           Position* p) {
+  for (size_t i = 0; i < 3; ++i) {
+    if (absl::Status s = ParseDouble(fields[first + i], line, first + i, &(*p)[i]); !s.ok()) {
+      return s;
+    }
+  }
+  return absl::OkStatus();
+}
+
+}  // namespace
+
+absl::StatusOr<std::string> ReadFileOrStdin(const std::string& path) {
+  if (path == "-") return std::string(std::istreambuf_iterator<char>(std::cin), {});
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return absl::NotFoundError(absl::StrFormat("cannot open %s", path));
+  std::ostringstream buffer;
+  buffer << in.rdbuf();
+  return buffer.str();
+}
+
+absl::StatusOr<ParsedPairs> ParsePairs(std::string_view text) {
+  ParsedPairs out;
+  absl::Status status = ForEachLine(text, [&](int64_t line, const auto& fields) {
+    if (absl::Status s = CheckCount(fields, 8, "fa a0 a1 a2 fb b0 b1 b2", line); !s.ok()) return s;
+    PointPair pair;
+    if (absl::Status s = ParsePoint(fields, 0, line, &pair.a); !s.ok()) return s;
+    if (absl::Status s = ParsePoint(fields, 4, line, &pair.b); !s.ok()) return s;
+    out.pairs.push_back(pair);
+    out.lines.push_back(line);
+    return absl::OkStatus();
+  });
+  if (!status.ok()) return status;
+  return out;
+}
+
+absl::StatusOr<ParsedPositionPairs> ParsePositionPairs(std::string_view text) {
+  ParsedPositionPairs out;
+  absl::Status status = ForEachLine(text, [&](int64_t line, const auto& fields) {
+    if (absl::Status s = CheckCount(fields, 6, "xa ya za xb yb zb", line); !s.ok()) return s;
+    Position a, b;
+    if (absl::Status s = ParsePosition(fields, 0, line, &a); !s.ok()) return s;
+    if (absl::Status s = ParsePosition(fields, 3, line, &b); !s.ok()) return s;
+    out.a.push_back(a);
+    out.b.push_back(b);
+    out.lines.push_back(line);
+    return absl::OkStatus();
+  });
+  if (!status.ok()) return status;
+  return out;
+}
+
+absl::StatusOr<ParsedPoints> ParsePoints(std::string_view text) {
+  ParsedPoints out;
+  absl::Status status = ForEachLine(text, [&](int64_t line, const auto& fields) {
+    if (absl::Status s = CheckCount(fields, 4, "f w0 w1 w2", line); !s.ok()) return s;
+    SurfacePoint p;
+    if (absl::Status s = ParsePoint(fields, 0, line, &p); !s.ok()) return s;
+    out.points.push_back(p);
+    out.lines.push_back(line);
+    return absl::OkStatus();
+  });
+  if (!status.ok()) return status;
+  return out;
+}
+
+absl::StatusOr<ParsedPositions> ParsePositions(std::string_view text) {
+  ParsedPositions out;
+  absl::Status status = ForEachLine(text, [&](int64_t line, const auto& fields) {
+    if (absl::Status s = CheckCount(fields, 3, "x y z", line); !s.ok()) return s;
+    Position p;
+    if (absl::Status s = ParsePosition(fields, 0, line, &p); !s.ok()) return s;
+    out.positions.push_back(p);
+    out.lines.push_back(line);
+    return absl::OkStatus();
+  });
+  if (!status.ok()) return status;
+  return out;
+}
+
+absl::Status CheckPoint(const SurfacePoint& p, int64_t num_faces, int64_t line) {
+  if (p.face >= num_faces) {
+    return absl::OutOfRangeError(absl::StrFormat(
+        "line %d: face %d is past the end (the model has %d faces)", line, p.face, num_faces));
+  }
+  constexpr double kTolerance = 1e-6;
+  for (double w : p.w) {
+    if (w < -kTolerance) {
+      return absl::InvalidArgumentError(
+          absl::StrFormat("line %d: barycentric weights (%g, %g, %g) must not be negative", line,
+                          p.w[0], p.w[1], p.w[2]));
+    }
+  }
+  const double sum = p.w[0] + p.w[1] + p.w[2];
+  if (std::abs(sum - 1.0) > kTolerance) {
+    return absl::InvalidArgumentError(
+        absl::StrFormat("line %d: barycentric weights (%g, %g, %g) sum to %.9g, not 1", line,
+                        p.w[0], p.w[1], p.w[2], sum));
+  }
+  return absl::OkStatus();
+}
+
+std::string FormatDistance(double d) {
+  if (std::isinf(d)) return "inf";
+  char buffer[64];
+  const auto [ptr, ec] = std::to_chars(buffer, buffer + sizeof(buffer), d);
+  return std::string(buffer, ptr);
+}
+
+}  // namespace geodex::client::cli

@@ -1,0 +1,110 @@
+#pragma once
+
+// Plain value types of the geodex client API. They mirror geodex.v1 messages
+// (proto/geodex/v1/geodex.proto) without exposing protobuf to callers.
+
+#include <array>
+#include <cstdint>
+#include <map>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace geodex::client {
+
+// A point on the model's mesh: a face id (as in the source mesh file, polygons
+// fan-triangulated in order) and the barycentric weights of that face's three
+// vertices in file order. Weights must be finite, >= 0 and sum to 1 (the
+// server allows 1e-6 either way).
+struct SurfacePoint {
+  int32_t face = 0;
+  std::array<double, 3> w = {1.0, 0.0, 0.0};
+
+  friend bool operator==(const SurfacePoint&, const SurfacePoint&) = default;
+};
+
+// Two surface points whose geodesic distance (or path) is asked for.
+struct PointPair {
+  SurfacePoint a;
+  SurfacePoint b;
+
+  friend bool operator==(const PointPair&, const PointPair&) = default;
+};
+
+// A 3D position in the mesh's coordinates: {x, y, z}.
+using Position = std::array<double, 3>;
+
+// Names a model and, optionally, one of its versions. Version 0 means the
+// newest version the server has loaded. Implicitly constructible from a name,
+// so `client.Distance("torus", pairs)` works.
+struct ModelRef {
+  ModelRef() = default;
+  ModelRef(std::string model_name, int64_t model_version = 0)  // NOLINT: implicit on purpose
+      : name(std::move(model_name)), version(model_version) {}
+  ModelRef(const char* model_name) : name(model_name) {}  // NOLINT: implicit on purpose
+
+  std::string name;
+  int64_t version = 0;
+};
+
+// What the server knows about one model (geodex.v1.ModelInfo).
+struct ModelInfo {
+  enum class State { kUnspecified, kLoading, kServing, kFailed };
+
+  std::string name;
+  int64_t version = 0;  // the version described: the served one, or the newest seen
+  std::vector<int64_t> available_versions;
+  State state = State::kUnspecified;
+  std::string reason;  // why loading failed (kFailed)
+  int64_t num_vertices = 0;
+  int64_t num_faces = 0;
+  int64_t num_samples = 0;    // m, after repair insertions
+  int64_t num_triangles = 0;  // geodesic triangles
+  Position bbox_min = {0, 0, 0};
+  Position bbox_max = {0, 0, 0};
+  int64_t requested_samples = 0;
+  uint64_t seed = 0;
+  int64_t samples_added_by_repair = 0;
+  std::string builder_version;
+  std::map<std::string, std::string> build_report;  // the builder's "key = value" figures
+  int64_t mapped_bytes = 0;
+  uint64_t mesh_hash = 0;
+};
+
+// "LOADING", "SERVING", ... as in the proto.
+const char* StateName(ModelInfo::State state);
+
+// All sources x targets distances, row-major: At(s, t) = values[s * cols + t].
+struct DistanceMatrix {
+  int64_t rows = 0;  // number of sources
+  int64_t cols = 0;  // number of targets
+  std::vector<double> values;
+  int64_t version = 0;  // the model version that answered
+
+  double At(int64_t source, int64_t target) const { return values[source * cols + target]; }
+};
+
+// A geodesic path: `points[0]` is the pair's `a`, `points.back()` its `b`;
+// `positions[i]` is `points[i]` in 3D. `length` is in the mesh's units.
+struct GeodesicPath {
+  std::vector<SurfacePoint> points;
+  std::vector<Position> positions;
+  double length = 0;
+};
+
+// A distance field: distances[v] is the distance from the nearest source to
+// mesh vertex v (+infinity when unreachable or unreferenced). nearest_source[v]
+// is that source's index, or -1; empty unless asked for.
+struct VertexDistances {
+  std::vector<double> distances;
+  std::vector<int32_t> nearest_source;
+  int64_t version = 0;
+};
+
+// The closest surface point to a 3D position and the Euclidean distance to it.
+struct LocatedPoint {
+  SurfacePoint point;
+  double distance = 0;
+};
+
+}  // namespace geodex::client

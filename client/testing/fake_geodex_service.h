@@ -1,0 +1,91 @@
+#pragma once
+
+// An in-process stand-in for the geodex server, for tests of the gRPC
+// connection and the CLI before (and independently of) server/. Its answers
+// follow simple closed forms so that tests can check them exactly:
+//
+//   distance(a, b)   = |a.face - b.face| + sum_i |a.w[i] - b.w[i]|
+//   path(a, b)       = [a, b] at positions (face, w1, w2), length = distance
+//   field(v)         = min over sources s of |v - s.face|   (num_vertices = 60)
+//   locate(x, y, z)  = face clamp(floor(x)), weights (1, 0, 0), distance |y|
+//
+// Models: "fake" (version 1, 100 faces, 60 vertices), "loading" (always
+// UNAVAILABLE), anything else NOT_FOUND. A face >= 100 is OUT_OF_RANGE, bad
+// weights INVALID_ARGUMENT (naming the element, e.g. "a[3]"), like the real
+// server. Thread-safe.
+
+#include <atomic>
+#include <cstdint>
+#include <memory>
+#include <string>
+
+#include "absl/synchronization/mutex.h"
+#include "geodex/v1/geodex.grpc.pb.h"
+#include "grpcpp/grpcpp.h"
+
+namespace geodex::client::testing {
+
+class FakeGeodexService final : public v1::Geodex::Service {
+ public:
+  static constexpr int64_t kNumFaces = 100;
+  static constexpr int64_t kNumVertices = 60;
+
+  grpc::Status ListModels(grpc::ServerContext* context, const v1::ListModelsRequest* request,
+                          v1::ListModelsResponse* response) override;
+  grpc::Status GetModel(grpc::ServerContext* context, const v1::GetModelRequest* request,
+                        v1::ModelInfo* response) override;
+  grpc::Status Distance(grpc::ServerContext* context, const v1::DistanceRequest* request,
+                        v1::DistanceResponse* response) override;
+  grpc::Status StreamDistances(
+      grpc::ServerContext* context,
+      grpc::ServerReaderWriter<v1::DistanceResult, v1::DistanceBatch>* stream) override;
+  grpc::Status Matrix(grpc::ServerContext* context, const v1::MatrixRequest* request,
+                      grpc::ServerWriter<v1::MatrixBlock>* writer) override;
+  grpc::Status Path(grpc::ServerContext* context, const v1::PathRequest* request,
+                    v1::PathResponse* response) override;
+  grpc::Status DistanceField(grpc::ServerContext* context, const v1::DistanceFieldRequest* request,
+                             grpc::ServerWriter<v1::DistanceFieldChunk>* writer) override;
+  grpc::Status Locate(grpc::ServerContext* context, const v1::LocateRequest* request,
+                      v1::LocateResponse* response) override;
+
+  // Fails the next `n` calls (of any method) with UNAVAILABLE.
+  void FailNext(int n) { fail_next_.store(n); }
+  // Every call sleeps this long first.
+  void SetDelay(absl::Duration delay) {
+    absl::MutexLock lock(&mu_);
+    delay_ = delay;
+  }
+  // Calls received (including failed ones).
+  int64_t calls() const { return calls_.load(); }
+  // The "authorization" metadata of the last call ("" if none).
+  std::string last_authorization() const {
+    absl::MutexLock lock(&mu_);
+    return last_authorization_;
+  }
+
+ private:
+  // Common entry of every method: counts, records metadata, delays, fails.
+  grpc::Status Enter(grpc::ServerContext* context);
+
+  std::atomic<int> fail_next_{0};
+  std::atomic<int64_t> calls_{0};
+  mutable absl::Mutex mu_;
+  absl::Duration delay_ ABSL_GUARDED_BY(mu_) = absl::ZeroDuration();
+  std::string last_authorization_ ABSL_GUARDED_BY(mu_);
+};
+
+// A FakeGeodexService listening on 127.0.0.1 on a free port.
+class FakeGeodexServer {
+ public:
+  FakeGeodexServer();
+  ~FakeGeodexServer();
+  const std::string& address() const { return address_; }  // "127.0.0.1:PORT"
+  FakeGeodexService& service() { return service_; }
+
+ private:
+  FakeGeodexService service_;
+  std::unique_ptr<grpc::Server> server_;
+  std::string address_;
+};
+
+}  // namespace geodex::client::testing
