@@ -21,6 +21,7 @@
 // Thread safety: a solver holds per-propagation state and is not thread-safe;
 // use one solver per thread. Any number of solvers may share one const Mesh.
 
+#include <cmath>
 #include <cstdint>
 #include <initializer_list>
 #include <limits>
@@ -154,6 +155,8 @@ class ExactGeodesicSolver {
   };
 
   void Reset();
+  void Push(QueueEntry entry);
+  QueueEntry PopMin();
   absl::Status AddSource(const SurfacePoint& p, int32_t source);
   void AddFaceSource(int32_t face, const std::array<double, 3>& w, int32_t source,
                      int32_t skip_halfedge);
