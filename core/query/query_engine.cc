@@ -62,10 +62,22 @@ struct Placed {
   double x[3], y[3];
 };
 
+// True when a placement at height y from distance d is almost on the edge's
+// line, where sqrt(d^2 - x^2) loses half its digits to cancellation (the
+// distances are float32).
+inline bool Weak(double y, double d, double limit = 1e-6) { return y * y < limit * d * d; }
+
 inline Placed PlaceInTriangle(const EdgeFrame* frames, const double* d) {
   Placed out;
   for (int i = 0; i < 3; ++i) {
-    PlaceSigned(frames[i], d[i], d[(i + 1) % 3], d[(i + 2) % 3], &out.x[i], &out.y[i]);
+    const EdgeFrame& e = frames[i];
+    const double da = d[i], dc = d[(i + 2) % 3];
+    PlaceSigned(e, da, d[(i + 1) % 3], dc, &out.x[i], &out.y[i]);
+    if (Weak(out.y[i], da, 1e-4) && e.cy > 1e-3 * e.l) {
+      // Near the edge's line: take the height from the third corner instead
+      // (linear, conditioned by the triangle's height; the point is near).
+      out.y[i] = (e.cx * e.cx + e.cy * e.cy - 2 * out.x[i] * e.cx + da * da - dc * dc) / (2 * e.cy);
+    }
   }
   return out;
 }
@@ -76,9 +88,8 @@ inline Placed PlaceInTriangle(const EdgeFrame* frames, const double* d) {
 // developable surface the edge the geodesic crosses gives the exact answer
 // and the others overestimate.
 inline double TwoSideToOutside2(const EdgeFrame* frames, const Placed& p, const double* e) {
-  // Placements of the other point almost on an edge's line lose most digits
-  // of their height to cancellation (distances are stored as float32); they
-  // only count when every edge is like that.
+  // Weak placements of the other point (see Weak) only count when every
+  // edge gives one.
   double best = kInf, best_collinear = kInf;
   for (int i = 0; i < 3; ++i) {
     double xs, ys;
@@ -99,7 +110,7 @@ inline double TwoSideToOutside2(const EdgeFrame* frames, const Placed& p, const 
     }
     const double dx = p.x[i] - xs, dy = p.y[i] - ys;
     const double d2 = dx * dx + dy * dy;
-    if (ys * ys < 1e-6 * e[i] * e[i]) {
+    if (Weak(ys, e[i])) {
       best_collinear = std::min(best_collinear, d2);
     } else {
       best = std::min(best, d2);

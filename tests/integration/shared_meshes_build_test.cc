@@ -1,0 +1,73 @@
+// The builder on every development mesh in ../shared/meshes (skipped when the
+// directory is absent): the plan (sampling and the repaired geodesic Delaunay
+// triangulation) must be valid everywhere; small meshes also get a full index
+// whose vertices must all be assigned. cow_nonmanifold_3k must fail clearly.
+
+#include <cstdlib>
+#include <filesystem>
+
+#include "core/build/builder.h"
+#include "core/mesh/mesh_io.h"
+#include "gmock/gmock.h"
+#include "gtest/gtest.h"
+
+namespace geodex {
+namespace {
+
+std::string SharedDir() {
+  const char* env = std::getenv("GEODEX_SHARED_MESHES");
+  return env != nullptr ? env : GEODEX_SHARED_MESHES_DEFAULT;
+}
+
+std::vector<std::string> SharedMeshes() {
+  std::vector<std::string> names;
+  std::error_code error;
+  for (const auto& entry : std::filesystem::directory_iterator(SharedDir(), error)) {
+    if (entry.path().extension() == ".obj") names.push_back(entry.path().stem().string());
+  }
+  std::sort(names.begin(), names.end());
+  if (names.empty()) names.push_back("none");
+  return names;
+}
+
+class SharedMeshBuildTest : public ::testing::TestWithParam<std::string> {};
+
+TEST_P(SharedMeshBuildTest, PlanIsValidAndSmallMeshesIndexCompletely) {
+  if (GetParam() == "none") {
+    GTEST_SKIP() << "no meshes in " << SharedDir()
+                 << " (set GEODEX_SHARED_MESHES to the development meshes)";
+  }
+  const std::string path = SharedDir() + "/" + GetParam() + ".obj";
+  auto mesh = mesh::LoadMesh(path);
+  if (GetParam() == "cow_nonmanifold_3k") {
+    ASSERT_FALSE(mesh.ok());
+    EXPECT_THAT(mesh.status().message(), ::testing::HasSubstr("non-manifold vertex"));
+    return;
+  }
+  ASSERT_TRUE(mesh.ok()) << mesh.status();
+  build::BuildOptions options;
+  options.num_samples = 150;
+  options.threads = 2;
+  auto plan = build::MakePlan(*mesh, options);
+  ASSERT_TRUE(plan.ok()) << plan.status();
+  const auto dual = triangulation::CheckDual(*mesh, plan->nearest, plan->num_samples());
+  EXPECT_TRUE(dual.violations.empty());
+  std::printf("%s: %d samples (%s), %zu triangles\n", GetParam().c_str(), plan->num_samples(),
+              plan->repair.Summary().c_str(), plan->triangles.size());
+  if (mesh->num_vertices() > 12000) return;  // full rows cost minutes on big meshes
+  std::vector<int32_t> all(plan->num_samples());
+  for (int32_t a = 0; a < plan->num_samples(); ++a) all[a] = a;
+  auto rows = build::ComputeRows(*mesh, *plan, all, options);
+  ASSERT_TRUE(rows.ok()) << rows.status();
+  build::BuildSummary summary;
+  auto data = build::Merge(*mesh, *plan, std::move(*rows), &summary);
+  ASSERT_TRUE(data.ok()) << data.status();
+  EXPECT_EQ(summary.unassigned_vertices, 0);
+  std::printf("%s", summary.ToText().c_str());
+}
+
+INSTANTIATE_TEST_SUITE_P(SharedMeshes, SharedMeshBuildTest, ::testing::ValuesIn(SharedMeshes()),
+                         [](const auto& info) { return info.param; });
+
+}  // namespace
+}  // namespace geodex
