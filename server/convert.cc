@@ -1,0 +1,184 @@
+#include "server/convert.h"
+
+#include <cmath>
+#include <limits>
+
+#include "absl/strings/ascii.h"
+#include "absl/strings/str_format.h"
+#include "absl/strings/str_split.h"
+
+namespace geodex::server {
+
+absl::Status PointsFromProto(const v1::SurfacePoints& points, std::string_view name,
+                             const query::QueryEngine& engine,
+                             std::vector<mesh::SurfacePoint>* out) {
+  const int64_t n = points.faces_size();
+  if (points.weights_size() != 3 * n) {
+    return absl::InvalidArgumentError(absl::StrFormat("%s: %d faces but %d weights (want %d)",
+                                                      std::string(name), n, points.weights_size(),
+                                                      3 * n));
+  }
+  out->resize(n);
+  const int32_t* faces = points.faces().data();
+  const double* weights = points.weights().data();
+  for (int64_t i = 0; i < n; ++i) {
+    mesh::SurfacePoint& p = (*out)[i];
+    p.face = faces[i];
+    p.w = {weights[3 * i], weights[3 * i + 1], weights[3 * i + 2]};
+    absl::Status status = engine.Validate(p);
+    if (!status.ok()) {
+      return absl::Status(status.code(), absl::StrFormat("%s[%d]: %s", std::string(name), i,
+                                                         std::string(status.message())));
+    }
+  }
+  return absl::OkStatus();
+}
+
+absl::Status PositionsFromProto(const v1::Positions& positions, std::string_view name,
+                                std::vector<mesh::Vec3>* out) {
+  const int64_t size = positions.xyz_size();
+  if (size % 3 != 0) {
+    return absl::InvalidArgumentError(
+        absl::StrFormat("%s: %d coordinates, not a multiple of 3", std::string(name), size));
+  }
+  const int64_t n = size / 3;
+  out->resize(n);
+  const double* xyz = positions.xyz().data();
+  for (int64_t i = 0; i < n; ++i) {
+    for (int c = 0; c < 3; ++c) {
+      if (!std::isfinite(xyz[3 * i + c])) {
+        return absl::InvalidArgumentError(absl::StrFormat(
+            "%s[%d]: %c is %g, not finite", std::string(name), i, "xyz"[c], xyz[3 * i + c]));
+      }
+    }
+    (*out)[i] = mesh::Vec3(xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]);
+  }
+  return absl::OkStatus();
+}
+
+void AppendPoint(const mesh::SurfacePoint& point, v1::SurfacePoints* points) {
+  points->add_faces(point.face);
+  for (double w : point.w) points->add_weights(w);
+}
+
+std::span<double> ResizeForOutput(google::protobuf::RepeatedField<double>* values, int64_t n) {
+  values->Resize(static_cast<int>(n), 0.0);
+  return {values->mutable_data(), static_cast<size_t>(n)};
+}
+
+void PathToProto(std::span<const query::PathPoint> path, v1::Polyline* polyline) {
+  polyline->Clear();
+  v1::SurfacePoints* points = polyline->mutable_points();
+  google::protobuf::RepeatedField<double>* xyz = polyline->mutable_positions()->mutable_xyz();
+  points->mutable_faces()->Reserve(static_cast<int>(path.size()));
+  points->mutable_weights()->Reserve(static_cast<int>(3 * path.size()));
+  xyz->Reserve(static_cast<int>(3 * path.size()));
+  double length = 0;
+  for (size_t i = 0; i < path.size(); ++i) {
+    AppendPoint(path[i].point, points);
+    for (int c = 0; c < 3; ++c) xyz->Add(path[i].position[c]);
+    if (i > 0) length += (path[i].position - path[i - 1].position).norm();
+  }
+  polyline->set_length(length);
+}
+
+void UnreachablePathToProto(v1::Polyline* polyline) {
+  polyline->Clear();
+  polyline->set_length(std::numeric_limits<double>::infinity());
+}
+
+void AppendLocated(const query::LocatedPoint& located, v1::LocateResponse* response) {
+  AppendPoint(located.point, response->mutable_points());
+  response->add_distances(located.distance);
+}
+
+void MatrixBlockToProto(int64_t row_offset, int64_t rows, int64_t num_targets,
+                        std::span<const double> values, int64_t version, v1::MatrixBlock* block) {
+  block->set_row_offset(row_offset);
+  block->set_rows(rows);
+  block->set_num_targets(num_targets);
+  block->set_version(version);
+  block->mutable_values()->Assign(values.begin(), values.end());
+}
+
+void FieldChunkToProto(const query::DistanceField& field, int64_t offset, int64_t count,
+                       bool with_nearest_source, int64_t version, v1::DistanceFieldChunk* chunk) {
+  chunk->set_vertex_offset(offset);
+  chunk->set_num_vertices(static_cast<int64_t>(field.distance.size()));
+  chunk->set_version(version);
+  chunk->mutable_distances()->Assign(field.distance.begin() + offset,
+                                     field.distance.begin() + offset + count);
+  if (with_nearest_source) {
+    chunk->mutable_nearest_source()->Assign(field.nearest.begin() + offset,
+                                            field.nearest.begin() + offset + count);
+  } else {
+    chunk->clear_nearest_source();
+  }
+}
+
+namespace {
+
+v1::ModelInfo::State ToProtoState(LoadState state) {
+  switch (state) {
+    case LoadState::kLoading:
+      return v1::ModelInfo::LOADING;
+    case LoadState::kServing:
+      return v1::ModelInfo::SERVING;
+    case LoadState::kFailed:
+      return v1::ModelInfo::FAILED;
+  }
+  return v1::ModelInfo::STATE_UNSPECIFIED;
+}
+
+}  // namespace
+
+void ModelInfoToProto(const ModelSnapshot& model, const ServedVersion* version,
+                      v1::ModelInfo* info) {
+  info->Clear();
+  info->set_name(model.name);
+  info->set_state(ToProtoState(model.state));
+  info->set_reason(model.reason);
+  for (int64_t v : model.available_versions) info->add_available_versions(v);
+  if (version == nullptr) {
+    info->set_version(model.available_versions.empty() ? 0 : model.available_versions.back());
+    return;
+  }
+  const index::Index& ix = version->index();
+  const index::FileHeader& h = ix.header();
+  info->set_version(version->version());
+  info->set_num_vertices(ix.num_vertices());
+  info->set_num_faces(ix.num_faces());
+  info->set_num_samples(ix.num_samples());
+  info->set_num_triangles(ix.num_triangles());
+  if (ix.num_vertices() > 0) {
+    std::span<const double> p = ix.positions();
+    double lo[3] = {p[0], p[1], p[2]}, hi[3] = {p[0], p[1], p[2]};
+    for (size_t v = 0; v < p.size() / 3; ++v) {
+      for (int c = 0; c < 3; ++c) {
+        lo[c] = std::min(lo[c], p[3 * v + c]);
+        hi[c] = std::max(hi[c], p[3 * v + c]);
+      }
+    }
+    for (int c = 0; c < 3; ++c) {
+      info->add_bbox_min(lo[c]);
+      info->add_bbox_max(hi[c]);
+    }
+  }
+  info->set_requested_samples(h.params.requested_samples);
+  info->set_seed(h.params.seed);
+  info->set_samples_added_by_repair(h.params.samples_added_by_repair);
+  info->set_builder_version(ix.builder_version());
+  info->set_mapped_bytes(version->mapped_bytes());
+  info->set_mesh_hash(h.mesh_hash);
+  auto* report = info->mutable_build_report();
+  const std::string text(ix.report());
+  for (absl::string_view line : absl::StrSplit(text, '\n')) {
+    const size_t eq = line.find('=');
+    if (eq == absl::string_view::npos) continue;
+    const std::string key(absl::StripAsciiWhitespace(line.substr(0, eq)));
+    if (key.empty()) continue;
+    (*report)[key] = std::string(absl::StripAsciiWhitespace(line.substr(eq + 1)));
+  }
+}
+
+}  // namespace geodex::server

@@ -1,0 +1,71 @@
+#pragma once
+
+// The one place where geodex.v1 messages become core types and back.
+//
+// Reading validates everything a query needs, with messages that name the
+// offending element the way the request spells it ("a[17]: face id 99999 out
+// of range [0, 5000)"), and with the codes of STYLE.md: InvalidArgument for
+// malformed input, OutOfRange for a face id past the end.
+//
+// Thread safety: pure functions (outputs are the caller's).
+
+#include <cstdint>
+#include <span>
+#include <string_view>
+#include <vector>
+
+#include "absl/status/status.h"
+#include "core/mesh/mesh.h"
+#include "core/query/query_engine.h"
+#include "geodex/v1/geodex.pb.h"
+#include "server/model_registry.h"
+
+namespace geodex::server {
+
+// Reads `points` (named `name` in messages) into `out` and validates each
+// point against `engine`'s index. Errors: InvalidArgument if weights are not 3
+// per face ("a: 4 faces but 11 weights (want 12)"); OutOfRange for a face id
+// past the end and InvalidArgument for NaN, infinite or negative weights or
+// weights not summing to 1, both naming the point ("a[17]: ...").
+absl::Status PointsFromProto(const v1::SurfacePoints& points, std::string_view name,
+                             const query::QueryEngine& engine,
+                             std::vector<mesh::SurfacePoint>* out);
+
+// Number of points in `points` (faces; weights are checked by PointsFromProto).
+inline int64_t PointCount(const v1::SurfacePoints& points) { return points.faces_size(); }
+
+// Reads packed 3D positions. Errors: InvalidArgument if xyz is not a multiple
+// of 3 long or a coordinate is not finite ("positions[4]: y is nan").
+absl::Status PositionsFromProto(const v1::Positions& positions, std::string_view name,
+                                std::vector<mesh::Vec3>* out);
+
+// Appends one point to `points`.
+void AppendPoint(const mesh::SurfacePoint& point, v1::SurfacePoints* points);
+
+// Resizes `values` to `n` and returns its storage, for the engine to fill.
+std::span<double> ResizeForOutput(google::protobuf::RepeatedField<double>* values, int64_t n);
+
+// A path from QueryEngine::Path; `length` is the sum of its 3D segments.
+void PathToProto(std::span<const query::PathPoint> path, v1::Polyline* polyline);
+// The answer for a pair on different connected components: no points,
+// length +Infinity.
+void UnreachablePathToProto(v1::Polyline* polyline);
+
+// A located point (QueryEngine::Locate) appended to a LocateResponse.
+void AppendLocated(const query::LocatedPoint& located, v1::LocateResponse* response);
+
+// Rows [row_offset, row_offset + rows) of a matrix, `values` row-major.
+void MatrixBlockToProto(int64_t row_offset, int64_t rows, int64_t num_targets,
+                        std::span<const double> values, int64_t version, v1::MatrixBlock* block);
+
+// Vertices [offset, offset + count) of a distance field.
+void FieldChunkToProto(const query::DistanceField& field, int64_t offset, int64_t count,
+                       bool with_nearest_source, int64_t version, v1::DistanceFieldChunk* chunk);
+
+// A model as GetModel and ListModels describe it: `version` (a served
+// version of `model`) if given, otherwise what is known without an index
+// (state, reason, versions on disk).
+void ModelInfoToProto(const ModelSnapshot& model, const ServedVersion* version,
+                      v1::ModelInfo* info);
+
+}  // namespace geodex::server

@@ -1,0 +1,148 @@
+#include "server/convert.h"
+
+#include <cmath>
+#include <limits>
+
+#include "absl/strings/str_format.h"
+#include "gmock/gmock.h"
+#include "gtest/gtest.h"
+#include "server/test_util.h"
+
+namespace geodex::server {
+namespace {
+
+using ::testing::HasSubstr;
+using ::testing::StartsWith;
+
+class ConvertTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    auto index = index::Index::FromBytes(testing::SphereIndexBytes());
+    ASSERT_TRUE(index.ok()) << index.status();
+    auto engine = query::QueryEngine::Create(*index);
+    ASSERT_TRUE(engine.ok()) << engine.status();
+    engine_ = *engine;
+  }
+  v1::SurfacePoints Points(std::vector<int32_t> faces, std::vector<double> weights) {
+    v1::SurfacePoints p;
+    for (int32_t f : faces) p.add_faces(f);
+    for (double w : weights) p.add_weights(w);
+    return p;
+  }
+  absl::Status Read(const v1::SurfacePoints& p, const char* name = "a") {
+    return PointsFromProto(p, name, *engine_, &out_);
+  }
+  std::shared_ptr<const query::QueryEngine> engine_;
+  std::vector<mesh::SurfacePoint> out_;
+};
+
+TEST_F(ConvertTest, ReadsValidPoints) {
+  ASSERT_TRUE(Read(Points({0, 5}, {1, 0, 0, 0.25, 0.25, 0.5})).ok());
+  ASSERT_EQ(out_.size(), 2u);
+  EXPECT_EQ(out_[1].face, 5);
+  EXPECT_EQ(out_[1].w[2], 0.5);
+}
+
+TEST_F(ConvertTest, NamesTheOffendingPoint) {
+  const int32_t n = engine_->index().num_faces();
+  absl::Status s = Read(Points({0, 99999}, {1, 0, 0, 1, 0, 0}));
+  EXPECT_EQ(s.code(), absl::StatusCode::kOutOfRange);
+  EXPECT_EQ(std::string(s.message()),
+            absl::StrFormat("a[1]: face id 99999 out of range [0, %d)", n));
+  s = Read(Points({-1}, {1, 0, 0}), "b");
+  EXPECT_EQ(s.code(), absl::StatusCode::kOutOfRange);
+  EXPECT_THAT(std::string(s.message()), StartsWith("b[0]: face id -1"));
+
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const double inf = std::numeric_limits<double>::infinity();
+  for (const auto& [weights, what] :
+       std::vector<std::pair<std::vector<double>, const char*>>{{{nan, 0.5, 0.5}, "not finite"},
+                                                                {{inf, 0, 0}, "not finite"},
+                                                                {{1.5, -0.5, 0}, "negative"},
+                                                                {{0.5, 0.2, 0.2}, "sum to"}}) {
+    std::vector<double> w = {1, 0, 0};
+    w.insert(w.end(), weights.begin(), weights.end());
+    s = Read(Points({0, 3}, w));
+    EXPECT_EQ(s.code(), absl::StatusCode::kInvalidArgument) << what;
+    EXPECT_THAT(std::string(s.message()), StartsWith("a[1]: ")) << what;
+    EXPECT_THAT(std::string(s.message()), HasSubstr(what));
+  }
+}
+
+TEST_F(ConvertTest, WeightsMustBeThreePerFace) {
+  absl::Status s = Read(Points({0, 1}, {1, 0, 0, 1, 0}));
+  EXPECT_EQ(s.code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_EQ(std::string(s.message()), "a: 2 faces but 5 weights (want 6)");
+}
+
+TEST_F(ConvertTest, WeightsWithinToleranceAreAccepted) {
+  EXPECT_TRUE(Read(Points({0}, {1 + 5e-7, -5e-7, 0})).ok());
+}
+
+TEST(ConvertPositionsTest, ChecksShapeAndFiniteness) {
+  std::vector<mesh::Vec3> out;
+  v1::Positions p;
+  for (double x : {0.0, 1.0, 2.0, 3.0}) p.add_xyz(x);
+  EXPECT_EQ(std::string(PositionsFromProto(p, "positions", &out).message()),
+            "positions: 4 coordinates, not a multiple of 3");
+  p.add_xyz(std::nan(""));
+  p.add_xyz(5);
+  absl::Status s = PositionsFromProto(p, "positions", &out);
+  EXPECT_EQ(s.code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(std::string(s.message()), StartsWith("positions[1]: y is nan"));
+  p.set_xyz(4, 4);
+  ASSERT_TRUE(PositionsFromProto(p, "positions", &out).ok());
+  EXPECT_EQ(out[1], mesh::Vec3(3, 4, 5));
+}
+
+TEST(ConvertPathTest, LengthIsTheSumOfSegments) {
+  std::vector<query::PathPoint> path(3);
+  path[0].position = {0, 0, 0};
+  path[1].position = {3, 4, 0};
+  path[2].position = {3, 4, 1};
+  v1::Polyline line;
+  PathToProto(path, &line);
+  EXPECT_DOUBLE_EQ(line.length(), 6);
+  EXPECT_EQ(line.points().faces_size(), 3);
+  EXPECT_EQ(line.positions().xyz_size(), 9);
+  UnreachablePathToProto(&line);
+  EXPECT_TRUE(std::isinf(line.length()));
+  EXPECT_EQ(line.points().faces_size(), 0);
+}
+
+TEST(ConvertModelInfoTest, DescribesAServedVersion) {
+  testing::TempDir dir;
+  testing::WriteModelVersion(dir.path(), "sphere", 3, testing::SphereIndexBytes());
+  const std::string path = dir.path() + "/sphere/3/index.gdx";
+  auto served = ServedVersion::Load(3, path, FileId{}, false);
+  ASSERT_TRUE(served.ok()) << served.status();
+  ModelSnapshot model;
+  model.name = "sphere";
+  model.state = LoadState::kServing;
+  model.available_versions = {3};
+  v1::ModelInfo info;
+  ModelInfoToProto(model, served->get(), &info);
+  const index::Index& ix = (*served)->index();
+  EXPECT_EQ(info.name(), "sphere");
+  EXPECT_EQ(info.version(), 3);
+  EXPECT_EQ(info.state(), v1::ModelInfo::SERVING);
+  EXPECT_EQ(info.num_vertices(), ix.num_vertices());
+  EXPECT_EQ(info.num_faces(), ix.num_faces());
+  EXPECT_EQ(info.num_samples(), ix.num_samples());
+  EXPECT_EQ(info.num_triangles(), ix.num_triangles());
+  EXPECT_EQ(info.requested_samples(), 40);
+  EXPECT_EQ(info.mapped_bytes(), static_cast<int64_t>(testing::SphereIndexBytes().size()));
+  EXPECT_EQ(info.mesh_hash(), ix.header().mesh_hash);
+  ASSERT_EQ(info.bbox_min_size(), 3);
+  EXPECT_NEAR(info.bbox_min(0), -1, 1e-9);
+  EXPECT_NEAR(info.bbox_max(2), 1, 1e-9);
+  EXPECT_FALSE(info.builder_version().empty());
+  EXPECT_FALSE(info.build_report().empty());
+  for (const auto& [key, value] : info.build_report()) {
+    EXPECT_FALSE(key.empty());
+    EXPECT_EQ(key.find(' '), std::string::npos) << key;
+  }
+}
+
+}  // namespace
+}  // namespace geodex::server

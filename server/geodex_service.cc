@@ -1,0 +1,847 @@
+#include "server/geodex_service.h"
+
+#include <algorithm>
+#include <atomic>
+#include <deque>
+#include <random>
+#include <utility>
+
+#include "absl/strings/str_format.h"
+#include "core/common/status_macros.h"
+#include "server/convert.h"
+#include "server/model_config.h"
+#include "server/status_conversion.h"
+#include "spdlog/spdlog.h"
+
+namespace geodex::server {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+// Largest payload of one streamed Matrix block or DistanceField chunk.
+constexpr int64_t kChunkBytes = 1 << 20;
+
+double SecondsSince(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+// A client-supplied request id is used when it is short and printable.
+bool IsSaneRequestId(grpc::string_ref id) {
+  if (id.empty() || id.size() > 64) return false;
+  return std::all_of(id.begin(), id.end(), [](char c) { return c > ' ' && c < 127; });
+}
+
+std::string NewRequestId() {
+  static const uint32_t prefix = std::random_device()();
+  static std::atomic<uint64_t> counter{0};
+  return absl::StrFormat("%08x-%d", prefix, counter.fetch_add(1) + 1);
+}
+
+// Client mistakes are logged at info, the server's own trouble at warn.
+bool IsClientError(absl::StatusCode code) {
+  switch (code) {
+    case absl::StatusCode::kInvalidArgument:
+    case absl::StatusCode::kOutOfRange:
+    case absl::StatusCode::kNotFound:
+    case absl::StatusCode::kResourceExhausted:
+    case absl::StatusCode::kUnauthenticated:
+    case absl::StatusCode::kCancelled:
+    case absl::StatusCode::kDeadlineExceeded:
+      return true;
+    default:
+      return false;
+  }
+}
+
+absl::Status WithPrefix(const absl::Status& status, const std::string& prefix) {
+  return absl::Status(status.code(), prefix + std::string(status.message()));
+}
+
+}  // namespace
+
+// --- calls ------------------------------------------------------------------------
+
+GeodexService::GeodexService(const ModelRegistry* registry, WorkerPool* pool, Metrics* metrics,
+                             const TokenAuth* auth, ServiceLimits limits)
+    : registry_(registry), pool_(pool), metrics_(metrics), auth_(auth), limits_(limits) {}
+
+GeodexService::~GeodexService() = default;
+
+GeodexService::Call GeodexService::StartCall(grpc::CallbackServerContext* context,
+                                             const char* method) const {
+  Call call;
+  call.method = method;
+  call.start = Clock::now();
+  const auto& metadata = context->client_metadata();
+  auto it = metadata.find("x-request-id");
+  call.request_id = it != metadata.end() && IsSaneRequestId(it->second)
+                        ? std::string(it->second.data(), it->second.size())
+                        : NewRequestId();
+  context->AddInitialMetadata("x-request-id", call.request_id);
+  return call;
+}
+
+grpc::Status GeodexService::FinishCall(Call& call, const absl::Status& status) const {
+  const double seconds = SecondsSince(call.start);
+  if (metrics_ != nullptr) {
+    metrics_->RecordCall(call.method, call.model, status.code(), call.pairs, seconds);
+  }
+  if (!status.ok()) {
+    const auto level = IsClientError(status.code()) ? spdlog::level::info : spdlog::level::warn;
+    spdlog::log(level, "[{}] {} model='{}' failed after {:.6f}s: {}", call.request_id, call.method,
+                call.model, seconds, status.ToString());
+  } else {
+    spdlog::debug("[{}] {} model='{}' ok: {} items in {:.6f}s", call.request_id, call.method,
+                  call.model, call.pairs, seconds);
+  }
+  return ToGrpcStatus(status);
+}
+
+absl::Status GeodexService::Authorize(const grpc::CallbackServerContext& context) const {
+  return auth_ == nullptr ? absl::OkStatus() : auth_->Check(context);
+}
+
+absl::Status GeodexService::CheckAlive(const grpc::CallbackServerContext& context) {
+  if (!context.IsCancelled()) return absl::OkStatus();
+  if (context.deadline() <= std::chrono::system_clock::now()) {
+    return absl::DeadlineExceededError("deadline exceeded");
+  }
+  return absl::CancelledError("call cancelled");
+}
+
+absl::Status GeodexService::Busy() const {
+  return absl::ResourceExhaustedError(
+      absl::StrFormat("server busy: %d jobs queued for %d workers; retry later",
+                      pool_->queue_depth(), pool_->threads()));
+}
+
+absl::StatusOr<ResolvedModel> GeodexService::Resolve(const v1::ModelRef& ref, Call& call) const {
+  absl::StatusOr<ResolvedModel> resolved = registry_->Resolve(ref.name(), ref.version());
+  if (resolved.ok()) call.model = resolved->model->name;
+  return resolved;
+}
+
+ServiceLimits GeodexService::LimitsFor(const ModelSnapshot& model) const {
+  return WithModelLimits(limits_, model.config.limits());
+}
+
+absl::Status GeodexService::ComputeDistances(const ResolvedModel& model, const v1::SurfacePoints& a,
+                                             const v1::SurfacePoints& b, bool exact_near_pairs,
+                                             WorkerContext& worker,
+                                             google::protobuf::RepeatedField<double>* out) const {
+  const ServiceLimits limits = LimitsFor(*model.model);
+  const int64_t na = PointCount(a), nb = PointCount(b);
+  if (std::max(na, nb) > limits.max_pairs_per_message) {
+    return absl::ResourceExhaustedError(
+        absl::StrFormat("%d pairs exceed the limit of %d per message (max_pairs_per_message)",
+                        std::max(na, nb), limits.max_pairs_per_message));
+  }
+  if (na != nb) {
+    return absl::InvalidArgumentError(
+        absl::StrFormat("a has %d points but b has %d; they must pair up", na, nb));
+  }
+  const query::QueryEngine* engine = &model.version->engine();
+  if (exact_near_pairs || model.model->config.exact_near_pairs()) {
+    GEODEX_ASSIGN_OR_RETURN(engine, model.version->ExactEngine());
+  }
+  GEODEX_RETURN_IF_ERROR(PointsFromProto(a, "a", *engine, &worker.a));
+  GEODEX_RETURN_IF_ERROR(PointsFromProto(b, "b", *engine, &worker.b));
+  return engine->DistanceBatch(worker.a, worker.b, ResizeForOutput(out, na), &worker.scratch);
+}
+
+template <class Fn>
+grpc::ServerUnaryReactor* GeodexService::RunUnary(grpc::CallbackServerContext* context,
+                                                  const char* method, Fn fn) {
+  grpc::ServerUnaryReactor* reactor = context->DefaultReactor();
+  auto call = std::make_shared<Call>(StartCall(context, method));
+  if (absl::Status status = Authorize(*context); !status.ok()) {
+    reactor->Finish(FinishCall(*call, status));
+    return reactor;
+  }
+  // The request, response and context live until Finish; the job calls
+  // Finish exactly once.
+  const bool queued = pool_->Submit([this, context, reactor, call, fn](WorkerContext& worker) {
+    absl::Status status = CheckAlive(*context);
+    if (status.ok()) status = fn(*call, worker);
+    reactor->Finish(FinishCall(*call, status));
+  });
+  if (!queued) reactor->Finish(FinishCall(*call, Busy()));
+  return reactor;
+}
+
+// --- unary calls ------------------------------------------------------------------
+
+grpc::ServerUnaryReactor* GeodexService::ListModels(grpc::CallbackServerContext* context,
+                                                    const v1::ListModelsRequest* /*request*/,
+                                                    v1::ListModelsResponse* response) {
+  return RunUnary(context, "ListModels", [this, response](Call&, WorkerContext&) {
+    std::shared_ptr<const RegistrySnapshot> snapshot = registry_->snapshot();
+    for (const auto& [name, model] : snapshot->models) {
+      ModelInfoToProto(*model, model->newest(), response->add_models());
+    }
+    return absl::OkStatus();
+  });
+}
+
+grpc::ServerUnaryReactor* GeodexService::GetModel(grpc::CallbackServerContext* context,
+                                                  const v1::GetModelRequest* request,
+                                                  v1::ModelInfo* response) {
+  return RunUnary(context, "GetModel", [this, request, response](Call& call, WorkerContext&) {
+    const v1::ModelRef& ref = request->model();
+    GEODEX_RETURN_IF_ERROR(ValidateModelName(ref.name()));
+    if (ref.version() < 0) {
+      return absl::InvalidArgumentError(
+          absl::StrFormat("model version %d is negative", ref.version()));
+    }
+    std::shared_ptr<const RegistrySnapshot> snapshot = registry_->snapshot();
+    auto it = snapshot->models.find(ref.name());
+    if (it == snapshot->models.end()) {
+      if (!snapshot->initial_scan_done) {
+        return absl::UnavailableError("the model repository is still being scanned");
+      }
+      return absl::NotFoundError(absl::StrFormat("unknown model '%s'", ref.name()));
+    }
+    const ModelSnapshot& model = *it->second;
+    call.model = model.name;
+    if (ref.version() == 0) {
+      ModelInfoToProto(model, model.newest(), response);
+      return absl::OkStatus();
+    }
+    // A pinned version: described if served.
+    GEODEX_ASSIGN_OR_RETURN(ResolvedModel resolved, Resolve(ref, call));
+    ModelInfoToProto(model, resolved.version, response);
+    return absl::OkStatus();
+  });
+}
+
+grpc::ServerUnaryReactor* GeodexService::Distance(grpc::CallbackServerContext* context,
+                                                  const v1::DistanceRequest* request,
+                                                  v1::DistanceResponse* response) {
+  return RunUnary(context, "Distance",
+                  [this, request, response](Call& call, WorkerContext& worker) -> absl::Status {
+                    GEODEX_ASSIGN_OR_RETURN(ResolvedModel model, Resolve(request->model(), call));
+                    GEODEX_RETURN_IF_ERROR(ComputeDistances(model, request->a(), request->b(),
+                                                            request->exact_near_pairs(), worker,
+                                                            response->mutable_distances()));
+                    call.pairs = PointCount(request->a());
+                    response->set_version(model.version->version());
+                    return absl::OkStatus();
+                  });
+}
+
+grpc::ServerUnaryReactor* GeodexService::Path(grpc::CallbackServerContext* context,
+                                              const v1::PathRequest* request,
+                                              v1::PathResponse* response) {
+  return RunUnary(
+      context, "Path",
+      [this, context, request, response](Call& call, WorkerContext& worker) -> absl::Status {
+        GEODEX_ASSIGN_OR_RETURN(ResolvedModel model, Resolve(request->model(), call));
+        const ServiceLimits limits = LimitsFor(*model.model);
+        const int64_t na = PointCount(request->a()), nb = PointCount(request->b());
+        if (std::max(na, nb) > limits.max_path_pairs) {
+          return absl::ResourceExhaustedError(
+              absl::StrFormat("%d pairs exceed the limit of %d per Path call (max_path_pairs)",
+                              std::max(na, nb), limits.max_path_pairs));
+        }
+        if (na != nb) {
+          return absl::InvalidArgumentError(
+              absl::StrFormat("a has %d points but b has %d; they must pair up", na, nb));
+        }
+        const query::QueryEngine& engine = model.version->engine();
+        GEODEX_RETURN_IF_ERROR(PointsFromProto(request->a(), "a", engine, &worker.a));
+        GEODEX_RETURN_IF_ERROR(PointsFromProto(request->b(), "b", engine, &worker.b));
+        response->mutable_paths()->Reserve(static_cast<int>(na));
+        for (int64_t i = 0; i < na; ++i) {
+          GEODEX_RETURN_IF_ERROR(CheckAlive(*context));
+          absl::StatusOr<std::vector<query::PathPoint>> path =
+              engine.Path(worker.a[i], worker.b[i]);
+          if (path.ok()) {
+            PathToProto(*path, response->add_paths());
+          } else if (path.status().code() == absl::StatusCode::kNotFound) {
+            UnreachablePathToProto(response->add_paths());  // different components
+          } else {
+            return WithPrefix(path.status(), absl::StrFormat("pair %d: ", i));
+          }
+        }
+        call.pairs = na;
+        response->set_version(model.version->version());
+        return absl::OkStatus();
+      });
+}
+
+grpc::ServerUnaryReactor* GeodexService::Locate(grpc::CallbackServerContext* context,
+                                                const v1::LocateRequest* request,
+                                                v1::LocateResponse* response) {
+  return RunUnary(
+      context, "Locate", [this, request, response](Call& call, WorkerContext&) -> absl::Status {
+        GEODEX_ASSIGN_OR_RETURN(ResolvedModel model, Resolve(request->model(), call));
+        const ServiceLimits limits = LimitsFor(*model.model);
+        const int64_t n = request->positions().xyz_size() / 3;
+        if (n > limits.max_locate_positions) {
+          return absl::ResourceExhaustedError(
+              absl::StrFormat("%d positions exceed the limit of %d per Locate call "
+                              "(max_locate_positions)",
+                              n, limits.max_locate_positions));
+        }
+        std::vector<mesh::Vec3> positions;
+        GEODEX_RETURN_IF_ERROR(PositionsFromProto(request->positions(), "positions", &positions));
+        const query::QueryEngine& engine = model.version->engine();
+        for (size_t i = 0; i < positions.size(); ++i) {
+          absl::StatusOr<query::LocatedPoint> located = engine.Locate(positions[i]);
+          if (!located.ok()) {
+            return WithPrefix(located.status(), absl::StrFormat("positions[%d]: ", i));
+          }
+          AppendLocated(*located, response);
+        }
+        call.pairs = n;
+        response->set_version(model.version->version());
+        return absl::OkStatus();
+      });
+}
+
+// --- streaming calls ----------------------------------------------------------------
+
+// A streaming call's reactor. Ownership: gRPC holds the reactor from the
+// handler's return until OnDone, where it deletes itself (the callback API's
+// contract); the service keeps a non-owning registration (for
+// BeginShutdown), removed in OnDone before the delete, under streams_mutex_.
+class GeodexService::StreamBase {
+ public:
+  virtual ~StreamBase() = default;
+  // Called under streams_mutex_ by BeginShutdown.
+  virtual void Drain() = 0;
+};
+
+absl::Status GeodexService::RegisterStream(StreamBase* stream) {
+  std::lock_guard<std::mutex> lock(streams_mutex_);
+  if (shutting_down_) return absl::UnavailableError("server is shutting down");
+  if (static_cast<int64_t>(streams_.size()) >= limits_.max_concurrent_streams) {
+    return absl::ResourceExhaustedError(absl::StrFormat(
+        "%d streaming calls already running (max_concurrent_streams)", streams_.size()));
+  }
+  streams_.insert(stream);
+  if (metrics_ != nullptr) metrics_->SetActiveStreams(static_cast<int64_t>(streams_.size()));
+  return absl::OkStatus();
+}
+
+void GeodexService::UnregisterStream(StreamBase* stream) {
+  std::lock_guard<std::mutex> lock(streams_mutex_);
+  streams_.erase(stream);
+  if (metrics_ != nullptr) metrics_->SetActiveStreams(static_cast<int64_t>(streams_.size()));
+}
+
+int64_t GeodexService::active_streams() const {
+  std::lock_guard<std::mutex> lock(streams_mutex_);
+  return static_cast<int64_t>(streams_.size());
+}
+
+void GeodexService::BeginShutdown() {
+  std::lock_guard<std::mutex> lock(streams_mutex_);
+  if (shutting_down_) return;
+  shutting_down_ = true;
+  for (StreamBase* stream : streams_) stream->Drain();
+}
+
+// StreamDistances. All state is guarded by mutex_, and gRPC operations are
+// started under it (reactions never run inline in StartRead/StartWrite/
+// Finish, so this cannot deadlock); Advance() decides the next operations.
+class GeodexService::DistanceStream final
+    : public grpc::ServerBidiReactor<v1::DistanceBatch, v1::DistanceResult>,
+      public GeodexService::StreamBase {
+ public:
+  DistanceStream(GeodexService* service, grpc::CallbackServerContext* context)
+      : service_(service),
+        context_(context),
+        call_(service->StartCall(context, "StreamDistances")),
+        window_(std::max<size_t>(1, service->limits_.stream_window)) {
+    absl::Status status = service->Authorize(*context);
+    if (status.ok()) status = service->RegisterStream(this);
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (!status.ok()) {
+      finished_ = true;
+      Finish(service_->FinishCall(call_, status));
+      return;
+    }
+    registered_ = true;
+    Advance();
+  }
+
+  void OnReadDone(bool ok) override {
+    std::lock_guard<std::mutex> lock(mutex_);
+    read_in_flight_ = false;
+    std::unique_ptr<Slot> slot = std::move(reading_);
+    if (finished_) return;
+    if (!ok) {
+      reads_done_ = true;  // the client half-closed (or the call ended)
+      Advance();
+      return;
+    }
+    slot->received = Clock::now();
+    // The first batch naming a model sets the stream's model; later batches
+    // may leave it empty.
+    if (!slot->request.model().name().empty()) stream_model_ = slot->request.model();
+    slot->model = stream_model_;
+    Slot* raw = slot.get();
+    slots_.push_back(std::move(slot));
+    ++jobs_;
+    if (!service_->pool_->Submit([this, raw](WorkerContext& worker) { Compute(raw, worker); })) {
+      --jobs_;
+      SetResult(raw, service_->Busy(), 0);
+      raw->done = true;
+    }
+    Advance();
+  }
+
+  void OnWriteDone(bool ok) override {
+    std::lock_guard<std::mutex> lock(mutex_);
+    write_in_flight_ = false;
+    if (ok) {
+      slots_.pop_front();
+    } else {
+      cancelled_ = true;  // the stream broke; nothing more can be written
+    }
+    Advance();
+  }
+
+  void OnCancel() override {
+    std::lock_guard<std::mutex> lock(mutex_);
+    cancelled_ = true;
+    Advance();
+  }
+
+  void Drain() override {
+    std::lock_guard<std::mutex> lock(mutex_);
+    draining_ = true;
+    Advance();
+  }
+
+  void OnDone() override {
+    // Wait out a worker that has just released the lock after its last
+    // Advance() (the one that called Finish).
+    { std::lock_guard<std::mutex> lock(mutex_); }
+    if (registered_) service_->UnregisterStream(this);
+    delete this;
+  }
+
+ private:
+  struct Slot {
+    v1::DistanceBatch request;
+    v1::DistanceResult result;
+    v1::ModelRef model;  // the batch's own or the stream's model
+    bool done = false;   // result ready to write
+    Clock::time_point received;
+  };
+
+  // Runs on a worker, without the lock while it computes.
+  void Compute(Slot* slot, WorkerContext& worker) {
+    bool skip;
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      skip = cancelled_;
+    }
+    absl::Status status;
+    int64_t version = 0;
+    std::string model_label;
+    if (skip) {
+      status = absl::CancelledError("call cancelled");
+    } else if (slot->model.name().empty()) {
+      status = absl::InvalidArgumentError(
+          absl::StrFormat("batch %d names no model, and no earlier batch of the stream did",
+                          slot->request.batch_id()));
+    } else {
+      Call batch_call;
+      absl::StatusOr<ResolvedModel> model = service_->Resolve(slot->model, batch_call);
+      status = model.status();
+      if (model.ok()) {
+        model_label = model->model->name;
+        version = model->version->version();
+        status = service_->ComputeDistances(*model, slot->request.a(), slot->request.b(),
+                                            slot->request.exact_near_pairs(), worker,
+                                            slot->result.mutable_distances());
+      }
+    }
+    const int64_t pairs = status.ok() ? PointCount(slot->request.a()) : 0;
+    SetResult(slot, status, version);
+    if (service_->metrics_ != nullptr) {
+      service_->metrics_->RecordBatch(model_label, status.code(), pairs,
+                                      SecondsSince(slot->received));
+    }
+    if (!status.ok() && !skip) {
+      const auto level = IsClientError(status.code()) ? spdlog::level::info : spdlog::level::warn;
+      spdlog::log(level, "[{}] StreamDistances batch {} model='{}' failed: {}", call_.request_id,
+                  slot->request.batch_id(), model_label, status.ToString());
+    }
+    slot->request.Clear();  // free the input early
+    std::lock_guard<std::mutex> lock(mutex_);
+    call_.pairs += pairs;
+    if (!model_label.empty()) call_.model = model_label;
+    slot->done = true;
+    --jobs_;
+    Advance();
+    // Nothing after this point: once the lock is released, OnDone may run.
+  }
+
+  void SetResult(Slot* slot, const absl::Status& status, int64_t version) {
+    v1::DistanceResult& r = slot->result;
+    r.set_batch_id(slot->request.batch_id());
+    r.set_version(version);
+    if (!status.ok()) {
+      r.clear_distances();
+      r.set_error_code(ToRpcCode(status));
+      r.set_error_message(std::string(status.message()));
+    }
+  }
+
+  // Starts whatever can start now; finishes when nothing is left. Holds mutex_.
+  void Advance() {
+    if (finished_) return;
+    if (!write_in_flight_ && !cancelled_ && !slots_.empty() && slots_.front()->done) {
+      write_in_flight_ = true;
+      last_written_ = slots_.front()->result.batch_id();
+      ++written_;
+      StartWrite(&slots_.front()->result);
+    }
+    if (!read_in_flight_ && !reads_done_ && !cancelled_ && !draining_ && slots_.size() < window_) {
+      read_in_flight_ = true;
+      reading_ = std::make_unique<Slot>();
+      StartRead(&reading_->request);
+    }
+    if (write_in_flight_ || jobs_ > 0) return;
+    absl::Status status;
+    if (cancelled_) {
+      status = CheckAlive(*context_);
+      if (status.ok()) status = absl::CancelledError("the client stopped reading answers");
+    } else if (slots_.empty() && reads_done_) {
+      status = absl::OkStatus();
+    } else if (slots_.empty() && draining_) {
+      // A read may still be pending; gRPC fails it once the call finishes.
+      status = absl::UnavailableError(absl::StrFormat(
+          "server shutting down: %d batches answered (last batch id %d); send the rest again",
+          written_, last_written_));
+    } else {
+      return;
+    }
+    finished_ = true;
+    Finish(service_->FinishCall(call_, status));
+  }
+
+  GeodexService* const service_;
+  grpc::CallbackServerContext* const context_;
+  Call call_;
+  const size_t window_;
+  bool registered_ = false;
+
+  std::mutex mutex_;
+  std::deque<std::unique_ptr<Slot>> slots_;  // read, in order; the front may be being written
+  std::unique_ptr<Slot> reading_;            // the slot a pending read fills
+  v1::ModelRef stream_model_;
+  int jobs_ = 0;  // Compute jobs queued or running
+  int64_t written_ = 0;
+  uint64_t last_written_ = 0;
+  bool read_in_flight_ = false;
+  bool write_in_flight_ = false;
+  bool reads_done_ = false;
+  bool cancelled_ = false;
+  bool draining_ = false;
+  bool finished_ = false;
+};
+
+grpc::ServerBidiReactor<v1::DistanceBatch, v1::DistanceResult>* GeodexService::StreamDistances(
+    grpc::CallbackServerContext* context) {
+  return new DistanceStream(this, context);
+}
+
+// Matrix: one block computed on a worker, then written; the next block is
+// computed only when the write has completed (backpressure). State guarded by
+// mutex_ as in DistanceStream.
+class GeodexService::MatrixStream final : public grpc::ServerWriteReactor<v1::MatrixBlock>,
+                                          public GeodexService::StreamBase {
+ public:
+  MatrixStream(GeodexService* service, grpc::CallbackServerContext* context,
+               const v1::MatrixRequest* request)
+      : service_(service),
+        context_(context),
+        request_(request),
+        call_(service->StartCall(context, "Matrix")) {
+    absl::Status status = service->Authorize(*context);
+    if (status.ok()) status = service->RegisterStream(this);
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (!status.ok()) {
+      FinishLocked(status);
+      return;
+    }
+    registered_ = true;
+    SubmitLocked();
+  }
+
+  void OnWriteDone(bool ok) override {
+    std::lock_guard<std::mutex> lock(mutex_);
+    write_in_flight_ = false;
+    if (!ok) {
+      cancelled_ = true;
+      FinishLocked(absl::CancelledError("the client stopped reading blocks"));
+    } else if (cancelled_) {
+      FinishLocked(CheckAlive(*context_).ok() ? absl::CancelledError("call cancelled")
+                                              : CheckAlive(*context_));
+    } else if (next_row_ < static_cast<int64_t>(sources_.size())) {
+      SubmitLocked();
+    } else {
+      FinishLocked(absl::OkStatus());
+    }
+  }
+
+  void OnCancel() override {
+    std::lock_guard<std::mutex> lock(mutex_);
+    cancelled_ = true;
+    if (!write_in_flight_ && !job_running_) {
+      FinishLocked(CheckAlive(*context_).ok() ? absl::CancelledError("call cancelled")
+                                              : CheckAlive(*context_));
+    }
+  }
+
+  void Drain() override {}  // finite; bounded by the server's shutdown deadline
+
+  void OnDone() override {
+    { std::lock_guard<std::mutex> lock(mutex_); }
+    if (registered_) service_->UnregisterStream(this);
+    delete this;
+  }
+
+ private:
+  void SubmitLocked() {
+    job_running_ = true;
+    if (!service_->pool_->Submit([this](WorkerContext& worker) { Work(worker); })) {
+      job_running_ = false;
+      FinishLocked(service_->Busy());
+    }
+  }
+
+  // Sets up on the first call, then computes the next block.
+  absl::Status Prepare() {
+    GEODEX_ASSIGN_OR_RETURN(model_, service_->Resolve(request_->model(), call_));
+    const ServiceLimits limits = service_->LimitsFor(*model_.model);
+    const int64_t s = PointCount(request_->sources()), t = PointCount(request_->targets());
+    if (s > 0 && t > limits.max_matrix_cells / s) {
+      return absl::ResourceExhaustedError(
+          absl::StrFormat("%d sources x %d targets exceed the limit of %d cells (max_matrix_cells)",
+                          s, t, limits.max_matrix_cells));
+    }
+    if (request_->block_rows() < 0) {
+      return absl::InvalidArgumentError(
+          absl::StrFormat("block_rows is negative (%d)", request_->block_rows()));
+    }
+    engine_ = &model_.version->engine();
+    if (model_.model->config.exact_near_pairs()) {
+      GEODEX_ASSIGN_OR_RETURN(engine_, model_.version->ExactEngine());
+    }
+    GEODEX_RETURN_IF_ERROR(PointsFromProto(request_->sources(), "sources", *engine_, &sources_));
+    GEODEX_RETURN_IF_ERROR(PointsFromProto(request_->targets(), "targets", *engine_, &targets_));
+    // At most kChunkBytes a block, whole rows (at least one).
+    block_rows_ = std::max<int64_t>(1, kChunkBytes / 8 / std::max<int64_t>(1, t));
+    if (request_->block_rows() > 0)
+      block_rows_ = std::min<int64_t>(block_rows_, request_->block_rows());
+    prepared_ = true;
+    return absl::OkStatus();
+  }
+
+  void Work(WorkerContext& worker) {
+    absl::Status status = CheckAlive(*context_);
+    if (status.ok() && !prepared_) status = Prepare();
+    const int64_t s = static_cast<int64_t>(sources_.size());
+    const int64_t t = static_cast<int64_t>(targets_.size());
+    int64_t rows = 0;
+    if (status.ok() && s > 0) {
+      rows = std::min(block_rows_, s - next_row_);
+      values_.resize(rows * t);
+      worker.a.resize(t);
+      for (int64_t r = 0; r < rows && status.ok(); ++r) {
+        status = CheckAlive(*context_);
+        if (!status.ok()) break;
+        std::fill(worker.a.begin(), worker.a.end(), sources_[next_row_ + r]);
+        status = engine_->DistanceBatch(
+            worker.a, targets_, std::span<double>(values_.data() + r * t, t), &worker.scratch);
+      }
+      if (status.ok()) {
+        MatrixBlockToProto(next_row_, rows, t, values_, model_.version->version(), &block_);
+      }
+    }
+    std::lock_guard<std::mutex> lock(mutex_);
+    job_running_ = false;
+    if (!status.ok()) {
+      FinishLocked(status);
+    } else if (cancelled_) {
+      FinishLocked(absl::CancelledError("call cancelled"));
+    } else if (s == 0) {
+      FinishLocked(absl::OkStatus());  // no rows: nothing to stream
+    } else {
+      next_row_ += rows;
+      call_.pairs += rows * t;
+      write_in_flight_ = true;
+      StartWrite(&block_);
+    }
+  }
+
+  void FinishLocked(const absl::Status& status) {
+    if (finished_) return;
+    finished_ = true;
+    Finish(service_->FinishCall(call_, status));
+  }
+
+  GeodexService* const service_;
+  grpc::CallbackServerContext* const context_;
+  const v1::MatrixRequest* const request_;
+  Call call_;
+  bool registered_ = false;
+
+  // Used by one job at a time (jobs are sequential).
+  bool prepared_ = false;
+  ResolvedModel model_;
+  const query::QueryEngine* engine_ = nullptr;
+  std::vector<mesh::SurfacePoint> sources_, targets_;
+  int64_t block_rows_ = 1;
+  int64_t next_row_ = 0;
+  std::vector<double> values_;
+  v1::MatrixBlock block_;
+
+  std::mutex mutex_;
+  bool job_running_ = false;
+  bool write_in_flight_ = false;
+  bool cancelled_ = false;
+  bool finished_ = false;
+};
+
+grpc::ServerWriteReactor<v1::MatrixBlock>* GeodexService::Matrix(
+    grpc::CallbackServerContext* context, const v1::MatrixRequest* request) {
+  return new MatrixStream(this, context, request);
+}
+
+// DistanceField: the field is computed by one job on a worker; chunks are
+// then copied out and written one at a time.
+class GeodexService::FieldStream final : public grpc::ServerWriteReactor<v1::DistanceFieldChunk>,
+                                         public GeodexService::StreamBase {
+ public:
+  FieldStream(GeodexService* service, grpc::CallbackServerContext* context,
+              const v1::DistanceFieldRequest* request)
+      : service_(service),
+        context_(context),
+        request_(request),
+        call_(service->StartCall(context, "DistanceField")) {
+    absl::Status status = service->Authorize(*context);
+    if (status.ok()) status = service->RegisterStream(this);
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (!status.ok()) {
+      FinishLocked(status);
+      return;
+    }
+    registered_ = true;
+    job_running_ = true;
+    if (!service_->pool_->Submit([this](WorkerContext& worker) { Work(worker); })) {
+      job_running_ = false;
+      FinishLocked(service_->Busy());
+    }
+  }
+
+  void OnWriteDone(bool ok) override {
+    std::lock_guard<std::mutex> lock(mutex_);
+    write_in_flight_ = false;
+    if (!ok || cancelled_) {
+      FinishLocked(CheckAlive(*context_).ok() ? absl::CancelledError("call cancelled")
+                                              : CheckAlive(*context_));
+    } else if (next_vertex_ < static_cast<int64_t>(field_.distance.size())) {
+      WriteNextLocked();
+    } else {
+      FinishLocked(absl::OkStatus());
+    }
+  }
+
+  void OnCancel() override {
+    std::lock_guard<std::mutex> lock(mutex_);
+    cancelled_ = true;
+    if (!write_in_flight_ && !job_running_) {
+      FinishLocked(CheckAlive(*context_).ok() ? absl::CancelledError("call cancelled")
+                                              : CheckAlive(*context_));
+    }
+  }
+
+  void Drain() override {}
+
+  void OnDone() override {
+    { std::lock_guard<std::mutex> lock(mutex_); }
+    if (registered_) service_->UnregisterStream(this);
+    delete this;
+  }
+
+ private:
+  absl::Status Compute(WorkerContext& worker) {
+    GEODEX_RETURN_IF_ERROR(CheckAlive(*context_));
+    GEODEX_ASSIGN_OR_RETURN(model_, service_->Resolve(request_->model(), call_));
+    const ServiceLimits limits = service_->LimitsFor(*model_.model);
+    const int64_t n = PointCount(request_->sources());
+    if (n > limits.max_field_sources) {
+      return absl::ResourceExhaustedError(absl::StrFormat(
+          "%d sources exceed the limit of %d (max_field_sources)", n, limits.max_field_sources));
+    }
+    if (n == 0) return absl::InvalidArgumentError("sources: no source given");
+    const query::QueryEngine& engine = model_.version->engine();
+    GEODEX_RETURN_IF_ERROR(PointsFromProto(request_->sources(), "sources", engine, &worker.a));
+    GEODEX_ASSIGN_OR_RETURN(field_, engine.Field(worker.a));
+    call_.pairs = n * static_cast<int64_t>(field_.distance.size());
+    chunk_vertices_ =
+        std::max<int64_t>(1, kChunkBytes / (request_->with_nearest_source() ? 12 : 8));
+    return absl::OkStatus();
+  }
+
+  void Work(WorkerContext& worker) {
+    const absl::Status status = Compute(worker);
+    std::lock_guard<std::mutex> lock(mutex_);
+    job_running_ = false;
+    if (!status.ok()) {
+      FinishLocked(status);
+    } else if (cancelled_) {
+      FinishLocked(absl::CancelledError("call cancelled"));
+    } else {
+      WriteNextLocked();
+    }
+  }
+
+  void WriteNextLocked() {
+    const int64_t n = static_cast<int64_t>(field_.distance.size());
+    const int64_t count = std::min(chunk_vertices_, n - next_vertex_);
+    FieldChunkToProto(field_, next_vertex_, count, request_->with_nearest_source(),
+                      model_.version->version(), &chunk_);
+    next_vertex_ += count;
+    write_in_flight_ = true;
+    StartWrite(&chunk_);
+  }
+
+  void FinishLocked(const absl::Status& status) {
+    if (finished_) return;
+    finished_ = true;
+    Finish(service_->FinishCall(call_, status));
+  }
+
+  GeodexService* const service_;
+  grpc::CallbackServerContext* const context_;
+  const v1::DistanceFieldRequest* const request_;
+  Call call_;
+  bool registered_ = false;
+
+  ResolvedModel model_;
+  query::DistanceField field_;
+  int64_t chunk_vertices_ = 1;
+  int64_t next_vertex_ = 0;
+  v1::DistanceFieldChunk chunk_;
+
+  std::mutex mutex_;
+  bool job_running_ = false;
+  bool write_in_flight_ = false;
+  bool cancelled_ = false;
+  bool finished_ = false;
+};
+
+grpc::ServerWriteReactor<v1::DistanceFieldChunk>* GeodexService::DistanceField(
+    grpc::CallbackServerContext* context, const v1::DistanceFieldRequest* request) {
+  return new FieldStream(this, context, request);
+}
+
+}  // namespace geodex::server

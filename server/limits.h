@@ -1,0 +1,40 @@
+#pragma once
+
+// Request limits of the Geodex service. Beyond any of them a call fails with
+// RESOURCE_EXHAUSTED, naming the limit. Server-wide values come from flags; a
+// model's config.textproto may lower them (server/model_config.proto).
+
+#include <cstdint>
+
+#include "server/model_config.pb.h"
+
+namespace geodex::server {
+
+struct ServiceLimits {
+  int64_t max_pairs_per_message = 1'000'000;  // Distance, each StreamDistances batch
+  int64_t max_matrix_cells = 50'000'000;      // sources x targets of one Matrix call
+  int64_t max_field_sources = 10'000;         // sources of one DistanceField call
+  int64_t max_path_pairs = 10'000;            // pairs of one Path call
+  int64_t max_locate_positions = 1'000'000;   // positions of one Locate call
+  int64_t max_message_bytes = 64 << 20;       // any received message (gRPC enforces it)
+  int32_t max_concurrent_streams = 64;        // StreamDistances + Matrix + DistanceField calls
+  // Batches of one StreamDistances call read ahead of the answers written:
+  // enough to keep a worker busy while the previous answer is on the wire,
+  // few enough that a slow reader stops the stream (backpressure).
+  int32_t stream_window = 4;
+};
+
+// `server` with every non-zero limit of `model` that is smaller applied.
+inline ServiceLimits WithModelLimits(ServiceLimits server, const ModelLimits& model) {
+  auto lower = [](int64_t* limit, int64_t value) {
+    if (value > 0 && value < *limit) *limit = value;
+  };
+  lower(&server.max_pairs_per_message, model.max_pairs_per_message());
+  lower(&server.max_matrix_cells, model.max_matrix_cells());
+  lower(&server.max_field_sources, model.max_field_sources());
+  lower(&server.max_path_pairs, model.max_path_pairs());
+  lower(&server.max_locate_positions, model.max_locate_positions());
+  return server;
+}
+
+}  // namespace geodex::server
