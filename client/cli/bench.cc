@@ -190,11 +190,7 @@ std::string FormatBenchReport(const BenchOptions& options, const BenchReport& re
       options.mode == "stream" ? absl::StrFormat(", window %d", options.window) : "", seconds,
       absl::ToDoubleSeconds(options.warmup));
   absl::StrAppendFormat(&out, "calls       %d ok", report.calls);
-  int64_t errors = 0;
-  for (const auto& [code, n] : report.errors) {
-    absl::StrAppendFormat(&out, ", %d %s", n, code);
-    errors += n;
-  }
+  for (const auto& [code, n] : report.errors) absl::StrAppendFormat(&out, ", %d %s", n, code);
   absl::StrAppendFormat(&out, "\nthroughput  %.1f calls/s, %.0f pairs/s\n", report.calls / seconds,
                         report.pairs / seconds);
   absl::StrAppendFormat(&out,
@@ -202,10 +198,6 @@ std::string FormatBenchReport(const BenchOptions& options, const BenchReport& re
                         "mean %.3f\n",
                         report.p50_ms, report.p90_ms, report.p99_ms, report.p999_ms, report.max_ms,
                         report.mean_ms);
-  if (report.calls > 0) {
-    absl::StrAppendFormat(&out, "per pair    %.3f us (p50 call latency / batch)\n",
-                          1000.0 * report.p50_ms / options.batch);
-  }
   return out;
 }
 

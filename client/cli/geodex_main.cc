@@ -139,15 +139,18 @@ absl::StatusOr<Parsed> ReadInput(const std::string& path,
   return parsed;
 }
 
-// The model's face count, for checking points before sending them.
+// The model's face count, for checking points before sending them; 0 when
+// the server does not know it yet (a model still loading), and then the
+// server checks the points.
 absl::StatusOr<int64_t> NumFaces(const Client& client, const ModelRef& model) {
   absl::StatusOr<ModelInfo> info = client.GetModel(model);
   if (!info.ok()) return info.status();
-  return info->num_faces;
+  return info->state == ModelInfo::State::kServing ? info->num_faces : 0;
 }
 
 absl::Status CheckPoints(const std::string& path, const std::vector<SurfacePoint>& points,
                          const std::vector<int64_t>& lines, int64_t num_faces) {
+  if (num_faces <= 0) return absl::OkStatus();
   for (size_t i = 0; i < points.size(); ++i) {
     if (absl::Status s = CheckPoint(points[i], num_faces, lines[i]); !s.ok()) {
       return InputError(

@@ -113,6 +113,9 @@ class Client {
   // All batches name `model` as given: with version 0, a call that overlaps a
   // model reload may be answered partly by the old and partly by the new
   // version. Pin ModelRef::version to avoid that.
+  //
+  // Each attempt (the unary call, or one stream) must end within
+  // ConnectOptions::deadline; raise it for very large inputs.
   absl::StatusOr<std::vector<double>> Distance(const ModelRef& model,
                                                absl::Span<const PointPair> pairs,
                                                bool exact_near_pairs = false) const;
