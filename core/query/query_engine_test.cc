@@ -231,6 +231,26 @@ TEST(QueryEngineTest, PathsStayOnTheSurfaceAndAreNearlyGeodesic) {
   }
 }
 
+// The approximate field of a coarse index has local minima and flats; path
+// tracing must still always arrive, on the surface.
+TEST(QueryEngineTest, PathsAlwaysArriveOnACoarseCube) {
+  const Mesh m = gen::Cube(12, 2.0);
+  auto engine = MakeEngine(m, 40);
+  const auto points = RandomPoints(m, 60, 21);
+  for (size_t i = 0; i + 1 < points.size(); i += 2) {
+    auto path = engine->Path(points[i], points[i + 1]);
+    ASSERT_TRUE(path.ok()) << path.status();
+    EXPECT_EQ(path->front().position, PositionOf(m, points[i]));
+    EXPECT_EQ(path->back().position, PositionOf(m, points[i + 1]));
+    for (const PathPoint& p : *path) {
+      const mesh::Vec3 x = p.position;
+      // On the cube's surface: some coordinate at 0 or 2, all within [0, 2].
+      const double to_face = std::min({x.x(), x.y(), x.z(), 2 - x.x(), 2 - x.y(), 2 - x.z()});
+      EXPECT_NEAR(to_face, 0, 1e-9);
+    }
+  }
+}
+
 TEST(QueryEngineTest, FieldIsTheMinimumOverSources) {
   const Mesh m = gen::Sphere(3, 1.0);
   auto engine = MakeEngine(m, 40);

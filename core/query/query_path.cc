@@ -141,6 +141,54 @@ absl::StatusOr<std::vector<PathPoint>> QueryEngine::Path(const SurfacePoint& fro
     return point_at(f, b);
   };
 
+  // Fallback: from vertex v (a vertex of face f) along mesh edges to a
+  // vertex of the face holding the source, by A* with the straight-line
+  // distance to the source as heuristic, then straight to the source.
+  const Vec3 goal = point_at(from.face, from.w).position;
+  auto finish_on_graph = [&](std::vector<PathPoint>& path, int32_t v,
+                             int32_t f) -> absl::StatusOr<std::vector<PathPoint>> {
+    if (path.back().position != Position(v)) path.push_back(vertex_point(f, v));
+    struct Node {
+      double g;
+      int32_t face;   // a face containing the vertex and its parent
+      int32_t parent;
+    };
+    std::unordered_map<int32_t, Node> seen;
+    using Item = std::pair<double, int32_t>;
+    std::priority_queue<Item, std::vector<Item>, std::greater<>> open;
+    seen[v] = {0, f, -1};
+    open.push({(Position(v) - goal).norm(), v});
+    int32_t reached = -1;
+    while (!open.empty()) {
+      const auto [key, u] = open.top();
+      open.pop();
+      const Node node = seen[u];
+      if (key > node.g + (Position(u) - goal).norm() + 1e-12) continue;  // stale
+      if (LocalIndex(faces_, from.face, u) >= 0) {
+        reached = u;
+        break;
+      }
+      for (int32_t g : tr.FacesAround(u, node.face)) {
+        for (int i = 0; i < 3; ++i) {
+          const int32_t w = faces_[3 * g + i];
+          if (w == u) continue;
+          const double cost = node.g + (Position(w) - Position(u)).norm();
+          auto it = seen.find(w);
+          if (it != seen.end() && it->second.g <= cost) continue;
+          seen[w] = {cost, g, u};
+          open.push({cost + (Position(w) - goal).norm(), w});
+        }
+      }
+    }
+    if (reached < 0) return absl::InternalError("no mesh path to the source");
+    std::vector<PathPoint> tail;
+    for (int32_t u = reached; u != v; u = seen[u].parent) tail.push_back(vertex_point(seen[u].face, u));
+    path.insert(path.end(), tail.rbegin(), tail.rend());
+    path.push_back(point_at(from.face, from.w));
+    std::reverse(path.begin(), path.end());
+    return path;
+  };
+
   std::vector<PathPoint> path = {point_at(to.face, to.w)};
   int32_t f = to.face;
   std::array<double, 3> b = to.w;
@@ -149,7 +197,11 @@ absl::StatusOr<std::vector<PathPoint>> QueryEngine::Path(const SurfacePoint& fro
     if (b[i] >= 1) at_vertex = faces_[3 * f + i];
   }
   const int64_t max_steps = 8 * int64_t{index_->num_faces()} + 64;
+  // A face entered again and again means the approximate field circles
+  // (numerical flats, saddles of the interpolant): finish on the graph.
+  std::unordered_map<int32_t, int> visits;
   for (int64_t step = 0; step < max_steps; ++step) {
+    if (++visits[f] > 6) return finish_on_graph(path, at_vertex >= 0 ? at_vertex : faces_[3 * f], f);
     if (contains_source(f)) {
       path.push_back(point_at(from.face, from.w));
       std::reverse(path.begin(), path.end());
@@ -199,8 +251,9 @@ absl::StatusOr<std::vector<PathPoint>> QueryEngine::Path(const SurfacePoint& fro
           }
         }
         if (next < 0) {
-          return absl::InternalError(absl::StrFormat(
-              "path tracing reached a local minimum of the approximate field at vertex %d", v));
+          // A local minimum of the approximate field: finish along mesh
+          // edges (A* towards the source), which always arrives.
+          return finish_on_graph(path, v, f);
         }
         f = next_face;
         at_vertex = next;
@@ -261,7 +314,7 @@ absl::StatusOr<std::vector<PathPoint>> QueryEngine::Path(const SurfacePoint& fro
     f = g / 3;
     b = nb;
   }
-  return absl::InternalError("path tracing did not reach the source");
+  return finish_on_graph(path, at_vertex >= 0 ? at_vertex : faces_[3 * f], f);
 }
 
 }  // namespace geodex::query
