@@ -154,18 +154,26 @@ grpc::ServerUnaryReactor* GeodexService::RunUnary(grpc::CallbackServerContext* c
                                                   const char* method, Fn fn) {
   grpc::ServerUnaryReactor* reactor = context->DefaultReactor();
   auto call = std::make_shared<Call>(StartCall(context, method));
-  if (absl::Status status = Authorize(*context); !status.ok()) {
+  ++unary_in_flight_;
+  // Finishes the call; nothing may touch it afterwards.
+  auto finish = [this, reactor, call](const absl::Status& status) {
     reactor->Finish(FinishCall(*call, status));
+    --unary_in_flight_;
+  };
+  absl::Status status = Authorize(*context);
+  if (status.ok() && shutting_down_) status = absl::UnavailableError("server is shutting down");
+  if (!status.ok()) {
+    finish(status);
     return reactor;
   }
   // The request, response and context live until Finish; the job calls
   // Finish exactly once.
-  const bool queued = pool_->Submit([this, context, reactor, call, fn](WorkerContext& worker) {
+  const bool queued = pool_->Submit([context, call, fn, finish](WorkerContext& worker) mutable {
     absl::Status status = CheckAlive(*context);
     if (status.ok()) status = fn(*call, worker);
-    reactor->Finish(FinishCall(*call, status));
+    finish(status);
   });
-  if (!queued) reactor->Finish(FinishCall(*call, Busy()));
+  if (!queued) finish(Busy());
   return reactor;
 }
 
@@ -329,6 +337,8 @@ void GeodexService::UnregisterStream(StreamBase* stream) {
   streams_.erase(stream);
   if (metrics_ != nullptr) metrics_->SetActiveStreams(static_cast<int64_t>(streams_.size()));
 }
+
+bool GeodexService::idle() const { return unary_in_flight_ == 0 && active_streams() == 0; }
 
 int64_t GeodexService::active_streams() const {
   std::lock_guard<std::mutex> lock(streams_mutex_);

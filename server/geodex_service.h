@@ -25,8 +25,8 @@
 // Deadlines and cancellation: a call cancelled or past its deadline is not
 // started, and long calls (Matrix rows, Path pairs) stop between items.
 //
-// Shutdown: BeginShutdown makes new streaming calls fail UNAVAILABLE and
-// each running StreamDistances stop reading, answer the batches it has read,
+// Shutdown: BeginShutdown makes new calls fail UNAVAILABLE and each running
+// StreamDistances stop reading, answer the batches it has read,
 // and finish UNAVAILABLE ("server shutting down", with the count of answered
 // batches) so that the client can send the rest elsewhere. grpc::Server's
 // Shutdown deadline bounds everything else.
@@ -34,6 +34,7 @@
 // Thread safety: the service is shared by all gRPC threads; all members are
 // thread-safe.
 
+#include <atomic>
 #include <chrono>
 #include <cstdint>
 #include <memory>
@@ -64,6 +65,8 @@ class GeodexService final : public v1::Geodex::CallbackService {
   void BeginShutdown();
   // Streaming calls running now.
   int64_t active_streams() const;
+  // True when no call of this service is running (unary or streaming).
+  bool idle() const;
 
   grpc::ServerUnaryReactor* ListModels(grpc::CallbackServerContext* context,
                                        const v1::ListModelsRequest* request,
@@ -135,7 +138,8 @@ class GeodexService final : public v1::Geodex::CallbackService {
 
   mutable std::mutex streams_mutex_;
   std::set<StreamBase*> streams_;  // registered, not owned (see StreamBase)
-  bool shutting_down_ = false;
+  std::atomic<bool> shutting_down_{false};
+  std::atomic<int64_t> unary_in_flight_{0};
 };
 
 }  // namespace geodex::server

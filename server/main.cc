@@ -15,6 +15,7 @@
 
 #include "CLI/CLI.hpp"
 #include "server/server.h"
+#include "spdlog/sinks/stdout_color_sinks.h"
 #include "spdlog/spdlog.h"
 
 int main(int argc, char** argv) {
@@ -28,6 +29,7 @@ int main(int argc, char** argv) {
   int64_t max_message_mib = options.limits.max_message_bytes >> 20;
   std::string log_level = "info";
 
+  const CLI::Range kPositive(int64_t{1}, int64_t{1} << 40);
   CLI::App app{"geodex-server: constant-time geodesic distance queries over gRPC"};
   app.add_option("--models", options.models_dir, "Model repository DIR/<model>/<version>/index.gdx")
       ->required()
@@ -36,14 +38,14 @@ int main(int argc, char** argv) {
   app.add_option("--metrics", options.metrics_listen,
                  "Prometheus /metrics address, e.g. 0.0.0.0:9090");
   app.add_option("--workers", options.workers, "Query worker threads (0: one per core)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(CLI::Range(0, 4096));
   app.add_option("--queue", options.queue_capacity,
                  "Jobs that may wait for a worker before RESOURCE_EXHAUSTED (0: 256 per worker)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(CLI::Range(int64_t{0}, int64_t{1} << 30));
   app.add_option("--poll-seconds", poll_seconds, "Repository poll interval (0: only on SIGHUP)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(CLI::Range(0.0, 86400.0));
   app.add_option("--drain-seconds", drain_seconds, "Graceful shutdown deadline")
-      ->check(CLI::NonNegativeNumber);
+      ->check(CLI::Range(0.0, 3600.0));
   auto* cert = app.add_option("--tls-cert", options.tls.cert_file, "PEM server certificate chain")
                    ->check(CLI::ExistingFile);
   auto* key = app.add_option("--tls-key", options.tls.key_file, "PEM private key")
@@ -63,22 +65,22 @@ int main(int argc, char** argv) {
   token_file->excludes(token_env);
   app.add_option("--max-pairs", options.limits.max_pairs_per_message,
                  "Pairs per Distance call or stream batch")
-      ->check(CLI::PositiveNumber);
+      ->check(kPositive);
   app.add_option("--max-matrix-cells", options.limits.max_matrix_cells,
                  "Sources x targets per Matrix call")
-      ->check(CLI::PositiveNumber);
+      ->check(kPositive);
   app.add_option("--max-field-sources", options.limits.max_field_sources,
                  "Sources per DistanceField call")
-      ->check(CLI::PositiveNumber);
+      ->check(kPositive);
   app.add_option("--max-path-pairs", options.limits.max_path_pairs, "Pairs per Path call")
-      ->check(CLI::PositiveNumber);
+      ->check(kPositive);
   app.add_option("--max-locate", options.limits.max_locate_positions, "Positions per Locate call")
-      ->check(CLI::PositiveNumber);
+      ->check(kPositive);
   app.add_option("--max-message-mib", max_message_mib, "Largest request message (MiB)")
       ->check(CLI::Range(1, 2047));
   app.add_option("--max-streams", options.limits.max_concurrent_streams,
                  "Concurrent streaming calls")
-      ->check(CLI::PositiveNumber);
+      ->check(kPositive);
   app.add_option("--stream-window", options.limits.stream_window,
                  "StreamDistances batches read ahead of the answers written")
       ->check(CLI::Range(1, 1024));
@@ -92,7 +94,10 @@ int main(int argc, char** argv) {
   }
   options.limits.max_message_bytes = max_message_mib << 20;
   options.poll_interval = absl::Seconds(poll_seconds);
+  // Logs go to stderr; stdout carries only the "listening on port N" line.
+  spdlog::set_default_logger(spdlog::stderr_color_mt("geodex-server"));
   spdlog::set_level(spdlog::level::from_str(log_level));
+  signal(SIGPIPE, SIG_IGN);
 
   // Signals are taken synchronously by this thread (sigwait); block them
   // before any thread starts so that none receives them asynchronously.

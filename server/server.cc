@@ -168,8 +168,17 @@ void GeodexServer::Shutdown(absl::Duration drain) {
     health_frozen_ = true;
     server_->GetHealthCheckService()->Shutdown();  // everything NOT_SERVING
   }
+  // Drain our own calls first: new ones are refused (UNAVAILABLE) while the
+  // running ones finish. grpc::Server::Shutdown is called only then, with a
+  // deadline already past, because it would otherwise also wait for idle
+  // client connections to go away (seconds) after the last call has ended.
   service_->BeginShutdown();
-  server_->Shutdown(std::chrono::system_clock::now() + absl::ToChronoMilliseconds(drain));
+  const auto deadline = std::chrono::steady_clock::now() + absl::ToChronoMilliseconds(drain);
+  while (!service_->idle() && std::chrono::steady_clock::now() < deadline) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  if (!service_->idle()) spdlog::warn("drain deadline reached; cancelling the remaining calls");
+  server_->Shutdown(std::chrono::system_clock::now());
   pool_->Stop();
   registry_->Stop();
   spdlog::info("shut down");

@@ -7,7 +7,9 @@
 
 #include <arpa/inet.h>
 #include <netinet/in.h>
+#include <signal.h>
 #include <sys/socket.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <atomic>
@@ -1237,6 +1239,107 @@ TEST(ServerTest, StartRejectsBadOptions) {
   options = DefaultOptions(dir.path());
   options.listen = "256.1.1.1:1";
   EXPECT_EQ(GeodexServer::Start(options).status().code(), absl::StatusCode::kUnavailable);
+}
+
+// --- the geodex-server binary: flags, SIGHUP, SIGTERM -----------------------------------
+
+struct Process {
+  pid_t pid = -1;
+  int port = 0;
+};
+
+// Starts geodex-server with `args`; reads the port it prints on stdout.
+Process Spawn(std::vector<std::string> args) {
+  args.insert(args.begin(), GEODEX_SERVER_BINARY);
+  int out[2];
+  if (pipe(out) != 0) return {};
+  const pid_t pid = fork();
+  if (pid == 0) {
+    dup2(out[1], STDOUT_FILENO);
+    close(out[0]);
+    close(out[1]);
+    std::vector<char*> argv;
+    for (std::string& a : args) argv.push_back(a.data());
+    argv.push_back(nullptr);
+    execv(argv[0], argv.data());
+    _exit(127);
+  }
+  close(out[1]);
+  Process p;
+  p.pid = pid;
+  FILE* in = fdopen(out[0], "r");
+  char line[256];
+  while (std::fgets(line, sizeof(line), in) != nullptr) {
+    if (std::sscanf(line, "listening on port %d", &p.port) == 1) break;
+  }
+  fclose(in);
+  return p;
+}
+
+int ExitCode(pid_t pid) {
+  int status = 0;
+  if (waitpid(pid, &status, 0) != pid) return -1;
+  return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+}
+
+TEST(ServerBinaryTest, BadFlagsExitWithTwo) {
+  Process p = Spawn({"--listen", "127.0.0.1:0"});  // no --models
+  EXPECT_EQ(ExitCode(p.pid), 2);
+  p = Spawn({"--models", "/nonexistent/dir", "--listen", "127.0.0.1:0"});
+  EXPECT_EQ(ExitCode(p.pid), 2);
+  testing::TempDir dir;
+  p = Spawn({"--models", dir.path(), "--listen", "127.0.0.1:0", "--workers", "-1"});
+  EXPECT_EQ(ExitCode(p.pid), 2);
+}
+
+TEST(ServerBinaryTest, SighupRescansAndSigtermDrains) {
+  testing::TempDir dir;
+  testing::WriteModelVersion(dir.path(), "sphere", 1, testing::SphereIndexBytes());
+  Process p = Spawn({"--models", dir.path(), "--listen", "127.0.0.1:0", "--poll-seconds", "0",
+                     "--workers", "1", "--log-level", "warn"});
+  ASSERT_GT(p.port, 0);
+  auto stub = v1::Geodex::NewStub(grpc::CreateChannel(absl::StrFormat("127.0.0.1:%d", p.port),
+                                                      grpc::InsecureChannelCredentials()));
+  auto count_serving = [&] {
+    v1::ListModelsResponse list;
+    auto context = Context(5);
+    if (!stub->ListModels(context.get(), {}, &list).ok()) return -1;
+    int n = 0;
+    for (const auto& m : list.models()) n += m.state() == v1::ModelInfo::SERVING;
+    return n;
+  };
+  auto wait_for = [&](int n) {
+    const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(20);
+    while (count_serving() != n && std::chrono::steady_clock::now() < until) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+    return count_serving() == n;
+  };
+  ASSERT_TRUE(wait_for(1));
+  testing::WriteModelVersion(dir.path(), "torus", 1, testing::TorusIndexBytes());
+  std::this_thread::sleep_for(std::chrono::milliseconds(200));
+  EXPECT_EQ(count_serving(), 1);  // no polling: not seen yet
+  kill(p.pid, SIGHUP);
+  EXPECT_TRUE(wait_for(2));
+
+  // SIGTERM during a stream: it is drained and the process exits 0.
+  auto context = Context(30);
+  auto stream = stub->StreamDistances(context.get());
+  v1::DistanceBatch batch;
+  batch.set_batch_id(5);
+  *batch.mutable_model() = Ref("sphere");
+  *batch.mutable_a() = ToProto(testing::RandomPoints(1280, 3, 1));
+  *batch.mutable_b() = ToProto(testing::RandomPoints(1280, 3, 2));
+  ASSERT_TRUE(stream->Write(batch));
+  v1::DistanceResult result;
+  ASSERT_TRUE(stream->Read(&result));
+  EXPECT_EQ(result.error_code(), 0);
+  kill(p.pid, SIGTERM);
+  EXPECT_FALSE(stream->Read(&result));
+  grpc::Status s = stream->Finish();
+  EXPECT_EQ(s.error_code(), grpc::StatusCode::UNAVAILABLE);
+  EXPECT_THAT(s.error_message(), HasSubstr("shutting down"));
+  EXPECT_EQ(ExitCode(p.pid), 0);
 }
 
 }  // namespace
