@@ -964,6 +964,40 @@ TEST(ServerTest, LoadingModelIsUnavailable) {
   EXPECT_EQ(HealthCheck(ts.TcpChannel(), "late"), 1);
 }
 
+TEST(ServerTest, PairsOnDifferentComponentsAreUnreachable) {
+  TestServer ts;
+  const int n = 12;  // two unit grids of n x n cells: faces [0, 2n^2) and [2n^2, 4n^2)
+  testing::WriteModelVersion(ts.root(), "two", 1,
+                             testing::BuildIndexBytes(mesh::gen::TwoComponents(n), 40));
+  ts.Rescan();
+  auto stub = v1::Geodex::NewStub(ts.TcpChannel());
+  std::vector<mesh::SurfacePoint> a = {{0, {1.0 / 3, 1.0 / 3, 1.0 / 3}}, {0, {1, 0, 0}}};
+  std::vector<mesh::SurfacePoint> b = {{2 * n * n + 5, {1.0 / 3, 1.0 / 3, 1.0 / 3}},
+                                       {2 * n * n - 1, {0, 1, 0}}};
+  v1::PathRequest request;
+  *request.mutable_model() = Ref("two");
+  *request.mutable_a() = ToProto(a);
+  *request.mutable_b() = ToProto(b);
+  v1::PathResponse response;
+  auto context = Context();
+  ASSERT_TRUE(stub->Path(context.get(), request, &response).ok());
+  ASSERT_EQ(response.paths_size(), 2);
+  EXPECT_TRUE(std::isinf(response.paths(0).length()));
+  EXPECT_EQ(response.paths(0).points().faces_size(), 0);
+  EXPECT_GT(response.paths(1).points().faces_size(), 1);
+  EXPECT_TRUE(std::isfinite(response.paths(1).length()));
+
+  v1::DistanceRequest distance;
+  *distance.mutable_model() = Ref("two");
+  *distance.mutable_a() = ToProto(a);
+  *distance.mutable_b() = ToProto(b);
+  v1::DistanceResponse answer;
+  context = Context();
+  ASSERT_TRUE(stub->Distance(context.get(), distance, &answer).ok());
+  EXPECT_TRUE(std::isinf(answer.distances(0)));
+  EXPECT_TRUE(std::isfinite(answer.distances(1)));
+}
+
 // --- shutdown -------------------------------------------------------------------------
 
 TEST(ServerTest, ShutdownDuringAStreamDrainsIt) {
