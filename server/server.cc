@@ -110,8 +110,8 @@ absl::StatusOr<std::unique_ptr<GeodexServer>> GeodexServer::Start(const ServerOp
         "cannot listen on %s (address in use or invalid, or unusable TLS files)", options.listen));
   }
   grpc::HealthCheckServiceInterface* health = server->server_->GetHealthCheckService();
-  health->SetServingStatus("", false);
-  health->SetServingStatus(kServiceName, false);
+  health->SetServingStatus("", false);           // ready after the first scan
+  health->SetServingStatus(kServiceName, true);  // alive
 
   GeodexServer* self = server.get();
   server->registry_->SetListener(
@@ -150,7 +150,6 @@ void GeodexServer::OnRegistryChange(const RegistrySnapshot& before, const Regist
     health->SetServingStatus(name, !model->served.empty());
   }
   health->SetServingStatus("", after.initial_scan_done);
-  health->SetServingStatus(kServiceName, after.initial_scan_done);
 }
 
 void GeodexServer::Shutdown(absl::Duration drain) {

@@ -5,10 +5,12 @@
 // model name), server reflection, optional TLS / mTLS and bearer tokens, and
 // Prometheus metrics on a port of their own.
 //
-// Health: "" (and "geodex.v1.Geodex") is SERVING once the first repository
-// scan has finished, NOT_SERVING before and after Shutdown begins; a model's
-// name is SERVING while at least one of its versions is served, NOT_SERVING
-// while it loads, has failed with nothing served, or has been removed.
+// Health: "" is SERVING once the first repository scan has finished (use it
+// for readiness), "geodex.v1.Geodex" is SERVING from start (use it for
+// liveness: a long first scan must not get the process restarted); both are
+// NOT_SERVING once Shutdown begins. A model's name is SERVING while at least
+// one of its versions is served, NOT_SERVING while it loads, has failed with
+// nothing served, or has been removed.
 //
 // Usage:
 //   ServerOptions options;

@@ -1081,7 +1081,33 @@ TEST(ServerTest, HealthOverallAndPerModel) {
   testing::RemoveModel(ts.root(), "torus");
   ts.Rescan();
   EXPECT_EQ(HealthCheck(channel, "torus"), 2);
-  ts.server().Shutdown(absl::Seconds(1));
+}
+
+TEST(ServerTest, HealthIsAliveButNotReadyDuringTheFirstScan) {
+  std::latch entered(1), release(1);
+  std::atomic<bool> first{true};
+  ServerOptions options;
+  testing::TempDir dir;
+  testing::WriteModelVersion(dir.path(), "sphere", 1, testing::SphereIndexBytes());
+  options = DefaultOptions(dir.path());
+  options.before_load = [&](const std::string&) {
+    if (first.exchange(false)) {
+      entered.count_down();
+      release.wait();
+    }
+  };
+  auto server = GeodexServer::Start(options);
+  ASSERT_TRUE(server.ok()) << server.status();
+  entered.wait();
+  auto channel = grpc::CreateChannel(absl::StrFormat("127.0.0.1:%d", (*server)->port()),
+                                     grpc::InsecureChannelCredentials());
+  EXPECT_EQ(HealthCheck(channel, ""), 2);                  // not ready
+  EXPECT_EQ(HealthCheck(channel, "geodex.v1.Geodex"), 1);  // alive
+  release.count_down();
+  (*server)->registry().RescanNow();
+  EXPECT_EQ(HealthCheck(channel, ""), 1);
+  (*server)->Shutdown(absl::Seconds(1));
+  EXPECT_NE(HealthCheck(channel, ""), 1);
 }
 
 TEST(ServerTest, ReflectionListsTheService) {
