@@ -149,31 +149,43 @@ absl::Status GeodexService::ComputeDistances(const ResolvedModel& model, const v
   return engine->DistanceBatch(worker.a, worker.b, ResizeForOutput(out, na), &worker.scratch);
 }
 
+// A unary call's reactor. It counts the call from its start until gRPC is
+// done with it (OnDone: the status has been sent or the call has failed), so
+// that shutdown knows when every call has really ended. Ownership: gRPC's
+// from the handler's return to OnDone, where it deletes itself.
+class GeodexService::UnaryReactor final : public grpc::ServerUnaryReactor {
+ public:
+  explicit UnaryReactor(GeodexService* service) : service_(service) {
+    ++service_->unary_in_flight_;
+  }
+  void OnDone() override {
+    --service_->unary_in_flight_;
+    delete this;
+  }
+
+ private:
+  GeodexService* const service_;
+};
+
 template <class Fn>
 grpc::ServerUnaryReactor* GeodexService::RunUnary(grpc::CallbackServerContext* context,
                                                   const char* method, Fn fn) {
-  grpc::ServerUnaryReactor* reactor = context->DefaultReactor();
+  auto* reactor = new UnaryReactor(this);
   auto call = std::make_shared<Call>(StartCall(context, method));
-  ++unary_in_flight_;
-  // Finishes the call; nothing may touch it afterwards.
-  auto finish = [this, reactor, call](const absl::Status& status) {
-    reactor->Finish(FinishCall(*call, status));
-    --unary_in_flight_;
-  };
   absl::Status status = Authorize(*context);
   if (status.ok() && shutting_down_) status = absl::UnavailableError("server is shutting down");
   if (!status.ok()) {
-    finish(status);
+    reactor->Finish(FinishCall(*call, status));
     return reactor;
   }
   // The request, response and context live until Finish; the job calls
   // Finish exactly once.
-  const bool queued = pool_->Submit([context, call, fn, finish](WorkerContext& worker) mutable {
+  const bool queued = pool_->Submit([this, context, reactor, call, fn](WorkerContext& worker) {
     absl::Status status = CheckAlive(*context);
     if (status.ok()) status = fn(*call, worker);
-    finish(status);
+    reactor->Finish(FinishCall(*call, status));
   });
-  if (!queued) finish(Busy());
+  if (!queued) reactor->Finish(FinishCall(*call, Busy()));
   return reactor;
 }
 

@@ -99,6 +99,7 @@ class GeodexService final : public v1::Geodex::CallbackService {
     int64_t pairs = 0;  // work items answered
     std::chrono::steady_clock::time_point start;
   };
+  class UnaryReactor;
   class StreamBase;
   class DistanceStream;
   class MatrixStream;
