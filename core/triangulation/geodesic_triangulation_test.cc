@@ -85,13 +85,9 @@ TEST(GeodesicTriangulationTest, ReportsEachViolationKind) {
   }
   EXPECT_TRUE(arc);
   EXPECT_TRUE(not_disk);
-  // A disconnected cell: relabel a far vertex.
+  // A disconnected cell: give cell 0 a vertex deep inside cell 1 (its sample).
   std::vector<int32_t> labels = set->nearest;
-  int32_t far = 0;
-  for (int32_t v = 0; v < sphere.num_vertices(); ++v) {
-    if (labels[v] == 1) far = v;
-  }
-  labels[far] = 0;
+  labels[set->samples[1]] = 0;
   bool disconnected = false;
   for (const Violation& v : CheckDual(sphere, labels, 2).violations) {
     disconnected |= v.kind == ViolationKind::kCellDisconnected;
