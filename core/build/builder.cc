@@ -10,6 +10,7 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "core/common/status_macros.h"
+#include "core/common/unfolding.h"
 #include "core/geodesic/exact_geodesic.h"
 #include "core/query/point_locator.h"
 #include "core/sampling/farthest_point_sampling.h"
@@ -40,27 +41,6 @@ std::vector<int32_t> CellVertices(const Plan& plan, const std::vector<int32_t>& 
     if (plan.nearest[v] != kNone && member[plan.nearest[v]]) out.push_back(v);
   }
   return out;
-}
-
-// Barycentric coordinates, in the unfolded geodesic triangle (a, b, c), of
-// the point at distances (da, db, dc) from its corners. The point is placed
-// from da and db on the side of ab that best matches dc (paper §5.1
-// unfolding); side lengths that break the triangle inequality are clamped.
-std::array<double, 3> UnfoldedBarycentric(double ab, double bc, double ca, double da, double db,
-                                          double dc) {
-  if (!(ab > 0)) return {1, 0, 0};
-  const double cx = (ab * ab + ca * ca - bc * bc) / (2 * ab);
-  const double cy = std::sqrt(std::max(ca * ca - cx * cx, 0.0));
-  const double px = (ab * ab + da * da - db * db) / (2 * ab);
-  const double h = std::sqrt(std::max(da * da - px * px, 0.0));
-  const double up = std::abs(std::hypot(px - cx, h - cy) - dc);
-  const double down = std::abs(std::hypot(px - cx, -h - cy) - dc);
-  const double py = up <= down ? h : -h;
-  const double area = ab * cy;  // twice the signed area of (a, b, c)
-  if (!(area > 1e-300)) return {1, 0, 0};
-  const double lc = py / cy;
-  const double lb = (px * cy - py * cx) / area;
-  return {1 - lb - lc, lb, lc};
 }
 
 }  // namespace
@@ -261,7 +241,7 @@ absl::StatusOr<index::IndexData> Merge(const Mesh& mesh, const Plan& plan,
       for (int i = 0; i < 3; ++i) d[i] = slots[slot_index(v, corners[i])];
       const auto lambda =
           UnfoldedBarycentric(matrix(corners[0], corners[1]), matrix(corners[1], corners[2]),
-                              matrix(corners[2], corners[0]), d[0], d[1], d[2]);
+                              matrix(corners[2], corners[0]), d);
       const double score = std::min({lambda[0], lambda[1], lambda[2]});
       if (score > best_score) {
         best_score = score;

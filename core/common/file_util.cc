@@ -3,6 +3,7 @@
 #include <fcntl.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstring>
 #include <fstream>
@@ -14,14 +15,15 @@
 namespace geodex {
 namespace {
 
-absl::Status ErrnoError(const std::string& what, const std::string& path) {
-  const int error = errno;
-  const std::string message = absl::StrFormat("%s %s: %s", what, path, std::strerror(error));
-  switch (error) {
+absl::Status ErrnoError(int err, const std::string& what, const std::string& path) {
+  const std::string message = absl::StrFormat("%s %s: %s", what, path, std::strerror(err));
+  switch (err) {
     case ENOENT:
+    case ENOTDIR:
       return absl::NotFoundError(message);
     case EACCES:
     case EPERM:
+    case EROFS:
       return absl::PermissionDeniedError(message);
     default:
       return absl::InternalError(message);
@@ -31,41 +33,48 @@ absl::Status ErrnoError(const std::string& what, const std::string& path) {
 }  // namespace
 
 absl::Status AtomicWriteFile(const std::string& path, std::string_view bytes) {
+  const size_t slash = path.rfind('/');
+  const std::string dir =
+      slash == std::string::npos ? "." : (slash == 0 ? "/" : path.substr(0, slash));
   std::random_device random;
-  const std::string temp = absl::StrFormat("%s.tmp.%d.%08x", path, getpid(), random());
-  const int fd = ::open(temp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
-  if (fd < 0) return ErrnoError("cannot create", temp);
+  const uint64_t nonce = (uint64_t{random()} << 32) ^ random();
+  const std::string tmp = absl::StrFormat("%s.tmp.%d.%016x", path, ::getpid(), nonce);
+
+  int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
+  if (fd < 0) return ErrnoError(errno, "cannot create temporary file", tmp);
+  // On any failure before the rename: close and remove the temporary file.
+  auto abandon = [&](int err, const std::string& what) {
+    if (fd >= 0) ::close(fd);
+    ::unlink(tmp.c_str());
+    return ErrnoError(err, what, tmp);
+  };
   size_t written = 0;
   while (written < bytes.size()) {
-    const ssize_t n = ::write(fd, bytes.data() + written, bytes.size() - written);
+    const size_t chunk = std::min<size_t>(bytes.size() - written, size_t{1} << 30);
+    const ssize_t n = ::write(fd, bytes.data() + written, chunk);
     if (n < 0) {
       if (errno == EINTR) continue;
-      absl::Status status = ErrnoError("cannot write", temp);
-      ::close(fd);
-      ::unlink(temp.c_str());
-      return status;
+      return abandon(errno, "cannot write");
     }
     written += static_cast<size_t>(n);
   }
-  if (::fsync(fd) != 0) {
-    absl::Status status = ErrnoError("cannot fsync", temp);
-    ::close(fd);
-    ::unlink(temp.c_str());
-    return status;
+  if (::fsync(fd) != 0) return abandon(errno, "cannot fsync");
+  const int close_result = ::close(fd);
+  fd = -1;
+  if (close_result != 0) return abandon(errno, "cannot close");
+  if (::rename(tmp.c_str(), path.c_str()) != 0) {
+    const int err = errno;
+    ::unlink(tmp.c_str());
+    return ErrnoError(err, absl::StrFormat("cannot rename %s to", tmp), path);
   }
-  ::close(fd);
-  if (::rename(temp.c_str(), path.c_str()) != 0) {
-    absl::Status status = ErrnoError("cannot rename onto", path);
-    ::unlink(temp.c_str());
-    return status;
-  }
-  const size_t slash = path.find_last_of('/');
-  const std::string dir = slash == std::string::npos ? "." : path.substr(0, slash + 1);
+  // The rename is durable only once the directory entry is. A failure here
+  // leaves the new file in place (complete) but reports the error.
   const int dir_fd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
-  if (dir_fd >= 0) {
-    ::fsync(dir_fd);
-    ::close(dir_fd);
-  }
+  if (dir_fd < 0) return ErrnoError(errno, "cannot open the directory of", path);
+  const int sync_result = ::fsync(dir_fd);
+  const int sync_errno = errno;
+  ::close(dir_fd);
+  if (sync_result != 0) return ErrnoError(sync_errno, "cannot fsync the directory of", path);
   return absl::OkStatus();
 }
 

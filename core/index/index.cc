@@ -19,6 +19,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
+#include "core/common/file_util.h"
 #include "core/common/status_macros.h"
 
 #define XXH_STATIC_LINKING_ONLY  // XXH64_state_t on the stack
@@ -412,50 +413,7 @@ absl::StatusOr<std::string> SerializeIndex(const IndexData& d) {
 
 absl::Status WriteIndexFile(const IndexData& data, const std::string& path) {
   GEODEX_ASSIGN_OR_RETURN(const std::string bytes, SerializeIndex(data));
-
-  const size_t slash = path.rfind('/');
-  const std::string dir =
-      slash == std::string::npos ? "." : (slash == 0 ? "/" : path.substr(0, slash));
-  std::random_device random;
-  const uint64_t nonce = (uint64_t{random()} << 32) ^ random();
-  const std::string tmp = absl::StrFormat("%s.tmp.%d.%016x", path, ::getpid(), nonce);
-
-  int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
-  if (fd < 0) return ErrnoStatus(errno, "cannot create temporary file", tmp);
-  // On any failure before the rename: close and remove the temporary file.
-  auto abandon = [&](int err, const std::string& what) {
-    if (fd >= 0) ::close(fd);
-    ::unlink(tmp.c_str());
-    return ErrnoStatus(err, what, tmp);
-  };
-  size_t written = 0;
-  while (written < bytes.size()) {
-    const size_t chunk = std::min<size_t>(bytes.size() - written, size_t{1} << 30);
-    const ssize_t n = ::write(fd, bytes.data() + written, chunk);
-    if (n < 0) {
-      if (errno == EINTR) continue;
-      return abandon(errno, "cannot write");
-    }
-    written += static_cast<size_t>(n);
-  }
-  if (::fsync(fd) != 0) return abandon(errno, "cannot fsync");
-  const int close_result = ::close(fd);
-  fd = -1;
-  if (close_result != 0) return abandon(errno, "cannot close");
-  if (::rename(tmp.c_str(), path.c_str()) != 0) {
-    const int err = errno;
-    ::unlink(tmp.c_str());
-    return ErrnoStatus(err, absl::StrCat("cannot rename ", tmp, " to"), path);
-  }
-  // The rename is durable only once the directory entry is. A failure here
-  // leaves the new file in place (complete) but reports the error.
-  const int dir_fd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
-  if (dir_fd < 0) return ErrnoStatus(errno, "cannot open the directory of", path);
-  const int sync_result = ::fsync(dir_fd);
-  const int sync_errno = errno;
-  ::close(dir_fd);
-  if (sync_result != 0) return ErrnoStatus(sync_errno, "cannot fsync the directory of", path);
-  return absl::OkStatus();
+  return AtomicWriteFile(path, bytes);
 }
 
 // The file must not shrink while mapped (SIGBUS): writers replace files by

@@ -7,6 +7,7 @@
 
 #include "absl/strings/str_format.h"
 #include "core/common/status_macros.h"
+#include "core/common/unfolding.h"
 
 namespace geodex::query {
 namespace {
@@ -16,15 +17,6 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 // sqrt(x^2 + y^2) without std::hypot's overflow care, which costs more than
 // the rest of a query.
 inline double Norm2(double x, double y) { return std::sqrt(x * x + y * y); }
-
-// Paper §5.1. Places a point at distances (da, db) from the ends of an edge of
-// length l lying on the x axis: x along the edge, y >= 0 its height. Distances
-// that break the triangle inequality (numerically, or because geodesic
-// triangles are curved) are clamped onto the edge instead of giving NaN.
-inline void Place(double l, double da, double db, double* x, double* y) {
-  *x = (l * l + da * da - db * db) / (2 * l);
-  *y = std::sqrt(std::max(da * da - *x * *x, 0.0));
-}
 
 // Squared distance of the images of p and q, p at (pa, pb) and q at (qa, qb)
 // from the ends of an edge of length l, on opposite sides of it (two-side
@@ -117,24 +109,6 @@ inline double TwoSideToOutside2(const EdgeFrame* frames, const Placed& p, const 
     }
   }
   return best < kInf ? best : best_collinear;
-}
-
-// Barycentric coordinates of the point at distances d from the corners of the
-// planar triangle with side lengths (ab, bc, ca), on the side that best
-// matches d[2] (used by the linear-interpolation baseline).
-std::array<double, 3> Barycentric(double ab, double bc, double ca, const std::array<double, 3>& d) {
-  if (!(ab > 0)) return {1, 0, 0};
-  double cx, cy, px, py;
-  Place(ab, ca, bc, &cx, &cy);
-  Place(ab, d[0], d[1], &px, &py);
-  if (std::abs(std::hypot(px - cx, -py - cy) - d[2]) < std::abs(std::hypot(px - cx, py - cy) - d[2])) {
-    py = -py;
-  }
-  const double area = ab * cy;
-  if (!(area > 0)) return {1, 0, 0};
-  const double lc = py / cy;
-  const double lb = (px * cy - py * cx) / area;
-  return {1 - lb - lc, lb, lc};
 }
 
 }  // namespace
@@ -450,7 +424,7 @@ double QueryEngine::LinearInterpolationDistance(const SurfacePoint& p0,
   const LiftedPoint p = Lift(Canonical(p0)), q = Lift(Canonical(q0));
   if (!(Matrix(p.corner[0], q.corner[0]) < kInf)) return kInf;
   auto lambda = [&](const LiftedPoint& x) {
-    return Barycentric(Matrix(x.corner[0], x.corner[1]), Matrix(x.corner[1], x.corner[2]),
+    return UnfoldedBarycentric(Matrix(x.corner[0], x.corner[1]), Matrix(x.corner[1], x.corner[2]),
                        Matrix(x.corner[2], x.corner[0]), x.distance);
   };
   const auto lp = lambda(p), lq = lambda(q);
