@@ -13,8 +13,6 @@
 #include "absl/strings/str_format.h"
 
 namespace geodex {
-namespace {
-
 absl::Status ErrnoError(int err, const std::string& what, const std::string& path) {
   const std::string message = absl::StrFormat("%s %s: %s", what, path, std::strerror(err));
   switch (err) {
@@ -29,8 +27,6 @@ absl::Status ErrnoError(int err, const std::string& what, const std::string& pat
       return absl::InternalError(message);
   }
 }
-
-}  // namespace
 
 absl::Status AtomicWriteFile(const std::string& path, std::string_view bytes) {
   const size_t slash = path.rfind('/');

@@ -19,6 +19,11 @@ namespace geodex {
 // or the new one, never a partial one. Errors name the path and the reason.
 absl::Status AtomicWriteFile(const std::string& path, std::string_view bytes);
 
+// An error for a failed system call: "<what> <path>: <strerror(err)>", as
+// NotFound (ENOENT, ENOTDIR), PermissionDenied (EACCES, EPERM, EROFS) or
+// Internal.
+absl::Status ErrnoError(int err, const std::string& what, const std::string& path);
+
 // Reads a whole file. Errors: NotFound, or Internal on read failure.
 absl::StatusOr<std::string> ReadWholeFile(const std::string& path);
 

@@ -266,20 +266,6 @@ std::span<const T> SectionView(const uint8_t* base, const std::optional<SectionE
   return std::span<const T>(reinterpret_cast<const T*>(base + e->offset), e->size / sizeof(T));
 }
 
-absl::Status ErrnoStatus(int err, const std::string& what, const std::string& path) {
-  const std::string message = absl::StrCat(what, " ", path, ": ", std::strerror(err));
-  switch (err) {
-    case ENOENT:
-    case ENOTDIR:
-      return absl::NotFoundError(message);
-    case EACCES:
-    case EPERM:
-    case EROFS:
-      return absl::PermissionDeniedError(message);
-    default:
-      return absl::InternalError(message);
-  }
-}
 
 absl::Status WithPath(const absl::Status& status, const std::string& path) {
   if (status.ok()) return status;
@@ -420,12 +406,12 @@ absl::Status WriteIndexFile(const IndexData& data, const std::string& path) {
 // rename (WriteIndexFile), which leaves this mapping on the old inode.
 absl::StatusOr<std::shared_ptr<const Index>> Index::Open(const std::string& path) {
   const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
-  if (fd < 0) return ErrnoStatus(errno, "cannot open", path);
+  if (fd < 0) return ErrnoError(errno, "cannot open", path);
   struct stat st;
   if (::fstat(fd, &st) != 0) {
     const int err = errno;
     ::close(fd);
-    return ErrnoStatus(err, "cannot stat", path);
+    return ErrnoError(err, "cannot stat", path);
   }
   if (!S_ISREG(st.st_mode)) {
     ::close(fd);
@@ -438,7 +424,7 @@ absl::StatusOr<std::shared_ptr<const Index>> Index::Open(const std::string& path
     if (map == MAP_FAILED) {
       const int err = errno;
       ::close(fd);
-      return ErrnoStatus(err, "cannot mmap", path);
+      return ErrnoError(err, "cannot mmap", path);
     }
     index->base_ = static_cast<const uint8_t*>(map);
     index->mapped_ = true;
