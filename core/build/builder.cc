@@ -94,11 +94,10 @@ absl::StatusOr<Plan> MakePlan(const Mesh& mesh, const BuildOptions& options) {
   start = std::chrono::steady_clock::now();
   if (options.progress) options.progress({"repair", 0, 1});
   const int32_t max_samples = std::max<int32_t>(4 * options.num_samples + 64, 256);
-  GEODEX_ASSIGN_OR_RETURN(
-      triangulation::DualComplex dual,
-      triangulation::RepairTriangulation(mesh, &set, options.max_repair_rounds,
-                                         std::min<int32_t>(max_samples, mesh.num_vertices()),
-                                         &plan.repair));
+  GEODEX_ASSIGN_OR_RETURN(triangulation::DualComplex dual,
+                          triangulation::RepairTriangulation(
+                              mesh, &set, options.max_repair_rounds,
+                              std::min<int32_t>(max_samples, mesh.num_vertices()), &plan.repair));
   plan.triangulation_seconds = SecondsSince(start);
   if (options.progress) options.progress({"repair", 1, 1});
   plan.samples = std::move(set.samples);
@@ -266,7 +265,8 @@ absl::StatusOr<index::IndexData> Merge(const Mesh& mesh, const Plan& plan,
   data.params.num_samples = m;
   data.params.seed = plan.seed;
   data.params.samples_added_by_repair = plan.repair.samples_added;
-  for (const auto& p : mesh.positions()) data.positions.insert(data.positions.end(), {p.x(), p.y(), p.z()});
+  for (const auto& p : mesh.positions())
+    data.positions.insert(data.positions.end(), {p.x(), p.y(), p.z()});
   for (const auto& f : mesh.faces()) data.faces.insert(data.faces.end(), f.begin(), f.end());
   for (int32_t h = 0; h < mesh.num_halfedges(); ++h) data.twins.push_back(mesh.Twin(h));
   data.samples = plan.samples;

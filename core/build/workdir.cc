@@ -59,8 +59,7 @@ absl::Status SavePlan(const mesh::Mesh& mesh, const Plan& plan, const std::strin
   std::error_code error;
   std::filesystem::create_directories(workdir, error);
   if (error) {
-    return absl::InternalError(
-        absl::StrFormat("cannot create %s: %s", workdir, error.message()));
+    return absl::InternalError(absl::StrFormat("cannot create %s: %s", workdir, error.message()));
   }
   GEODEX_RETURN_IF_ERROR(mesh::WritePly(mesh, PlanMeshPath(workdir)));
   ByteWriter w;
@@ -114,7 +113,8 @@ absl::StatusOr<std::pair<mesh::Mesh, Plan>> LoadPlan(const std::string& workdir)
     for (int32_t a : t) valid &= a >= 0 && a < m;
   }
   for (const auto& n : plan.neighbors) {
-    for (int32_t t : n) valid &= t >= mesh::kNone && t < static_cast<int32_t>(plan.triangles.size());
+    for (int32_t t : n)
+      valid &= t >= mesh::kNone && t < static_cast<int32_t>(plan.triangles.size());
   }
   if (!valid) return absl::DataLossError(absl::StrFormat("%s holds inconsistent data", path));
   return std::make_pair(std::move(mesh), std::move(plan));
@@ -157,8 +157,8 @@ absl::StatusOr<std::vector<SampleRow>> LoadAllRows(const Plan& plan, const std::
   const int32_t num_shards = found.front().second;
   for (const auto& [shard, count] : found) {
     if (count != num_shards) {
-      return absl::InvalidArgumentError(absl::StrFormat(
-          "%s mixes shardings (%d and %d shards)", workdir, num_shards, count));
+      return absl::InvalidArgumentError(
+          absl::StrFormat("%s mixes shardings (%d and %d shards)", workdir, num_shards, count));
     }
   }
   if (static_cast<int32_t>(found.size()) != num_shards) {
@@ -192,8 +192,8 @@ absl::StatusOr<std::vector<SampleRow>> LoadAllRows(const Plan& plan, const std::
     }
     const std::vector<int32_t> expected = ShardSamples(m, shard, num_shards);
     if (count != expected.size()) {
-      return absl::DataLossError(absl::StrFormat("%s holds %d rows, expected %d", path, count,
-                                                 expected.size()));
+      return absl::DataLossError(
+          absl::StrFormat("%s holds %d rows, expected %d", path, count, expected.size()));
     }
     for (uint64_t k = 0; k < count; ++k) {
       SampleRow row;

@@ -13,6 +13,7 @@
 #include "absl/strings/str_format.h"
 
 namespace geodex {
+
 absl::Status ErrnoError(int err, const std::string& what, const std::string& path) {
   const std::string message = absl::StrFormat("%s %s: %s", what, path, std::strerror(err));
   switch (err) {

@@ -46,9 +46,8 @@ ExactGeodesicSolver::ExactGeodesicSolver(const Mesh& mesh) : mesh_(mesh) {
   for (int32_t h = 0; h < nh; ++h) corner_angle_[h] = std::atan2(frame_[h].cy, frame_[h].cx);
   emits_.resize(mesh.num_vertices());
   for (int32_t v = 0; v < mesh.num_vertices(); ++v) {
-    emits_[v] = mesh.IsReferenced(v) &&
-                (mesh.IsBoundaryVertex(v) ||
-                 mesh.AngleSum(v) >= 2 * std::numbers::pi - kSaddleSlack);
+    emits_[v] = mesh.IsReferenced(v) && (mesh.IsBoundaryVertex(v) ||
+                                         mesh.AngleSum(v) >= 2 * std::numbers::pi - kSaddleSlack);
   }
 }
 
@@ -219,8 +218,8 @@ double ExactGeodesicSolver::BackAngle(int32_t v) const {
     const Frame& f = frame_[w.h];
     // v = C of the window's face; its corner there starts at C->A.
     const int32_t corner = Mesh::Prev(w.h);
-    const double ax = -f.cx, ay = -f.cy;                  // A - C
-    const double sx = w.sx - f.cx, sy = w.sy - f.cy;      // S - C
+    const double ax = -f.cx, ay = -f.cy;              // A - C
+    const double sx = w.sx - f.cx, sy = w.sy - f.cy;  // S - C
     const double beta = std::atan2(ax * sy - ay * sx, ax * sx + ay * sy);
     double phi = 0;
     for (const int32_t h : fan) {
@@ -306,8 +305,7 @@ void ExactGeodesicSolver::EmitFromVertex(int32_t v) {
   }
 }
 
-void ExactGeodesicSolver::UpdateVertex(int32_t v, double d, int32_t source, Via via,
-                                       int32_t id) {
+void ExactGeodesicSolver::UpdateVertex(int32_t v, double d, int32_t source, Via via, int32_t id) {
   if (!(d < dist_[v])) return;
   dist_[v] = d;
   nearest_[v] = source;
@@ -419,7 +417,7 @@ void ExactGeodesicSolver::PropagateWindow(int32_t index) {
     const int32_t t = mesh_.Twin(Mesh::Next(h));
     if (t != kNone) {
       const double bx = f.length - f.cx, by = -f.cy;  // B - C
-      auto hit = [&](double b) {  // fraction along C->B
+      auto hit = [&](double b) {                      // fraction along C->B
         if (b <= xc) return 0.0;
         const double dx = b - w.sx, dy = -w.sy;
         const double num = (w.sx - f.cx) * dy - (w.sy - f.cy) * dx;
@@ -469,9 +467,7 @@ std::array<double, 2> ExactGeodesicSolver::InFrame(int32_t h, const SurfacePoint
   return {wb * f.length + wc * f.cx, wc * f.cy};
 }
 
-double ExactGeodesicSolver::UpperBoundAt(const SurfacePoint& p) const {
-  return BestAt(p).distance;
-}
+double ExactGeodesicSolver::UpperBoundAt(const SurfacePoint& p) const { return BestAt(p).distance; }
 
 ExactGeodesicSolver::Candidate ExactGeodesicSolver::BestAt(const SurfacePoint& p) const {
   Candidate best;
@@ -503,12 +499,9 @@ ExactGeodesicSolver::Candidate ExactGeodesicSolver::BestAt(const SurfacePoint& p
   return best;
 }
 
-double ExactGeodesicSolver::DistanceAt(const SurfacePoint& p) const {
-  return BestAt(p).distance;
-}
+double ExactGeodesicSolver::DistanceAt(const SurfacePoint& p) const { return BestAt(p).distance; }
 
-absl::StatusOr<std::vector<SurfacePoint>> ExactGeodesicSolver::PathTo(
-    const SurfacePoint& p) const {
+absl::StatusOr<std::vector<SurfacePoint>> ExactGeodesicSolver::PathTo(const SurfacePoint& p) const {
   GEODEX_RETURN_IF_ERROR(mesh::ValidateSurfacePoint(mesh_, p));
   std::vector<SurfacePoint> path = {p};
   Candidate c = BestAt(p);

@@ -179,7 +179,7 @@ class ExactGeodesicSolver {
   const Mesh& mesh_;
   std::vector<Frame> frame_;
   std::vector<double> corner_angle_;  // angle at Origin(h) in FaceOf(h)
-  std::vector<uint8_t> emits_;  // saddle or boundary vertex: a pseudo-source
+  std::vector<uint8_t> emits_;        // saddle or boundary vertex: a pseudo-source
 
   std::vector<double> dist_;
   std::vector<int32_t> nearest_;
@@ -198,7 +198,8 @@ class ExactGeodesicSolver {
 };
 
 // One-shot convenience: exact distances at all vertices from `sources`.
-absl::StatusOr<std::vector<double>> ExactGeodesicDistances(
-    const Mesh& mesh, std::span<const SurfacePoint> sources, const GeodesicOptions& options = {});
+absl::StatusOr<std::vector<double>> ExactGeodesicDistances(const Mesh& mesh,
+                                                           std::span<const SurfacePoint> sources,
+                                                           const GeodesicOptions& options = {});
 
 }  // namespace geodex::geodesic

@@ -65,8 +65,8 @@ void ExpectPathOnSurface(const Mesh& m, const std::vector<SurfacePoint>& path) {
     for (int32_t f = 0; f < m.num_faces() && !inside; ++f) {
       inside = FaceContains(m, f, a) && FaceContains(m, f, b);
     }
-    EXPECT_TRUE(inside) << "segment " << i << " from " << a.transpose() << " to "
-                        << b.transpose() << " leaves the surface";
+    EXPECT_TRUE(inside) << "segment " << i << " from " << a.transpose() << " to " << b.transpose()
+                        << " leaves the surface";
   }
 }
 
@@ -135,8 +135,7 @@ TEST(ExactGeodesicTest, LShapePathBendsAroundTheReentrantCorner) {
   const int32_t s = NearestVertex(m, Vec3(0.1, 1.9, 0));
   const int32_t t = NearestVertex(m, Vec3(1.9, 0.1, 0));
   ASSERT_TRUE(solver.Propagate({AtVertex(m, s)}).ok());
-  const double expected =
-      (m.position(s) - corner).norm() + (corner - m.position(t)).norm();
+  const double expected = (m.position(s) - corner).norm() + (corner - m.position(t)).norm();
   EXPECT_NEAR(solver.VertexDistance(t), expected, 1e-12);
   auto path = solver.PathTo(AtVertex(m, t));
   ASSERT_TRUE(path.ok()) << path.status();
@@ -416,8 +415,7 @@ TEST(ExactGeodesicTest, InvalidSourcesAreRejected) {
   GeodesicOptions options;
   std::vector<double> wrong_size(3, 0.0);
   options.initial_distance = wrong_size;
-  EXPECT_EQ(solver.Propagate({AtVertex(m, 0)}, options).code(),
-            absl::StatusCode::kInvalidArgument);
+  EXPECT_EQ(solver.Propagate({AtVertex(m, 0)}, options).code(), absl::StatusCode::kInvalidArgument);
   options = {};
   options.max_windows = 5;
   EXPECT_EQ(solver.Propagate({AtVertex(m, 0)}, options).code(),

@@ -266,7 +266,6 @@ std::span<const T> SectionView(const uint8_t* base, const std::optional<SectionE
   return std::span<const T>(reinterpret_cast<const T*>(base + e->offset), e->size / sizeof(T));
 }
 
-
 absl::Status WithPath(const absl::Status& status, const std::string& path) {
   if (status.ok()) return status;
   return absl::Status(status.code(), absl::StrCat(path, ": ", status.message()));

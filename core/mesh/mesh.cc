@@ -43,9 +43,9 @@ absl::StatusOr<Mesh> Mesh::Create(std::vector<Vec3> positions, std::vector<Trian
   }
   for (size_t v = 0; v < positions.size(); ++v) {
     if (!positions[v].allFinite()) {
-      return absl::InvalidArgumentError(absl::StrFormat(
-          "%s: vertex %d has a non-finite coordinate (%g, %g, %g)", mesh.name_, v, positions[v].x(),
-          positions[v].y(), positions[v].z()));
+      return absl::InvalidArgumentError(
+          absl::StrFormat("%s: vertex %d has a non-finite coordinate (%g, %g, %g)", mesh.name_, v,
+                          positions[v].x(), positions[v].y(), positions[v].z()));
     }
   }
   const int64_t n = static_cast<int64_t>(positions.size());
@@ -53,14 +53,13 @@ absl::StatusOr<Mesh> Mesh::Create(std::vector<Vec3> positions, std::vector<Trian
     const Triangle& t = faces[f];
     for (int i = 0; i < 3; ++i) {
       if (t[i] < 0 || t[i] >= n) {
-        return absl::InvalidArgumentError(
-            absl::StrFormat("%s: face %d references vertex %d, out of range [0, %d)", mesh.name_, f,
-                            t[i], n));
+        return absl::InvalidArgumentError(absl::StrFormat(
+            "%s: face %d references vertex %d, out of range [0, %d)", mesh.name_, f, t[i], n));
       }
     }
     if (t[0] == t[1] || t[1] == t[2] || t[0] == t[2]) {
-      return absl::InvalidArgumentError(absl::StrFormat(
-          "%s: face %d repeats a vertex (%d %d %d)", mesh.name_, f, t[0], t[1], t[2]));
+      return absl::InvalidArgumentError(absl::StrFormat("%s: face %d repeats a vertex (%d %d %d)",
+                                                        mesh.name_, f, t[0], t[1], t[2]));
     }
     const Vec3& a = positions[t[0]];
     const Vec3& b = positions[t[1]];
@@ -85,10 +84,10 @@ absl::StatusOr<Mesh> Mesh::Create(std::vector<Vec3> positions, std::vector<Trian
     std::sort(sorted.begin(), sorted.end());
     for (size_t i = 1; i < sorted.size(); ++i) {
       if (sorted[i].first == sorted[i - 1].first) {
-        return absl::InvalidArgumentError(absl::StrFormat(
-            "%s: faces %d and %d are duplicates (vertices %d %d %d)", mesh.name_,
-            sorted[i - 1].second, sorted[i].second, sorted[i].first[0], sorted[i].first[1],
-            sorted[i].first[2]));
+        return absl::InvalidArgumentError(
+            absl::StrFormat("%s: faces %d and %d are duplicates (vertices %d %d %d)", mesh.name_,
+                            sorted[i - 1].second, sorted[i].second, sorted[i].first[0],
+                            sorted[i].first[1], sorted[i].first[2]));
       }
     }
   }
@@ -182,9 +181,9 @@ absl::Status Mesh::BuildAdjacency() {
       h = back;
     } while (h != start && count < end - begin);
     if (count != end - begin) {
-      return absl::InvalidArgumentError(absl::StrFormat(
-          "%s: non-manifold vertex %d: its %d faces form more than one fan", name_, v,
-          end - begin));
+      return absl::InvalidArgumentError(
+          absl::StrFormat("%s: non-manifold vertex %d: its %d faces form more than one fan", name_,
+                          v, end - begin));
     }
     for (int32_t k = begin; k < end; ++k) {
       const int32_t o = outgoing_[k];
@@ -217,9 +216,8 @@ absl::Status Mesh::BuildAdjacency() {
 
 double Mesh::Area(int32_t f) const {
   const Triangle& t = faces_[f];
-  return 0.5 * (positions_[t[1]] - positions_[t[0]])
-                   .cross(positions_[t[2]] - positions_[t[0]])
-                   .norm();
+  return 0.5 *
+         (positions_[t[1]] - positions_[t[0]]).cross(positions_[t[2]] - positions_[t[0]]).norm();
 }
 
 double Mesh::TotalArea() const {
@@ -248,8 +246,7 @@ double Mesh::BoundingBoxDiagonal() const { return (BoundingBoxMax() - BoundingBo
 
 Vec3 PositionOf(const Mesh& mesh, const SurfacePoint& p) {
   const Triangle& t = mesh.face(p.face);
-  return p.w[0] * mesh.position(t[0]) + p.w[1] * mesh.position(t[1]) +
-         p.w[2] * mesh.position(t[2]);
+  return p.w[0] * mesh.position(t[0]) + p.w[1] * mesh.position(t[1]) + p.w[2] * mesh.position(t[2]);
 }
 
 absl::Status ValidateSurfacePoint(const Mesh& mesh, const SurfacePoint& p, double tolerance) {
@@ -270,9 +267,9 @@ absl::Status ValidateSurfacePoint(const Mesh& mesh, const SurfacePoint& p, doubl
     sum += p.w[i];
   }
   if (std::abs(sum - 1.0) > tolerance) {
-    return absl::InvalidArgumentError(absl::StrFormat(
-        "barycentric weights of face %d sum to %.17g, not 1 (tolerance %g)", p.face, sum,
-        tolerance));
+    return absl::InvalidArgumentError(
+        absl::StrFormat("barycentric weights of face %d sum to %.17g, not 1 (tolerance %g)", p.face,
+                        sum, tolerance));
   }
   return absl::OkStatus();
 }

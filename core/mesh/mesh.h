@@ -72,8 +72,7 @@ class Mesh {
   // face whose origin is `v`), in counter-clockwise fan order; for a boundary
   // vertex the fan starts at the boundary. Empty for unreferenced vertices.
   std::span<const int32_t> Outgoing(int32_t v) const {
-    return {outgoing_.data() + outgoing_offset_[v],
-            outgoing_.data() + outgoing_offset_[v + 1]};
+    return {outgoing_.data() + outgoing_offset_[v], outgoing_.data() + outgoing_offset_[v + 1]};
   }
 
   bool IsBoundaryVertex(int32_t v) const { return is_boundary_[v] != 0; }
@@ -127,8 +126,7 @@ Vec3 PositionOf(const Mesh& mesh, const SurfacePoint& p);
 // Checks face range, finiteness, non-negativity (>= -tolerance) and that the
 // weights sum to 1 within `tolerance`. Errors: OutOfRange for a bad face id,
 // InvalidArgument otherwise; messages name the offending value.
-absl::Status ValidateSurfacePoint(const Mesh& mesh, const SurfacePoint& p,
-                                  double tolerance = 1e-6);
+absl::Status ValidateSurfacePoint(const Mesh& mesh, const SurfacePoint& p, double tolerance = 1e-6);
 
 // The surface point at vertex `v` (in its first incident face). Errors:
 // OutOfRange for a bad id, FailedPrecondition for an unreferenced vertex.

@@ -18,8 +18,8 @@ std::vector<std::string_view> Fields(std::string_view line) {
   std::vector<std::string_view> fields;
   size_t i = 0;
   while (i < line.size()) {
-    while (i < line.size() && (line[i] == ' ' || line[i] == '\t' || line[i] == ',' ||
-                               line[i] == '\r')) {
+    while (i < line.size() &&
+           (line[i] == ' ' || line[i] == '\t' || line[i] == ',' || line[i] == '\r')) {
       ++i;
     }
     const size_t start = i;
@@ -47,9 +47,9 @@ absl::StatusOr<std::vector<PointPair>> ParsePairs(std::string_view contents) {
     const std::vector<std::string_view> fields = Fields(line);
     if (fields.empty() || fields[0][0] == '#') continue;
     if (fields.size() != 8) {
-      return absl::InvalidArgumentError(absl::StrFormat(
-          "line %d: expected 8 fields 'fa a0 a1 a2 fb b0 b1 b2', found %d", line_number,
-          fields.size()));
+      return absl::InvalidArgumentError(
+          absl::StrFormat("line %d: expected 8 fields 'fa a0 a1 a2 fb b0 b1 b2', found %d",
+                          line_number, fields.size()));
     }
     PointPair pair;
     pair.line = line_number;
@@ -70,9 +70,8 @@ absl::StatusOr<std::vector<PointPair>> ParsePairs(std::string_view contents) {
         double value = 0;
         const auto [p2, ec2] = std::from_chars(text.data(), text.data() + text.size(), value);
         if (ec2 != std::errc() || p2 != text.data() + text.size() || !std::isfinite(value)) {
-          return absl::InvalidArgumentError(
-              absl::StrFormat("line %d: field %d ('%s') is not a finite number", line_number,
-                              4 * k + 2 + i, text));
+          return absl::InvalidArgumentError(absl::StrFormat(
+              "line %d: field %d ('%s') is not a finite number", line_number, 4 * k + 2 + i, text));
         }
         points[k]->w[i] = value;
       }

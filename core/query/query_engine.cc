@@ -30,7 +30,6 @@ inline double TwoSide2(double l, double pa, double pb, double qa, double qb) {
   return dx * dx + dy * dy;
 }
 
-
 // Places a point at distances (da, db) from the edge's ends and dc from the
 // third corner: like Place, on the side of the edge whose mirror image
 // matches dc better. Points beyond an edge of the triangle (common near mesh
@@ -128,7 +127,8 @@ absl::StatusOr<std::shared_ptr<const QueryEngine>> QueryEngine::Create(
     for (int32_t f = 0; f < ix.num_faces(); ++f) {
       faces[f] = {ix.faces()[3 * f], ix.faces()[3 * f + 1], ix.faces()[3 * f + 2]};
     }
-    GEODEX_ASSIGN_OR_RETURN(mesh::Mesh m, mesh::Mesh::Create(std::move(positions), std::move(faces), "index"));
+    GEODEX_ASSIGN_OR_RETURN(mesh::Mesh m,
+                            mesh::Mesh::Create(std::move(positions), std::move(faces), "index"));
     engine->mesh_ = std::make_unique<mesh::Mesh>(std::move(m));
   }
   return std::shared_ptr<const QueryEngine>(std::move(engine));
@@ -208,7 +208,7 @@ SurfacePoint QueryEngine::Canonical(const SurfacePoint& p) const {
     const int32_t g = twins_[h];
     if (g >= 0 && g / 3 < c.face) {
       SurfacePoint t{g / 3, {0, 0, 0}};
-      t.w[g % 3] = c.w[(zero + 2) % 3];        // Origin(g) = Dest(h)
+      t.w[g % 3] = c.w[(zero + 2) % 3];            // Origin(g) = Dest(h)
       t.w[(g % 3 + 1) % 3] = c.w[(zero + 1) % 3];  // Dest(g) = Origin(h)
       return t;
     }
@@ -280,14 +280,13 @@ LiftedPoint QueryEngine::Lift(const SurfacePoint& p) const {
       // Exact distances of one field at the three corners of a face fix the
       // unfolded source: trilaterate it (linear, no square roots) and measure.
       const double sx = (l * l + d[0][c] * d[0][c] - d[1][c] * d[1][c]) / (2 * l);
-      const double sy = (cx * cx + cy * cy - 2 * sx * cx + d[0][c] * d[0][c] - d[2][c] * d[2][c]) /
-                        (2 * cy);
+      const double sy =
+          (cx * cx + cy * cy - 2 * sx * cx + d[0][c] * d[0][c] - d[2][c] * d[2][c]) / (2 * cy);
       out.distance[c] = Norm2(px - sx, py - sy);
       continue;
     }
     // Paper §5.2, case 4: two-side unfolding about each edge of the face.
-    const double to_vertex[3] = {Norm2(px, py), Norm2(px - l, py),
-                                 Norm2(px - cx, py - cy)};
+    const double to_vertex[3] = {Norm2(px, py), Norm2(px - l, py), Norm2(px - cx, py - cy)};
     const double edge[3] = {l, Norm2(cx - l, cy), Norm2(cx, cy)};
     double best = kInf;
     for (int i = 0; i < 3; ++i) {
@@ -329,8 +328,7 @@ double QueryEngine::LiftedDistance(const LiftedPoint& p0, const LiftedPoint& q0)
       if (p.corner[i] == s) to_corner[j] = p.distance[i];  // case 2.1
     }
     if (to_corner[j] < 0) {
-      const double e[3] = {Matrix(s, p.corner[0]), Matrix(s, p.corner[1]),
-                           Matrix(s, p.corner[2])};
+      const double e[3] = {Matrix(s, p.corner[0]), Matrix(s, p.corner[1]), Matrix(s, p.corner[2])};
       to_corner[j] = std::sqrt(TwoSideToOutside2(p_frames, p_placed, e));
     }
   }
@@ -383,15 +381,16 @@ absl::Status QueryEngine::DistanceBatch(std::span<const SurfacePoint> a,
                                         std::span<const SurfacePoint> b, std::span<double> out,
                                         QueryScratch* scratch) const {
   if (a.size() != b.size() || a.size() != out.size()) {
-    return absl::InvalidArgumentError(absl::StrFormat(
-        "batch arrays differ in length (%d, %d, %d)", a.size(), b.size(), out.size()));
+    return absl::InvalidArgumentError(absl::StrFormat("batch arrays differ in length (%d, %d, %d)",
+                                                      a.size(), b.size(), out.size()));
   }
   for (size_t i = 0; i < a.size(); ++i) {
     for (const SurfacePoint* p : {&a[i], &b[i]}) {
       const absl::Status status = Validate(*p);
       if (!status.ok()) {
-        return absl::Status(status.code(), absl::StrFormat("pair %d, point %c: %s", i,
-                                                           p == &a[i] ? 'A' : 'B', status.message()));
+        return absl::Status(
+            status.code(),
+            absl::StrFormat("pair %d, point %c: %s", i, p == &a[i] ? 'A' : 'B', status.message()));
       }
     }
   }
@@ -425,7 +424,7 @@ double QueryEngine::LinearInterpolationDistance(const SurfacePoint& p0,
   if (!(Matrix(p.corner[0], q.corner[0]) < kInf)) return kInf;
   auto lambda = [&](const LiftedPoint& x) {
     return UnfoldedBarycentric(Matrix(x.corner[0], x.corner[1]), Matrix(x.corner[1], x.corner[2]),
-                       Matrix(x.corner[2], x.corner[0]), x.distance);
+                               Matrix(x.corner[2], x.corner[0]), x.distance);
   };
   const auto lp = lambda(p), lq = lambda(q);
   double d = 0;

@@ -146,7 +146,8 @@ class QueryEngine {
   double ToSample(const LiftedPoint& p, int32_t s) const;
   LiftedPoint VertexLift(int32_t v) const {
     const index::VertexRecord& r = records_[v];
-    return {r.triangle, {r.corner[0], r.corner[1], r.corner[2]},
+    return {r.triangle,
+            {r.corner[0], r.corner[1], r.corner[2]},
             {r.distance[0], r.distance[1], r.distance[2]}};
   }
   double ExactNearDistance(const SurfacePoint& p, const SurfacePoint& q,

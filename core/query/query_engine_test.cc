@@ -64,7 +64,8 @@ Mesh HalfCylinder(int n_around, int n_along, double radius, double length) {
   for (int j = 0; j <= n_along; ++j) {
     for (int k = 0; k <= n_around; ++k) {
       const double angle = M_PI * k / n_around;
-      positions.push_back({radius * std::cos(angle), radius * std::sin(angle), length * j / n_along});
+      positions.push_back(
+          {radius * std::cos(angle), radius * std::sin(angle), length * j / n_along});
     }
   }
   auto id = [&](int k, int j) { return j * (n_around + 1) + k; };
@@ -190,8 +191,7 @@ TEST(QueryEngineTest, BatchEqualsSingleAndValidatesEveryPoint) {
   EXPECT_THAT(engine->DistanceBatch(a, bad, out).message(), HasSubstr("negative"));
   bad[42] = {0, {0.5, 0.5, 0.5}};
   EXPECT_THAT(engine->DistanceBatch(a, bad, out).message(), HasSubstr("sum"));
-  EXPECT_EQ(engine->Distance({-1, {1, 0, 0}}, a[0]).status().code(),
-            absl::StatusCode::kOutOfRange);
+  EXPECT_EQ(engine->Distance({-1, {1, 0, 0}}, a[0]).status().code(), absl::StatusCode::kOutOfRange);
 }
 
 TEST(QueryEngineTest, ExactNearPairsMatchTheExactEngine) {
@@ -293,7 +293,8 @@ TEST(QueryEngineTest, LinearBaselineIsWorseThanUnfolding) {
     for (size_t j = 5; j < points.size(); ++j) {
       const double exact = solver.DistanceAt(points[j]);
       unfold2 += std::pow((*engine->Distance(points[i], points[j]) - exact) / exact, 2);
-      linear2 += std::pow((engine->LinearInterpolationDistance(points[i], points[j]) - exact) / exact, 2);
+      linear2 +=
+          std::pow((engine->LinearInterpolationDistance(points[i], points[j]) - exact) / exact, 2);
     }
   }
   EXPECT_LT(unfold2, linear2);

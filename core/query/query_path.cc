@@ -150,7 +150,7 @@ absl::StatusOr<std::vector<PathPoint>> QueryEngine::Path(const SurfacePoint& fro
     if (path.back().position != Position(v)) path.push_back(vertex_point(f, v));
     struct Node {
       double g;
-      int32_t face;   // a face containing the vertex and its parent
+      int32_t face;  // a face containing the vertex and its parent
       int32_t parent;
     };
     std::unordered_map<int32_t, Node> seen;
@@ -182,7 +182,8 @@ absl::StatusOr<std::vector<PathPoint>> QueryEngine::Path(const SurfacePoint& fro
     }
     if (reached < 0) return absl::InternalError("no mesh path to the source");
     std::vector<PathPoint> tail;
-    for (int32_t u = reached; u != v; u = seen[u].parent) tail.push_back(vertex_point(seen[u].face, u));
+    for (int32_t u = reached; u != v; u = seen[u].parent)
+      tail.push_back(vertex_point(seen[u].face, u));
     path.insert(path.end(), tail.rbegin(), tail.rend());
     path.push_back(point_at(from.face, from.w));
     std::reverse(path.begin(), path.end());
@@ -201,7 +202,8 @@ absl::StatusOr<std::vector<PathPoint>> QueryEngine::Path(const SurfacePoint& fro
   // (numerical flats, saddles of the interpolant): finish on the graph.
   std::unordered_map<int32_t, int> visits;
   for (int64_t step = 0; step < max_steps; ++step) {
-    if (++visits[f] > 6) return finish_on_graph(path, at_vertex >= 0 ? at_vertex : faces_[3 * f], f);
+    if (++visits[f] > 6)
+      return finish_on_graph(path, at_vertex >= 0 ? at_vertex : faces_[3 * f], f);
     if (contains_source(f)) {
       path.push_back(point_at(from.face, from.w));
       std::reverse(path.begin(), path.end());

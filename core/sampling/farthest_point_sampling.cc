@@ -63,8 +63,7 @@ absl::StatusOr<SampleSet> FarthestPointSampling(const mesh::Mesh& mesh, int32_t 
   for (int32_t v = 0; v < mesh.num_vertices(); ++v) referenced += mesh.IsReferenced(v);
   if (num_samples < 1 || num_samples > referenced) {
     return absl::InvalidArgumentError(absl::StrFormat(
-        "cannot take %d samples from a mesh with %d referenced vertices", num_samples,
-        referenced));
+        "cannot take %d samples from a mesh with %d referenced vertices", num_samples, referenced));
   }
   geodesic::ExactGeodesicSolver solver(mesh);
   int32_t start = static_cast<int32_t>(SplitMix64(seed) % mesh.num_vertices());

@@ -25,9 +25,9 @@
 namespace geodex::sampling {
 
 struct SampleSet {
-  std::vector<int32_t> samples;   // vertex of each sample
-  std::vector<double> distance;   // per vertex: distance to the nearest sample
-  std::vector<int32_t> nearest;   // per vertex: index of the nearest sample (kNone if none)
+  std::vector<int32_t> samples;  // vertex of each sample
+  std::vector<double> distance;  // per vertex: distance to the nearest sample
+  std::vector<int32_t> nearest;  // per vertex: index of the nearest sample (kNone if none)
 };
 
 // Errors: InvalidArgument if num_samples < 1 or exceeds the referenced vertex

@@ -38,8 +38,8 @@ absl::StatusOr<mesh::Mesh> LoadInput(const std::string& path) {
   if (name == "sphere") return mesh::gen::Sphere(5, 1.0);
   if (name == "cube") return mesh::gen::Cube(24, 2.0);
   if (name == "double-torus") return mesh::gen::DoubleTorus(24, 4.0);
-  return absl::InvalidArgumentError(absl::StrFormat(
-      "unknown built-in mesh '%s' (torus, sphere, cube, double-torus)", name));
+  return absl::InvalidArgumentError(
+      absl::StrFormat("unknown built-in mesh '%s' (torus, sphere, cube, double-torus)", name));
 }
 
 std::string FormatSeconds(double s) {
@@ -65,8 +65,7 @@ class ProgressPrinter {
                                              p.total, 100 * fraction, FormatSeconds(elapsed), eta);
     if (tty_) {
       std::fprintf(stderr, "\r\033[K%s%s", line.c_str(), p.done >= p.total ? "\n" : "");
-    } else if (p.done >= p.total ||
-               std::chrono::duration<double>(now - last_log_).count() >= 10) {
+    } else if (p.done >= p.total || std::chrono::duration<double>(now - last_log_).count() >= 10) {
       std::fprintf(stderr, "%s\n", line.c_str());
       last_log_ = now;
     }
@@ -132,7 +131,8 @@ int main(int argc, char** argv) {
   app.add_option("-o,--output", out, "Output index file (.gdx)");
   app.add_option("--samples", samples, "Number of samples m")->check(CLI::PositiveNumber);
   app.add_option("--seed", seed, "Sampling seed");
-  app.add_option("--threads", threads, "Worker threads (0: all cores)")->check(CLI::NonNegativeNumber);
+  app.add_option("--threads", threads, "Worker threads (0: all cores)")
+      ->check(CLI::NonNegativeNumber);
 
   CLI::App* plan_cmd = app.add_subcommand("plan", "Distributed build, step 1: sampling");
   plan_cmd->add_option("mesh", mesh_path, "Mesh file")->required();

@@ -55,8 +55,9 @@ absl::Status Run(const std::string& mesh_path, const std::string& pairs_path, in
       for (int64_t i : groups[g].pairs) options.stop_points.push_back(pairs[i].b);
       const absl::Status status = solver.Propagate({&groups[g].source, 1}, options);
       if (!status.ok()) {
-        errors[id] = absl::Status(status.code(), absl::StrCat("line ", pairs[groups[g].pairs[0]].line,
-                                                              ": ", status.message()));
+        errors[id] = absl::Status(
+            status.code(),
+            absl::StrCat("line ", pairs[groups[g].pairs[0]].line, ": ", status.message()));
         return;
       }
       for (int64_t i : groups[g].pairs) result[i] = solver.DistanceAt(pairs[i].b);

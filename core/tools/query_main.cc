@@ -35,7 +35,8 @@ absl::StatusOr<std::vector<std::vector<double>>> ReadNumberLines(const std::stri
     const std::string line = text.substr(begin, end - begin);
     begin = end + 1;
     ++number;
-    if (line.find_first_not_of(" \t\r") == std::string::npos || line[line.find_first_not_of(" \t")] == '#') {
+    if (line.find_first_not_of(" \t\r") == std::string::npos ||
+        line[line.find_first_not_of(" \t")] == '#') {
       continue;
     }
     std::vector<double> values;
@@ -62,7 +63,8 @@ absl::StatusOr<std::vector<std::vector<double>>> ReadNumberLines(const std::stri
   return lines;
 }
 
-absl::Status CheckPairs(const query::QueryEngine& engine, const std::vector<mesh::PointPair>& pairs) {
+absl::Status CheckPairs(const query::QueryEngine& engine,
+                        const std::vector<mesh::PointPair>& pairs) {
   for (const mesh::PointPair& pair : pairs) {
     for (const mesh::SurfacePoint* p : {&pair.a, &pair.b}) {
       const absl::Status status = engine.Validate(*p);
@@ -115,14 +117,16 @@ absl::Status Run(const Args& args) {
         out += "  [";
         for (size_t k = 0; k < path->size(); ++k) {
           const auto& p = (*path)[k];
-          out += absl::StrFormat("%s{\"face\": %d, \"w\": [%.17g, %.17g, %.17g], \"xyz\": [%.17g, %.17g, %.17g]}",
-                                 k ? ", " : "", p.point.face, p.point.w[0], p.point.w[1],
-                                 p.point.w[2], p.position.x(), p.position.y(), p.position.z());
+          out += absl::StrFormat(
+              "%s{\"face\": %d, \"w\": [%.17g, %.17g, %.17g], \"xyz\": [%.17g, %.17g, %.17g]}",
+              k ? ", " : "", p.point.face, p.point.w[0], p.point.w[1], p.point.w[2], p.position.x(),
+              p.position.y(), p.position.z());
         }
         out += i + 1 < pairs.size() ? "],\n" : "]\n";
       } else {
         for (const auto& p : *path) {
-          out += absl::StrFormat("%.17g %.17g %.17g\n", p.position.x(), p.position.y(), p.position.z());
+          out += absl::StrFormat("%.17g %.17g %.17g\n", p.position.x(), p.position.y(),
+                                 p.position.z());
         }
         out += "\n";
       }
@@ -159,7 +163,8 @@ int main(int argc, char** argv) {
   geodex::Args args;
   CLI::App app{"geodex-query: geodesic queries from an index file, offline."};
   app.add_option("index", args.index, "Index file (.gdx)")->required();
-  auto* pairs = app.add_option("--pairs", args.pairs, "Distances for lines 'fa a0 a1 a2 fb b0 b1 b2'");
+  auto* pairs =
+      app.add_option("--pairs", args.pairs, "Distances for lines 'fa a0 a1 a2 fb b0 b1 b2'");
   auto* paths = app.add_option("--paths", args.paths, "Paths for lines 'fa a0 a1 a2 fb b0 b1 b2'");
   auto* field = app.add_option("--field", args.field, "Distance field from lines 'f w0 w1 w2'");
   auto* locate = app.add_option("--locate", args.locate, "Closest surface points to lines 'x y z'");

@@ -61,8 +61,7 @@ std::string RepairReport::Summary() const {
   return out;
 }
 
-DualComplex CheckDual(const Mesh& mesh, const std::vector<int32_t>& nearest,
-                      int32_t num_samples) {
+DualComplex CheckDual(const Mesh& mesh, const std::vector<int32_t>& nearest, int32_t num_samples) {
   DualComplex out;
   auto violate = [&](ViolationKind kind, std::vector<int32_t> cells) {
     out.violations.push_back({kind, std::move(cells)});
@@ -101,7 +100,8 @@ DualComplex CheckDual(const Mesh& mesh, const std::vector<int32_t>& nearest,
       }
     }
     int clusters = 0;
-    for (size_t k = 0; k < group.size(); ++k) clusters += Find(parent, k) == static_cast<int32_t>(k);
+    for (size_t k = 0; k < group.size(); ++k)
+      clusters += Find(parent, k) == static_cast<int32_t>(k);
     if (clusters > 1) violate(ViolationKind::kRepeatedVoronoiVertex, {key[0], key[1], key[2]});
     // Orientation of each face's labels.
     std::array<int32_t, 3> oriented{};
@@ -209,8 +209,7 @@ DualComplex CheckDual(const Mesh& mesh, const std::vector<int32_t>& nearest,
       }
       size_t walked = 0;
       int32_t x = start;
-      for (auto it = next.find(x); it != next.end() && walked <= edges.size();
-           it = next.find(x)) {
+      for (auto it = next.find(x); it != next.end() && walked <= edges.size(); it = next.find(x)) {
         x = it->second;
         ++walked;
         if (x == start) break;
@@ -243,7 +242,8 @@ DualComplex CheckDual(const Mesh& mesh, const std::vector<int32_t>& nearest,
       if (mesh.IsReferenced(v)) ++mesh_chi[mesh.VertexComponent(v)];
     }
     for (int32_t h = 0; h < mesh.num_halfedges(); ++h) {
-      if (mesh.Twin(h) == kNone || mesh.Twin(h) > h) --mesh_chi[mesh.FaceComponent(Mesh::FaceOf(h))];
+      if (mesh.Twin(h) == kNone || mesh.Twin(h) > h)
+        --mesh_chi[mesh.FaceComponent(Mesh::FaceOf(h))];
     }
     for (int32_t f = 0; f < nf; ++f) ++mesh_chi[mesh.FaceComponent(f)];
     std::vector<int32_t> sample_component(num_samples, kNone);
@@ -286,8 +286,7 @@ absl::StatusOr<DualComplex> RepairTriangulation(const Mesh& mesh, sampling::Samp
       return absl::FailedPreconditionError(absl::StrFormat(
           "no valid geodesic triangulation after %d repair rounds and %d samples: %d violations "
           "left, e.g. %s at samples %s",
-          round, m, dual.violations.size(), ViolationName(v.kind),
-          absl::StrJoin(v.cells, ",")));
+          round, m, dual.violations.size(), ViolationName(v.kind), absl::StrJoin(v.cells, ",")));
     }
     // The farthest vertex of each cell.
     std::vector<int32_t> far(m, kNone);

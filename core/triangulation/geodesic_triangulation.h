@@ -66,8 +66,8 @@ struct RepairReport {
 // Adds samples to `set` until CheckDual finds no violation, and returns the
 // valid dual. Errors: FailedPrecondition when no valid triangulation is found
 // within `max_rounds` rounds or once samples exceed `max_samples`.
-absl::StatusOr<DualComplex> RepairTriangulation(const mesh::Mesh& mesh,
-                                                sampling::SampleSet* set, int32_t max_rounds,
-                                                int32_t max_samples, RepairReport* report);
+absl::StatusOr<DualComplex> RepairTriangulation(const mesh::Mesh& mesh, sampling::SampleSet* set,
+                                                int32_t max_rounds, int32_t max_samples,
+                                                RepairReport* report);
 
 }  // namespace geodex::triangulation

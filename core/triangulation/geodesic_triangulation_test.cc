@@ -50,7 +50,8 @@ TEST(GeodesicTriangulationTest, RepairReachesAValidTriangulationOnEveryShape) {
       const int64_t f = dual->triangles.size();
       const int64_t v = set->samples.size();
       int64_t chi_mesh = 0;
-      chi_mesh = shape.mesh.num_vertices() - shape.mesh.num_halfedges() / 2 + shape.mesh.num_faces();
+      chi_mesh =
+          shape.mesh.num_vertices() - shape.mesh.num_halfedges() / 2 + shape.mesh.num_faces();
       EXPECT_EQ(v - 3 * f / 2 + f, chi_mesh);
     }
     std::printf("%-18s %4zu samples (%s), %zu triangles\n", shape.name, set->samples.size(),

@@ -35,11 +35,11 @@ std::string AccuracyReport::MarkdownHeader() {
 
 std::string AccuracyReport::ToMarkdownRow(const std::string& label) const {
   auto pct = [](double x) { return absl::StrFormat("%.3f%%", 100 * x); };
-  return absl::StrFormat("| %s | %d | %s | %s | %s | %s | %s | %d | %s | %s | %s | %s | %s | %.4f |\n",
-                         label, all.count, pct(all.rms), pct(all.mean), pct(all.p99),
-                         pct(all.max), pct(far.p99), near.count, pct(near.rms), pct(near.p99),
-                         pct(near_exact_mode.p99), pct(all_exact_mode.rms), pct(baseline.rms),
-                         path_ratio.count ? 1 + path_ratio.p99 : 0.0);
+  return absl::StrFormat(
+      "| %s | %d | %s | %s | %s | %s | %s | %d | %s | %s | %s | %s | %s | %.4f |\n", label,
+      all.count, pct(all.rms), pct(all.mean), pct(all.p99), pct(all.max), pct(far.p99), near.count,
+      pct(near.rms), pct(near.p99), pct(near_exact_mode.p99), pct(all_exact_mode.rms),
+      pct(baseline.rms), path_ratio.count ? 1 + path_ratio.p99 : 0.0);
 }
 
 std::vector<mesh::SurfacePoint> RandomSurfacePoints(const mesh::Mesh& mesh, int32_t count,
@@ -80,7 +80,8 @@ AccuracyReport MeasureAccuracy(const mesh::Mesh& mesh, const query::QueryEngine&
       all.push_back(e);
       const bool is_near = engine.IsNearPair(points[s], points[k]);
       (is_near ? near : far).push_back(e);
-      baseline.push_back((engine.LinearInterpolationDistance(points[s], points[k]) - exact) / exact);
+      baseline.push_back((engine.LinearInterpolationDistance(points[s], points[k]) - exact) /
+                         exact);
       if (exact_engine != nullptr) {
         const double fixed = *exact_engine->Distance(points[s], points[k], &scratch);
         all_exact.push_back((fixed - exact) / exact);

@@ -76,7 +76,8 @@ double Gather(const index::Index& ix, const mesh::SurfacePoint& p, const mesh::S
     anchor[k] = &records[f[0]];
   }
   for (int i = 0; i < 3; ++i) {
-    for (int j = 0; j < 3; ++j) acc += ix.SampleDistance(anchor[0]->corner[i], anchor[1]->corner[j]);
+    for (int j = 0; j < 3; ++j)
+      acc += ix.SampleDistance(anchor[0]->corner[i], anchor[1]->corner[j]);
   }
   return acc;
 }
@@ -111,8 +112,7 @@ void Bench(const std::string& label, std::shared_ptr<const index::Index> ix, int
   });
   std::printf("| %s | %d | %d | %.2fM | %.2fM | %.2fM | %.2fM | %.2f | %.2fM |\n", label.c_str(),
               ix->num_vertices(), ix->num_samples(), vertex_rate / 1e6, interior_rate / 1e6,
-              batch_rate / 1e6, gather_rate / 1e6, gather_rate / interior_rate,
-              linear_rate / 1e6);
+              batch_rate / 1e6, gather_rate / 1e6, gather_rate / interior_rate, linear_rate / 1e6);
 }
 
 }  // namespace
@@ -127,7 +127,8 @@ int main(int argc, char** argv) {
   CLI11_PARSE(app, argc, argv);
   std::printf(
       "| index | vertices | m | vertex pairs/s | interior pairs/s | batch (validated) pairs/s | "
-      "gather-only/s | gather/query | linear baseline/s |\n|---|---|---|---|---|---|---|---|---|\n");
+      "gather-only/s | gather/query | linear baseline/s "
+      "|\n|---|---|---|---|---|---|---|---|---|\n");
   if (indexes.empty()) {
     std::printf("(no --index given: a generated sphere, m = 500)\n");
     geodex::build::BuildOptions options;
