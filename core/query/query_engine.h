@@ -45,6 +45,9 @@ struct QueryOptions {
   // Answer pairs in the same or adjacent geodesic triangles exactly, by a
   // local propagation (not O(1); needs a QueryScratch). Off: pure O(1).
   bool exact_near_pairs = false;
+  // Straighten traced paths through the faces they cross (funnel algorithm,
+  // see path_straightening.h). Off: the raw gradient trace of §6.2.
+  bool straighten_paths = true;
   // Barycentric tolerance for validation (weights >= -tol, |sum - 1| <= tol).
   double weight_tolerance = 1e-6;
 };
@@ -122,6 +125,11 @@ class QueryEngine {
   // a mesh face. Errors: as Validate; NotFound between components.
   absl::StatusOr<std::vector<PathPoint>> Path(const SurfacePoint& from,
                                               const SurfacePoint& to) const;
+
+  // The gradient trace of Path before straightening, for comparisons. The
+  // points must be valid (see Validate).
+  absl::StatusOr<std::vector<PathPoint>> TracePath(const SurfacePoint& from,
+                                                   const SurfacePoint& to) const;
 
   // Distance from the nearest of `sources` to every vertex, O(l n).
   // Errors: as Validate (naming the source index); InvalidArgument if empty.

@@ -1,5 +1,6 @@
 #include "core/query/query_engine.h"
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 
@@ -228,6 +229,58 @@ TEST(QueryEngineTest, PathsStayOnTheSurfaceAndAreNearlyGeodesic) {
       EXPECT_LT(std::abs((*path)[k].position.z()), 1e-12);  // on the plane
     }
     EXPECT_LE(length, (a - b).norm() * 1.01 + 1e-9);
+  }
+}
+
+double PathLength(const std::vector<PathPoint>& path) {
+  double length = 0;
+  for (size_t k = 1; k < path.size(); ++k)
+    length += (path[k].position - path[k - 1].position).norm();
+  return length;
+}
+
+// Consecutive points share a face of the mesh.
+bool SharesFaces(const Mesh& m, const std::vector<PathPoint>& path) {
+  auto support = [&](const PathPoint& p) {
+    std::vector<int32_t> out;
+    for (int i = 0; i < 3; ++i) {
+      if (p.point.w[i] > 1e-12) out.push_back(m.face(p.point.face)[i]);
+    }
+    return out;
+  };
+  for (size_t k = 1; k < path.size(); ++k) {
+    std::vector<int32_t> both = support(path[k - 1]);
+    for (int32_t v : support(path[k])) both.push_back(v);
+    bool shared = false;
+    for (int32_t f = 0; f < m.num_faces() && !shared; ++f) {
+      shared = std::all_of(both.begin(), both.end(), [&](int32_t v) {
+        const auto t = m.face(f);
+        return t[0] == v || t[1] == v || t[2] == v;
+      });
+    }
+    if (!shared) return false;
+  }
+  return true;
+}
+
+// Straightened through the faces it crosses, a traced path on a developable
+// surface is the exact geodesic, and never longer than the trace.
+TEST(QueryEngineTest, StraightenedPathsAreExactOnDevelopableSurfaces) {
+  for (const Mesh& m :
+       {gen::Grid(30, 30, 1.0, 1.0, 0.2, 4), gen::FoldedSheet(30, 20, 2.0, 1.0, 1.1)}) {
+    auto engine = MakeEngine(m, 40);
+    const auto points = RandomPoints(m, 40, 8);
+    for (size_t i = 0; i + 1 < points.size(); i += 2) {
+      auto path = engine->Path(points[i], points[i + 1]);
+      auto traced = engine->TracePath(points[i], points[i + 1]);
+      ASSERT_TRUE(path.ok() && traced.ok());
+      EXPECT_EQ(path->front().position, PositionOf(m, points[i]));
+      EXPECT_EQ(path->back().position, PositionOf(m, points[i + 1]));
+      EXPECT_TRUE(SharesFaces(m, *path)) << m.name() << " pair " << i;
+      const double exact = Exact(m, points[i], points[i + 1]);
+      EXPECT_NEAR(PathLength(*path), exact, 1e-9 * (1 + exact)) << m.name() << " pair " << i;
+      EXPECT_LE(PathLength(*path), PathLength(*traced) + 1e-12);
+    }
   }
 }
 

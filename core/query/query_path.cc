@@ -8,6 +8,7 @@
 
 #include "absl/strings/str_format.h"
 #include "core/common/status_macros.h"
+#include "core/query/path_straightening.h"
 #include "core/query/query_engine.h"
 
 namespace geodex::query {
@@ -109,10 +110,36 @@ int LocalIndex(std::span<const int32_t> faces, int32_t f, int32_t v) {
 
 }  // namespace
 
-absl::StatusOr<std::vector<PathPoint>> QueryEngine::Path(const SurfacePoint& from_in,
-                                                         const SurfacePoint& to_in) const {
-  GEODEX_RETURN_IF_ERROR(Validate(from_in));
-  GEODEX_RETURN_IF_ERROR(Validate(to_in));
+absl::StatusOr<std::vector<PathPoint>> QueryEngine::Path(const SurfacePoint& from,
+                                                         const SurfacePoint& to) const {
+  GEODEX_RETURN_IF_ERROR(Validate(from));
+  GEODEX_RETURN_IF_ERROR(Validate(to));
+  GEODEX_ASSIGN_OR_RETURN(std::vector<PathPoint> path, TracePath(from, to));
+  if (!options_.straighten_paths) return path;
+  const MeshArrays mesh{positions_, faces_, twins_};
+  path = StraightenPath(mesh, std::move(path));
+  // The trace of the other point's field may run in a better corridor (the
+  // two approximate fields err differently): keep the shorter.
+  absl::StatusOr<std::vector<PathPoint>> back = TracePath(to, from);
+  if (back.ok()) {
+    std::vector<PathPoint> other = StraightenPath(mesh, *std::move(back));
+    std::reverse(other.begin(), other.end());
+    auto length = [](const std::vector<PathPoint>& p) {
+      double sum = 0;
+      for (size_t i = 1; i < p.size(); ++i) sum += (p[i].position - p[i - 1].position).norm();
+      return sum;
+    };
+    if (length(other) < length(path)) {
+      other.front() = path.front();  // the exact endpoints, as given
+      other.back() = path.back();
+      path = std::move(other);
+    }
+  }
+  return path;
+}
+
+absl::StatusOr<std::vector<PathPoint>> QueryEngine::TracePath(const SurfacePoint& from_in,
+                                                              const SurfacePoint& to_in) const {
   const SurfacePoint from = Canonical(from_in), to = Canonical(to_in);
   Tracer tr{*this, positions_, faces_, twins_, Lift(from), {}};
   if (!(LiftedDistance(tr.source, Lift(to)) < std::numeric_limits<double>::infinity())) {

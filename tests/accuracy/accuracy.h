@@ -26,6 +26,7 @@ struct ErrorStats {
 
 struct AccuracyReport {
   ErrorStats all, far, near, near_exact_mode, all_exact_mode, baseline, path_ratio;
+  ErrorStats traced_path_ratio;  // the gradient trace before straightening
   std::string ToMarkdownRow(const std::string& label) const;
   static std::string MarkdownHeader();
 };
