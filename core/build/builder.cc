@@ -74,9 +74,12 @@ std::string BuildSummary::ToText() const {
   return absl::StrFormat(
       "requested_samples = %d\nsamples = %d\nrepair = %s\ntriangles = %d\n"
       "referenced_vertices = %d\nunassigned_vertices = %d\nshare_outside_triangle = %.6g\n"
-      "longest_edge = %.9g\nbbox_diagonal = %.9g\n",
+      "longest_edge = %.9g\nbbox_diagonal = %.9g\ngeodesic_edges = %d\n"
+      "edge_crossings_found = %d\ngeodesic_edge_length_total = %.9g\n"
+      "geodesic_edge_length_max = %.9g\ngeodesic_edge_length_error = %.3g\n",
       requested_samples, num_samples, repair, num_triangles, referenced_vertices,
-      unassigned_vertices, share_outside, longest_edge, bbox_diagonal);
+      unassigned_vertices, share_outside, longest_edge, bbox_diagonal, geodesic_edges,
+      edge_crossings_found, edge_length_total, edge_length_max, edge_length_error);
 }
 
 absl::StatusOr<Plan> MakePlan(const Mesh& mesh, const BuildOptions& options) {
@@ -93,17 +96,22 @@ absl::StatusOr<Plan> MakePlan(const Mesh& mesh, const BuildOptions& options) {
 
   start = std::chrono::steady_clock::now();
   if (options.progress) options.progress({"repair", 0, 1});
-  const int32_t max_samples = std::max<int32_t>(4 * options.num_samples + 64, 256);
+  triangulation::RepairOptions repair;
+  repair.max_rounds = options.max_repair_rounds;
+  repair.max_samples =
+      std::min<int32_t>(std::max<int32_t>(4 * options.num_samples + 64, 256), mesh.num_vertices());
+  repair.check_edges = options.check_edges;
+  repair.threads = ThreadCount(options);
   GEODEX_ASSIGN_OR_RETURN(triangulation::DualComplex dual,
-                          triangulation::RepairTriangulation(
-                              mesh, &set, options.max_repair_rounds,
-                              std::min<int32_t>(max_samples, mesh.num_vertices()), &plan.repair));
+                          triangulation::RepairTriangulation(mesh, &set, repair, &plan.repair));
   plan.triangulation_seconds = SecondsSince(start);
   if (options.progress) options.progress({"repair", 1, 1});
   plan.samples = std::move(set.samples);
   plan.nearest = std::move(set.nearest);
   plan.triangles = std::move(dual.triangles);
   plan.neighbors = std::move(dual.neighbors);
+  plan.edges = std::move(dual.edges);
+  plan.edge_stats = triangulation::SummarizeEdges(plan.edges);
   return plan;
 }
 
@@ -294,6 +302,11 @@ absl::StatusOr<index::IndexData> Merge(const Mesh& mesh, const Plan& plan,
   summary->unassigned_vertices = unassigned;
   summary->share_outside = referenced > 0 ? static_cast<double>(outside) / referenced : 0;
   summary->longest_edge = longest;
+  summary->geodesic_edges = plan.edge_stats.count;
+  summary->edge_crossings_found = plan.repair.crossings_found;
+  summary->edge_length_total = plan.edge_stats.total_length;
+  summary->edge_length_max = plan.edge_stats.longest;
+  summary->edge_length_error = plan.edge_stats.max_relative_error;
   summary->bbox_diagonal = mesh.BoundingBoxDiagonal();
   summary->merge_seconds = SecondsSince(start);
   if (unassigned > 0) {
@@ -307,6 +320,12 @@ absl::StatusOr<index::IndexData> Merge(const Mesh& mesh, const Plan& plan,
 absl::StatusOr<index::IndexData> BuildIndex(const Mesh& mesh, const BuildOptions& options,
                                             BuildSummary* summary) {
   GEODEX_ASSIGN_OR_RETURN(const Plan plan, MakePlan(mesh, options));
+  return BuildIndexFromPlan(mesh, plan, options, summary);
+}
+
+absl::StatusOr<index::IndexData> BuildIndexFromPlan(const Mesh& mesh, const Plan& plan,
+                                                    const BuildOptions& options,
+                                                    BuildSummary* summary) {
   std::vector<int32_t> all(plan.num_samples());
   for (int32_t a = 0; a < plan.num_samples(); ++a) all[a] = a;
   const auto start = std::chrono::steady_clock::now();

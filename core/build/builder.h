@@ -3,8 +3,8 @@
 // The offline builder: mesh -> geodex index (paper §4).
 //
 //   1. Plan: farthest-point sampling, the geodesic Voronoi diagram and its
-//      dual Delaunay triangulation, repaired until valid (sampling,
-//      triangulation).
+//      dual Delaunay triangulation, whose edges are traced as exact geodesics;
+//      repaired until valid and no two edges cross (sampling, triangulation).
 //   2. Rows: one full exact propagation per sample, in parallel: the sample
 //      distance matrix row and the distances from the sample to every vertex
 //      of its own and its neighbours' Voronoi cells. Shardable: any subset of
@@ -45,6 +45,9 @@ struct BuildOptions {
   uint64_t seed = 1;
   int threads = 0;  // 0: all hardware threads
   int32_t max_repair_rounds = 200;
+  // Trace every Delaunay edge as an exact geodesic and repair edges that cross
+  // (triangulation::RepairOptions::check_edges).
+  bool check_edges = true;
   // Called from builder threads (serialised by the builder) as work advances.
   std::function<void(const Progress&)> progress;
 };
@@ -58,6 +61,10 @@ struct Plan {
   std::vector<std::array<int32_t, 3>> triangles;
   std::vector<std::array<int32_t, 3>> neighbors;
   triangulation::RepairReport repair;
+  triangulation::EdgeStats edge_stats;  // of the final geodesic edges
+  // The final geodesic edges when traced. Only in the process that made the
+  // plan: the work directory keeps edge_stats, not the paths.
+  std::vector<triangulation::GeodesicEdge> edges;
   double sampling_seconds = 0;
   double triangulation_seconds = 0;
 
@@ -88,6 +95,14 @@ struct BuildSummary {
   int64_t unassigned_vertices = 0;
   double share_outside = 0;  // vertices whose unfolded barycentrics leave [-0.01, 1.01]
   double longest_edge = 0;   // longest geodesic-triangle edge
+  // Delaunay edges traced as exact geodesics (0 when not checked), pairs of
+  // them found crossing over all repair rounds (the samples added for them are
+  // in `repair`), and the lengths of the final traced edges.
+  int32_t geodesic_edges = 0;
+  int32_t edge_crossings_found = 0;
+  double edge_length_total = 0;
+  double edge_length_max = 0;
+  double edge_length_error = 0;  // max |traced length - d(a,b)| / d(a,b)
   double bbox_diagonal = 0;
   uint64_t index_bytes = 0;
   // "key = value" lines without the timings (the index stores them, and the
@@ -110,6 +125,10 @@ absl::StatusOr<index::IndexData> Merge(const mesh::Mesh& mesh, const Plan& plan,
 // All three phases in one process.
 absl::StatusOr<index::IndexData> BuildIndex(const mesh::Mesh& mesh, const BuildOptions& options,
                                             BuildSummary* summary);
+// The rows and merge phases in one process, for a plan already made.
+absl::StatusOr<index::IndexData> BuildIndexFromPlan(const mesh::Mesh& mesh, const Plan& plan,
+                                                    const BuildOptions& options,
+                                                    BuildSummary* summary);
 
 uint64_t HashMesh(const mesh::Mesh& mesh);
 

@@ -3,6 +3,7 @@
 #include <filesystem>
 #include <fstream>
 
+#include "absl/strings/str_cat.h"
 #include "core/build/workdir.h"
 #include "core/mesh/generators.h"
 #include "gtest/gtest.h"
@@ -125,6 +126,60 @@ TEST(BuilderTest, ShardedBuildIsByteIdenticalToOneProcess) {
   }
   EXPECT_EQ(LoadAllRows(loaded->second, dir).status().code(), absl::StatusCode::kDataLoss);
   std::filesystem::remove_all(dir);
+}
+
+TEST(BuilderTest, PlanTracesTheEdgesAndTheWorkDirectoryKeepsTheirFigures) {
+  const mesh::Mesh m = gen::Torus(48, 24, 2.0, 0.7);
+  BuildOptions options;
+  options.num_samples = 50;
+  options.threads = 2;
+  auto plan = MakePlan(m, options);
+  ASSERT_TRUE(plan.ok()) << plan.status();
+  const size_t num_edges = triangulation::DelaunayEdges(plan->triangles).size();
+  ASSERT_EQ(plan->edges.size(), num_edges);
+  EXPECT_EQ(plan->edge_stats.count, static_cast<int32_t>(num_edges));
+  EXPECT_GT(plan->edge_stats.longest, 0);
+  EXPECT_LT(plan->edge_stats.max_relative_error, 1e-9);
+
+  const std::string dir = TempDir("edges");
+  ASSERT_TRUE(SavePlan(m, *plan, dir).ok());
+  auto loaded = LoadPlan(dir);
+  ASSERT_TRUE(loaded.ok()) << loaded.status();
+  const Plan& again = loaded->second;
+  EXPECT_TRUE(again.edges.empty());  // the paths stay in the planning process
+  EXPECT_EQ(again.edge_stats.count, plan->edge_stats.count);
+  EXPECT_EQ(again.edge_stats.total_length, plan->edge_stats.total_length);
+  EXPECT_EQ(again.edge_stats.longest, plan->edge_stats.longest);
+  EXPECT_EQ(again.repair.crossings_found, plan->repair.crossings_found);
+  EXPECT_EQ(again.repair.added_for, plan->repair.added_for);
+
+  std::vector<int32_t> all(again.num_samples());
+  for (int32_t a = 0; a < again.num_samples(); ++a) all[a] = a;
+  auto rows = ComputeRows(loaded->first, again, all, options);
+  ASSERT_TRUE(rows.ok());
+  BuildSummary summary;
+  auto data = Merge(loaded->first, again, std::move(*rows), &summary);
+  ASSERT_TRUE(data.ok()) << data.status();
+  EXPECT_EQ(summary.geodesic_edges, static_cast<int32_t>(num_edges));
+  EXPECT_EQ(summary.edge_length_max, plan->edge_stats.longest);
+  EXPECT_NE(data->report.find(absl::StrCat("geodesic_edges = ", num_edges, "\n")),
+            std::string::npos);
+  EXPECT_NE(data->report.find("edge_crossings_found = "), std::string::npos);
+
+  // A plan file of the previous format version is refused, not misread.
+  {
+    std::fstream f(dir + "/plan.bin", std::ios::in | std::ios::out | std::ios::binary);
+    f.seekp(7);
+    f.put('1');
+  }
+  EXPECT_EQ(LoadPlan(dir).status().code(), absl::StatusCode::kFailedPrecondition);
+  std::filesystem::remove_all(dir);
+
+  options.check_edges = false;
+  auto unchecked = MakePlan(m, options);
+  ASSERT_TRUE(unchecked.ok());
+  EXPECT_TRUE(unchecked->edges.empty());
+  EXPECT_EQ(unchecked->edge_stats.count, 0);
 }
 
 TEST(BuilderTest, MeshWithBoundaryAndTwoComponents) {

@@ -15,7 +15,10 @@
 namespace geodex::build {
 namespace {
 
-constexpr char kPlanMagic[8] = {'G', 'D', 'X', 'P', 'L', 'A', 'N', '1'};
+// The last byte of a magic is the format version. Plan versions: 1 initial;
+// 2 adds kEdgesCross to the repair report (9 counters), the crossings found
+// and the figures of the traced geodesic edges.
+constexpr char kPlanMagic[8] = {'G', 'D', 'X', 'P', 'L', 'A', 'N', '2'};
 constexpr char kRowsMagic[8] = {'G', 'D', 'X', 'R', 'O', 'W', 'S', '1'};
 
 std::string PlanPath(const std::string& workdir) { return workdir + "/plan.bin"; }
@@ -32,9 +35,16 @@ void Seal(ByteWriter& writer) {
 // Checks magic and trailing checksum; returns the payload after the magic.
 absl::StatusOr<std::string_view> Unseal(const std::string& bytes, const char (&magic)[8],
                                         const std::string& path) {
+  constexpr size_t kKind = sizeof(magic) - 1;  // the magic without its version byte
   if (bytes.size() < sizeof(magic) + sizeof(uint64_t) ||
-      std::memcmp(bytes.data(), magic, sizeof(magic)) != 0) {
+      std::memcmp(bytes.data(), magic, kKind) != 0) {
     return absl::DataLossError(absl::StrFormat("%s is not a geodex work file", path));
+  }
+  if (bytes[kKind] != magic[kKind]) {
+    return absl::FailedPreconditionError(
+        absl::StrFormat("%s has format version %c, this geodex-build reads version %c: redo the "
+                        "step that wrote it",
+                        path, bytes[kKind], magic[kKind]));
   }
   uint64_t stored;
   std::memcpy(&stored, bytes.data() + bytes.size() - sizeof(stored), sizeof(stored));
@@ -74,6 +84,11 @@ absl::Status SavePlan(const mesh::Mesh& mesh, const Plan& plan, const std::strin
   w.Put(plan.repair.rounds);
   w.Put(plan.repair.samples_added);
   w.Put(plan.repair.added_for);
+  w.Put(plan.repair.crossings_found);
+  w.Put(plan.edge_stats.count);
+  w.Put(plan.edge_stats.total_length);
+  w.Put(plan.edge_stats.longest);
+  w.Put(plan.edge_stats.max_relative_error);
   w.Put(plan.sampling_seconds);
   w.Put(plan.triangulation_seconds);
   Seal(w);
@@ -97,6 +112,11 @@ absl::StatusOr<std::pair<mesh::Mesh, Plan>> LoadPlan(const std::string& workdir)
   GEODEX_RETURN_IF_ERROR(r.Get(&plan.repair.rounds));
   GEODEX_RETURN_IF_ERROR(r.Get(&plan.repair.samples_added));
   GEODEX_RETURN_IF_ERROR(r.Get(&plan.repair.added_for));
+  GEODEX_RETURN_IF_ERROR(r.Get(&plan.repair.crossings_found));
+  GEODEX_RETURN_IF_ERROR(r.Get(&plan.edge_stats.count));
+  GEODEX_RETURN_IF_ERROR(r.Get(&plan.edge_stats.total_length));
+  GEODEX_RETURN_IF_ERROR(r.Get(&plan.edge_stats.longest));
+  GEODEX_RETURN_IF_ERROR(r.Get(&plan.edge_stats.max_relative_error));
   GEODEX_RETURN_IF_ERROR(r.Get(&plan.sampling_seconds));
   GEODEX_RETURN_IF_ERROR(r.Get(&plan.triangulation_seconds));
   if (!r.AtEnd()) return absl::DataLossError(absl::StrFormat("%s has trailing bytes", path));

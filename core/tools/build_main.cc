@@ -1,13 +1,14 @@
 // geodex-build: the offline builder job (mesh -> .gdx index).
 //
-//   geodex-build MESH -o OUT.gdx --samples M [--threads N] [--seed S]
-//   geodex-build plan MESH --samples M [--seed S] -o WORKDIR
+//   geodex-build MESH -o OUT.gdx --samples M [--threads N] [--seed S] [--edges-obj FILE]
+//   geodex-build plan MESH --samples M [--seed S] [--threads N] [--edges-obj FILE] -o WORKDIR
 //   geodex-build rows WORKDIR --shard I/N [--threads T]
 //   geodex-build merge WORKDIR -o OUT.gdx
 //
 // MESH is a .obj/.ply/.off file, or builtin:NAME for a generated demo mesh
-// (torus, sphere, cube, double-torus). Exit codes: 0 success, 2 bad input or
-// usage, 1 any other failure.
+// (torus, sphere, cube, double-torus). --edges-obj writes the geodesic
+// Delaunay edges as OBJ polylines (v and l lines) to view over the mesh. Exit
+// codes: 0 success, 2 bad input or usage, 1 any other failure.
 
 #include <unistd.h>
 
@@ -22,6 +23,7 @@
 #include "absl/strings/str_format.h"
 #include "core/build/builder.h"
 #include "core/build/workdir.h"
+#include "core/common/file_util.h"
 #include "core/common/status_macros.h"
 #include "core/index/index.h"
 #include "core/mesh/generators.h"
@@ -78,20 +80,41 @@ class ProgressPrinter {
   std::chrono::steady_clock::time_point last_log_{};
 };
 
+std::string EdgeLine(int32_t edges, int32_t crossings, double total, double longest) {
+  if (edges == 0) return "not traced";
+  return absl::StrFormat(
+      "%d traced as exact geodesics, %d crossing pairs found and repaired, "
+      "total length %.6g, longest %.6g",
+      edges, crossings, total, longest);
+}
+
 void PrintSummary(const build::BuildSummary& s, const std::string& out) {
   std::printf(
       "geodex-build: wrote %s (%.1f MiB)\n"
       "  samples          %d requested, %d final (%s)\n"
       "  triangles        %d geodesic triangles\n"
-      "  vertices         %d referenced, %d unassigned\n"
+      "  edges            %s\n"
+      "  vertices         %lld referenced, %lld unassigned\n"
       "  outside [-0.01,1.01]  %.4f%% of vertices\n"
       "  longest edge     %.6g (%.4f of the bounding-box diagonal)\n"
       "  time             sampling %s, triangulation %s, rows %s, merge %s\n",
       out.c_str(), s.index_bytes / 1048576.0, s.requested_samples, s.num_samples, s.repair.c_str(),
-      s.num_triangles, s.referenced_vertices, s.unassigned_vertices, 100 * s.share_outside,
-      s.longest_edge, s.bbox_diagonal > 0 ? s.longest_edge / s.bbox_diagonal : 0.0,
+      s.num_triangles,
+      EdgeLine(s.geodesic_edges, s.edge_crossings_found, s.edge_length_total, s.edge_length_max)
+          .c_str(),
+      static_cast<long long>(s.referenced_vertices), static_cast<long long>(s.unassigned_vertices),
+      100 * s.share_outside, s.longest_edge,
+      s.bbox_diagonal > 0 ? s.longest_edge / s.bbox_diagonal : 0.0,
       FormatSeconds(s.sampling_seconds).c_str(), FormatSeconds(s.triangulation_seconds).c_str(),
       FormatSeconds(s.rows_seconds).c_str(), FormatSeconds(s.merge_seconds).c_str());
+}
+
+// Writes the plan's traced edges for --edges-obj (nothing when `path` is empty).
+absl::Status WriteEdges(const mesh::Mesh& mesh, const build::Plan& plan, const std::string& path) {
+  if (path.empty()) return absl::OkStatus();
+  GEODEX_RETURN_IF_ERROR(AtomicWriteFile(path, triangulation::EdgesToObj(mesh, plan.edges)));
+  std::printf("geodex-build: wrote %zu geodesic edges to %s\n", plan.edges.size(), path.c_str());
+  return absl::OkStatus();
 }
 
 absl::Status WriteAndReport(const index::IndexData& data, build::BuildSummary& summary,
@@ -123,7 +146,7 @@ int main(int argc, char** argv) {
   using namespace geodex;
   CLI::App app{"geodex-build: builds a geodex index (.gdx) from a triangle mesh."};
   app.require_subcommand(0, 1);
-  std::string mesh_path, out, workdir, shard_text;
+  std::string mesh_path, out, workdir, shard_text, edges_obj;
   int32_t samples = 1000;
   uint64_t seed = 1;
   int threads = 0;
@@ -133,12 +156,16 @@ int main(int argc, char** argv) {
   app.add_option("--seed", seed, "Sampling seed");
   app.add_option("--threads", threads, "Worker threads (0: all cores)")
       ->check(CLI::NonNegativeNumber);
+  app.add_option("--edges-obj", edges_obj, "Also write the geodesic edges as OBJ polylines");
 
   CLI::App* plan_cmd = app.add_subcommand("plan", "Distributed build, step 1: sampling");
   plan_cmd->add_option("mesh", mesh_path, "Mesh file")->required();
   plan_cmd->add_option("--samples", samples, "Number of samples m")->check(CLI::PositiveNumber);
   plan_cmd->add_option("--seed", seed, "Sampling seed");
   plan_cmd->add_option("-o,--output", workdir, "Work directory")->required();
+  plan_cmd->add_option("--threads", threads, "Worker threads (0: all cores)")
+      ->check(CLI::NonNegativeNumber);
+  plan_cmd->add_option("--edges-obj", edges_obj, "Also write the geodesic edges as OBJ polylines");
 
   CLI::App* rows_cmd = app.add_subcommand("rows", "Distributed build, step 2: one shard of rows");
   rows_cmd->add_option("workdir", workdir, "Work directory")->required();
@@ -164,9 +191,13 @@ int main(int argc, char** argv) {
       GEODEX_ASSIGN_OR_RETURN(const mesh::Mesh mesh, LoadInput(mesh_path));
       GEODEX_ASSIGN_OR_RETURN(const build::Plan plan, build::MakePlan(mesh, options));
       GEODEX_RETURN_IF_ERROR(build::SavePlan(mesh, plan, workdir));
-      std::printf("geodex-build plan: %d samples (%s) in %s\n", plan.num_samples(),
-                  plan.repair.Summary().c_str(), workdir.c_str());
-      return absl::OkStatus();
+      std::printf("geodex-build plan: %d samples (%s), %zu triangles, edges %s, in %s\n",
+                  plan.num_samples(), plan.repair.Summary().c_str(), plan.triangles.size(),
+                  EdgeLine(plan.edge_stats.count, plan.repair.crossings_found,
+                           plan.edge_stats.total_length, plan.edge_stats.longest)
+                      .c_str(),
+                  workdir.c_str());
+      return WriteEdges(mesh, plan, edges_obj);
     }();
   } else if (*rows_cmd) {
     status = [&]() -> absl::Status {
@@ -202,8 +233,11 @@ int main(int argc, char** argv) {
     }
     status = [&]() -> absl::Status {
       GEODEX_ASSIGN_OR_RETURN(const mesh::Mesh mesh, LoadInput(mesh_path));
+      GEODEX_ASSIGN_OR_RETURN(const build::Plan plan, build::MakePlan(mesh, options));
+      GEODEX_RETURN_IF_ERROR(WriteEdges(mesh, plan, edges_obj));
       build::BuildSummary summary;
-      GEODEX_ASSIGN_OR_RETURN(const auto data, build::BuildIndex(mesh, options, &summary));
+      GEODEX_ASSIGN_OR_RETURN(const auto data,
+                              build::BuildIndexFromPlan(mesh, plan, options, &summary));
       return WriteAndReport(data, summary, out);
     }();
   }

@@ -8,7 +8,9 @@
 // Voronoi vertex and gives a Delaunay triangle, oriented like the face. The
 // dual is a valid triangulation of the surface only when the samples are dense
 // enough: CheckDual finds every way it can fail, and RepairTriangulation adds
-// samples (the farthest vertex of an offending cell) until none is left.
+// samples (the farthest vertex of an offending cell) until none is left. Once
+// the dual is valid, RepairTriangulation can also trace its edges as exact
+// geodesics (geodesic_edges.h) and repair edges that cross.
 //
 // Thread safety: the functions are reentrant.
 
@@ -21,6 +23,7 @@
 #include "core/geodesic/exact_geodesic.h"
 #include "core/mesh/mesh.h"
 #include "core/sampling/farthest_point_sampling.h"
+#include "core/triangulation/geodesic_edges.h"
 
 namespace geodex::triangulation {
 
@@ -33,7 +36,9 @@ enum class ViolationKind {
   kCellNotDisk,            // the triangles around a sample do not form one fan
   kCellDisconnected,       // a Voronoi cell in several pieces
   kEulerCharacteristic,    // right locally, wrong globally (e.g. a missed handle)
+  kEdgesCross,             // two traced geodesic edges cross or touch (not CheckDual's)
 };
+inline constexpr int kNumViolationKinds = 9;
 
 const char* ViolationName(ViolationKind kind);
 
@@ -48,6 +53,9 @@ struct DualComplex {
   std::vector<std::array<int32_t, 3>> triangles;
   std::vector<std::array<int32_t, 3>> neighbors;
   std::vector<Violation> violations;
+  // The edges traced as exact geodesics, sorted by (a, b): filled by
+  // RepairTriangulation when RepairOptions::check_edges is set, else empty.
+  std::vector<GeodesicEdge> edges;
 };
 
 // Builds the dual of the Voronoi labels (`nearest` per vertex, sample count
@@ -59,15 +67,28 @@ struct RepairReport {
   int32_t rounds = 0;
   int32_t samples_added = 0;
   // How many samples were added for each kind of violation.
-  std::array<int32_t, 8> added_for = {};
+  std::array<int32_t, kNumViolationKinds> added_for = {};
+  // Pairs of crossing geodesic edges found, summed over the rounds.
+  int32_t crossings_found = 0;
   std::string Summary() const;
 };
 
-// Adds samples to `set` until CheckDual finds no violation, and returns the
-// valid dual. Errors: FailedPrecondition when no valid triangulation is found
-// within `max_rounds` rounds or once samples exceed `max_samples`.
+struct RepairOptions {
+  int32_t max_rounds = 200;
+  int32_t max_samples = 1 << 30;
+  // Once CheckDual passes, trace every edge (TraceEdges) and treat edges that
+  // cross (FindCrossings) as violations too; the final edges are returned in
+  // DualComplex::edges.
+  bool check_edges = false;
+  int threads = 1;  // for tracing; 0: all hardware threads
+};
+
+// Adds samples to `set` until CheckDual (and, with check_edges, FindCrossings)
+// finds no violation, and returns the valid dual. The result does not depend
+// on `threads`. Errors: FailedPrecondition when no valid triangulation is
+// found within `max_rounds` rounds or once samples reach `max_samples`; errors
+// of TraceEdges / FindCrossings.
 absl::StatusOr<DualComplex> RepairTriangulation(const mesh::Mesh& mesh, sampling::SampleSet* set,
-                                                int32_t max_rounds, int32_t max_samples,
-                                                RepairReport* report);
+                                                const RepairOptions& options, RepairReport* report);
 
 }  // namespace geodex::triangulation

@@ -1,5 +1,8 @@
 #include "core/triangulation/geodesic_triangulation.h"
 
+#include <set>
+#include <string>
+
 #include "core/mesh/generators.h"
 #include "gtest/gtest.h"
 
@@ -32,7 +35,8 @@ TEST(GeodesicTriangulationTest, RepairReachesAValidTriangulationOnEveryShape) {
     auto set = sampling::FarthestPointSampling(shape.mesh, shape.samples, 1);
     ASSERT_TRUE(set.ok());
     RepairReport report;
-    auto dual = RepairTriangulation(shape.mesh, &*set, 200, 2000, &report);
+    auto dual =
+        RepairTriangulation(shape.mesh, &*set, {.max_rounds = 200, .max_samples = 2000}, &report);
     ASSERT_TRUE(dual.ok()) << dual.status();
     EXPECT_TRUE(dual->violations.empty());
     EXPECT_FALSE(dual->triangles.empty());
@@ -66,7 +70,7 @@ TEST(GeodesicTriangulationTest, SparseSamplesOnATorusAreDetectedAndRepaired) {
   const DualComplex sparse = CheckDual(torus, set->nearest, 4);
   EXPECT_FALSE(sparse.violations.empty());
   RepairReport report;
-  auto dual = RepairTriangulation(torus, &*set, 200, 2000, &report);
+  auto dual = RepairTriangulation(torus, &*set, {.max_rounds = 200, .max_samples = 2000}, &report);
   ASSERT_TRUE(dual.ok()) << dual.status();
   EXPECT_GT(report.samples_added, 0);
   EXPECT_GT(set->samples.size(), 4u);
@@ -96,12 +100,29 @@ TEST(GeodesicTriangulationTest, ReportsEachViolationKind) {
   EXPECT_TRUE(disconnected);
 }
 
+TEST(GeodesicTriangulationTest, EveryViolationKindHasANameAndACounter) {
+  RepairReport report;
+  ASSERT_EQ(report.added_for.size(), static_cast<size_t>(kNumViolationKinds));
+  std::set<std::string> names;
+  for (int k = 0; k < kNumViolationKinds; ++k) {
+    const std::string name = ViolationName(static_cast<ViolationKind>(k));
+    EXPECT_NE(name, "?");
+    names.insert(name);
+    report.added_for[k] = k + 1;
+  }
+  EXPECT_EQ(names.size(), static_cast<size_t>(kNumViolationKinds));
+  EXPECT_EQ(static_cast<int>(ViolationKind::kEdgesCross), kNumViolationKinds - 1);
+  const std::string summary = report.Summary();
+  EXPECT_NE(summary.find("1 for three cells meeting more than once"), std::string::npos);
+  EXPECT_NE(summary.find("9 for geodesic edges crossing"), std::string::npos);
+}
+
 TEST(GeodesicTriangulationTest, FailsCleanlyWhenRepairIsCapped) {
   const mesh::Mesh torus = gen::Torus(64, 32, 2.0, 0.7);
   auto set = sampling::FarthestPointSampling(torus, 3, 1);
   ASSERT_TRUE(set.ok());
   RepairReport report;
-  auto dual = RepairTriangulation(torus, &*set, 1, 4, &report);
+  auto dual = RepairTriangulation(torus, &*set, {.max_rounds = 1, .max_samples = 4}, &report);
   EXPECT_EQ(dual.status().code(), absl::StatusCode::kFailedPrecondition);
 }
 
