@@ -159,6 +159,8 @@ QueryEngine::QueryEngine(std::shared_ptr<const index::Index> index, QueryOptions
       }
     }
   }
+  face_lifts_.resize(index_->num_faces());
+  for (int32_t f = 0; f < index_->num_faces(); ++f) face_lifts_[f] = MakeFaceLift(f);
 }
 
 absl::Status QueryEngine::Validate(const SurfacePoint& p) const {
@@ -225,7 +227,97 @@ double QueryEngine::ToSample(const LiftedPoint& p, int32_t s) const {
   return std::sqrt(TwoSideToOutside2(frames, PlaceInTriangle(frames, p.distance.data()), e));
 }
 
+QueryEngine::FaceLift QueryEngine::MakeFaceLift(int32_t face) const {
+  const int32_t* f = &faces_[3 * face];
+  FaceLift out;
+  // Anchor on the geodesic triangle most of the face's vertices share (fewer
+  // approximate distances), else on the first vertex's.
+  const int32_t t0 = records_[f[0]].triangle, t1 = records_[f[1]].triangle,
+                t2 = records_[f[2]].triangle;
+  if (t0 != t1 && t0 != t2 && t1 != t2) return out;  // anchored point by point
+  const LiftedPoint anchor = VertexLift(f[t0 == t1 || t0 == t2 ? 0 : 1]);
+  if (anchor.triangle < 0) return out;
+  out.exact = t0 == t1 && t1 == t2;
+  // Distances from the face's vertices to the anchor triangle's corners:
+  // exact for vertices of that triangle, case 2.2 for the others.
+  double d[3][3];
+  for (int i = 0; i < 3; ++i) {
+    const index::VertexRecord& r = records_[f[i]];
+    if (r.triangle < 0) return out;
+    if (r.triangle == anchor.triangle) {
+      for (int c = 0; c < 3; ++c) d[i][c] = r.distance[c];
+      continue;
+    }
+    const LiftedPoint vi = VertexLift(f[i]);
+    const EdgeFrame* frames = &frames_[3 * vi.triangle];
+    const Placed placed = PlaceInTriangle(frames, vi.distance.data());
+    for (int c = 0; c < 3; ++c) {
+      const int32_t s = anchor.corner[c];
+      d[i][c] = -1;
+      for (int j = 0; j < 3; ++j) {
+        if (vi.corner[j] == s) d[i][c] = vi.distance[j];
+      }
+      if (d[i][c] < 0) {
+        const double e[3] = {Matrix(s, vi.corner[0]), Matrix(s, vi.corner[1]),
+                             Matrix(s, vi.corner[2])};
+        d[i][c] = std::sqrt(TwoSideToOutside2(frames, placed, e));
+      }
+    }
+  }
+  // The face in its own plane: v0 at the origin, v1 on the x axis.
+  const mesh::Vec3 v0 = Position(f[0]), e1 = Position(f[1]) - v0, e2 = Position(f[2]) - v0;
+  const double l = e1.norm();
+  const double cx = e1.dot(e2) / l, cy = e1.cross(e2).norm() / l;
+  if (!(cy > 1e-3 * l)) return out;  // a sliver: lifted point by point
+  out.triangle = anchor.triangle;
+  out.l = l;
+  out.cx = cx;
+  out.cy = cy;
+  for (int i = 0; i < 3; ++i) {
+    for (int c = 0; c < 3; ++c) out.d[i][c] = d[i][c];
+  }
+  return out;
+}
+
 LiftedPoint QueryEngine::Lift(const SurfacePoint& p) const {
+  const int32_t* f = &faces_[3 * p.face];
+  int k = 0;
+  for (int i = 1; i < 3; ++i) {
+    if (p.w[i] > p.w[k]) k = i;
+  }
+  if (p.w[k] >= 1.0) return VertexLift(f[k]);  // at a vertex: its record is exact
+  const FaceLift& fl = face_lifts_[p.face];
+  if (fl.triangle < 0) return SlowLift(p);
+  LiftedPoint out;
+  out.triangle = fl.triangle;
+  const double l = fl.l, cx = fl.cx, cy = fl.cy;
+  const double px = p.w[1] * l + p.w[2] * cx, py = p.w[2] * cy;
+  for (int c = 0; c < 3; ++c) {
+    out.corner[c] = triangles_[fl.triangle].corner[c];
+    const double d0 = fl.d[0][c], d1 = fl.d[1][c], d2 = fl.d[2][c];
+    if (fl.exact) {
+      // Exact distances of one field at the three corners of a face fix the
+      // unfolded source: trilaterate it (linear, no square roots) and measure.
+      const double sx = (l * l + d0 * d0 - d1 * d1) / (2 * l);
+      const double sy = (cx * cx + cy * cy - 2 * sx * cx + d0 * d0 - d2 * d2) / (2 * cy);
+      out.distance[c] = Norm2(px - sx, py - sy);
+      continue;
+    }
+    // Paper §5.2, case 4: two-side unfolding about each edge of the face.
+    const double to_vertex[3] = {Norm2(px, py), Norm2(px - l, py), Norm2(px - cx, py - cy)};
+    const double edge[3] = {l, Norm2(cx - l, cy), Norm2(cx, cy)};
+    const double dv[3] = {d0, d1, d2};
+    double best = kInf;
+    for (int i = 0; i < 3; ++i) {
+      const int j = (i + 1) % 3;
+      best = std::min(best, TwoSide2(edge[i], to_vertex[i], to_vertex[j], dv[i], dv[j]));
+    }
+    out.distance[c] = std::sqrt(best);
+  }
+  return out;
+}
+
+LiftedPoint QueryEngine::SlowLift(const SurfacePoint& p) const {
   const int32_t* f = &faces_[3 * p.face];
   int k = 0;
   for (int i = 1; i < 3; ++i) {

@@ -158,6 +158,19 @@ class QueryEngine {
             {r.corner[0], r.corner[1], r.corner[2]},
             {r.distance[0], r.distance[1], r.distance[2]}};
   }
+  // Lifting of a face's interior points, derived at load: the anchor
+  // triangle and the distances from the face's vertices to its corners, and
+  // the face in its plane (vertex 0 at the origin, vertex 1 at (l, 0),
+  // vertex 2 at (cx, cy)). triangle -1: lifted by SlowLift (faces whose
+  // vertices lie in three different triangles, slivers, unreferenced).
+  struct FaceLift {
+    int32_t triangle = -1;
+    bool exact = false;  // all three vertices in the anchor triangle
+    float l = 0, cx = 0, cy = 0;
+    float d[3][3] = {};  // d[vertex][corner]
+  };
+  FaceLift MakeFaceLift(int32_t face) const;
+  LiftedPoint SlowLift(const SurfacePoint& p) const;
   double ExactNearDistance(const SurfacePoint& p, const SurfacePoint& q,
                            QueryScratch* scratch) const;
   SurfacePoint Canonical(const SurfacePoint& p) const;
@@ -173,6 +186,7 @@ class QueryEngine {
   int32_t num_samples_ = 0;
   PointLocator locator_;
   std::vector<EdgeFrame> frames_;     // 3 per geodesic triangle, derived at load
+  std::vector<FaceLift> face_lifts_;  // one per face, derived at load
   std::unique_ptr<mesh::Mesh> mesh_;  // only with exact_near_pairs
 };
 
