@@ -542,6 +542,85 @@ absl::StatusOr<std::vector<LocatedPoint>> Client::Locate(
   return located;
 }
 
+absl::StatusOr<Mesh> Client::GetMesh(const ModelRef& model) const {
+  if (absl::Status s = CheckModel(model); !s.ok()) return s;
+  v1::GetMeshRequest request;
+  *request.mutable_model() = ToProto(model);
+  absl::StatusOr<std::vector<v1::MeshChunk>> chunks = connection_->GetMesh(request);
+  if (!chunks.ok()) return chunks.status();
+  if (chunks->empty()) return absl::DataLossError("the server sent no mesh chunks");
+
+  const v1::MeshChunk& first = chunks->front();
+  const uint64_t num_vertices = first.num_vertices();
+  const uint64_t num_faces = first.num_faces();
+  const int64_t version = first.version();
+  if (model.version != 0 && version != model.version) {
+    return absl::DataLossError(
+        absl::StrFormat("the server sent the mesh of version %d when version %d was asked for",
+                        version, model.version));
+  }
+  // The ranges are checked before anything is allocated: the totals are only
+  // the server's word until the chunks add up to them.
+  uint64_t next_vertex = 0, next_face = 0;
+  for (size_t k = 0; k < chunks->size(); ++k) {
+    const v1::MeshChunk& chunk = (*chunks)[k];
+    if (chunk.num_vertices() != num_vertices || chunk.num_faces() != num_faces ||
+        chunk.version() != version) {
+      return absl::DataLossError(absl::StrFormat(
+          "mesh chunk %d is of a mesh of %d vertices and %d faces, version %d; chunk 0 of one of "
+          "%d vertices and %d faces, version %d",
+          k, chunk.num_vertices(), chunk.num_faces(), chunk.version(), num_vertices, num_faces,
+          version));
+    }
+    if (chunk.positions_size() % 3 != 0 || chunk.faces_size() % 3 != 0) {
+      return absl::DataLossError(absl::StrFormat(
+          "mesh chunk %d has %d coordinates and %d face vertex ids; both must be multiples of 3", k,
+          chunk.positions_size(), chunk.faces_size()));
+    }
+    if (chunk.vertex_offset() != next_vertex || chunk.face_offset() != next_face) {
+      return absl::DataLossError(absl::StrFormat(
+          "mesh chunk %d starts at vertex %d and face %d, not at vertex %d and face %d where the "
+          "chunks before it stopped",
+          k, chunk.vertex_offset(), chunk.face_offset(), next_vertex, next_face));
+    }
+    next_vertex += chunk.positions_size() / 3;
+    next_face += chunk.faces_size() / 3;
+    if (next_vertex > num_vertices || next_face > num_faces) {
+      return absl::DataLossError(absl::StrFormat(
+          "mesh chunk %d goes past the end of the mesh: to vertex %d of %d and face %d of %d", k,
+          next_vertex, num_vertices, next_face, num_faces));
+    }
+  }
+  if (next_vertex != num_vertices || next_face != num_faces) {
+    return absl::DataLossError(
+        absl::StrFormat("the server sent %d of %d mesh vertices and %d of %d faces", next_vertex,
+                        num_vertices, next_face, num_faces));
+  }
+
+  Mesh mesh;
+  mesh.version = version;
+  mesh.positions.reserve(num_vertices);
+  mesh.faces.reserve(num_faces);
+  for (const v1::MeshChunk& chunk : *chunks) {
+    const auto& xyz = chunk.positions();
+    for (int i = 0; i < xyz.size(); i += 3) {
+      mesh.positions.push_back({xyz[i], xyz[i + 1], xyz[i + 2]});
+    }
+    const auto& ids = chunk.faces();
+    for (int i = 0; i < ids.size(); i += 3) {
+      for (int c = 0; c < 3; ++c) {
+        if (ids[i + c] >= num_vertices) {
+          return absl::DataLossError(
+              absl::StrFormat("mesh face %d names vertex %d, past the end (%d vertices)",
+                              mesh.faces.size(), ids[i + c], num_vertices));
+        }
+      }
+      mesh.faces.push_back({ids[i], ids[i + 1], ids[i + 2]});
+    }
+  }
+  return mesh;
+}
+
 // ---------------------------------------------------------------------------
 // Connect
 

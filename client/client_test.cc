@@ -2,6 +2,7 @@
 
 #include <atomic>
 #include <deque>
+#include <functional>
 #include <thread>
 
 #include "absl/synchronization/mutex.h"
@@ -476,6 +477,100 @@ TEST(ClientDistanceField, GapIsDataLoss) {
             absl::StatusCode::kDataLoss);
 }
 
+// A mesh of 4 vertices (vertex v at (v, 10 v, 100 v)) and 3 faces in two
+// chunks: vertices 0-2 and faces 0-1, then vertex 3 and face 2.
+std::vector<v1::MeshChunk> TwoMeshChunks() {
+  std::vector<v1::MeshChunk> chunks(2);
+  for (v1::MeshChunk& chunk : chunks) {
+    chunk.set_num_vertices(4);
+    chunk.set_num_faces(3);
+    chunk.set_version(7);
+  }
+  for (int v = 0; v < 3; ++v) {
+    for (double c : {1.0 * v, 10.0 * v, 100.0 * v}) chunks[0].add_positions(c);
+  }
+  for (uint32_t id : {0, 1, 2, 0, 2, 3}) chunks[0].add_faces(id);
+  chunks[1].set_vertex_offset(3);
+  chunks[1].set_face_offset(2);
+  for (double c : {3.0, 30.0, 300.0}) chunks[1].add_positions(c);
+  for (uint32_t id : {3, 1, 0}) chunks[1].add_faces(id);
+  return chunks;
+}
+
+TEST(ClientMesh, ChunksAreAssembled) {
+  auto mock = std::make_shared<MockGeodexConnection>();
+  EXPECT_CALL(*mock, GetMesh).WillOnce([](const v1::GetMeshRequest& r) {
+    EXPECT_EQ(r.model().name(), "torus");
+    EXPECT_EQ(r.model().version(), 7);
+    return TwoMeshChunks();
+  });
+  Client client(mock);
+  absl::StatusOr<Mesh> mesh = client.GetMesh({"torus", 7});
+  ASSERT_TRUE(mesh.ok()) << mesh.status();
+  EXPECT_EQ(mesh->version, 7);
+  EXPECT_THAT(mesh->positions, ElementsAre(Position{0, 0, 0}, Position{1, 10, 100},
+                                           Position{2, 20, 200}, Position{3, 30, 300}));
+  using Face = std::array<uint32_t, 3>;
+  EXPECT_THAT(mesh->faces, ElementsAre(Face{0, 1, 2}, Face{0, 2, 3}, Face{3, 1, 0}));
+}
+
+TEST(ClientMesh, ServerErrorsPassThroughAndNoModelIsInvalid) {
+  auto mock = std::make_shared<MockGeodexConnection>();
+  EXPECT_CALL(*mock, GetMesh).WillOnce(Return(absl::NotFoundError("unknown model 'nope'")));
+  Client client(mock);
+  EXPECT_EQ(client.GetMesh("nope").status(), absl::NotFoundError("unknown model 'nope'"));
+  EXPECT_EQ(client.GetMesh("").status().code(), absl::StatusCode::kInvalidArgument);
+}
+
+// Every way the chunks can fail to be one mesh is DATA_LOSS, with a message
+// that says what was wrong.
+TEST(ClientMesh, MalformedChunksAreDataLoss) {
+  struct Case {
+    const char* name;
+    std::function<void(std::vector<v1::MeshChunk>&)> spoil;
+    const char* message;
+  };
+  const std::vector<Case> cases = {
+      {"no chunks", [](auto& c) { c.clear(); }, "no mesh chunks"},
+      {"totals change", [](auto& c) { c[1].set_num_vertices(5); }, "chunk 1 is of a mesh of 5"},
+      {"face total changes", [](auto& c) { c[1].set_num_faces(2); }, "chunk 1 is of a mesh"},
+      {"version changes", [](auto& c) { c[1].set_version(8); }, "version 8"},
+      {"gap", [](auto& c) { c[1].set_vertex_offset(4); }, "chunk 1 starts at vertex 4"},
+      {"overlap", [](auto& c) { c[1].set_face_offset(1); },
+       "and face 1, not at vertex 3 and face 2"},
+      {"out of order", [](auto& c) { std::swap(c[0], c[1]); },
+       "chunk 0 starts at vertex 3 and face 2"},
+      {"repeated", [](auto& c) { c[1] = c[0]; }, "chunk 1 starts at vertex 0"},
+      {"coordinates not in threes", [](auto& c) { c[1].add_positions(1); }, "multiples of 3"},
+      {"face ids not in threes", [](auto& c) { c[1].add_faces(1); }, "multiples of 3"},
+      {"missing vertices", [](auto& c) { c[1].clear_positions(); },
+       "sent 3 of 4 mesh vertices and 3 of 3 faces"},
+      {"missing chunk", [](auto& c) { c.pop_back(); }, "sent 3 of 4 mesh vertices and 2 of 3"},
+      {"past the end",
+       [](auto& c) {
+         for (auto& chunk : c) chunk.set_num_faces(1);
+       },
+       "past the end of the mesh: to vertex 3 of 4 and face 2 of 1"},
+      {"vertex id past the end", [](auto& c) { c[1].set_faces(1, 4); },
+       "mesh face 2 names vertex 4, past the end (4 vertices)"},
+      {"another version than pinned",
+       [](auto& c) {
+         for (auto& chunk : c) chunk.set_version(6);
+       },
+       "mesh of version 6 when version 7 was asked for"},
+  };
+  for (const Case& test : cases) {
+    auto mock = std::make_shared<MockGeodexConnection>();
+    std::vector<v1::MeshChunk> chunks = TwoMeshChunks();
+    test.spoil(chunks);
+    EXPECT_CALL(*mock, GetMesh).WillOnce(Return(chunks));
+    Client client(mock);
+    const absl::Status status = client.GetMesh({"torus", 7}).status();
+    EXPECT_EQ(status.code(), absl::StatusCode::kDataLoss) << test.name << ": " << status;
+    EXPECT_THAT(status.message(), HasSubstr(test.message)) << test.name;
+  }
+}
+
 TEST(ClientPath, SplitIntoCallsAndConverted) {
   auto mock = std::make_shared<MockGeodexConnection>();
   int calls = 0;
@@ -588,6 +683,7 @@ TEST(GeodexConnection, UnimplementedByDefault) {
   EXPECT_EQ(client.ListModels().status().code(), absl::StatusCode::kUnimplemented);
   EXPECT_EQ(client.Distance("torus", NumberedPairs(5000)).status().code(),
             absl::StatusCode::kUnimplemented);
+  EXPECT_EQ(client.GetMesh("torus").status().code(), absl::StatusCode::kUnimplemented);
 }
 
 }  // namespace

@@ -49,5 +49,8 @@ absl::StatusOr<std::vector<v1::DistanceFieldChunk>> GeodexConnection::DistanceFi
 absl::StatusOr<v1::LocateResponse> GeodexConnection::Locate(const v1::LocateRequest&) {
   return NotImplemented("Locate");
 }
+absl::StatusOr<std::vector<v1::MeshChunk>> GeodexConnection::GetMesh(const v1::GetMeshRequest&) {
+  return NotImplemented("GetMesh");
+}
 
 }  // namespace geodex::client

@@ -110,6 +110,9 @@ class GrpcConnection : public GeodexConnection {
       const v1::DistanceFieldRequest& r) override {
     return ServerStream<v1::DistanceFieldChunk>(r, &v1::Geodex::Stub::DistanceField);
   }
+  absl::StatusOr<std::vector<v1::MeshChunk>> GetMesh(const v1::GetMeshRequest& r) override {
+    return ServerStream<v1::MeshChunk>(r, &v1::Geodex::Stub::GetMesh);
+  }
 
  private:
   std::unique_ptr<grpc::ClientContext> MakeContext(absl::Duration deadline) const {

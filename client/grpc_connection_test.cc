@@ -104,6 +104,15 @@ TEST(GrpcClient, AllMethodsOverTheWire) {
   ASSERT_TRUE(located.ok()) << located.status();
   EXPECT_EQ((*located)[0].point.face, 4);
   EXPECT_EQ((*located)[0].distance, 2);
+
+  absl::StatusOr<Mesh> mesh = client->GetMesh({"fake", 1});  // in 10 chunks
+  ASSERT_TRUE(mesh.ok()) << mesh.status();
+  EXPECT_EQ(mesh->version, 1);
+  ASSERT_EQ(mesh->positions.size(), 60u);
+  ASSERT_EQ(mesh->faces.size(), 100u);
+  EXPECT_EQ(mesh->positions[59], (Position{59, 1, 0}));
+  EXPECT_EQ(mesh->faces[99], (std::array<uint32_t, 3>{39, 40, 41}));
+  EXPECT_EQ(client->GetMesh("nope").status().code(), absl::StatusCode::kNotFound);
 }
 
 TEST(GrpcClient, ManyPairsStreamedInOrder) {

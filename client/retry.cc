@@ -67,6 +67,9 @@ class RetryingConnection : public GeodexConnection {
   absl::StatusOr<v1::LocateResponse> Locate(const v1::LocateRequest& r) override {
     return RetryLoop(policy_, sleep_, [&] { return inner_->Locate(r); });
   }
+  absl::StatusOr<std::vector<v1::MeshChunk>> GetMesh(const v1::GetMeshRequest& r) override {
+    return RetryLoop(policy_, sleep_, [&] { return inner_->GetMesh(r); });
+  }
 
  private:
   std::shared_ptr<GeodexConnection> inner_;

@@ -91,10 +91,14 @@ TEST(RetryingConnection, ServerStreamsAreRetriedWhole) {
   EXPECT_CALL(*mock, DistanceField)
       .WillOnce(Return(absl::UnavailableError("reset")))
       .WillOnce(Return(std::vector<v1::DistanceFieldChunk>(2)));
+  EXPECT_CALL(*mock, GetMesh)
+      .WillOnce(Return(absl::UnavailableError("reset")))
+      .WillOnce(Return(std::vector<v1::MeshChunk>(4)));
   RecordingSleeper sleep;
   auto connection = MakeRetryingConnection(mock, RetryPolicy{}, sleep.sleeper());
   EXPECT_EQ(connection->Matrix({})->size(), 3u);
   EXPECT_EQ(connection->DistanceField({})->size(), 2u);
+  EXPECT_EQ(connection->GetMesh({})->size(), 4u);
 }
 
 TEST(RetryingConnection, StreamDistancesIsPassedThrough) {

@@ -2,7 +2,8 @@
 # The README's first command. On a fresh Debian 12 machine: installs the
 # dependencies, builds geodex, builds an index of the built-in torus, starts
 # geodex-server on loopback, asks it for a distance, a path and a distance
-# field with the `geodex` CLI, prints the answers, and stops the server.
+# field (as text and as the torus colored by distance, field.ply, for MeshLab)
+# with the `geodex` CLI, prints the answers, and stops the server.
 #
 #   bash deploy/demo.sh
 #
@@ -114,8 +115,15 @@ echo "  source on the surface (face w0 w1 w2): $(cat sources.txt)"
 awk '$1 != "inf" { n++; s += $1; if (n == 1 || $1 > max) { max = $1; far = NR - 1 } }
      END { printf "  %d vertex distances: mean %.4f, farthest vertex %d at %.4f\n", n, s / n, far, max }
   ' field.txt
-echo "  per-vertex distances in $DEMO_DIR/field.txt (text: a colored PLY needs the mesh, which"
-echo "  the API cannot send yet)"
+echo "  per-vertex distances in $DEMO_DIR/field.txt"
+
+echo
+echo "-- the same field on the mesh (geodex field --out field.ply: GetMesh + the field)"
+"$GEODEX" field --model torus --sources sources.txt --out field.ply
+echo "  $DEMO_DIR/field.ply (open it in MeshLab: color = distance, vertex quality = distance):"
+awk '{ print "    " $0 }
+     /^end_header$/ { body = NR }
+     body && NR >= body + 3 { print "    ..."; exit }' field.ply
 
 step "6/6 stop the server"
 stop_server

@@ -1,5 +1,6 @@
 #include "server/convert.h"
 
+#include <cassert>
 #include <cmath>
 #include <limits>
 
@@ -114,6 +115,28 @@ void FieldChunkToProto(const query::DistanceField& field, int64_t offset, int64_
   } else {
     chunk->clear_nearest_source();
   }
+}
+
+void MeshChunkToProto(const index::Index& index, int64_t vertex_offset, int64_t vertex_count,
+                      int64_t face_offset, int64_t face_count, int64_t version,
+                      v1::MeshChunk* chunk) {
+  assert(vertex_offset >= 0 && vertex_count >= 0 &&
+         vertex_offset + vertex_count <= index.num_vertices());
+  assert(face_offset >= 0 && face_count >= 0 && face_offset + face_count <= index.num_faces());
+  chunk->set_num_vertices(static_cast<uint32_t>(index.num_vertices()));
+  chunk->set_num_faces(static_cast<uint32_t>(index.num_faces()));
+  chunk->set_version(version);
+  chunk->set_vertex_offset(static_cast<uint32_t>(vertex_offset));
+  chunk->set_face_offset(static_cast<uint32_t>(face_offset));
+  const std::span<const double> positions =
+      index.positions().subspan(3 * vertex_offset, 3 * vertex_count);
+  chunk->mutable_positions()->Assign(positions.begin(), positions.end());
+  // Vertex ids are int32 in the index and >= 0 (Index::Open checks them).
+  const std::span<const int32_t> faces = index.faces().subspan(3 * face_offset, 3 * face_count);
+  google::protobuf::RepeatedField<uint32_t>* out = chunk->mutable_faces();
+  out->Clear();
+  out->Reserve(static_cast<int>(faces.size()));
+  for (const int32_t v : faces) out->AddAlreadyReserved(static_cast<uint32_t>(v));
 }
 
 namespace {

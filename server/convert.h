@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "absl/status/status.h"
+#include "core/index/index.h"
 #include "core/mesh/mesh.h"
 #include "core/query/query_engine.h"
 #include "geodex/v1/geodex.pb.h"
@@ -61,6 +62,14 @@ void MatrixBlockToProto(int64_t row_offset, int64_t rows, int64_t num_targets,
 // Vertices [offset, offset + count) of a distance field.
 void FieldChunkToProto(const query::DistanceField& field, int64_t offset, int64_t count,
                        bool with_nearest_source, int64_t version, v1::DistanceFieldChunk* chunk);
+
+// Vertices [vertex_offset, vertex_offset + vertex_count) and faces
+// [face_offset, face_offset + face_count) of `index`'s mesh, with the mesh's
+// totals and `version`. The ranges must lie within the mesh (the index has
+// checked that every face's vertex ids are in range).
+void MeshChunkToProto(const index::Index& index, int64_t vertex_offset, int64_t vertex_count,
+                      int64_t face_offset, int64_t face_count, int64_t version,
+                      v1::MeshChunk* chunk);
 
 // A model as GetModel and ListModels describe it: `version` (a served
 // version of `model`) if given, otherwise what is known without an index

@@ -110,6 +110,29 @@ TEST(ConvertPathTest, LengthIsTheSumOfSegments) {
   EXPECT_EQ(line.points().faces_size(), 0);
 }
 
+TEST_F(ConvertTest, MeshChunkIsASliceOfTheIndexMesh) {
+  const index::Index& ix = engine_->index();
+  v1::MeshChunk chunk;
+  MeshChunkToProto(ix, 10, 5, 100, 4, 3, &chunk);
+  EXPECT_EQ(chunk.num_vertices(), static_cast<uint32_t>(ix.num_vertices()));
+  EXPECT_EQ(chunk.num_faces(), static_cast<uint32_t>(ix.num_faces()));
+  EXPECT_EQ(chunk.version(), 3);
+  EXPECT_EQ(chunk.vertex_offset(), 10u);
+  EXPECT_EQ(chunk.face_offset(), 100u);
+  ASSERT_EQ(chunk.positions_size(), 15);
+  for (int i = 0; i < 15; ++i) EXPECT_EQ(chunk.positions(i), ix.positions()[30 + i]);
+  ASSERT_EQ(chunk.faces_size(), 12);
+  for (int i = 0; i < 12; ++i)
+    EXPECT_EQ(chunk.faces(i), static_cast<uint32_t>(ix.faces()[300 + i]));
+
+  // Empty ranges at the end, as in the last chunks of a mesh with more faces
+  // than vertices; a reused message is overwritten.
+  MeshChunkToProto(ix, ix.num_vertices(), 0, ix.num_faces() - 1, 1, 3, &chunk);
+  EXPECT_EQ(chunk.vertex_offset(), static_cast<uint32_t>(ix.num_vertices()));
+  EXPECT_EQ(chunk.positions_size(), 0);
+  EXPECT_EQ(chunk.faces_size(), 3);
+}
+
 TEST(ConvertModelInfoTest, DescribesAServedVersion) {
   testing::TempDir dir;
   testing::WriteModelVersion(dir.path(), "sphere", 3, testing::SphereIndexBytes());

@@ -866,4 +866,143 @@ grpc::ServerWriteReactor<v1::DistanceFieldChunk>* GeodexService::DistanceField(
   return new FieldStream(this, context, request);
 }
 
+// GetMesh: one chunk copied out of the mapped index on a worker, then
+// written; the next is copied only when the write has completed
+// (backpressure, as in MatrixStream). model_ holds the snapshot, and so the
+// mapped index, until the reactor is deleted. State guarded by mutex_ as in
+// MatrixStream.
+class GeodexService::MeshStream final : public grpc::ServerWriteReactor<v1::MeshChunk>,
+                                        public GeodexService::StreamBase {
+ public:
+  MeshStream(GeodexService* service, grpc::CallbackServerContext* context,
+             const v1::GetMeshRequest* request)
+      : service_(service),
+        context_(context),
+        request_(request),
+        call_(service->StartCall(context, "GetMesh")),
+        chunk_elements_(std::clamp<int64_t>(service->limits_.mesh_chunk_elements, 1, 1 << 16)) {
+    absl::Status status = service->Authorize(*context);
+    if (status.ok()) status = service->RegisterStream(this);
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (!status.ok()) {
+      FinishLocked(status);
+      return;
+    }
+    registered_ = true;
+    SubmitLocked();
+  }
+
+  void OnWriteDone(bool ok) override {
+    std::lock_guard<std::mutex> lock(mutex_);
+    write_in_flight_ = false;
+    if (!ok) {
+      cancelled_ = true;
+      FinishLocked(absl::CancelledError("the client stopped reading mesh chunks"));
+    } else if (cancelled_) {
+      FinishLocked(CheckAlive(*context_).ok() ? absl::CancelledError("call cancelled")
+                                              : CheckAlive(*context_));
+    } else if (next_chunk_ < num_chunks_) {
+      SubmitLocked();
+    } else {
+      FinishLocked(absl::OkStatus());
+    }
+  }
+
+  void OnCancel() override {
+    std::lock_guard<std::mutex> lock(mutex_);
+    cancelled_ = true;
+    if (!write_in_flight_ && !job_running_) {
+      FinishLocked(CheckAlive(*context_).ok() ? absl::CancelledError("call cancelled")
+                                              : CheckAlive(*context_));
+    }
+  }
+
+  void Drain() override {}  // finite; bounded by the server's shutdown deadline
+
+  void OnDone() override {
+    { std::lock_guard<std::mutex> lock(mutex_); }
+    if (registered_) service_->UnregisterStream(this);
+    delete this;
+  }
+
+ private:
+  void SubmitLocked() {
+    job_running_ = true;
+    if (!service_->pool_->Submit([this](WorkerContext&) { Work(); })) {
+      job_running_ = false;
+      FinishLocked(service_->Busy());
+    }
+  }
+
+  absl::Status Prepare() {
+    GEODEX_ASSIGN_OR_RETURN(model_, service_->Resolve(request_->model(), call_));
+    const index::Index& ix = model_.version->index();
+    const auto chunks = [this](int64_t n) { return (n + chunk_elements_ - 1) / chunk_elements_; };
+    num_chunks_ = std::max<int64_t>({1, chunks(ix.num_vertices()), chunks(ix.num_faces())});
+    prepared_ = true;
+    return absl::OkStatus();
+  }
+
+  // Copies chunk next_chunk_: vertices and faces from next_chunk_ *
+  // chunk_elements_ on (either range may be empty near the end).
+  void Work() {
+    absl::Status status = CheckAlive(*context_);
+    if (status.ok() && !prepared_) status = Prepare();
+    int64_t items = 0;
+    if (status.ok()) {
+      const index::Index& ix = model_.version->index();
+      const int64_t begin = next_chunk_ * chunk_elements_;
+      const int64_t nv = std::clamp<int64_t>(ix.num_vertices() - begin, 0, chunk_elements_);
+      const int64_t nf = std::clamp<int64_t>(ix.num_faces() - begin, 0, chunk_elements_);
+      const int64_t vertex_offset = std::min<int64_t>(begin, ix.num_vertices());
+      const int64_t face_offset = std::min<int64_t>(begin, ix.num_faces());
+      MeshChunkToProto(ix, vertex_offset, nv, face_offset, nf, model_.version->version(), &chunk_);
+      items = nv + nf;
+    }
+    std::lock_guard<std::mutex> lock(mutex_);
+    job_running_ = false;
+    if (!status.ok()) {
+      FinishLocked(status);
+    } else if (cancelled_) {
+      FinishLocked(absl::CancelledError("call cancelled"));
+    } else {
+      ++next_chunk_;
+      call_.pairs += items;
+      write_in_flight_ = true;
+      StartWrite(&chunk_);
+    }
+  }
+
+  void FinishLocked(const absl::Status& status) {
+    if (finished_) return;
+    finished_ = true;
+    Finish(service_->FinishCall(call_, status));
+  }
+
+  GeodexService* const service_;
+  grpc::CallbackServerContext* const context_;
+  const v1::GetMeshRequest* const request_;
+  Call call_;
+  const int64_t chunk_elements_;
+  bool registered_ = false;
+
+  // Used by one job at a time (jobs are sequential).
+  bool prepared_ = false;
+  ResolvedModel model_;
+  int64_t num_chunks_ = 1;
+  int64_t next_chunk_ = 0;
+  v1::MeshChunk chunk_;
+
+  std::mutex mutex_;
+  bool job_running_ = false;
+  bool write_in_flight_ = false;
+  bool cancelled_ = false;
+  bool finished_ = false;
+};
+
+grpc::ServerWriteReactor<v1::MeshChunk>* GeodexService::GetMesh(
+    grpc::CallbackServerContext* context, const v1::GetMeshRequest* request) {
+  return new MeshStream(this, context, request);
+}
+
 }  // namespace geodex::server

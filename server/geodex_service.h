@@ -20,10 +20,14 @@
 //   carries the version).
 // - Matrix computes one block of rows, writes it, and computes the next only
 //   when the write has completed; DistanceField computes the field, then
-//   writes chunks of at most 1 MiB one at a time.
+//   writes chunks of at most 1 MiB one at a time. GetMesh copies one chunk of
+//   the mapped mesh on a worker, writes it, and copies the next only when the
+//   write has completed; the resolved model (and so the mapped index) stays
+//   alive until the stream ends, even if the version is swapped out meanwhile.
 //
 // Deadlines and cancellation: a call cancelled or past its deadline is not
-// started, and long calls (Matrix rows, Path pairs) stop between items.
+// started, and long calls (Matrix rows, Path pairs, GetMesh chunks) stop
+// between items.
 //
 // Shutdown: BeginShutdown makes new calls fail UNAVAILABLE and each running
 // StreamDistances stop reading, answer the batches it has read,
@@ -89,6 +93,8 @@ class GeodexService final : public v1::Geodex::CallbackService {
   grpc::ServerUnaryReactor* Locate(grpc::CallbackServerContext* context,
                                    const v1::LocateRequest* request,
                                    v1::LocateResponse* response) override;
+  grpc::ServerWriteReactor<v1::MeshChunk>* GetMesh(grpc::CallbackServerContext* context,
+                                                   const v1::GetMeshRequest* request) override;
 
  private:
   // One call: what its log lines and metrics need.
@@ -104,6 +110,7 @@ class GeodexService final : public v1::Geodex::CallbackService {
   class DistanceStream;
   class MatrixStream;
   class FieldStream;
+  class MeshStream;
 
   // Names the call (the client's x-request-id if it sent a sane one) and
   // echoes the id in the initial metadata.

@@ -17,11 +17,16 @@ struct ServiceLimits {
   int64_t max_path_pairs = 10'000;            // pairs of one Path call
   int64_t max_locate_positions = 1'000'000;   // positions of one Locate call
   int64_t max_message_bytes = 64 << 20;       // any received message (gRPC enforces it)
-  int32_t max_concurrent_streams = 64;        // StreamDistances + Matrix + DistanceField calls
+  // Streaming calls running at once: StreamDistances, Matrix, DistanceField, GetMesh.
+  int32_t max_concurrent_streams = 64;
   // Batches of one StreamDistances call read ahead of the answers written:
   // enough to keep a worker busy while the previous answer is on the wire,
   // few enough that a slow reader stops the stream (backpressure).
   int32_t stream_window = 4;
+  // Vertices, and faces, per GetMesh chunk: at most this many of each,
+  // clamped to [1, 65536] (the most geodex.v1 allows; about 2.5 MiB, under
+  // gRPC's 4 MiB default message size). Tests lower it to get many chunks.
+  int32_t mesh_chunk_elements = 1 << 16;
 };
 
 // `server` with every non-zero limit of `model` that is smaller applied.

@@ -5,7 +5,8 @@
 //
 //   geodex_requests_total{method,model,code}         finished calls
 //   geodex_pairs_total{method,model}                 work items: pairs,
-//       matrix cells, field sources x vertices, positions
+//       matrix cells, field sources x vertices, positions, mesh vertices +
+//       faces sent
 //   geodex_request_duration_seconds{method,model}    call latency; for
 //       StreamDistances, the latency of each batch (read to answer queued)
 //   geodex_errors_total{method,code}                 calls and stream batches

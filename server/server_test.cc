@@ -50,6 +50,22 @@ const std::string& OtherSphereBytes() {
   return *bytes;
 }
 
+// A mesh too big for one GetMesh chunk that still builds in a moment: the
+// Sphere(3) index's surface plus `kExtraVertices` unreferenced vertices (which
+// the builder carries along but never propagates over).
+constexpr int kExtraVertices = 400'000;
+const std::string& WideSphereBytes() {
+  static const std::string* bytes = [] {
+    const mesh::Mesh sphere = mesh::gen::Sphere(3, 1.0);
+    std::vector<mesh::Vec3> positions = sphere.positions();
+    for (int i = 0; i < kExtraVertices; ++i) positions.emplace_back(2 + 1e-5 * i, 0.5, -0.25);
+    auto wide = mesh::Mesh::Create(std::move(positions), sphere.faces(), "wide sphere");
+    EXPECT_TRUE(wide.ok()) << wide.status();
+    return new std::string(testing::BuildIndexBytes(*wide, 40));
+  }();
+  return *bytes;
+}
+
 std::shared_ptr<const query::QueryEngine> ReferenceEngine(const std::string& bytes,
                                                           bool exact = false) {
   auto index = index::Index::FromBytes(bytes);
@@ -102,6 +118,50 @@ class TestServer {
   ServerOptions options_;
   std::unique_ptr<GeodexServer> server_;
 };
+
+// Reads a GetMesh stream to its end.
+struct MeshReply {
+  grpc::Status status;
+  std::vector<v1::MeshChunk> chunks;
+};
+MeshReply ReadMesh(v1::Geodex::Stub& stub, const v1::ModelRef& model) {
+  v1::GetMeshRequest request;
+  *request.mutable_model() = model;
+  auto context = std::make_unique<grpc::ClientContext>();
+  context->set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(60));
+  auto reader = stub.GetMesh(context.get(), request);
+  MeshReply reply;
+  v1::MeshChunk chunk;
+  while (reader->Read(&chunk)) reply.chunks.push_back(chunk);
+  reply.status = reader->Finish();
+  return reply;
+}
+
+// Expects `chunks` to tile `ix`'s mesh in order, each with the totals and
+// `version`, at most `per_chunk` vertices and faces each, and the positions
+// and faces to be exactly the index's.
+void ExpectMeshOfIndex(const std::vector<v1::MeshChunk>& chunks, const index::Index& ix,
+                       int64_t version, int per_chunk = 1 << 16) {
+  std::vector<double> positions;
+  std::vector<int32_t> faces;
+  for (const v1::MeshChunk& chunk : chunks) {
+    EXPECT_EQ(chunk.num_vertices(), static_cast<uint32_t>(ix.num_vertices()));
+    EXPECT_EQ(chunk.num_faces(), static_cast<uint32_t>(ix.num_faces()));
+    EXPECT_EQ(chunk.version(), version);
+    EXPECT_EQ(chunk.vertex_offset(), positions.size() / 3);
+    EXPECT_EQ(chunk.face_offset(), faces.size() / 3);
+    EXPECT_LE(chunk.positions_size(), 3 * per_chunk);
+    EXPECT_LE(chunk.faces_size(), 3 * per_chunk);
+    EXPECT_LT(chunk.ByteSizeLong(), 5u << 19);  // 2.5 MiB
+    ASSERT_EQ(chunk.positions_size() % 3, 0);
+    ASSERT_EQ(chunk.faces_size() % 3, 0);
+    positions.insert(positions.end(), chunk.positions().begin(), chunk.positions().end());
+    faces.insert(faces.end(), chunk.faces().begin(), chunk.faces().end());
+  }
+  EXPECT_TRUE(
+      std::equal(positions.begin(), positions.end(), ix.positions().begin(), ix.positions().end()));
+  EXPECT_TRUE(std::equal(faces.begin(), faces.end(), ix.faces().begin(), ix.faces().end()));
+}
 
 v1::SurfacePoints ToProto(std::span<const mesh::SurfacePoint> points) {
   v1::SurfacePoints proto;
@@ -454,6 +514,31 @@ TEST_P(RpcTest, DistanceFieldMatchesTheEngine) {
   EXPECT_EQ(next, sphere_->index().num_vertices());
 }
 
+TEST_P(RpcTest, GetMeshIsTheIndexMesh) {
+  const MeshReply reply = ReadMesh(*stub_, Ref("sphere"));
+  ASSERT_TRUE(reply.status.ok()) << reply.status.error_message();
+  ASSERT_EQ(reply.chunks.size(), 1u);  // 642 vertices, 1280 faces
+  EXPECT_EQ(reply.chunks[0].num_vertices(), 642u);
+  EXPECT_EQ(reply.chunks[0].num_faces(), 1280u);
+  ExpectMeshOfIndex(reply.chunks, sphere_->index(), 1);
+
+  const MeshReply pinned = ReadMesh(*stub_, Ref("torus", 1));
+  ASSERT_TRUE(pinned.status.ok()) << pinned.status.error_message();
+  ExpectMeshOfIndex(pinned.chunks, ReferenceEngine(testing::TorusIndexBytes())->index(), 1);
+}
+
+TEST_P(RpcTest, GetMeshOfAnUnknownModelOrVersionIsNotFound) {
+  MeshReply reply = ReadMesh(*stub_, Ref("nope"));
+  EXPECT_EQ(reply.status.error_code(), grpc::StatusCode::NOT_FOUND);
+  EXPECT_THAT(reply.status.error_message(), HasSubstr("nope"));
+  EXPECT_TRUE(reply.chunks.empty());
+  reply = ReadMesh(*stub_, Ref("sphere", 9));
+  EXPECT_EQ(reply.status.error_code(), grpc::StatusCode::NOT_FOUND);
+  EXPECT_TRUE(reply.chunks.empty());
+  reply = ReadMesh(*stub_, Ref("../sphere"));
+  EXPECT_EQ(reply.status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+}
+
 TEST_P(RpcTest, LocateMatchesTheEngine) {
   v1::LocateRequest request;
   *request.mutable_model() = Ref("sphere");
@@ -740,6 +825,93 @@ TEST(ServerTest, CancelledMatrixStopsComputing) {
   // Far fewer than the 2000 rows were computed.
   const std::string text = ts.server().metrics().Text();
   EXPECT_THAT(text, HasSubstr("geodex_requests_total{code=\"CANCELLED\",method=\"Matrix\""));
+}
+
+TEST(ServerTest, GetMeshOfALargeMeshComesInSeveralChunks) {
+  TestServer ts;
+  testing::WriteModelVersion(ts.root(), "wide", 1, WideSphereBytes());
+  ts.Rescan();
+  auto stub = v1::Geodex::NewStub(ts.TcpChannel());
+  const MeshReply reply = ReadMesh(*stub, Ref("wide"));
+  ASSERT_TRUE(reply.status.ok()) << reply.status.error_message();
+  auto index = index::Index::FromBytes(WideSphereBytes());
+  ASSERT_TRUE(index.ok()) << index.status();
+  ASSERT_EQ((*index)->num_vertices(), 642 + kExtraVertices);
+  // 400642 vertices in chunks of 65536; the 1280 faces all in the first.
+  ASSERT_EQ(reply.chunks.size(), 7u);
+  EXPECT_EQ(reply.chunks[0].faces_size(), 3 * 1280);
+  EXPECT_EQ(reply.chunks[1].faces_size(), 0);
+  EXPECT_EQ(reply.chunks[1].face_offset(), 1280u);
+  ExpectMeshOfIndex(reply.chunks, **index, 1);
+}
+
+TEST(ServerTest, GetMeshInSmallChunksTilesVerticesAndFaces) {
+  TestServer ts([](ServerOptions& o) { o.limits.mesh_chunk_elements = 100; });
+  auto stub = v1::Geodex::NewStub(ts.TcpChannel());
+  const MeshReply reply = ReadMesh(*stub, Ref("sphere"));
+  ASSERT_TRUE(reply.status.ok()) << reply.status.error_message();
+  // 642 vertices: 7 chunks; 1280 faces: 13 chunks, the last 6 without vertices.
+  ASSERT_EQ(reply.chunks.size(), 13u);
+  EXPECT_EQ(reply.chunks[6].positions_size(), 3 * 42);
+  EXPECT_EQ(reply.chunks[7].positions_size(), 0);
+  EXPECT_EQ(reply.chunks[7].vertex_offset(), 642u);
+  EXPECT_EQ(reply.chunks[12].faces_size(), 3 * 80);
+  ExpectMeshOfIndex(reply.chunks, ReferenceEngine(testing::SphereIndexBytes())->index(), 1, 100);
+  const std::string text = ts.server().metrics().Text();
+  EXPECT_THAT(text, HasSubstr("geodex_requests_total{code=\"OK\",method=\"GetMesh\""));
+  EXPECT_THAT(text, HasSubstr("geodex_pairs_total{method=\"GetMesh\",model=\"sphere\"} 1922"));
+}
+
+TEST(ServerTest, GetMeshKeepsItsVersionWhenTheModelIsRemovedMidStream) {
+  TestServer ts([](ServerOptions& o) { o.limits.mesh_chunk_elements = 1000; });
+  testing::WriteModelVersion(ts.root(), "wide", 1, WideSphereBytes());
+  ts.Rescan();
+  auto stub = v1::Geodex::NewStub(ts.TcpChannel());
+  v1::GetMeshRequest request;
+  *request.mutable_model() = Ref("wide");
+  auto context = Context();
+  auto reader = stub->GetMesh(context.get(), request);
+  std::vector<v1::MeshChunk> chunks(1);
+  ASSERT_TRUE(reader->Read(&chunks[0]));
+  // The model disappears: new calls fail, the running stream goes on with
+  // the index it resolved.
+  testing::RemoveModel(ts.root(), "wide");
+  ts.Rescan();
+  EXPECT_EQ(ReadMesh(*stub, Ref("wide")).status.error_code(), grpc::StatusCode::NOT_FOUND);
+  v1::MeshChunk chunk;
+  while (reader->Read(&chunk)) chunks.push_back(chunk);
+  const grpc::Status status = reader->Finish();
+  ASSERT_TRUE(status.ok()) << status.error_message();
+  EXPECT_EQ(chunks.size(), 401u);
+  auto index = index::Index::FromBytes(WideSphereBytes());
+  ASSERT_TRUE(index.ok()) << index.status();
+  ExpectMeshOfIndex(chunks, **index, 1, 1000);
+}
+
+TEST(ServerTest, CancelledGetMeshStops) {
+  TestServer ts([](ServerOptions& o) { o.workers = 1; });
+  testing::WriteModelVersion(ts.root(), "wide", 1, WideSphereBytes());
+  ts.Rescan();
+  auto stub = v1::Geodex::NewStub(ts.TcpChannel());
+  v1::GetMeshRequest request;
+  *request.mutable_model() = Ref("wide");
+  auto context = Context();
+  auto reader = stub->GetMesh(context.get(), request);
+  v1::MeshChunk chunk;
+  ASSERT_TRUE(reader->Read(&chunk));  // 1.5 MiB of the 9.6 MiB of positions
+  EXPECT_EQ(chunk.vertex_offset(), 0u);
+  context->TryCancel();
+  int more = 0;
+  while (reader->Read(&chunk)) ++more;
+  EXPECT_LT(more, 6);
+  EXPECT_EQ(reader->Finish().error_code(), grpc::StatusCode::CANCELLED);
+  const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(5);
+  while (ts.server().service().active_streams() > 0 && std::chrono::steady_clock::now() < until) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  EXPECT_EQ(ts.server().service().active_streams(), 0);
+  EXPECT_THAT(ts.server().metrics().Text(),
+              HasSubstr("geodex_requests_total{code=\"CANCELLED\",method=\"GetMesh\""));
 }
 
 TEST(ServerTest, SlowReaderStopsTheStream) {

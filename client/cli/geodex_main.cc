@@ -4,7 +4,7 @@
 //   geodex info --model M                           one model, with its build report
 //   geodex distance --model M --pairs FILE|- [--xyz]
 //   geodex path --model M --pairs FILE --format obj|ply|json --out F
-//   geodex field --model M --sources FILE --out field.txt
+//   geodex field --model M --sources FILE --out field.txt|field.ply
 //   geodex locate --model M --points FILE
 //   geodex matrix --model M --sources FILE --targets FILE
 //   geodex bench --model M --concurrency C --duration S --batch B
@@ -13,6 +13,13 @@
 // localhost:50051), --tls-ca/--tls-cert/--tls-key, --token/--token-file and
 // --timeout. Input lines are those of geodex-query (client/cli/text_io.h).
 // Results go to standard output (or --out), errors to standard error.
+//
+// `field --out X.ply` asks for the distance field, then for the mesh of the
+// version that answered it (GetMesh pinned to that version, so that both
+// come from the same index even if the model is reloaded in between), and
+// writes the mesh colored by distance with the distance as the vertex
+// quality; unreachable vertices are gray with quality -1 (FieldToPly in
+// client/cli/outputs.h).
 //
 // Exit codes: 0 success; 2 bad usage or bad input, found before anything was
 // asked of the server (unreadable or malformed file, with its line number;
@@ -293,15 +300,37 @@ struct FieldFlags {
   bool nearest = false;
 };
 
+// The mesh the distance field `field` was computed on: GetMesh pinned to the
+// version that answered the field, so that a model reloaded between the two
+// calls cannot pair one version's distances with another's mesh.
+absl::StatusOr<Mesh> MeshOfField(const Client& client, const ModelFlags& model,
+                                 const VertexDistances& field) {
+  const int64_t version = field.version != 0 ? field.version : model.version;
+  absl::StatusOr<Mesh> mesh = client.GetMesh(ModelRef(model.name, version));
+  if (!mesh.ok()) {
+    return absl::Status(mesh.status().code(),
+                        absl::StrFormat("the mesh of model '%s' version %d (the version that "
+                                        "answered the distance field): %s",
+                                        model.name, version, mesh.status().message()));
+  }
+  if (version != 0 && mesh->version != version) {
+    return absl::DataLossError(absl::StrFormat(
+        "the server sent the mesh of version %d for the distance field of version %d",
+        mesh->version, version));
+  }
+  if (mesh->positions.size() != field.distances.size()) {
+    return absl::DataLossError(
+        absl::StrFormat("the distance field has %d vertices but the mesh of version %d has %d",
+                        field.distances.size(), mesh->version, mesh->positions.size()));
+  }
+  return mesh;
+}
+
 absl::Status Field(const ConnectionFlags& conn, const FieldFlags& flags) {
-  if (absl::EndsWithIgnoreCase(flags.out, ".ply")) {
-    // A colored PLY needs the mesh's vertices and faces, and geodex.v1 has no
-    // call that returns them yet (a GetMesh RPC is proposed). FieldToPly is
-    // ready for when it lands.
-    return InputError(absl::UnimplementedError(
-        "PLY output needs the model's mesh, which the server cannot send yet (no GetMesh "
-        "call in geodex.v1); write the per-vertex distances as text instead "
-        "(e.g. --out field.txt)"));
+  const bool ply = absl::EndsWithIgnoreCase(flags.out, ".ply");
+  if (ply && flags.nearest) {
+    return InputError(absl::InvalidArgumentError(
+        "--nearest is for text output; a .ply holds the distances and colors only"));
   }
   absl::StatusOr<Client> client = MakeClient(conn);
   if (!client.ok()) return client.status();
@@ -315,7 +344,10 @@ absl::Status Field(const ConnectionFlags& conn, const FieldFlags& flags) {
   absl::StatusOr<VertexDistances> field =
       client->DistanceField(flags.model.ref(), *sources, flags.nearest);
   if (!field.ok()) return field.status();
-  return WriteOutput(flags.out, FieldToText(*field));
+  if (!ply) return WriteOutput(flags.out, FieldToText(*field));
+  absl::StatusOr<Mesh> mesh = MeshOfField(*client, flags.model, *field);
+  if (!mesh.ok()) return mesh.status();
+  return WriteOutput(flags.out, FieldToPly(*mesh, field->distances));
 }
 
 absl::Status Locate(const ConnectionFlags& conn, const ModelFlags& model, const std::string& points,
@@ -432,17 +464,22 @@ int Main(int argc, char** argv) {
   path->callback([&] { status = Path(conn, path_flags); });
 
   CLI::App* field = app.add_subcommand(
-      "field", "Distance from the nearest source to every mesh vertex, one line per vertex");
+      "field",
+      "Distance from the nearest source to every mesh vertex: one line per vertex, or with "
+      "--out X.ply the model's mesh colored by distance");
   AddConnectionFlags(field, &conn);
   FieldFlags field_flags;
   AddModelFlags(field, &field_flags.model);
   field->add_option("--sources", field_flags.sources, "File of lines 'f w0 w1 w2'")->required();
   field->add_flag("--nearest", field_flags.nearest,
-                  "Also print the index of the nearest source on each line");
+                  "Also print the index of the nearest source on each line (text output only)");
   field
       ->add_option("-o,--out", field_flags.out,
-                   "Output file ('-': standard output). Text; a colored .ply needs a GetMesh "
-                   "call the server does not have yet")
+                   "Output file ('-': standard output). Text, one distance per vertex ('inf': "
+                   "unreachable); a name ending in .ply gets an ASCII PLY of the mesh (of the "
+                   "version that answered) for MeshLab: per vertex x y z, a color (dark purple "
+                   "at the sources to yellow at the farthest vertex) and quality = distance; "
+                   "unreachable vertices are gray (128 128 128) with quality -1")
       ->capture_default_str();
   field->callback([&] { status = Field(conn, field_flags); });
 

@@ -125,7 +125,7 @@ std::array<uint8_t, 3> RampColor(double t) {
   return rgb;
 }
 
-std::string FieldToPly(const MeshGeometry& mesh, const std::vector<double>& distances) {
+std::string FieldToPly(const Mesh& mesh, const std::vector<double>& distances) {
   double max_distance = 0;
   for (double d : distances) {
     if (std::isfinite(d)) max_distance = std::max(max_distance, d);
@@ -139,7 +139,7 @@ std::string FieldToPly(const MeshGeometry& mesh, const std::vector<double>& dist
   for (size_t v = 0; v < mesh.positions.size(); ++v) {
     const Position& p = mesh.positions[v];
     const double d = distances[v];
-    std::array<uint8_t, 3> rgb = {128, 128, 128};  // unreachable
+    std::array<uint8_t, 3> rgb = kUnreachableColor;
     if (std::isfinite(d)) rgb = RampColor(max_distance > 0 ? d / max_distance : 0.0);
     // PLY has no infinity for float; -1 marks "unreachable" in the quality.
     absl::StrAppendFormat(&out, "%.17g %.17g %.17g %d %d %d %.9g\n", p[0], p[1], p[2], rgb[0],

@@ -26,17 +26,18 @@ std::string PathsToJson(const std::vector<GeodesicPath>& paths);
 // nearest sources, "distance nearest_source".
 std::string FieldToText(const VertexDistances& field);
 
-// A triangle mesh's geometry: positions (#V) and vertex-index triples (#F).
-struct MeshGeometry {
-  std::vector<Position> positions;
-  std::vector<std::array<int32_t, 3>> faces;
-};
+// An ASCII PLY of `mesh` (vertices x y z, triangles) colored by a distance
+// field, for MeshLab and the like. Each vertex has the color RampColor(d /
+// largest finite distance), dark purple at the sources to yellow at the
+// farthest vertex, and the distance as its `quality` (MeshLab shows and
+// filters on it). Vertices with no finite distance (on another connected
+// component than every source, or unreferenced) are kUnreachableColor, a gray
+// the ramp never takes, with quality -1, since a PLY float cannot hold
+// infinity. Requires distances.size() == mesh.positions.size().
+std::string FieldToPly(const Mesh& mesh, const std::vector<double>& distances);
 
-// An ASCII PLY of `mesh` with per-vertex colors (a blue-to-yellow ramp over
-// [0, largest finite distance]; unreachable vertices gray) and the distance as
-// the vertex `quality`, which MeshLab shows and filters on. Requires
-// distances.size() == mesh.positions.size().
-std::string FieldToPly(const MeshGeometry& mesh, const std::vector<double>& distances);
+// The color FieldToPly gives vertices with no finite distance.
+inline constexpr std::array<uint8_t, 3> kUnreachableColor = {128, 128, 128};
 
 // The color of t in [0, 1] on the ramp FieldToPly uses.
 std::array<uint8_t, 3> RampColor(double t);

@@ -1,6 +1,10 @@
 #include "client/cli/outputs.h"
 
+#include <cmath>
 #include <limits>
+#include <sstream>
+#include <string>
+#include <vector>
 
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
@@ -54,7 +58,7 @@ TEST(FieldToText, OneLinePerVertex) {
 }
 
 TEST(FieldToPly, ColoredMeshWithQuality) {
-  MeshGeometry mesh;
+  Mesh mesh;
   mesh.positions = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {5, 5, 5}};
   mesh.faces = {{0, 1, 2}};
   const std::string ply = FieldToPly(mesh, {0, 1, 2, std::numeric_limits<double>::infinity()});
@@ -65,6 +69,104 @@ TEST(FieldToPly, ColoredMeshWithQuality) {
   EXPECT_THAT(ply, HasSubstr("\n0 1 0 253 231 37 2\n"));    // farthest: ramp end
   EXPECT_THAT(ply, HasSubstr("\n5 5 5 128 128 128 -1\n"));  // unreachable
   EXPECT_THAT(ply, HasSubstr("\n3 0 1 2\n"));
+}
+
+// What FieldToPly wrote, read back line by line the way a PLY reader would.
+struct ReadPly {
+  int64_t num_vertices = -1, num_faces = -1;
+  std::vector<std::string> vertex_properties;
+  std::vector<std::vector<double>> vertices;  // x y z red green blue quality
+  std::vector<std::vector<int64_t>> faces;    // count, then the ids
+  bool ok = false;                            // header and body parsed completely
+};
+
+ReadPly ParsePly(const std::string& text) {
+  ReadPly ply;
+  std::istringstream in(text);
+  std::string line;
+  if (!std::getline(in, line) || line != "ply") return ply;
+  if (!std::getline(in, line) || line != "format ascii 1.0") return ply;
+  std::string element;
+  while (std::getline(in, line) && line != "end_header") {
+    std::istringstream words(line);
+    std::string keyword;
+    words >> keyword;
+    if (keyword == "element") {
+      int64_t count = -1;
+      words >> element >> count;
+      (element == "vertex" ? ply.num_vertices : ply.num_faces) = count;
+    } else if (keyword == "property" && element == "vertex") {
+      std::string type, name;
+      words >> type >> name;
+      ply.vertex_properties.push_back(name);
+    }
+  }
+  if (line != "end_header" || ply.num_vertices < 0 || ply.num_faces < 0) return ply;
+  for (int64_t v = 0; v < ply.num_vertices && std::getline(in, line); ++v) {
+    std::istringstream words(line);
+    std::vector<double> row;
+    double x;
+    while (words >> x) row.push_back(x);
+    ply.vertices.push_back(row);
+  }
+  for (int64_t f = 0; f < ply.num_faces && std::getline(in, line); ++f) {
+    std::istringstream words(line);
+    std::vector<int64_t> row;
+    int64_t id;
+    while (words >> id) row.push_back(id);
+    ply.faces.push_back(row);
+  }
+  ply.ok = static_cast<int64_t>(ply.vertices.size()) == ply.num_vertices &&
+           static_cast<int64_t>(ply.faces.size()) == ply.num_faces && !std::getline(in, line);
+  return ply;
+}
+
+TEST(FieldToPly, ReadsBackAsTheMeshWithDistancesAndColors) {
+  // A unit square of two triangles, a vertex on another component (a third
+  // triangle) and an unreferenced vertex.
+  Mesh mesh;
+  mesh.positions = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0.125},
+                    {5, 5, 5}, {6, 5, 5}, {5, 6, 5}, {-1.0 / 3, 1e-17, 2.5e10}};
+  mesh.faces = {{0, 1, 2}, {0, 2, 3}, {4, 5, 6}};
+  const double inf = std::numeric_limits<double>::infinity();
+  const std::vector<double> d = {0, 1, std::sqrt(2.0), 1, inf, inf, inf, inf};
+  const ReadPly ply = ParsePly(FieldToPly(mesh, d));
+  ASSERT_TRUE(ply.ok);
+  EXPECT_EQ(ply.num_vertices, 8);
+  EXPECT_EQ(ply.num_faces, 3);
+  EXPECT_THAT(ply.vertex_properties,
+              ::testing::ElementsAre("x", "y", "z", "red", "green", "blue", "quality"));
+  for (size_t v = 0; v < mesh.positions.size(); ++v) {
+    const std::vector<double>& row = ply.vertices[v];
+    ASSERT_EQ(row.size(), 7u) << v;
+    for (int c = 0; c < 3; ++c) EXPECT_EQ(row[c], mesh.positions[v][c]) << v;  // exact
+    const std::array<uint8_t, 3> rgb =
+        std::isfinite(d[v]) ? RampColor(d[v] / std::sqrt(2.0)) : kUnreachableColor;
+    for (int c = 0; c < 3; ++c) EXPECT_EQ(row[3 + c], rgb[c]) << v;
+    if (std::isfinite(d[v])) {
+      EXPECT_FLOAT_EQ(row[6], d[v]) << v;
+    } else {
+      EXPECT_EQ(row[6], -1) << v;
+    }
+  }
+  for (size_t f = 0; f < mesh.faces.size(); ++f) {
+    EXPECT_THAT(ply.faces[f],
+                ::testing::ElementsAre(3, mesh.faces[f][0], mesh.faces[f][1], mesh.faces[f][2]));
+  }
+  // The ramp never gives the unreachable gray.
+  for (int i = 0; i <= 1000; ++i) EXPECT_NE(RampColor(i / 1000.0), kUnreachableColor) << i;
+}
+
+TEST(FieldToPly, AllAtTheSourceIsTheRampStart) {
+  Mesh mesh;
+  mesh.positions = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+  mesh.faces = {{0, 1, 2}};
+  const ReadPly ply = ParsePly(FieldToPly(mesh, {0, 0, 0}));
+  ASSERT_TRUE(ply.ok);
+  for (const auto& row : ply.vertices) {
+    EXPECT_THAT(row,
+                ::testing::ElementsAre(::testing::_, ::testing::_, ::testing::_, 68, 1, 84, 0));
+  }
 }
 
 TEST(RampColor, MonotoneBrightness) {

@@ -287,6 +287,34 @@ grpc::Status FakeGeodexService::Locate(grpc::ServerContext* context,
   return grpc::Status::OK;
 }
 
+grpc::Status FakeGeodexService::GetMesh(grpc::ServerContext* context,
+                                        const v1::GetMeshRequest* request,
+                                        grpc::ServerWriter<v1::MeshChunk>* writer) {
+  if (grpc::Status s = Enter(context); !s.ok()) return s;
+  if (grpc::Status s = CheckModel(request->model()); !s.ok()) return s;
+  constexpr int64_t kVerticesPerChunk = 7, kFacesPerChunk = 11;
+  for (int64_t k = 0; k * kVerticesPerChunk < kNumVertices || k * kFacesPerChunk < kNumFaces; ++k) {
+    v1::MeshChunk chunk;
+    chunk.set_num_vertices(kNumVertices);
+    chunk.set_num_faces(kNumFaces);
+    chunk.set_version(1);
+    const int64_t v0 = std::min(kNumVertices, k * kVerticesPerChunk);
+    const int64_t f0 = std::min(kNumFaces, k * kFacesPerChunk);
+    chunk.set_vertex_offset(v0);
+    chunk.set_face_offset(f0);
+    for (int64_t v = v0; v < std::min(kNumVertices, v0 + kVerticesPerChunk); ++v) {
+      chunk.add_positions(v);
+      chunk.add_positions(v % 2);
+      chunk.add_positions(0);
+    }
+    for (int64_t f = f0; f < std::min(kNumFaces, f0 + kFacesPerChunk); ++f) {
+      for (int64_t c = 0; c < 3; ++c) chunk.add_faces((f + c) % kNumVertices);
+    }
+    if (!writer->Write(chunk)) break;
+  }
+  return grpc::Status::OK;
+}
+
 FakeGeodexServer::FakeGeodexServer() {
   grpc::ServerBuilder builder;
   int port = 0;

@@ -8,6 +8,9 @@
 //   path(a, b)       = [a, b] at positions (face, w1, w2), length = distance
 //   field(v)         = min over sources s of |v - s.face|   (num_vertices = 60)
 //   locate(x, y, z)  = face clamp(floor(x)), weights (1, 0, 0), distance |y|
+//   mesh             = vertex v at (v, v % 2, 0), face f = (f % 60, (f + 1) % 60,
+//                      (f + 2) % 60); chunk k holds vertices [7k, 7k + 7) and
+//                      faces [11k, 11k + 11) (10 chunks)
 //
 // Models: "fake" (version 1, 100 faces, 60 vertices), "loading" (always
 // UNAVAILABLE), anything else NOT_FOUND. A face >= 100 is OUT_OF_RANGE, bad
@@ -47,6 +50,8 @@ class FakeGeodexService final : public v1::Geodex::Service {
                              grpc::ServerWriter<v1::DistanceFieldChunk>* writer) override;
   grpc::Status Locate(grpc::ServerContext* context, const v1::LocateRequest* request,
                       v1::LocateResponse* response) override;
+  grpc::Status GetMesh(grpc::ServerContext* context, const v1::GetMeshRequest* request,
+                       grpc::ServerWriter<v1::MeshChunk>* writer) override;
 
   // Fails the next `n` calls (of any method) with UNAVAILABLE.
   void FailNext(int n) { fail_next_.store(n); }

@@ -252,9 +252,47 @@ if [ $FAKE -eq 0 ]; then
   same_numbers field_offline.txt field.txt && pass "field equals geodex-query" ||
     fail "field differs from geodex-query" err.txt
 fi
-"$GEODEX" field "${S[@]}" --model "$MODEL" --sources sources.txt --out field.ply > /dev/null 2> err.txt
-[ $? -eq 2 ] && grep -q "GetMesh" err.txt && pass "field --out X.ply explains it needs GetMesh" ||
-  fail "field ply" err.txt
+# The field as a colored mesh (GetMesh): a complete ASCII PLY with the model's
+# vertex and face counts, faces naming existing vertices, and as vertex quality
+# the same distances as the text field (the model is connected: all finite,
+# the smallest 0, at the source vertex).
+if "$GEODEX" field "${S[@]}" --model "$MODEL" --sources sources.txt --out field.ply \
+    > /dev/null 2> err.txt; then
+  pass "field --out field.ply"
+else
+  fail "field --out field.ply" err.txt
+fi
+if [ "$(sed -n '1p;2p' field.ply | tr '\n' ' ')" = "ply format ascii 1.0 " ] &&
+   grep -qx "element vertex $NUM_VERTICES" field.ply && grep -qx "element face $NUM_FACES" field.ply &&
+   grep -qx "property float quality" field.ply &&
+   awk -v nv="$NUM_VERTICES" -v nf="$NUM_FACES" '
+     body == 0 { if ($0 == "end_header") body = 1; next }
+     body && v < nv { v++; if (NF != 7) exit 1
+                      for (i = 4; i <= 6; i++) if ($i !~ /^[0-9]+$/ || $i > 255) exit 1
+                      next }
+     body && f < nf { f++; if (NF != 4 || $1 != 3) exit 1
+                      for (i = 2; i <= 4; i++) if ($i !~ /^[0-9]+$/ || $i >= nv) exit 1
+                      next }
+     { exit 1 }
+     END { exit !(v == nv && f == nf) }' field.ply; then
+  pass "field.ply: $NUM_VERTICES colored vertices and $NUM_FACES faces, as the model has"
+else
+  fail "field.ply is not a PLY of the model's mesh" field.ply
+fi
+awk '/^end_header$/ { body = 1; next } body && NF == 7 { print $7 }' field.ply > ply_quality.txt
+if awk 'NR == FNR { d[FNR] = $1; n = FNR; next }
+        { q = $1 + 0; e = d[FNR] - q; if (e < 0) e = -e; s = q < 1 ? 1 : q
+          if (d[FNR] == "inf" || q < 0 || e > 1e-6 * s) exit 1
+          if (FNR == 1 || q < min) min = q; m = FNR }
+        END { exit !(m == n && min == 0) }' field.txt ply_quality.txt; then
+  pass "field.ply quality: the text field's distances, all finite, the smallest 0"
+else
+  fail "field.ply quality differs from field.txt" ply_quality.txt field.txt
+fi
+if [ $FAKE -eq 0 ]; then
+  [ "$(grep -cx 0 ply_quality.txt)" -eq 1 ] && pass "field.ply: one vertex at distance 0 (the source)" ||
+    fail "field.ply: not exactly one vertex at distance 0" ply_quality.txt
+fi
 
 "$GEODEX" matrix "${S[@]}" --model "$MODEL" --sources sources.txt --targets sources.txt > m.txt 2> err.txt &&
   [ "$(wc -l < m.txt)" -eq 2 ] && awk '{ if ($1 + 0 != $1 || NF != 2) exit 1 }' m.txt &&
@@ -307,6 +345,10 @@ expect "unknown model: exit 1 with NOT_FOUND" 1 "NOT_FOUND" \
   "$GEODEX" distance "${S[@]}" --model no-such-model --pairs pairs.txt
 expect "unknown model (models info): exit 1" 1 "NOT_FOUND" \
   "$GEODEX" info "${S[@]}" --model no-such-model
+expect "unknown model (field --out X.ply): exit 1" 1 "NOT_FOUND" \
+  "$GEODEX" field "${S[@]}" --model no-such-model --sources sources.txt --out none.ply
+expect "field --nearest with a .ply: exit 2" 2 "--nearest is for text output" \
+  "$GEODEX" field "${S[@]}" --model "$MODEL" --sources sources.txt --nearest --out nearest.ply
 NO_SERVER="127.0.0.1:$(free_port)"
 expect "no server: exit 1 with UNAVAILABLE" 1 "UNAVAILABLE" \
   "$GEODEX" models --server "$NO_SERVER" --attempts 2 --timeout 5

@@ -21,6 +21,17 @@ class FixedConnection : public geodex::client::GeodexConnection {
     }
     return response;
   }
+  // One triangle, in one chunk.
+  absl::StatusOr<std::vector<geodex::v1::MeshChunk>> GetMesh(
+      const geodex::v1::GetMeshRequest& request) override {
+    geodex::v1::MeshChunk chunk;
+    chunk.set_num_vertices(3);
+    chunk.set_num_faces(1);
+    chunk.set_version(request.model().version());
+    for (double c : {0, 0, 0, 1, 0, 0, 0, 1, 0}) chunk.add_positions(c);
+    for (uint32_t v : {0, 1, 2}) chunk.add_faces(v);
+    return std::vector<geodex::v1::MeshChunk>{chunk};
+  }
 };
 
 int Fail(const char* what) {
@@ -37,6 +48,11 @@ int main() {
   absl::StatusOr<std::vector<double>> d = client.Distance("demo", pairs);
   if (!d.ok() || d->size() != 2 || (*d)[0] != 2 || (*d)[1] != 9) {
     return Fail("Distance over a custom connection gave the wrong answer");
+  }
+
+  absl::StatusOr<geodex::client::Mesh> mesh = client.GetMesh({"demo", 4});
+  if (!mesh.ok() || mesh->positions.size() != 3 || mesh->faces.size() != 1 || mesh->version != 4) {
+    return Fail("GetMesh over a custom connection gave the wrong mesh");
   }
 
   geodex::client::ConnectOptions options;

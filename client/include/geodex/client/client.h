@@ -145,6 +145,21 @@ class Client {
   absl::StatusOr<std::vector<LocatedPoint>> Locate(const ModelRef& model,
                                                    absl::Span<const Position> positions) const;
 
+  // The model's triangle mesh, assembled from the streamed chunks; Mesh::version
+  // says which version it is. To get the mesh a DistanceField was computed on,
+  // pin the field's version:
+  //
+  //   absl::StatusOr<VertexDistances> field = client.DistanceField("torus", sources);
+  //   absl::StatusOr<Mesh> mesh = client.GetMesh({"torus", field->version});
+  //
+  // Errors: NOT_FOUND for an unknown model or version (also when a pinned
+  // version has been retired meanwhile); DATA_LOSS if the chunks are not one
+  // consistent mesh (totals or version that change between chunks, vertex or
+  // face ranges that are not contiguous or do not add up to the totals, a face
+  // naming a vertex past the end, the mesh of another version than the pinned
+  // one).
+  absl::StatusOr<Mesh> GetMesh(const ModelRef& model) const;
+
   const std::shared_ptr<GeodexConnection>& connection() const { return connection_; }
   const ClientOptions& options() const { return options_; }
 

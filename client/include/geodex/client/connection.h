@@ -69,6 +69,8 @@ class GeodexConnection {
   virtual absl::StatusOr<std::vector<v1::DistanceFieldChunk>> DistanceField(
       const v1::DistanceFieldRequest& request);
   virtual absl::StatusOr<v1::LocateResponse> Locate(const v1::LocateRequest& request);
+  // All chunks of the server stream, in the order received.
+  virtual absl::StatusOr<std::vector<v1::MeshChunk>> GetMesh(const v1::GetMeshRequest& request);
 };
 
 }  // namespace geodex::client

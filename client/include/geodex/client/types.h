@@ -101,6 +101,16 @@ struct VertexDistances {
   int64_t version = 0;
 };
 
+// A model's triangle mesh as its index holds it: vertex v is positions[v]
+// (unreferenced vertices included), face f is faces[f], three vertex ids in
+// the order of the source file. The ids are those of SurfacePoint::face and
+// VertexDistances::distances.
+struct Mesh {
+  std::vector<Position> positions;             // #V
+  std::vector<std::array<uint32_t, 3>> faces;  // #F, each id < positions.size()
+  int64_t version = 0;                         // the model version whose mesh this is
+};
+
 // The closest surface point to a 3D position and the Euclidean distance to it.
 struct LocatedPoint {
   SurfacePoint point;
