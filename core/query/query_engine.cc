@@ -110,6 +110,34 @@ inline double TwoSideToOutside2(const EdgeFrame* frames, const Placed& p, const 
   return best < kInf ? best : best_collinear;
 }
 
+// Distances from a point of a mesh face to the three corners of a geodesic
+// triangle, from the distances d[vertex][corner] of the face's vertices. The
+// face lies in its plane (vertex 0 at the origin, vertex 1 at (l, 0), vertex 2
+// at (cx, cy)), the point at (px, py).
+inline void LiftInFace(double l, double cx, double cy, double px, double py, bool exact,
+                       const double (&d)[3][3], std::array<double, 3>* out) {
+  for (int c = 0; c < 3; ++c) {
+    if (exact && cy > 1e-3 * l) {
+      // Exact distances of one field at the three corners of a face fix the
+      // unfolded source: trilaterate it (linear, no square roots) and measure.
+      const double sx = (l * l + d[0][c] * d[0][c] - d[1][c] * d[1][c]) / (2 * l);
+      const double sy =
+          (cx * cx + cy * cy - 2 * sx * cx + d[0][c] * d[0][c] - d[2][c] * d[2][c]) / (2 * cy);
+      (*out)[c] = Norm2(px - sx, py - sy);
+      continue;
+    }
+    // Paper §5.2, case 4: two-side unfolding about each edge of the face.
+    const double to_vertex[3] = {Norm2(px, py), Norm2(px - l, py), Norm2(px - cx, py - cy)};
+    const double edge[3] = {l, Norm2(cx - l, cy), Norm2(cx, cy)};
+    double best = kInf;
+    for (int i = 0; i < 3; ++i) {
+      const int j = (i + 1) % 3;
+      best = std::min(best, TwoSide2(edge[i], to_vertex[i], to_vertex[j], d[i][c], d[j][c]));
+    }
+    (*out)[c] = std::sqrt(best);
+  }
+}
+
 }  // namespace
 
 absl::StatusOr<std::shared_ptr<const QueryEngine>> QueryEngine::Create(
@@ -227,27 +255,17 @@ double QueryEngine::ToSample(const LiftedPoint& p, int32_t s) const {
   return std::sqrt(TwoSideToOutside2(frames, PlaceInTriangle(frames, p.distance.data()), e));
 }
 
-QueryEngine::FaceLift QueryEngine::MakeFaceLift(int32_t face) const {
-  const int32_t* f = &faces_[3 * face];
-  FaceLift out;
-  // Anchor on the geodesic triangle most of the face's vertices share (fewer
-  // approximate distances), else on the first vertex's.
-  const int32_t t0 = records_[f[0]].triangle, t1 = records_[f[1]].triangle,
-                t2 = records_[f[2]].triangle;
-  if (t0 != t1 && t0 != t2 && t1 != t2) return out;  // anchored point by point
-  const LiftedPoint anchor = VertexLift(f[t0 == t1 || t0 == t2 ? 0 : 1]);
-  if (anchor.triangle < 0) return out;
-  out.exact = t0 == t1 && t1 == t2;
-  // Distances from the face's vertices to the anchor triangle's corners:
-  // exact for vertices of that triangle, case 2.2 for the others.
-  double d[3][3];
+bool QueryEngine::FaceDistances(const int32_t* f, const LiftedPoint& anchor,
+                                double (&d)[3][3]) const {
+  // Exact for vertices of the anchor triangle, case 2.2 for the others.
+  bool exact = true;
   for (int i = 0; i < 3; ++i) {
     const index::VertexRecord& r = records_[f[i]];
-    if (r.triangle < 0) return out;
     if (r.triangle == anchor.triangle) {
       for (int c = 0; c < 3; ++c) d[i][c] = r.distance[c];
       continue;
     }
+    exact = false;
     const LiftedPoint vi = VertexLift(f[i]);
     const EdgeFrame* frames = &frames_[3 * vi.triangle];
     const Placed placed = PlaceInTriangle(frames, vi.distance.data());
@@ -264,15 +282,34 @@ QueryEngine::FaceLift QueryEngine::MakeFaceLift(int32_t face) const {
       }
     }
   }
+  return exact;
+}
+
+QueryEngine::FaceFrame QueryEngine::FaceFrameOf(const int32_t* f) const {
   // The face in its own plane: v0 at the origin, v1 on the x axis.
   const mesh::Vec3 v0 = Position(f[0]), e1 = Position(f[1]) - v0, e2 = Position(f[2]) - v0;
   const double l = e1.norm();
-  const double cx = e1.dot(e2) / l, cy = e1.cross(e2).norm() / l;
-  if (!(cy > 1e-3 * l)) return out;  // a sliver: lifted point by point
+  return {l, e1.dot(e2) / l, e1.cross(e2).norm() / l};
+}
+
+// Anchor on the geodesic triangle most of the face's vertices share (fewer
+// approximate distances); when all three differ, the lift depends on the
+// point and is left to SlowLift.
+QueryEngine::FaceLift QueryEngine::MakeFaceLift(int32_t face) const {
+  const int32_t* f = &faces_[3 * face];
+  FaceLift out;
+  const int32_t t0 = records_[f[0]].triangle, t1 = records_[f[1]].triangle,
+                t2 = records_[f[2]].triangle;
+  if (t0 != t1 && t0 != t2 && t1 != t2) return out;
+  const LiftedPoint anchor = VertexLift(f[t0 == t1 || t0 == t2 ? 0 : 1]);
+  double d[3][3];
+  out.exact = FaceDistances(f, anchor, d);
+  const FaceFrame frame = FaceFrameOf(f);
+  if (!(frame.cy > 1e-3 * frame.l)) return out;  // a sliver: lifted point by point
   out.triangle = anchor.triangle;
-  out.l = l;
-  out.cx = cx;
-  out.cy = cy;
+  out.l = frame.l;
+  out.cx = frame.cx;
+  out.cy = frame.cy;
   for (int i = 0; i < 3; ++i) {
     for (int c = 0; c < 3; ++c) out.d[i][c] = d[i][c];
   }
@@ -287,106 +324,35 @@ LiftedPoint QueryEngine::Lift(const SurfacePoint& p) const {
   }
   if (p.w[k] >= 1.0) return VertexLift(f[k]);  // at a vertex: its record is exact
   const FaceLift& fl = face_lifts_[p.face];
-  if (fl.triangle < 0) return SlowLift(p);
+  if (fl.triangle < 0) return SlowLift(p, k);
   LiftedPoint out;
   out.triangle = fl.triangle;
-  const double l = fl.l, cx = fl.cx, cy = fl.cy;
-  const double px = p.w[1] * l + p.w[2] * cx, py = p.w[2] * cy;
-  for (int c = 0; c < 3; ++c) {
-    out.corner[c] = triangles_[fl.triangle].corner[c];
-    const double d0 = fl.d[0][c], d1 = fl.d[1][c], d2 = fl.d[2][c];
-    if (fl.exact) {
-      // Exact distances of one field at the three corners of a face fix the
-      // unfolded source: trilaterate it (linear, no square roots) and measure.
-      const double sx = (l * l + d0 * d0 - d1 * d1) / (2 * l);
-      const double sy = (cx * cx + cy * cy - 2 * sx * cx + d0 * d0 - d2 * d2) / (2 * cy);
-      out.distance[c] = Norm2(px - sx, py - sy);
-      continue;
-    }
-    // Paper §5.2, case 4: two-side unfolding about each edge of the face.
-    const double to_vertex[3] = {Norm2(px, py), Norm2(px - l, py), Norm2(px - cx, py - cy)};
-    const double edge[3] = {l, Norm2(cx - l, cy), Norm2(cx, cy)};
-    const double dv[3] = {d0, d1, d2};
-    double best = kInf;
-    for (int i = 0; i < 3; ++i) {
-      const int j = (i + 1) % 3;
-      best = std::min(best, TwoSide2(edge[i], to_vertex[i], to_vertex[j], dv[i], dv[j]));
-    }
-    out.distance[c] = std::sqrt(best);
+  for (int c = 0; c < 3; ++c) out.corner[c] = triangles_[fl.triangle].corner[c];
+  double d[3][3];
+  for (int i = 0; i < 3; ++i) {
+    for (int c = 0; c < 3; ++c) d[i][c] = fl.d[i][c];
   }
+  const double l = fl.l, cx = fl.cx, cy = fl.cy;
+  LiftInFace(l, cx, cy, p.w[1] * l + p.w[2] * cx, p.w[2] * cy, fl.exact, d, &out.distance);
   return out;
 }
 
-LiftedPoint QueryEngine::SlowLift(const SurfacePoint& p) const {
+LiftedPoint QueryEngine::SlowLift(const SurfacePoint& p, int heaviest) const {
   const int32_t* f = &faces_[3 * p.face];
-  int k = 0;
-  for (int i = 1; i < 3; ++i) {
-    if (p.w[i] > p.w[k]) k = i;
-  }
-  if (p.w[k] >= 1.0) return VertexLift(f[k]);  // at a vertex: its record is exact
-  // Anchor on the geodesic triangle most of the face's vertices share (fewer
-  // approximate distances), else on the vertex with the largest weight.
   const int32_t t0 = records_[f[0]].triangle, t1 = records_[f[1]].triangle,
                 t2 = records_[f[2]].triangle;
+  int k = heaviest;
   if (t0 == t1 || t0 == t2) {
     k = 0;
   } else if (t1 == t2) {
     k = 1;
   }
   LiftedPoint out = VertexLift(f[k]);
-
-  // Distances from the face's vertices to the anchor triangle's corners:
-  // exact for vertices of that triangle, case 2.2 for the others.
   double d[3][3];
-  bool exact = true;
-  for (int i = 0; i < 3; ++i) {
-    const index::VertexRecord& r = records_[f[i]];
-    if (r.triangle == out.triangle) {
-      for (int c = 0; c < 3; ++c) d[i][c] = r.distance[c];
-      continue;
-    }
-    exact = false;
-    const LiftedPoint vi = VertexLift(f[i]);
-    const EdgeFrame* frames = &frames_[3 * vi.triangle];
-    const Placed placed = PlaceInTriangle(frames, vi.distance.data());
-    for (int c = 0; c < 3; ++c) {
-      const int32_t s = out.corner[c];
-      d[i][c] = -1;
-      for (int j = 0; j < 3; ++j) {
-        if (vi.corner[j] == s) d[i][c] = vi.distance[j];
-      }
-      if (d[i][c] < 0) {
-        const double e[3] = {Matrix(s, vi.corner[0]), Matrix(s, vi.corner[1]),
-                             Matrix(s, vi.corner[2])};
-        d[i][c] = std::sqrt(TwoSideToOutside2(frames, placed, e));
-      }
-    }
-  }
-  // The face in its own plane: v0 at the origin, v1 on the x axis.
-  const mesh::Vec3 v0 = Position(f[0]), e1 = Position(f[1]) - v0, e2 = Position(f[2]) - v0;
-  const double l = e1.norm();
-  const double cx = e1.dot(e2) / l, cy = e1.cross(e2).norm() / l;
-  const double px = p.w[1] * l + p.w[2] * cx, py = p.w[2] * cy;
-  for (int c = 0; c < 3; ++c) {
-    if (exact && cy > 1e-3 * l) {
-      // Exact distances of one field at the three corners of a face fix the
-      // unfolded source: trilaterate it (linear, no square roots) and measure.
-      const double sx = (l * l + d[0][c] * d[0][c] - d[1][c] * d[1][c]) / (2 * l);
-      const double sy =
-          (cx * cx + cy * cy - 2 * sx * cx + d[0][c] * d[0][c] - d[2][c] * d[2][c]) / (2 * cy);
-      out.distance[c] = Norm2(px - sx, py - sy);
-      continue;
-    }
-    // Paper §5.2, case 4: two-side unfolding about each edge of the face.
-    const double to_vertex[3] = {Norm2(px, py), Norm2(px - l, py), Norm2(px - cx, py - cy)};
-    const double edge[3] = {l, Norm2(cx - l, cy), Norm2(cx, cy)};
-    double best = kInf;
-    for (int i = 0; i < 3; ++i) {
-      const int j = (i + 1) % 3;
-      best = std::min(best, TwoSide2(edge[i], to_vertex[i], to_vertex[j], d[i][c], d[j][c]));
-    }
-    out.distance[c] = std::sqrt(best);
-  }
+  const bool exact = FaceDistances(f, out, d);
+  const FaceFrame frame = FaceFrameOf(f);
+  LiftInFace(frame.l, frame.cx, frame.cy, p.w[1] * frame.l + p.w[2] * frame.cx, p.w[2] * frame.cy,
+             exact, d, &out.distance);
   return out;
 }
 

@@ -169,8 +169,18 @@ class QueryEngine {
     float l = 0, cx = 0, cy = 0;
     float d[3][3] = {};  // d[vertex][corner]
   };
+  struct FaceFrame {
+    double l, cx, cy;
+  };
+  FaceFrame FaceFrameOf(const int32_t* face_vertices) const;
+  // Distances from a face's vertices to the anchor's corners; true when all
+  // are exact (the vertices lie in the anchor triangle).
+  bool FaceDistances(const int32_t* face_vertices, const LiftedPoint& anchor,
+                     double (&d)[3][3]) const;
   FaceLift MakeFaceLift(int32_t face) const;
-  LiftedPoint SlowLift(const SurfacePoint& p) const;
+  // Lifts a point of a face without a FaceLift; `heaviest` is the face
+  // vertex of largest weight (the anchor when the vertices share none).
+  LiftedPoint SlowLift(const SurfacePoint& p, int heaviest) const;
   double ExactNearDistance(const SurfacePoint& p, const SurfacePoint& q,
                            QueryScratch* scratch) const;
   SurfacePoint Canonical(const SurfacePoint& p) const;
