@@ -303,13 +303,14 @@ QueryEngine::FaceLift QueryEngine::MakeFaceLift(int32_t face) const {
   if (t0 != t1 && t0 != t2 && t1 != t2) return out;
   const LiftedPoint anchor = VertexLift(f[t0 == t1 || t0 == t2 ? 0 : 1]);
   double d[3][3];
-  out.exact = FaceDistances(f, anchor, d);
+  const bool exact = FaceDistances(f, anchor, d);
   const FaceFrame frame = FaceFrameOf(f);
   if (!(frame.cy > 1e-3 * frame.l)) return out;  // a sliver: lifted point by point
   out.triangle = anchor.triangle;
+  for (int c = 0; c < 3; ++c) out.corner[c] = anchor.corner[c];
   out.l = frame.l;
   out.cx = frame.cx;
-  out.cy = frame.cy;
+  out.cy = exact ? frame.cy : -frame.cy;
   for (int i = 0; i < 3; ++i) {
     for (int c = 0; c < 3; ++c) out.d[i][c] = d[i][c];
   }
@@ -327,13 +328,13 @@ LiftedPoint QueryEngine::Lift(const SurfacePoint& p) const {
   if (fl.triangle < 0) return SlowLift(p, k);
   LiftedPoint out;
   out.triangle = fl.triangle;
-  for (int c = 0; c < 3; ++c) out.corner[c] = triangles_[fl.triangle].corner[c];
+  for (int c = 0; c < 3; ++c) out.corner[c] = fl.corner[c];
   double d[3][3];
   for (int i = 0; i < 3; ++i) {
     for (int c = 0; c < 3; ++c) d[i][c] = fl.d[i][c];
   }
-  const double l = fl.l, cx = fl.cx, cy = fl.cy;
-  LiftInFace(l, cx, cy, p.w[1] * l + p.w[2] * cx, p.w[2] * cy, fl.exact, d, &out.distance);
+  const double l = fl.l, cx = fl.cx, cy = std::abs(fl.cy);
+  LiftInFace(l, cx, cy, p.w[1] * l + p.w[2] * cx, p.w[2] * cy, fl.exact(), d, &out.distance);
   return out;
 }
 
@@ -452,26 +453,56 @@ absl::Status QueryEngine::DistanceBatch(std::span<const SurfacePoint> a,
       }
     }
   }
-  const bool exact = options_.exact_near_pairs && scratch != nullptr;
-  // A query's loads depend on each other (face -> vertex records -> matrix),
-  // so the batch prefetches ahead: face indices 16 pairs ahead, the records
-  // of those faces' vertices 8 pairs ahead.
   const size_t n = a.size();
-  for (size_t i = 0; i < n; ++i) {
-    if (i + 16 < n) {
-      __builtin_prefetch(&faces_[3 * a[i + 16].face]);
-      __builtin_prefetch(&faces_[3 * b[i + 16].face]);
+  if (options_.exact_near_pairs && scratch != nullptr) {
+    for (size_t i = 0; i < n; ++i) {
+      const SurfacePoint p = Canonical(a[i]), q = Canonical(b[i]);
+      out[i] = IsNearPair(p, q) ? ExactNearDistance(p, q, scratch) : DistanceUnchecked(p, q);
     }
-    if (i + 8 < n) {
-      for (const SurfacePoint* x : {&a[i + 8], &b[i + 8]}) {
+    return absl::OkStatus();
+  }
+  // A query's loads depend on each other (face -> face lift or vertex
+  // records -> geodesic triangles -> sample matrix), so the batch runs as a
+  // software pipeline: the faces 16 pairs ahead are prefetched, their
+  // vertices' records 12 ahead, the points 8 ahead are lifted (and the frames
+  // and matrix entries their distance will read are prefetched), and the
+  // distance of pair i is computed from its lifts.
+  constexpr size_t kFaceAhead = 16, kRecordAhead = 12, kLiftAhead = 8, kRing = 8;
+  LiftedPoint lift_a[kRing], lift_b[kRing];
+  auto lift = [&](size_t j) {
+    LiftedPoint& p = lift_a[j % kRing];
+    LiftedPoint& q = lift_b[j % kRing];
+    p = Lift(Canonical(a[j]));
+    q = Lift(Canonical(b[j]));
+    __builtin_prefetch(&frames_[3 * p.triangle]);
+    __builtin_prefetch(&frames_[3 * q.triangle]);
+    // The entries LiftedDistance reads: rows of the corners of the point in
+    // the triangle of larger id, columns of the other's.
+    const LiftedPoint& lo = p.triangle > q.triangle ? q : p;
+    const LiftedPoint& hi = p.triangle > q.triangle ? p : q;
+    for (int r = 0; r < 3; ++r) {
+      const float* row = &matrix_[static_cast<size_t>(hi.corner[r]) * num_samples_];
+      for (int c = 0; c < 3; ++c) __builtin_prefetch(row + lo.corner[c]);
+    }
+  };
+  for (size_t j = 0; j < std::min(n, kLiftAhead); ++j) lift(j);
+  for (size_t i = 0; i < n; ++i) {
+    if (i + kFaceAhead < n) {
+      __builtin_prefetch(&faces_[3 * a[i + kFaceAhead].face]);
+      __builtin_prefetch(&faces_[3 * b[i + kFaceAhead].face]);
+      __builtin_prefetch(&face_lifts_[a[i + kFaceAhead].face]);
+      __builtin_prefetch(&face_lifts_[b[i + kFaceAhead].face]);
+    }
+    if (i + kRecordAhead < n) {
+      for (const SurfacePoint* x : {&a[i + kRecordAhead], &b[i + kRecordAhead]}) {
         const int32_t* f = &faces_[3 * x->face];
         __builtin_prefetch(&records_[f[0]]);
         __builtin_prefetch(&records_[f[1]]);
         __builtin_prefetch(&records_[f[2]]);
       }
     }
-    const SurfacePoint p = Canonical(a[i]), q = Canonical(b[i]);
-    out[i] = exact && IsNearPair(p, q) ? ExactNearDistance(p, q, scratch) : DistanceUnchecked(p, q);
+    out[i] = LiftedDistance(lift_a[i % kRing], lift_b[i % kRing]);
+    if (i + kLiftAhead < n) lift(i + kLiftAhead);
   }
   return absl::OkStatus();
 }

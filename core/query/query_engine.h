@@ -159,16 +159,20 @@ class QueryEngine {
             {r.distance[0], r.distance[1], r.distance[2]}};
   }
   // Lifting of a face's interior points, derived at load: the anchor
-  // triangle and the distances from the face's vertices to its corners, and
-  // the face in its plane (vertex 0 at the origin, vertex 1 at (l, 0),
-  // vertex 2 at (cx, cy)). triangle -1: lifted by SlowLift (faces whose
-  // vertices lie in three different triangles, slivers, unreferenced).
-  struct FaceLift {
+  // triangle and its corners, the distances from the face's vertices to
+  // them, and the face in its plane (vertex 0 at the origin, vertex 1 at
+  // (l, 0), vertex 2 at (cx, |cy|)). One cache line, so that a lift costs one
+  // load. triangle -1: lifted by SlowLift (faces whose vertices lie in three
+  // different triangles, slivers).
+  struct alignas(64) FaceLift {
     int32_t triangle = -1;
-    bool exact = false;  // all three vertices in the anchor triangle
-    float l = 0, cx = 0, cy = 0;
+    int32_t corner[3] = {-1, -1, -1};
+    float l = 0, cx = 0;
+    float cy = 0;        // negative when the distances are approximate (case 2.2)
     float d[3][3] = {};  // d[vertex][corner]
+    bool exact() const { return cy > 0; }
   };
+  static_assert(sizeof(FaceLift) == 64);
   struct FaceFrame {
     double l, cx, cy;
   };

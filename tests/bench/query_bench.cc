@@ -82,6 +82,46 @@ double Gather(const index::Index& ix, const mesh::SurfacePoint& p, const mesh::S
   return acc;
 }
 
+// The sample matrix packed as its strict lower triangle, m(m-1)/2 float32:
+// the storage alternative to the index's full m x m matrix, measured here by
+// the same gather loop.
+struct PackedMatrix {
+  std::vector<float> values;
+  explicit PackedMatrix(const index::Index& ix) {
+    const int64_t m = ix.num_samples();
+    values.reserve(m * (m - 1) / 2);
+    for (int64_t a = 1; a < m; ++a) {
+      for (int64_t b = 0; b < a; ++b) values.push_back(ix.sample_distances()[a * m + b]);
+    }
+  }
+  double operator()(int32_t a, int32_t b) const {
+    if (a == b) return 0;
+    if (a < b) std::swap(a, b);
+    return values[static_cast<int64_t>(a) * (a - 1) / 2 + b];
+  }
+};
+
+double GatherPacked(const index::Index& ix, const PackedMatrix& packed, const mesh::SurfacePoint& p,
+                    const mesh::SurfacePoint& q) {
+  const auto faces = ix.faces();
+  const auto records = ix.vertices();
+  const auto positions = ix.positions();
+  double acc = 0;
+  const index::VertexRecord* anchor[2];
+  const mesh::SurfacePoint* pts[2] = {&p, &q};
+  for (int k = 0; k < 2; ++k) {
+    const int32_t* f = &faces[3 * pts[k]->face];
+    for (int i = 0; i < 3; ++i) {
+      acc += records[f[i]].distance[0] + positions[3 * f[i]];
+    }
+    anchor[k] = &records[f[0]];
+  }
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) acc += packed(anchor[0]->corner[i], anchor[1]->corner[j]);
+  }
+  return acc;
+}
+
 void Bench(const std::string& label, std::shared_ptr<const index::Index> ix, int n) {
   auto engine = *query::QueryEngine::Create(ix);
   const auto a = InteriorPoints(*ix, n, 1), b = InteriorPoints(*ix, n, 2);
@@ -105,14 +145,23 @@ void Bench(const std::string& label, std::shared_ptr<const index::Index> ix, int
     for (int i = 0; i < n; ++i) acc += Gather(*ix, a[i], b[i]);
     sink = sink + acc;
   });
+  const PackedMatrix packed(*ix);
+  const double packed_gather_rate = Rate(n, [&] {
+    double acc = 0;
+    for (int i = 0; i < n; ++i) acc += GatherPacked(*ix, packed, a[i], b[i]);
+    sink = sink + acc;
+  });
   const double linear_rate = Rate(n, [&] {
     double acc = 0;
     for (int i = 0; i < n; ++i) acc += engine->LinearInterpolationDistance(a[i], b[i]);
     sink = sink + acc;
   });
-  std::printf("| %s | %d | %d | %.2fM | %.2fM | %.2fM | %.2fM | %.2f | %.2fM |\n", label.c_str(),
-              ix->num_vertices(), ix->num_samples(), vertex_rate / 1e6, interior_rate / 1e6,
-              batch_rate / 1e6, gather_rate / 1e6, gather_rate / interior_rate, linear_rate / 1e6);
+  const double m = ix->num_samples();
+  std::printf(
+      "| %s | %d | %d | %.2fM | %.2fM | %.2fM | %.2fM | %.2f | %.2fM | %.2fM (%.1f / %.1f MiB) |\n",
+      label.c_str(), ix->num_vertices(), ix->num_samples(), vertex_rate / 1e6, interior_rate / 1e6,
+      batch_rate / 1e6, gather_rate / 1e6, gather_rate / interior_rate, linear_rate / 1e6,
+      packed_gather_rate / 1e6, m * m * 4 / (1 << 20), m * (m - 1) / 2 * 4 / (1 << 20));
 }
 
 }  // namespace
@@ -127,8 +176,8 @@ int main(int argc, char** argv) {
   CLI11_PARSE(app, argc, argv);
   std::printf(
       "| index | vertices | m | vertex pairs/s | interior pairs/s | batch (validated) pairs/s | "
-      "gather-only/s | gather/query | linear baseline/s "
-      "|\n|---|---|---|---|---|---|---|---|---|\n");
+      "gather-only/s | gather/query | linear baseline/s | gather-only, packed matrix/s "
+      "(full / packed size) |\n|---|---|---|---|---|---|---|---|---|---|\n");
   if (indexes.empty()) {
     std::printf("(no --index given: a generated sphere, m = 500)\n");
     geodex::build::BuildOptions options;
