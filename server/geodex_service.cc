@@ -364,29 +364,78 @@ void GeodexService::BeginShutdown() {
   for (StreamBase* stream : streams_) stream->Drain();
 }
 
-// StreamDistances. All state is guarded by mutex_, and gRPC operations are
-// started under it (reactions never run inline in StartRead/StartWrite/
-// Finish, so this cannot deadlock); Advance() decides the next operations.
-class GeodexService::DistanceStream final
-    : public grpc::ServerBidiReactor<v1::DistanceBatch, v1::DistanceResult>,
-      public GeodexService::StreamBase {
+// What every streaming reactor shares: admission, one Finish, and the
+// registration that OnDone removes before the reactor deletes itself.
+// `Reactor` is the gRPC reactor type. State is guarded by mutex_, and gRPC
+// operations are started under it (reactions never run inline in StartRead/
+// StartWrite/Finish, so this cannot deadlock). The handler calls Start() once
+// the reactor is fully constructed, since a job it submits may run at once.
+template <class Reactor>
+class GeodexService::Stream : public Reactor, public GeodexService::StreamBase {
  public:
-  DistanceStream(GeodexService* service, grpc::CallbackServerContext* context)
-      : service_(service),
-        context_(context),
-        call_(service->StartCall(context, "StreamDistances")),
-        window_(std::max<size_t>(1, service->limits_.stream_window)) {
-    absl::Status status = service->Authorize(*context);
-    if (status.ok()) status = service->RegisterStream(this);
+  // Admits the call (Authorize, RegisterStream) and starts it with
+  // StartLocked(), or finishes it with the error. Returns this, for the
+  // handler to hand to gRPC.
+  Reactor* Start() {
+    absl::Status status = service_->Authorize(*context_);
+    if (status.ok()) status = service_->RegisterStream(this);
     std::lock_guard<std::mutex> lock(mutex_);
     if (!status.ok()) {
-      finished_ = true;
-      Finish(service_->FinishCall(call_, status));
-      return;
+      FinishLocked(status);
+      return this;
     }
     registered_ = true;
-    Advance();
+    StartLocked();
+    return this;
   }
+
+  void OnDone() final {
+    // Wait out a worker that has just released the lock after the call that
+    // finished the stream.
+    { std::lock_guard<std::mutex> lock(mutex_); }
+    if (registered_) service_->UnregisterStream(this);
+    delete this;
+  }
+
+ protected:
+  Stream(GeodexService* service, grpc::CallbackServerContext* context, const char* method)
+      : service_(service), context_(context), call_(service->StartCall(context, method)) {}
+
+  // The first operations of an admitted call. Holds mutex_.
+  virtual void StartLocked() = 0;
+
+  // Finishes the call with `status` unless it has finished already. Holds
+  // mutex_.
+  void FinishLocked(const absl::Status& status) {
+    if (finished_) return;
+    finished_ = true;
+    this->Finish(service_->FinishCall(call_, status));
+  }
+
+  // The status of a stream that stops early: CheckAlive's error once the
+  // call is over (Cancelled, DeadlineExceeded), else Cancelled(`message`).
+  absl::Status StoppedStatus(const char* message) const {
+    absl::Status status = CheckAlive(*context_);
+    return status.ok() ? absl::CancelledError(message) : status;
+  }
+
+  GeodexService* const service_;
+  grpc::CallbackServerContext* const context_;
+  Call call_;
+  std::mutex mutex_;
+  bool finished_ = false;
+
+ private:
+  bool registered_ = false;
+};
+
+// StreamDistances. Advance() decides the next operations.
+class GeodexService::DistanceStream final
+    : public GeodexService::Stream<grpc::ServerBidiReactor<v1::DistanceBatch, v1::DistanceResult>> {
+ public:
+  DistanceStream(GeodexService* service, grpc::CallbackServerContext* context)
+      : Stream(service, context, "StreamDistances"),
+        window_(std::max<size_t>(1, service->limits_.stream_window)) {}
 
   void OnReadDone(bool ok) override {
     std::lock_guard<std::mutex> lock(mutex_);
@@ -437,14 +486,6 @@ class GeodexService::DistanceStream final
     Advance();
   }
 
-  void OnDone() override {
-    // Wait out a worker that has just released the lock after its last
-    // Advance() (the one that called Finish).
-    { std::lock_guard<std::mutex> lock(mutex_); }
-    if (registered_) service_->UnregisterStream(this);
-    delete this;
-  }
-
  private:
   struct Slot {
     v1::DistanceBatch request;
@@ -453,6 +494,8 @@ class GeodexService::DistanceStream final
     bool done = false;   // result ready to write
     Clock::time_point received;
   };
+
+  void StartLocked() override { Advance(); }
 
   // Runs on a worker, without the lock while it computes.
   void Compute(Slot* slot, WorkerContext& worker) {
@@ -531,8 +574,7 @@ class GeodexService::DistanceStream final
     if (write_in_flight_ || jobs_ > 0) return;
     absl::Status status;
     if (cancelled_) {
-      status = CheckAlive(*context_);
-      if (status.ok()) status = absl::CancelledError("the client stopped reading answers");
+      status = StoppedStatus("the client stopped reading answers");
     } else if (slots_.empty() && reads_done_) {
       status = absl::OkStatus();
     } else if (slots_.empty() && draining_) {
@@ -543,17 +585,11 @@ class GeodexService::DistanceStream final
     } else {
       return;
     }
-    finished_ = true;
-    Finish(service_->FinishCall(call_, status));
+    FinishLocked(status);
   }
 
-  GeodexService* const service_;
-  grpc::CallbackServerContext* const context_;
-  Call call_;
   const size_t window_;
-  bool registered_ = false;
 
-  std::mutex mutex_;
   std::deque<std::unique_ptr<Slot>> slots_;  // read, in order; the front may be being written
   std::unique_ptr<Slot> reading_;            // the slot a pending read fills
   v1::ModelRef stream_model_;
@@ -565,80 +601,114 @@ class GeodexService::DistanceStream final
   bool reads_done_ = false;
   bool cancelled_ = false;
   bool draining_ = false;
-  bool finished_ = false;
 };
 
 grpc::ServerBidiReactor<v1::DistanceBatch, v1::DistanceResult>* GeodexService::StreamDistances(
     grpc::CallbackServerContext* context) {
-  return new DistanceStream(this, context);
+  return (new DistanceStream(this, context))->Start();
 }
 
-// Matrix: one block computed on a worker, then written; the next block is
-// computed only when the write has completed (backpressure). State guarded by
-// mutex_ as in DistanceStream.
-class GeodexService::MatrixStream final : public grpc::ServerWriteReactor<v1::MatrixBlock>,
-                                          public GeodexService::StreamBase {
+// A server stream written one message at a time (Matrix, DistanceField,
+// GetMesh): a job on the pool computes the next message, the reactor writes
+// it, and only then is the next one made (backpressure). A job and a write
+// are never in flight together and jobs are sequential, so what a job fills
+// needs no lock.
+template <class Response>
+class GeodexService::ChunkedWriteStream
+    : public GeodexService::Stream<grpc::ServerWriteReactor<Response>> {
  public:
-  MatrixStream(GeodexService* service, grpc::CallbackServerContext* context,
-               const v1::MatrixRequest* request)
-      : service_(service),
-        context_(context),
-        request_(request),
-        call_(service->StartCall(context, "Matrix")) {
-    absl::Status status = service->Authorize(*context);
-    if (status.ok()) status = service->RegisterStream(this);
-    std::lock_guard<std::mutex> lock(mutex_);
-    if (!status.ok()) {
-      FinishLocked(status);
-      return;
-    }
-    registered_ = true;
-    SubmitLocked();
-  }
-
   void OnWriteDone(bool ok) override {
-    std::lock_guard<std::mutex> lock(mutex_);
+    std::lock_guard<std::mutex> lock(this->mutex_);
     write_in_flight_ = false;
-    if (!ok) {
+    if (!ok && unread_ != nullptr) {
       cancelled_ = true;
-      FinishLocked(absl::CancelledError("the client stopped reading blocks"));
-    } else if (cancelled_) {
-      FinishLocked(CheckAlive(*context_).ok() ? absl::CancelledError("call cancelled")
-                                              : CheckAlive(*context_));
-    } else if (next_row_ < static_cast<int64_t>(sources_.size())) {
-      SubmitLocked();
+      this->FinishLocked(
+          absl::CancelledError(absl::StrFormat("the client stopped reading %s", unread_)));
+    } else if (!ok || cancelled_) {
+      this->FinishLocked(this->StoppedStatus("call cancelled"));
+    } else if (HasMoreLocked()) {
+      NextLocked();
     } else {
-      FinishLocked(absl::OkStatus());
+      this->FinishLocked(absl::OkStatus());
     }
   }
 
   void OnCancel() override {
-    std::lock_guard<std::mutex> lock(mutex_);
+    std::lock_guard<std::mutex> lock(this->mutex_);
     cancelled_ = true;
-    if (!write_in_flight_ && !job_running_) {
-      FinishLocked(CheckAlive(*context_).ok() ? absl::CancelledError("call cancelled")
-                                              : CheckAlive(*context_));
-    }
+    if (!write_in_flight_ && !job_running_)
+      this->FinishLocked(this->StoppedStatus("call cancelled"));
   }
 
   void Drain() override {}  // finite; bounded by the server's shutdown deadline
 
-  void OnDone() override {
-    { std::lock_guard<std::mutex> lock(mutex_); }
-    if (registered_) service_->UnregisterStream(this);
-    delete this;
+ protected:
+  // `unread` names the messages in the status of a failed write ("the client
+  // stopped reading blocks"); null reports why the call ended instead.
+  ChunkedWriteStream(GeodexService* service, grpc::CallbackServerContext* context,
+                     const char* method, const char* unread)
+      : GeodexService::Stream<grpc::ServerWriteReactor<Response>>(service, context, method),
+        unread_(unread) {}
+
+  // Runs on a worker, without the lock: computes the next message.
+  virtual absl::Status ComputeNext(WorkerContext& worker) = 0;
+  // The message to write next, counted in the call's items, or null when
+  // there is none. Called after a successful ComputeNext on a live call (and
+  // by NextLocked overrides). Holds mutex_.
+  virtual const Response* TakeNextLocked() = 0;
+  // True when another message follows the one just written. Holds mutex_.
+  virtual bool HasMoreLocked() const = 0;
+  // Makes and writes the next message: by default a job computes it. Holds
+  // mutex_.
+  virtual void NextLocked() { SubmitLocked(); }
+
+  void WriteLocked(const Response* message) {
+    write_in_flight_ = true;
+    this->StartWrite(message);
   }
 
  private:
+  void StartLocked() final { SubmitLocked(); }
+
   void SubmitLocked() {
     job_running_ = true;
-    if (!service_->pool_->Submit([this](WorkerContext& worker) { Work(worker); })) {
+    if (!this->service_->pool_->Submit([this](WorkerContext& worker) { Job(worker); })) {
       job_running_ = false;
-      FinishLocked(service_->Busy());
+      this->FinishLocked(this->service_->Busy());
     }
   }
 
-  // Sets up on the first call, then computes the next block.
+  void Job(WorkerContext& worker) {
+    const absl::Status status = ComputeNext(worker);
+    std::lock_guard<std::mutex> lock(this->mutex_);
+    job_running_ = false;
+    if (!status.ok()) {
+      this->FinishLocked(status);
+    } else if (cancelled_) {
+      this->FinishLocked(absl::CancelledError("call cancelled"));
+    } else if (const Response* message = TakeNextLocked()) {
+      WriteLocked(message);
+    } else {
+      this->FinishLocked(absl::OkStatus());  // nothing to stream
+    }
+    // Nothing after this point: once the lock is released, OnDone may run.
+  }
+
+  const char* const unread_;
+  bool job_running_ = false;
+  bool write_in_flight_ = false;
+  bool cancelled_ = false;
+};
+
+// Matrix: each job computes one block of whole rows.
+class GeodexService::MatrixStream final : public ChunkedWriteStream<v1::MatrixBlock> {
+ public:
+  MatrixStream(GeodexService* service, grpc::CallbackServerContext* context,
+               const v1::MatrixRequest* request)
+      : ChunkedWriteStream(service, context, "Matrix", "blocks"), request_(request) {}
+
+ private:
+  // Sets up on the first job.
   absl::Status Prepare() {
     GEODEX_ASSIGN_OR_RETURN(model_, service_->Resolve(request_->model(), call_));
     const ServiceLimits limits = service_->LimitsFor(*model_.model);
@@ -666,54 +736,35 @@ class GeodexService::MatrixStream final : public grpc::ServerWriteReactor<v1::Ma
     return absl::OkStatus();
   }
 
-  void Work(WorkerContext& worker) {
-    absl::Status status = CheckAlive(*context_);
-    if (status.ok() && !prepared_) status = Prepare();
+  absl::Status ComputeNext(WorkerContext& worker) override {
+    GEODEX_RETURN_IF_ERROR(CheckAlive(*context_));
+    if (!prepared_) GEODEX_RETURN_IF_ERROR(Prepare());
     const int64_t s = static_cast<int64_t>(sources_.size());
     const int64_t t = static_cast<int64_t>(targets_.size());
-    int64_t rows = 0;
-    if (status.ok() && s > 0) {
-      rows = std::min(block_rows_, s - next_row_);
-      values_.resize(rows * t);
-      worker.a.resize(t);
-      for (int64_t r = 0; r < rows && status.ok(); ++r) {
-        status = CheckAlive(*context_);
-        if (!status.ok()) break;
-        std::fill(worker.a.begin(), worker.a.end(), sources_[next_row_ + r]);
-        status = engine_->DistanceBatch(
-            worker.a, targets_, std::span<double>(values_.data() + r * t, t), &worker.scratch);
-      }
-      if (status.ok()) {
-        MatrixBlockToProto(next_row_, rows, t, values_, model_.version->version(), &block_);
-      }
+    if (s == 0) return absl::OkStatus();  // no rows: nothing to stream
+    rows_ = std::min(block_rows_, s - next_row_);
+    values_.resize(rows_ * t);
+    worker.a.resize(t);
+    for (int64_t r = 0; r < rows_; ++r) {
+      GEODEX_RETURN_IF_ERROR(CheckAlive(*context_));
+      std::fill(worker.a.begin(), worker.a.end(), sources_[next_row_ + r]);
+      GEODEX_RETURN_IF_ERROR(engine_->DistanceBatch(
+          worker.a, targets_, std::span<double>(values_.data() + r * t, t), &worker.scratch));
     }
-    std::lock_guard<std::mutex> lock(mutex_);
-    job_running_ = false;
-    if (!status.ok()) {
-      FinishLocked(status);
-    } else if (cancelled_) {
-      FinishLocked(absl::CancelledError("call cancelled"));
-    } else if (s == 0) {
-      FinishLocked(absl::OkStatus());  // no rows: nothing to stream
-    } else {
-      next_row_ += rows;
-      call_.pairs += rows * t;
-      write_in_flight_ = true;
-      StartWrite(&block_);
-    }
+    MatrixBlockToProto(next_row_, rows_, t, values_, model_.version->version(), &block_);
+    return absl::OkStatus();
   }
 
-  void FinishLocked(const absl::Status& status) {
-    if (finished_) return;
-    finished_ = true;
-    Finish(service_->FinishCall(call_, status));
+  const v1::MatrixBlock* TakeNextLocked() override {
+    if (sources_.empty()) return nullptr;
+    next_row_ += rows_;
+    call_.pairs += rows_ * static_cast<int64_t>(targets_.size());
+    return &block_;
   }
 
-  GeodexService* const service_;
-  grpc::CallbackServerContext* const context_;
+  bool HasMoreLocked() const override { return next_row_ < static_cast<int64_t>(sources_.size()); }
+
   const v1::MatrixRequest* const request_;
-  Call call_;
-  bool registered_ = false;
 
   // Used by one job at a time (jobs are sequential).
   bool prepared_ = false;
@@ -722,79 +773,27 @@ class GeodexService::MatrixStream final : public grpc::ServerWriteReactor<v1::Ma
   std::vector<mesh::SurfacePoint> sources_, targets_;
   int64_t block_rows_ = 1;
   int64_t next_row_ = 0;
+  int64_t rows_ = 0;  // in block_
   std::vector<double> values_;
   v1::MatrixBlock block_;
-
-  std::mutex mutex_;
-  bool job_running_ = false;
-  bool write_in_flight_ = false;
-  bool cancelled_ = false;
-  bool finished_ = false;
 };
 
 grpc::ServerWriteReactor<v1::MatrixBlock>* GeodexService::Matrix(
     grpc::CallbackServerContext* context, const v1::MatrixRequest* request) {
-  return new MatrixStream(this, context, request);
+  return (new MatrixStream(this, context, request))->Start();
 }
 
-// DistanceField: the field is computed by one job on a worker; chunks are
-// then copied out and written one at a time.
-class GeodexService::FieldStream final : public grpc::ServerWriteReactor<v1::DistanceFieldChunk>,
-                                         public GeodexService::StreamBase {
+// DistanceField: one job computes the whole field; its chunks of at most
+// kChunkBytes are then copied out and written one at a time, with no further
+// job.
+class GeodexService::FieldStream final : public ChunkedWriteStream<v1::DistanceFieldChunk> {
  public:
   FieldStream(GeodexService* service, grpc::CallbackServerContext* context,
               const v1::DistanceFieldRequest* request)
-      : service_(service),
-        context_(context),
-        request_(request),
-        call_(service->StartCall(context, "DistanceField")) {
-    absl::Status status = service->Authorize(*context);
-    if (status.ok()) status = service->RegisterStream(this);
-    std::lock_guard<std::mutex> lock(mutex_);
-    if (!status.ok()) {
-      FinishLocked(status);
-      return;
-    }
-    registered_ = true;
-    job_running_ = true;
-    if (!service_->pool_->Submit([this](WorkerContext& worker) { Work(worker); })) {
-      job_running_ = false;
-      FinishLocked(service_->Busy());
-    }
-  }
-
-  void OnWriteDone(bool ok) override {
-    std::lock_guard<std::mutex> lock(mutex_);
-    write_in_flight_ = false;
-    if (!ok || cancelled_) {
-      FinishLocked(CheckAlive(*context_).ok() ? absl::CancelledError("call cancelled")
-                                              : CheckAlive(*context_));
-    } else if (next_vertex_ < static_cast<int64_t>(field_.distance.size())) {
-      WriteNextLocked();
-    } else {
-      FinishLocked(absl::OkStatus());
-    }
-  }
-
-  void OnCancel() override {
-    std::lock_guard<std::mutex> lock(mutex_);
-    cancelled_ = true;
-    if (!write_in_flight_ && !job_running_) {
-      FinishLocked(CheckAlive(*context_).ok() ? absl::CancelledError("call cancelled")
-                                              : CheckAlive(*context_));
-    }
-  }
-
-  void Drain() override {}
-
-  void OnDone() override {
-    { std::lock_guard<std::mutex> lock(mutex_); }
-    if (registered_) service_->UnregisterStream(this);
-    delete this;
-  }
+      : ChunkedWriteStream(service, context, "DistanceField", nullptr), request_(request) {}
 
  private:
-  absl::Status Compute(WorkerContext& worker) {
+  absl::Status ComputeNext(WorkerContext& worker) override {
     GEODEX_RETURN_IF_ERROR(CheckAlive(*context_));
     GEODEX_ASSIGN_OR_RETURN(model_, service_->Resolve(request_->model(), call_));
     const ServiceLimits limits = service_->LimitsFor(*model_.model);
@@ -813,127 +812,46 @@ class GeodexService::FieldStream final : public grpc::ServerWriteReactor<v1::Dis
     return absl::OkStatus();
   }
 
-  void Work(WorkerContext& worker) {
-    const absl::Status status = Compute(worker);
-    std::lock_guard<std::mutex> lock(mutex_);
-    job_running_ = false;
-    if (!status.ok()) {
-      FinishLocked(status);
-    } else if (cancelled_) {
-      FinishLocked(absl::CancelledError("call cancelled"));
-    } else {
-      WriteNextLocked();
-    }
-  }
-
-  void WriteNextLocked() {
+  const v1::DistanceFieldChunk* TakeNextLocked() override {
     const int64_t n = static_cast<int64_t>(field_.distance.size());
     const int64_t count = std::min(chunk_vertices_, n - next_vertex_);
     FieldChunkToProto(field_, next_vertex_, count, request_->with_nearest_source(),
                       model_.version->version(), &chunk_);
     next_vertex_ += count;
-    write_in_flight_ = true;
-    StartWrite(&chunk_);
+    return &chunk_;
   }
 
-  void FinishLocked(const absl::Status& status) {
-    if (finished_) return;
-    finished_ = true;
-    Finish(service_->FinishCall(call_, status));
+  bool HasMoreLocked() const override {
+    return next_vertex_ < static_cast<int64_t>(field_.distance.size());
   }
 
-  GeodexService* const service_;
-  grpc::CallbackServerContext* const context_;
+  void NextLocked() override { WriteLocked(TakeNextLocked()); }
+
   const v1::DistanceFieldRequest* const request_;
-  Call call_;
-  bool registered_ = false;
 
   ResolvedModel model_;
   query::DistanceField field_;
   int64_t chunk_vertices_ = 1;
   int64_t next_vertex_ = 0;
   v1::DistanceFieldChunk chunk_;
-
-  std::mutex mutex_;
-  bool job_running_ = false;
-  bool write_in_flight_ = false;
-  bool cancelled_ = false;
-  bool finished_ = false;
 };
 
 grpc::ServerWriteReactor<v1::DistanceFieldChunk>* GeodexService::DistanceField(
     grpc::CallbackServerContext* context, const v1::DistanceFieldRequest* request) {
-  return new FieldStream(this, context, request);
+  return (new FieldStream(this, context, request))->Start();
 }
 
-// GetMesh: one chunk copied out of the mapped index on a worker, then
-// written; the next is copied only when the write has completed
-// (backpressure, as in MatrixStream). model_ holds the snapshot, and so the
-// mapped index, until the reactor is deleted. State guarded by mutex_ as in
-// MatrixStream.
-class GeodexService::MeshStream final : public grpc::ServerWriteReactor<v1::MeshChunk>,
-                                        public GeodexService::StreamBase {
+// GetMesh: each job copies one chunk out of the mapped index. model_ holds
+// the snapshot, and so the mapped index, until the reactor is deleted.
+class GeodexService::MeshStream final : public ChunkedWriteStream<v1::MeshChunk> {
  public:
   MeshStream(GeodexService* service, grpc::CallbackServerContext* context,
              const v1::GetMeshRequest* request)
-      : service_(service),
-        context_(context),
+      : ChunkedWriteStream(service, context, "GetMesh", "mesh chunks"),
         request_(request),
-        call_(service->StartCall(context, "GetMesh")),
-        chunk_elements_(std::clamp<int64_t>(service->limits_.mesh_chunk_elements, 1, 1 << 16)) {
-    absl::Status status = service->Authorize(*context);
-    if (status.ok()) status = service->RegisterStream(this);
-    std::lock_guard<std::mutex> lock(mutex_);
-    if (!status.ok()) {
-      FinishLocked(status);
-      return;
-    }
-    registered_ = true;
-    SubmitLocked();
-  }
-
-  void OnWriteDone(bool ok) override {
-    std::lock_guard<std::mutex> lock(mutex_);
-    write_in_flight_ = false;
-    if (!ok) {
-      cancelled_ = true;
-      FinishLocked(absl::CancelledError("the client stopped reading mesh chunks"));
-    } else if (cancelled_) {
-      FinishLocked(CheckAlive(*context_).ok() ? absl::CancelledError("call cancelled")
-                                              : CheckAlive(*context_));
-    } else if (next_chunk_ < num_chunks_) {
-      SubmitLocked();
-    } else {
-      FinishLocked(absl::OkStatus());
-    }
-  }
-
-  void OnCancel() override {
-    std::lock_guard<std::mutex> lock(mutex_);
-    cancelled_ = true;
-    if (!write_in_flight_ && !job_running_) {
-      FinishLocked(CheckAlive(*context_).ok() ? absl::CancelledError("call cancelled")
-                                              : CheckAlive(*context_));
-    }
-  }
-
-  void Drain() override {}  // finite; bounded by the server's shutdown deadline
-
-  void OnDone() override {
-    { std::lock_guard<std::mutex> lock(mutex_); }
-    if (registered_) service_->UnregisterStream(this);
-    delete this;
-  }
+        chunk_elements_(std::clamp<int64_t>(service->limits_.mesh_chunk_elements, 1, 1 << 16)) {}
 
  private:
-  void SubmitLocked() {
-    job_running_ = true;
-    if (!service_->pool_->Submit([this](WorkerContext&) { Work(); })) {
-      job_running_ = false;
-      FinishLocked(service_->Busy());
-    }
-  }
-
   absl::Status Prepare() {
     GEODEX_ASSIGN_OR_RETURN(model_, service_->Resolve(request_->model(), call_));
     const index::Index& ix = model_.version->index();
@@ -945,64 +863,43 @@ class GeodexService::MeshStream final : public grpc::ServerWriteReactor<v1::Mesh
 
   // Copies chunk next_chunk_: vertices and faces from next_chunk_ *
   // chunk_elements_ on (either range may be empty near the end).
-  void Work() {
-    absl::Status status = CheckAlive(*context_);
-    if (status.ok() && !prepared_) status = Prepare();
-    int64_t items = 0;
-    if (status.ok()) {
-      const index::Index& ix = model_.version->index();
-      const int64_t begin = next_chunk_ * chunk_elements_;
-      const int64_t nv = std::clamp<int64_t>(ix.num_vertices() - begin, 0, chunk_elements_);
-      const int64_t nf = std::clamp<int64_t>(ix.num_faces() - begin, 0, chunk_elements_);
-      const int64_t vertex_offset = std::min<int64_t>(begin, ix.num_vertices());
-      const int64_t face_offset = std::min<int64_t>(begin, ix.num_faces());
-      MeshChunkToProto(ix, vertex_offset, nv, face_offset, nf, model_.version->version(), &chunk_);
-      items = nv + nf;
-    }
-    std::lock_guard<std::mutex> lock(mutex_);
-    job_running_ = false;
-    if (!status.ok()) {
-      FinishLocked(status);
-    } else if (cancelled_) {
-      FinishLocked(absl::CancelledError("call cancelled"));
-    } else {
-      ++next_chunk_;
-      call_.pairs += items;
-      write_in_flight_ = true;
-      StartWrite(&chunk_);
-    }
+  absl::Status ComputeNext(WorkerContext& /*worker*/) override {
+    GEODEX_RETURN_IF_ERROR(CheckAlive(*context_));
+    if (!prepared_) GEODEX_RETURN_IF_ERROR(Prepare());
+    const index::Index& ix = model_.version->index();
+    const int64_t begin = next_chunk_ * chunk_elements_;
+    const int64_t nv = std::clamp<int64_t>(ix.num_vertices() - begin, 0, chunk_elements_);
+    const int64_t nf = std::clamp<int64_t>(ix.num_faces() - begin, 0, chunk_elements_);
+    const int64_t vertex_offset = std::min<int64_t>(begin, ix.num_vertices());
+    const int64_t face_offset = std::min<int64_t>(begin, ix.num_faces());
+    MeshChunkToProto(ix, vertex_offset, nv, face_offset, nf, model_.version->version(), &chunk_);
+    items_ = nv + nf;
+    return absl::OkStatus();
   }
 
-  void FinishLocked(const absl::Status& status) {
-    if (finished_) return;
-    finished_ = true;
-    Finish(service_->FinishCall(call_, status));
+  const v1::MeshChunk* TakeNextLocked() override {
+    ++next_chunk_;
+    call_.pairs += items_;
+    return &chunk_;
   }
 
-  GeodexService* const service_;
-  grpc::CallbackServerContext* const context_;
+  bool HasMoreLocked() const override { return next_chunk_ < num_chunks_; }
+
   const v1::GetMeshRequest* const request_;
-  Call call_;
   const int64_t chunk_elements_;
-  bool registered_ = false;
 
   // Used by one job at a time (jobs are sequential).
   bool prepared_ = false;
   ResolvedModel model_;
   int64_t num_chunks_ = 1;
   int64_t next_chunk_ = 0;
+  int64_t items_ = 0;  // vertices and faces in chunk_
   v1::MeshChunk chunk_;
-
-  std::mutex mutex_;
-  bool job_running_ = false;
-  bool write_in_flight_ = false;
-  bool cancelled_ = false;
-  bool finished_ = false;
 };
 
 grpc::ServerWriteReactor<v1::MeshChunk>* GeodexService::GetMesh(
     grpc::CallbackServerContext* context, const v1::GetMeshRequest* request) {
-  return new MeshStream(this, context, request);
+  return (new MeshStream(this, context, request))->Start();
 }
 
 }  // namespace geodex::server

@@ -107,6 +107,10 @@ class GeodexService final : public v1::Geodex::CallbackService {
   };
   class UnaryReactor;
   class StreamBase;
+  template <class Reactor>
+  class Stream;
+  template <class Response>
+  class ChunkedWriteStream;
   class DistanceStream;
   class MatrixStream;
   class FieldStream;
