@@ -18,16 +18,10 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 // the rest of a query.
 inline double Norm2(double x, double y) { return std::sqrt(x * x + y * y); }
 
-// Squared distance of the images of p and q, p at (pa, pb) and q at (qa, qb)
-// from the ends of an edge of length l, on opposite sides of it (two-side
-// unfolding).
-inline double TwoSide2(double l, double pa, double pb, double qa, double qb) {
-  if (!(l > 0)) return (pa + qa) * (pa + qa);
-  double xp, yp, xq, yq;
-  Place(l, pa, pb, &xp, &yp);
-  Place(l, qa, qb, &xq, &yq);
-  const double dx = xp - xq, dy = yp + yq;
-  return dx * dx + dy * dy;
+// Place on an edge frame, with the division by 2 l precomputed.
+inline void PlaceOn(const EdgeFrame& e, double da, double db, double* x, double* y) {
+  *x = (e.l * e.l + da * da - db * db) * e.inv_2l;
+  *y = std::sqrt(std::max(da * da - *x * *x, 0.0));
 }
 
 // Places a point at distances (da, db) from the edge's ends and dc from the
@@ -41,7 +35,7 @@ inline void PlaceSigned(const EdgeFrame& e, double da, double db, double dc, dou
     *y = da;
     return;
   }
-  Place(e.l, da, db, x, y);
+  PlaceOn(e, da, db, x, y);
   // Squared distances to the third corner from (x, +y) and (x, -y) differ by
   // 4 y cy; pick the side whose value is nearer dc^2.
   const double dx = *x - e.cx;
@@ -86,7 +80,7 @@ inline double TwoSideToOutside2(const EdgeFrame* frames, const Placed& p, const 
     double xs, ys;
     if (!(frames[i].l > 0)) continue;
     if (p.y[i] >= 0) {
-      Place(frames[i].l, e[i], e[(i + 1) % 3], &xs, &ys);
+      PlaceOn(frames[i], e[i], e[(i + 1) % 3], &xs, &ys);
       // Mirror across the edge (two-side) unless the third distance says
       // clearly that the other point is on this side: closer to the third
       // corner than even the same-side placement.
@@ -116,23 +110,39 @@ inline double TwoSideToOutside2(const EdgeFrame* frames, const Placed& p, const 
 // at (cx, cy)), the point at (px, py).
 inline void LiftInFace(double l, double cx, double cy, double px, double py, bool exact,
                        const double (&d)[3][3], std::array<double, 3>* out) {
-  for (int c = 0; c < 3; ++c) {
-    if (exact && cy > 1e-3 * l) {
+  if (exact && cy > 1e-3 * l) {
+    for (int c = 0; c < 3; ++c) {
       // Exact distances of one field at the three corners of a face fix the
       // unfolded source: trilaterate it (linear, no square roots) and measure.
       const double sx = (l * l + d[0][c] * d[0][c] - d[1][c] * d[1][c]) / (2 * l);
       const double sy =
           (cx * cx + cy * cy - 2 * sx * cx + d[0][c] * d[0][c] - d[2][c] * d[2][c]) / (2 * cy);
       (*out)[c] = Norm2(px - sx, py - sy);
-      continue;
     }
-    // Paper §5.2, case 4: two-side unfolding about each edge of the face.
-    const double to_vertex[3] = {Norm2(px, py), Norm2(px - l, py), Norm2(px - cx, py - cy)};
-    const double edge[3] = {l, Norm2(cx - l, cy), Norm2(cx, cy)};
+    return;
+  }
+  // Paper §5.2, case 4: two-side unfolding about each edge of the face: the
+  // point placed from its distances to the edge's ends, the corner mirrored
+  // on the other side; the smallest over the edges. The point's placements
+  // do not depend on the corner.
+  const double to_vertex[3] = {Norm2(px, py), Norm2(px - l, py), Norm2(px - cx, py - cy)};
+  const double edge[3] = {l, Norm2(cx - l, cy), Norm2(cx, cy)};
+  double xp[3], yp[3];
+  for (int i = 0; i < 3; ++i) {
+    if (edge[i] > 0) Place(edge[i], to_vertex[i], to_vertex[(i + 1) % 3], &xp[i], &yp[i]);
+  }
+  for (int c = 0; c < 3; ++c) {
     double best = kInf;
     for (int i = 0; i < 3; ++i) {
       const int j = (i + 1) % 3;
-      best = std::min(best, TwoSide2(edge[i], to_vertex[i], to_vertex[j], d[i][c], d[j][c]));
+      if (!(edge[i] > 0)) {
+        best = std::min(best, (to_vertex[i] + d[i][c]) * (to_vertex[i] + d[i][c]));
+        continue;
+      }
+      double xq, yq;
+      Place(edge[i], d[i][c], d[j][c], &xq, &yq);
+      const double dx = xp[i] - xq, dy = yp[i] + yq;
+      best = std::min(best, dx * dx + dy * dy);
     }
     (*out)[c] = std::sqrt(best);
   }
@@ -182,8 +192,9 @@ QueryEngine::QueryEngine(std::shared_ptr<const index::Index> index, QueryOptions
       e.l = Matrix(a, b);
       if (e.l > 0) {
         Place(e.l, Matrix(a, o), Matrix(b, o), &e.cx, &e.cy);
+        e.inv_2l = 1 / (2 * e.l);
       } else {
-        e.cx = e.cy = 0;
+        e.cx = e.cy = e.inv_2l = 0;
       }
     }
   }
@@ -358,7 +369,6 @@ LiftedPoint QueryEngine::SlowLift(const SurfacePoint& p, int heaviest) const {
 }
 
 double QueryEngine::LiftedDistance(const LiftedPoint& p0, const LiftedPoint& q0) const {
-  if (!(Matrix(p0.corner[0], q0.corner[0]) < kInf)) return kInf;  // different components
   if (p0.triangle == q0.triangle) {
     // Case 3.1: both placed in the triangle (each on the side its distances
     // say, which for points inside is the one-side unfolding).
@@ -377,6 +387,8 @@ double QueryEngine::LiftedDistance(const LiftedPoint& p0, const LiftedPoint& q0)
   const bool swap = p0.triangle > q0.triangle;
   const LiftedPoint& p = swap ? q0 : p0;
   const LiftedPoint& q = swap ? p0 : q0;
+  // Rows of q's corners: the entries DistanceBatch prefetches.
+  if (!(Matrix(q.corner[0], p.corner[0]) < kInf)) return kInf;  // different components
   const EdgeFrame* p_frames = &frames_[3 * p.triangle];
   const Placed p_placed = PlaceInTriangle(p_frames, p.distance.data());
   double to_corner[3];

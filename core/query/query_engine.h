@@ -79,6 +79,7 @@ struct PathPoint {
 // origin, corner i+1 at (l, 0), the third corner at (cx, cy), cy >= 0.
 struct EdgeFrame {
   double l, cx, cy;
+  double inv_2l;  // 1 / (2 l), or 0 for a degenerate edge
 };
 
 struct DistanceField {
