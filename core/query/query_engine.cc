@@ -108,15 +108,21 @@ inline double TwoSideToOutside2(const EdgeFrame* frames, const Placed& p, const 
 // triangle, from the distances d[vertex][corner] of the face's vertices. The
 // face lies in its plane (vertex 0 at the origin, vertex 1 at (l, 0), vertex 2
 // at (cx, cy)), the point at (px, py).
+// Exact distances d0, d1, d2 of one field at the three corners of a face fix
+// the unfolded source of the field in the face's plane: trilaterate it
+// (linear, no square roots).
+inline void Trilaterate(double l, double cx, double cy, double d0, double d1, double d2, double* sx,
+                        double* sy) {
+  *sx = (l * l + d0 * d0 - d1 * d1) / (2 * l);
+  *sy = (cx * cx + cy * cy - 2 * *sx * cx + d0 * d0 - d2 * d2) / (2 * cy);
+}
+
 inline void LiftInFace(double l, double cx, double cy, double px, double py, bool exact,
                        const double (&d)[3][3], std::array<double, 3>* out) {
   if (exact && cy > 1e-3 * l) {
     for (int c = 0; c < 3; ++c) {
-      // Exact distances of one field at the three corners of a face fix the
-      // unfolded source: trilaterate it (linear, no square roots) and measure.
-      const double sx = (l * l + d[0][c] * d[0][c] - d[1][c] * d[1][c]) / (2 * l);
-      const double sy =
-          (cx * cx + cy * cy - 2 * sx * cx + d[0][c] * d[0][c] - d[2][c] * d[2][c]) / (2 * cy);
+      double sx, sy;
+      Trilaterate(l, cx, cy, d[0][c], d[1][c], d[2][c], &sx, &sy);
       (*out)[c] = Norm2(px - sx, py - sy);
     }
     return;
@@ -323,7 +329,14 @@ QueryEngine::FaceLift QueryEngine::MakeFaceLift(int32_t face) const {
   out.cx = frame.cx;
   out.cy = exact ? frame.cy : -frame.cy;
   for (int i = 0; i < 3; ++i) {
-    for (int c = 0; c < 3; ++c) out.d[i][c] = d[i][c];
+    if (exact) {
+      double sx, sy;
+      Trilaterate(frame.l, frame.cx, frame.cy, d[0][i], d[1][i], d[2][i], &sx, &sy);
+      out.v[i][0] = sx;
+      out.v[i][1] = sy;
+      continue;
+    }
+    for (int c = 0; c < 3; ++c) out.v[i][c] = d[i][c];
   }
   return out;
 }
@@ -340,12 +353,17 @@ LiftedPoint QueryEngine::Lift(const SurfacePoint& p) const {
   LiftedPoint out;
   out.triangle = fl.triangle;
   for (int c = 0; c < 3; ++c) out.corner[c] = fl.corner[c];
+  const double l = fl.l, cx = fl.cx, cy = std::abs(fl.cy);
+  const double px = p.w[1] * l + p.w[2] * cx, py = p.w[2] * cy;
+  if (fl.exact()) {
+    for (int c = 0; c < 3; ++c) out.distance[c] = Norm2(px - fl.v[c][0], py - fl.v[c][1]);
+    return out;
+  }
   double d[3][3];
   for (int i = 0; i < 3; ++i) {
-    for (int c = 0; c < 3; ++c) d[i][c] = fl.d[i][c];
+    for (int c = 0; c < 3; ++c) d[i][c] = fl.v[i][c];
   }
-  const double l = fl.l, cx = fl.cx, cy = std::abs(fl.cy);
-  LiftInFace(l, cx, cy, p.w[1] * l + p.w[2] * cx, p.w[2] * cy, fl.exact(), d, &out.distance);
+  LiftInFace(l, cx, cy, px, py, false, d, &out.distance);
   return out;
 }
 

@@ -160,8 +160,8 @@ class QueryEngine {
             {r.distance[0], r.distance[1], r.distance[2]}};
   }
   // Lifting of a face's interior points, derived at load: the anchor
-  // triangle and its corners, the distances from the face's vertices to
-  // them, and the face in its plane (vertex 0 at the origin, vertex 1 at
+  // triangle and its corners, what the face's vertices' distances to them
+  // give (see v), and the face in its plane (vertex 0 at the origin, vertex 1 at
   // (l, 0), vertex 2 at (cx, |cy|)). One cache line, so that a lift costs one
   // load. triangle -1: lifted by SlowLift (faces whose vertices lie in three
   // different triangles, slivers).
@@ -169,8 +169,10 @@ class QueryEngine {
     int32_t triangle = -1;
     int32_t corner[3] = {-1, -1, -1};
     float l = 0, cx = 0;
-    float cy = 0;        // negative when the distances are approximate (case 2.2)
-    float d[3][3] = {};  // d[vertex][corner]
+    float cy = 0;  // negative when the distances are approximate (case 2.2)
+    // Exact: per corner c, the field's unfolded source (v[c][0], v[c][1]) in
+    // the face's plane. Approximate: v[vertex][corner], the distances.
+    float v[3][3] = {};
     bool exact() const { return cy > 0; }
   };
   static_assert(sizeof(FaceLift) == 64);
