@@ -310,61 +310,120 @@ QueryEngine::FaceFrame QueryEngine::FaceFrameOf(const int32_t* f) const {
 }
 
 // Anchor on the geodesic triangle most of the face's vertices share (fewer
-// approximate distances); when all three differ, the lift depends on the
-// point and is left to SlowLift.
-QueryEngine::FaceLift QueryEngine::MakeFaceLift(int32_t face) const {
+// approximate distances); when all three differ, on the triangle of the
+// point's heaviest vertex (three ApproxLifts).
+QueryEngine::FaceLift QueryEngine::MakeFaceLift(int32_t face) {
   const int32_t* f = &faces_[3 * face];
   FaceLift out;
-  const int32_t t0 = records_[f[0]].triangle, t1 = records_[f[1]].triangle,
-                t2 = records_[f[2]].triangle;
-  if (t0 != t1 && t0 != t2 && t1 != t2) return out;
-  const LiftedPoint anchor = VertexLift(f[t0 == t1 || t0 == t2 ? 0 : 1]);
-  double d[3][3];
-  const bool exact = FaceDistances(f, anchor, d);
   const FaceFrame frame = FaceFrameOf(f);
-  if (!(frame.cy > 1e-3 * frame.l)) return out;  // a sliver: lifted point by point
-  out.triangle = anchor.triangle;
-  for (int c = 0; c < 3; ++c) out.corner[c] = anchor.corner[c];
+  const double edge[3] = {frame.l, std::hypot(frame.cx - frame.l, frame.cy),
+                          std::hypot(frame.cx, frame.cy)};
+  if (!(edge[0] > 0 && edge[1] > 0 && edge[2] > 0)) return out;  // SlowLift
   out.l = frame.l;
   out.cx = frame.cx;
-  out.cy = exact ? frame.cy : -frame.cy;
-  for (int i = 0; i < 3; ++i) {
-    if (exact) {
+  out.cy = frame.cy;
+  const int32_t t0 = records_[f[0]].triangle, t1 = records_[f[1]].triangle,
+                t2 = records_[f[2]].triangle;
+  if (t0 != t1 && t0 != t2 && t1 != t2) {
+    out.approx = static_cast<int32_t>(approx_lifts_.size());
+    out.anchors = 3;
+    for (int k = 0; k < 3; ++k) approx_lifts_.push_back(MakeApproxLift(f, frame, k));
+    out.triangle = approx_lifts_[out.approx].triangle;
+    return out;
+  }
+  const int k = t0 == t1 || t0 == t2 ? 0 : 1;
+  const LiftedPoint anchor = VertexLift(f[k]);
+  out.triangle = anchor.triangle;
+  for (int c = 0; c < 3; ++c) out.corner[c] = anchor.corner[c];
+  double d[3][3];
+  if (FaceDistances(f, anchor, d) && frame.cy > 1e-3 * frame.l) {
+    for (int c = 0; c < 3; ++c) {
       double sx, sy;
-      Trilaterate(frame.l, frame.cx, frame.cy, d[0][i], d[1][i], d[2][i], &sx, &sy);
-      out.v[i][0] = sx;
-      out.v[i][1] = sy;
-      continue;
+      Trilaterate(frame.l, frame.cx, frame.cy, d[0][c], d[1][c], d[2][c], &sx, &sy);
+      out.src[c][0] = sx;
+      out.src[c][1] = sy;
     }
-    for (int c = 0; c < 3; ++c) out.v[i][c] = d[i][c];
+    return out;
+  }
+  out.approx = static_cast<int32_t>(approx_lifts_.size());
+  out.anchors = 1;
+  approx_lifts_.push_back(MakeApproxLift(f, frame, k));
+  return out;
+}
+
+QueryEngine::ApproxLift QueryEngine::MakeApproxLift(const int32_t* f, const FaceFrame& frame,
+                                                    int k) const {
+  const LiftedPoint anchor = VertexLift(f[k]);
+  ApproxLift out;
+  out.triangle = anchor.triangle;
+  for (int c = 0; c < 3; ++c) out.corner[c] = anchor.corner[c];
+  double d[3][3];
+  FaceDistances(f, anchor, d);
+  // Paper §5.2, case 4: corner c unfolded about face edge i (vertex i to
+  // vertex i+1) from its distances to the edge's ends, on the far side of the
+  // edge (two-side), in the face's plane.
+  const double vx[3] = {0, frame.l, frame.cx}, vy[3] = {0, 0, frame.cy};
+  for (int i = 0; i < 3; ++i) {
+    const int j = (i + 1) % 3;
+    const double len = std::hypot(vx[j] - vx[i], vy[j] - vy[i]);
+    const double ux = (vx[j] - vx[i]) / len, uy = (vy[j] - vy[i]) / len;
+    // (-uy, ux) points into the face: it is counter-clockwise (cy > 0).
+    for (int c = 0; c < 3; ++c) {
+      double x, y;
+      Place(len, d[i][c], d[j][c], &x, &y);
+      out.image[c][i][0] = static_cast<float>(vx[i] + x * ux + y * uy);
+      out.image[c][i][1] = static_cast<float>(vy[i] + x * uy - y * ux);
+    }
   }
   return out;
 }
 
 LiftedPoint QueryEngine::Lift(const SurfacePoint& p) const {
-  const int32_t* f = &faces_[3 * p.face];
   int k = 0;
   for (int i = 1; i < 3; ++i) {
     if (p.w[i] > p.w[k]) k = i;
   }
-  if (p.w[k] >= 1.0) return VertexLift(f[k]);  // at a vertex: its record is exact
+  if (p.w[k] >= 1.0) return VertexLift(faces_[3 * p.face + k]);  // at a vertex: exact record
   const FaceLift& fl = face_lifts_[p.face];
   if (fl.triangle < 0) return SlowLift(p, k);
+  const double px = p.w[1] * fl.l + p.w[2] * fl.cx, py = p.w[2] * fl.cy;
   LiftedPoint out;
-  out.triangle = fl.triangle;
-  for (int c = 0; c < 3; ++c) out.corner[c] = fl.corner[c];
-  const double l = fl.l, cx = fl.cx, cy = std::abs(fl.cy);
-  const double px = p.w[1] * l + p.w[2] * cx, py = p.w[2] * cy;
-  if (fl.exact()) {
-    for (int c = 0; c < 3; ++c) out.distance[c] = Norm2(px - fl.v[c][0], py - fl.v[c][1]);
+  if (fl.approx < 0) {
+    out.triangle = fl.triangle;
+    for (int c = 0; c < 3; ++c) {
+      out.corner[c] = fl.corner[c];
+      out.distance[c] = Norm2(px - fl.src[c][0], py - fl.src[c][1]);
+    }
     return out;
   }
-  double d[3][3];
-  for (int i = 0; i < 3; ++i) {
-    for (int c = 0; c < 3; ++c) d[i][c] = fl.v[i][c];
+  const ApproxLift& al = approx_lifts_[fl.approx + (fl.anchors == 3 ? k : 0)];
+  out.triangle = al.triangle;
+  for (int c = 0; c < 3; ++c) {
+    out.corner[c] = al.corner[c];
+    double best = kInf;
+    for (int i = 0; i < 3; ++i) {
+      const double dx = px - al.image[c][i][0], dy = py - al.image[c][i][1];
+      best = std::min(best, dx * dx + dy * dy);
+    }
+    out.distance[c] = std::sqrt(best);
   }
-  LiftInFace(l, cx, cy, px, py, false, d, &out.distance);
   return out;
+}
+
+void QueryEngine::PrefetchLift(const SurfacePoint& p) const {
+  int k = 0;
+  for (int i = 1; i < 3; ++i) {
+    if (p.w[i] > p.w[k]) k = i;
+  }
+  const FaceLift& fl = face_lifts_[p.face];
+  if (p.w[k] >= 1.0 || fl.triangle < 0) {
+    __builtin_prefetch(&records_[faces_[3 * p.face + k]]);
+  } else if (fl.approx >= 0) {
+    const char* line =
+        reinterpret_cast<const char*>(&approx_lifts_[fl.approx + (fl.anchors == 3 ? k : 0)]);
+    __builtin_prefetch(line);
+    __builtin_prefetch(line + sizeof(ApproxLift) - 1);
+  }
 }
 
 LiftedPoint QueryEngine::SlowLift(const SurfacePoint& p, int heaviest) const {
@@ -491,10 +550,10 @@ absl::Status QueryEngine::DistanceBatch(std::span<const SurfacePoint> a,
     }
     return absl::OkStatus();
   }
-  // A query's loads depend on each other (face -> face lift or vertex
-  // records -> geodesic triangles -> sample matrix), so the batch runs as a
-  // software pipeline: the faces 16 pairs ahead are prefetched, their
-  // vertices' records 12 ahead, the points 8 ahead are lifted (and the frames
+  // A query's loads depend on each other (face -> face lift -> approximate
+  // lift or vertex record -> geodesic triangles -> sample matrix), so the
+  // batch runs as a software pipeline: the faces 16 pairs ahead are
+  // prefetched, what their lifts read next 12 ahead, the points 8 ahead are lifted (and the frames
   // and matrix entries their distance will read are prefetched), and the
   // distance of pair i is computed from its lifts.
   constexpr size_t kFaceAhead = 16, kRecordAhead = 12, kLiftAhead = 8, kRing = 8;
@@ -524,12 +583,7 @@ absl::Status QueryEngine::DistanceBatch(std::span<const SurfacePoint> a,
       __builtin_prefetch(&face_lifts_[b[i + kFaceAhead].face]);
     }
     if (i + kRecordAhead < n) {
-      for (const SurfacePoint* x : {&a[i + kRecordAhead], &b[i + kRecordAhead]}) {
-        const int32_t* f = &faces_[3 * x->face];
-        __builtin_prefetch(&records_[f[0]]);
-        __builtin_prefetch(&records_[f[1]]);
-        __builtin_prefetch(&records_[f[2]]);
-      }
+      for (const SurfacePoint* x : {&a[i + kRecordAhead], &b[i + kRecordAhead]}) PrefetchLift(*x);
     }
     out[i] = LiftedDistance(lift_a[i % kRing], lift_b[i % kRing]);
     if (i + kLiftAhead < n) lift(i + kLiftAhead);

@@ -159,32 +159,47 @@ class QueryEngine {
             {r.corner[0], r.corner[1], r.corner[2]},
             {r.distance[0], r.distance[1], r.distance[2]}};
   }
-  // Lifting of a face's interior points, derived at load: the anchor
-  // triangle and its corners, what the face's vertices' distances to them
-  // give (see v), and the face in its plane (vertex 0 at the origin, vertex 1 at
-  // (l, 0), vertex 2 at (cx, |cy|)). One cache line, so that a lift costs one
-  // load. triangle -1: lifted by SlowLift (faces whose vertices lie in three
-  // different triangles, slivers).
+  // Lifting of a face's interior points, derived at load, so that a lift
+  // costs one or two cache-line loads and no unfolding. The face lies in its
+  // plane (vertex 0 at the origin, vertex 1 at (l, 0), vertex 2 at (cx, cy)).
+  //  - Exact faces (all three vertices in the anchor triangle): per corner c,
+  //    the unfolded source of the corner's field, src[c], trilaterated from
+  //    the vertices' exact distances; a distance is |point - src[c]|.
+  //  - Approximate faces (a vertex outside the anchor triangle, or a sliver):
+  //    the paper's two-side unfolding (§5.2, case 4) about each face edge
+  //    puts corner c at a fixed image beyond the edge; the distance is the
+  //    smallest over the three images (ApproxLift). Faces whose vertices lie
+  //    in three different triangles take the anchor of the point's heaviest
+  //    vertex, so they keep three ApproxLifts.
+  //  - triangle -1: lifted by SlowLift (faces with a zero-length edge).
   struct alignas(64) FaceLift {
     int32_t triangle = -1;
     int32_t corner[3] = {-1, -1, -1};
-    float l = 0, cx = 0;
-    float cy = 0;  // negative when the distances are approximate (case 2.2)
-    // Exact: per corner c, the field's unfolded source (v[c][0], v[c][1]) in
-    // the face's plane. Approximate: v[vertex][corner], the distances.
-    float v[3][3] = {};
-    bool exact() const { return cy > 0; }
+    float l = 0, cx = 0, cy = 0;
+    int32_t approx = -1;  // first ApproxLift, or -1 for an exact face
+    int32_t anchors = 0;  // ApproxLifts of the face: 1, or 3 (by heaviest vertex)
+    float src[3][2] = {};
   };
   static_assert(sizeof(FaceLift) == 64);
+  struct ApproxLift {
+    int32_t triangle;
+    int32_t corner[3];
+    float image[3][3][2];  // [corner][face edge] = (x, y) in the face's plane
+  };
   struct FaceFrame {
     double l, cx, cy;
   };
+  // The ApproxLift of `face` anchored on the triangle of its vertex `k`.
+  ApproxLift MakeApproxLift(const int32_t* face_vertices, const FaceFrame& frame, int k) const;
   FaceFrame FaceFrameOf(const int32_t* face_vertices) const;
   // Distances from a face's vertices to the anchor's corners; true when all
   // are exact (the vertices lie in the anchor triangle).
   bool FaceDistances(const int32_t* face_vertices, const LiftedPoint& anchor,
                      double (&d)[3][3]) const;
-  FaceLift MakeFaceLift(int32_t face) const;
+  // Appends the face's ApproxLifts to approx_lifts_ when it has any.
+  FaceLift MakeFaceLift(int32_t face);
+  // Prefetches what Lift(p) will read after the face's FaceLift.
+  void PrefetchLift(const SurfacePoint& p) const;
   // Lifts a point of a face without a FaceLift; `heaviest` is the face
   // vertex of largest weight (the anchor when the vertices share none).
   LiftedPoint SlowLift(const SurfacePoint& p, int heaviest) const;
@@ -203,7 +218,8 @@ class QueryEngine {
   int32_t num_samples_ = 0;
   PointLocator locator_;
   std::vector<EdgeFrame> frames_;     // 3 per geodesic triangle, derived at load
-  std::vector<FaceLift> face_lifts_;  // one per face, derived at load
+  std::vector<FaceLift> face_lifts_;      // one per face, derived at load
+  std::vector<ApproxLift> approx_lifts_;  // of the approximate faces
   std::unique_ptr<mesh::Mesh> mesh_;  // only with exact_near_pairs
 };
 

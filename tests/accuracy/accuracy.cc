@@ -62,6 +62,51 @@ std::vector<mesh::SurfacePoint> RandomSurfacePoints(const mesh::Mesh& mesh, int3
   return points;
 }
 
+namespace {
+
+// Draws area-uniform points of the faces lifted into a geodesic triangle or
+// one of its neighbours.
+class NearPointSampler {
+ public:
+  NearPointSampler(const mesh::Mesh& mesh, const query::QueryEngine& engine)
+      : mesh_(mesh), engine_(engine), faces_of_(engine.index().num_triangles()) {
+    for (int32_t f = 0; f < mesh.num_faces(); ++f) {
+      const int32_t t = engine.Lift({f, {1.0 / 3, 1.0 / 3, 1.0 / 3}}).triangle;
+      if (t >= 0) faces_of_[t].push_back(f);
+    }
+  }
+
+  std::vector<mesh::SurfacePoint> Sample(const mesh::SurfacePoint& p, int32_t count,
+                                         std::mt19937_64& rng) const {
+    const int32_t t = engine_.Lift(p).triangle;
+    std::vector<int32_t> faces = faces_of_[t];
+    for (int32_t n : engine_.index().triangles()[t].neighbor) {
+      if (n >= 0) faces.insert(faces.end(), faces_of_[n].begin(), faces_of_[n].end());
+    }
+    std::vector<double> cumulative;
+    double total = 0;
+    for (int32_t f : faces) cumulative.push_back(total += mesh_.Area(f));
+    std::vector<mesh::SurfacePoint> out;
+    if (faces.empty()) return out;
+    std::uniform_real_distribution<double> u(0, 1);
+    for (int32_t k = 0; k < count; ++k) {
+      const size_t i = std::lower_bound(cumulative.begin(), cumulative.end(), u(rng) * total) -
+                       cumulative.begin();
+      double a = u(rng), b = u(rng);
+      if (a + b > 1) a = 1 - a, b = 1 - b;
+      out.push_back({faces[std::min(i, faces.size() - 1)], {1 - a - b, a, b}});
+    }
+    return out;
+  }
+
+ private:
+  const mesh::Mesh& mesh_;
+  const query::QueryEngine& engine_;
+  std::vector<std::vector<int32_t>> faces_of_;
+};
+
+}  // namespace
+
 AccuracyReport MeasureAccuracy(const mesh::Mesh& mesh, const query::QueryEngine& engine,
                                const query::QueryEngine* exact_engine,
                                const AccuracyOptions& options) {
@@ -72,8 +117,19 @@ AccuracyReport MeasureAccuracy(const mesh::Mesh& mesh, const query::QueryEngine&
   query::QueryScratch scratch;
   const double tiny = 1e-9 * mesh.BoundingBoxDiagonal();
   int32_t paths_left = options.num_paths;
+  const NearPointSampler near_sampler(mesh, engine);
+  std::mt19937_64 near_rng(options.seed + 1);
   for (int32_t s = 0; s < sources; ++s) {
     if (!solver.Propagate({points[s]}).ok()) continue;
+    for (const mesh::SurfacePoint& q : near_sampler.Sample(points[s], options.num_near_points,
+                                                           near_rng)) {
+      const double exact = solver.DistanceAt(q);
+      if (!(exact > tiny) || !std::isfinite(exact) || !engine.IsNearPair(points[s], q)) continue;
+      near.push_back((*engine.Distance(points[s], q) - exact) / exact);
+      if (exact_engine != nullptr) {
+        near_exact.push_back((*exact_engine->Distance(points[s], q, &scratch) - exact) / exact);
+      }
+    }
     for (int32_t k = sources; k < options.num_points; ++k) {
       const double exact = solver.DistanceAt(points[k]);
       if (!(exact > tiny) || !std::isfinite(exact)) continue;

@@ -4,8 +4,11 @@
 // on area-uniform random surface point pairs.
 //
 // Relative error e = (approx - exact) / exact per pair; reported as relative
-// RMS = sqrt(mean(e^2)), mean |e|, p99 |e| and max |e|, separately for far
-// pairs and near pairs (the same or adjacent geodesic triangles), for the
+// RMS = sqrt(mean(e^2)), mean |e|, p99 |e| and max |e|: over area-uniform
+// pairs (all, and the far ones), and over near pairs (the same or adjacent
+// geodesic triangles), which uniform pairs rarely are, so they are drawn on
+// purpose: area-uniform points of the faces of each source's geodesic
+// triangle and its neighbours; for the
 // pure O(1) mode, the exact-near-pairs mode and the paper's linear
 // interpolation baseline (§6.3); and path length / exact distance.
 
@@ -25,6 +28,9 @@ struct ErrorStats {
 };
 
 struct AccuracyReport {
+  // all, far, all_exact_mode, baseline: area-uniform pairs; near,
+  // near_exact_mode: the near pairs drawn on purpose and the uniform ones
+  // that happen to be near.
   ErrorStats all, far, near, near_exact_mode, all_exact_mode, baseline, path_ratio;
   ErrorStats traced_path_ratio;  // the gradient trace before straightening
   std::string ToMarkdownRow(const std::string& label) const;
@@ -35,6 +41,7 @@ struct AccuracyOptions {
   int32_t num_points = 400;  // random points; pairs are (source, point)
   int32_t num_sources = 20;  // exact propagations
   int32_t num_paths = 100;   // pairs whose path length is measured
+  int32_t num_near_points = 40;  // near points drawn per source
   uint64_t seed = 1;
 };
 
