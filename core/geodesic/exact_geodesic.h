@@ -30,6 +30,7 @@
 
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
+#include "core/geodesic/radix_heap.h"
 #include "core/mesh/mesh.h"
 
 namespace geodex::geodesic {
@@ -115,8 +116,9 @@ class ExactGeodesicSolver {
   // A window lies on the edge of half-edge `h` and looks into FaceOf(h). The
   // interval [b0,b1] is measured from Origin(h); the pseudo-source (sx,sy),
   // sy <= 0, is unfolded into h's frame, at geodesic distance `sigma` from
-  // the source.
-  struct Window {
+  // the source. Aligned to a cache line, so that reading one (prefetched as
+  // it nears the front of the queue) costs one line.
+  struct alignas(64) Window {
     double b0, b1;
     double sx, sy;
     double sigma;
@@ -126,6 +128,7 @@ class ExactGeodesicSolver {
     int32_t source;  // source index
     int32_t next_on_edge;
   };
+  static_assert(sizeof(Window) == 64);
   // How a vertex got its distance, for path tracing.
   enum class Via : uint8_t { kNone, kInitial, kSource, kVertex, kWindow };
   struct VertexOrigin {
@@ -136,11 +139,6 @@ class ExactGeodesicSolver {
     int32_t face;
     int32_t source;
     mesh::Vec3 position;
-  };
-  struct QueueEntry {
-    double key;
-    int32_t id;  // window index, or ~vertex for a vertex event
-    bool operator>(const QueueEntry& o) const { return key > o.key; }
   };
   // Shortest path seen to the opposite vertex through a half-edge: its
   // distance and where it crosses the edge.
@@ -155,8 +153,6 @@ class ExactGeodesicSolver {
   };
 
   void Reset();
-  void Push(QueueEntry entry);
-  QueueEntry PopMin();
   absl::Status AddSource(const SurfacePoint& p, int32_t source);
   void AddFaceSource(int32_t face, const std::array<double, 3>& w, int32_t source,
                      int32_t skip_halfedge);
@@ -184,10 +180,26 @@ class ExactGeodesicSolver {
   std::vector<double> dist_;
   std::vector<int32_t> nearest_;
   std::vector<VertexOrigin> origin_;
+  // Reset clears windows_ and queue_ but keeps their memory: a reused solver
+  // does not regrow them (on a fresh solver, growing windows_ takes a third
+  // or more of the time of a large full propagation).
   std::vector<Window> windows_;
   std::vector<int32_t> edge_head_;  // first window on each half-edge
   std::vector<Split> split_;
-  std::vector<QueueEntry> heap_;
+  // Pending work by distance: window indices, and ~v for a vertex event of v.
+  // A monotone queue suffices: whatever is pushed while an entry is processed
+  // (the children of a window, the events of the vertices it reaches, the
+  // windows a vertex emits) is at least as far from the sources as that
+  // entry, up to rounding. A key that rounding puts below the last popped
+  // one is clamped to it by the queue, i.e. popped next. That is harmless:
+  // every window and vertex distance stands for an actual path, and the
+  // filters only discard what such a path beats, so the result does not
+  // depend on the pop order, only the amount of work does; and the clamped
+  // keys differ from the exact ones by rounding only (measured: under 1% of
+  // the pushes, by a few units in the last place). Pops report the keys as
+  // pushed, so vertex events still match dist_ exactly and stop_radius and
+  // the stop targets compare against true distances.
+  RadixHeap<int32_t> queue_;
   std::vector<SourceInFace> face_sources_;
   std::vector<SurfacePoint> sources_;
   double stop_radius_ = kInfinity;
