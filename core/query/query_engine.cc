@@ -13,6 +13,8 @@ namespace geodex::query {
 namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
+// Relative rounding of squared float32 distances, with a margin.
+constexpr double kSameSideTolerance = 1e-6;
 
 // sqrt(x^2 + y^2) without std::hypot's overflow care, which costs more than
 // the rest of a query.
@@ -82,11 +84,13 @@ inline double TwoSideToOutside2(const EdgeFrame* frames, const Placed& p, const 
     if (p.y[i] >= 0) {
       PlaceOn(frames[i], e[i], e[(i + 1) % 3], &xs, &ys);
       // Mirror across the edge (two-side) unless the third distance says
-      // clearly that the other point is on this side: closer to the third
-      // corner than even the same-side placement.
+      // that the other point is on this side: no farther from the third
+      // corner than the same-side placement, to rounding. Exact agreement is
+      // what a developable surface gives for a point beside the triangle
+      // (round a shared corner); mirroring it there would put it too close.
       const double dx = xs - frames[i].cx, dy = ys - frames[i].cy;
       const double ek = e[(i + 2) % 3];
-      if (!(ek * ek < dx * dx + dy * dy)) ys = -ys;
+      if (!(ek * ek * (1 - kSameSideTolerance) < dx * dx + dy * dy)) ys = -ys;
     } else {
       // The point itself lies beyond this edge (outside its triangle, as near
       // mesh boundaries): mirroring the other point here would bring it

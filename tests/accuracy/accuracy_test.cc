@@ -38,6 +38,8 @@ TEST(AccuracyTest, DevelopableSurfacesAreExact) {
   for (const mesh::Mesh& m : {gen::FoldedSheet(32, 20, 2.0, 1.0, 1.1)}) {
     const AccuracyReport r = Measure(m, 60, 200, 10);
     EXPECT_LT(r.all.max, 1e-5);
+    EXPECT_GT(r.near.count, 100);
+    EXPECT_LT(r.near.max, 1e-5);
   }
 }
 
