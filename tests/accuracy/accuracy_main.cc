@@ -76,6 +76,8 @@ int main(int argc, char** argv) {
   app.add_option("--points", options.num_points, "Random points");
   app.add_option("--sources", options.num_sources, "Exact propagations (pairs = sources x points)");
   app.add_option("--paths", options.num_paths, "Pairs whose paths are measured");
+  app.add_option("--near-points", options.num_near_points,
+                 "Points drawn per source in its own and the adjacent geodesic triangles");
   app.add_option("--seed", options.seed, "Random seed");
   app.add_option("--index-dir", index_dir, "Cache built indexes here");
   app.add_option("--threads", threads, "Builder threads (0: all)");
