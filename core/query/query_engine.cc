@@ -76,7 +76,10 @@ inline Placed PlaceInTriangle(const EdgeFrame* frames, const double* d) {
 // and the others overestimate.
 inline double TwoSideToOutside2(const EdgeFrame* frames, const Placed& p, const double* e) {
   // Weak placements of the other point (see Weak) only count when every
-  // edge gives one.
+  // edge gives one. Within 1% of the edge's line (in height over distance)
+  // a placement's float32 rounding is amplified a hundredfold; another edge
+  // then places the point better.
+  constexpr double kWeakOther = 1e-4;
   double best = kInf, best_collinear = kInf;
   for (int i = 0; i < 3; ++i) {
     double xs, ys;
@@ -99,7 +102,7 @@ inline double TwoSideToOutside2(const EdgeFrame* frames, const Placed& p, const 
     }
     const double dx = p.x[i] - xs, dy = p.y[i] - ys;
     const double d2 = dx * dx + dy * dy;
-    if (Weak(ys, e[i])) {
+    if (Weak(ys, e[i], kWeakOther)) {
       best_collinear = std::min(best_collinear, d2);
     } else {
       best = std::min(best, d2);

@@ -2,6 +2,8 @@
 
 #include "tests/accuracy/accuracy.h"
 
+#include <utility>
+
 #include "core/build/builder.h"
 #include "core/mesh/generators.h"
 #include "gtest/gtest.h"
@@ -35,8 +37,12 @@ AccuracyReport Measure(const mesh::Mesh& m, int32_t samples, int32_t points, int
 }
 
 TEST(AccuracyTest, DevelopableSurfacesAreExact) {
-  for (const mesh::Mesh& m : {gen::FoldedSheet(32, 20, 2.0, 1.0, 1.1)}) {
-    const AccuracyReport r = Measure(m, 60, 200, 10);
+  // m=120 on the finer sheet once gave a 25.7% error: a point beside the
+  // triangle unfolded to the wrong side of an edge.
+  const std::pair<mesh::Mesh, int32_t> cases[] = {{gen::FoldedSheet(32, 20, 2.0, 1.0, 1.1), 60},
+                                                 {gen::FoldedSheet(40, 24, 2.0, 1.0, 1.1), 120}};
+  for (const auto& [m, samples] : cases) {
+    const AccuracyReport r = Measure(m, samples, 200, 10);
     EXPECT_LT(r.all.max, 1e-5);
     EXPECT_GT(r.near.count, 100);
     EXPECT_LT(r.near.max, 1e-5);
