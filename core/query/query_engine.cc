@@ -16,6 +16,16 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 // Relative rounding of squared float32 distances, with a margin.
 constexpr double kSameSideTolerance = 1e-6;
 
+// The face vertex of largest weight: the anchor of points of faces whose
+// vertices lie in three different triangles.
+inline int Heaviest(const SurfacePoint& p) {
+  int k = 0;
+  for (int i = 1; i < 3; ++i) {
+    if (p.w[i] > p.w[k]) k = i;
+  }
+  return k;
+}
+
 // sqrt(x^2 + y^2) without std::hypot's overflow care, which costs more than
 // the rest of a query.
 inline double Norm2(double x, double y) { return std::sqrt(x * x + y * y); }
@@ -386,10 +396,7 @@ QueryEngine::ApproxLift QueryEngine::MakeApproxLift(const int32_t* f, const Face
 }
 
 LiftedPoint QueryEngine::Lift(const SurfacePoint& p) const {
-  int k = 0;
-  for (int i = 1; i < 3; ++i) {
-    if (p.w[i] > p.w[k]) k = i;
-  }
+  const int k = Heaviest(p);
   if (p.w[k] >= 1.0) return VertexLift(faces_[3 * p.face + k]);  // at a vertex: exact record
   const FaceLift& fl = face_lifts_[p.face];
   if (fl.triangle < 0) return SlowLift(p, k);
@@ -403,7 +410,7 @@ LiftedPoint QueryEngine::Lift(const SurfacePoint& p) const {
     }
     return out;
   }
-  const ApproxLift& al = approx_lifts_[fl.approx + (fl.anchors == 3 ? k : 0)];
+  const ApproxLift& al = ApproxLiftOf(fl, k);
   out.triangle = al.triangle;
   for (int c = 0; c < 3; ++c) {
     out.corner[c] = al.corner[c];
@@ -418,16 +425,12 @@ LiftedPoint QueryEngine::Lift(const SurfacePoint& p) const {
 }
 
 void QueryEngine::PrefetchLift(const SurfacePoint& p) const {
-  int k = 0;
-  for (int i = 1; i < 3; ++i) {
-    if (p.w[i] > p.w[k]) k = i;
-  }
+  const int k = Heaviest(p);
   const FaceLift& fl = face_lifts_[p.face];
   if (p.w[k] >= 1.0 || fl.triangle < 0) {
     __builtin_prefetch(&records_[faces_[3 * p.face + k]]);
   } else if (fl.approx >= 0) {
-    const char* line =
-        reinterpret_cast<const char*>(&approx_lifts_[fl.approx + (fl.anchors == 3 ? k : 0)]);
+    const char* line = reinterpret_cast<const char*>(&ApproxLiftOf(fl, k));
     __builtin_prefetch(line);
     __builtin_prefetch(line + sizeof(ApproxLift) - 1);
   }
@@ -560,10 +563,10 @@ absl::Status QueryEngine::DistanceBatch(std::span<const SurfacePoint> a,
   // A query's loads depend on each other (face -> face lift -> approximate
   // lift or vertex record -> geodesic triangles -> sample matrix), so the
   // batch runs as a software pipeline: the faces 16 pairs ahead are
-  // prefetched, what their lifts read next 12 ahead, the points 8 ahead are lifted (and the frames
-  // and matrix entries their distance will read are prefetched), and the
-  // distance of pair i is computed from its lifts.
-  constexpr size_t kFaceAhead = 16, kRecordAhead = 12, kLiftAhead = 8, kRing = 8;
+  // prefetched, what their lifts read next 12 ahead, the points 8 ahead are
+  // lifted (and the frames and matrix entries their distance will read are
+  // prefetched), and the distance of pair i is computed from its lifts.
+  constexpr size_t kFaceAhead = 16, kLiftDataAhead = 12, kLiftAhead = 8, kRing = 8;
   LiftedPoint lift_a[kRing], lift_b[kRing];
   auto lift = [&](size_t j) {
     LiftedPoint& p = lift_a[j % kRing];
@@ -589,8 +592,9 @@ absl::Status QueryEngine::DistanceBatch(std::span<const SurfacePoint> a,
       __builtin_prefetch(&face_lifts_[a[i + kFaceAhead].face]);
       __builtin_prefetch(&face_lifts_[b[i + kFaceAhead].face]);
     }
-    if (i + kRecordAhead < n) {
-      for (const SurfacePoint* x : {&a[i + kRecordAhead], &b[i + kRecordAhead]}) PrefetchLift(*x);
+    if (i + kLiftDataAhead < n) {
+      PrefetchLift(a[i + kLiftDataAhead]);
+      PrefetchLift(b[i + kLiftDataAhead]);
     }
     out[i] = LiftedDistance(lift_a[i % kRing], lift_b[i % kRing]);
     if (i + kLiftAhead < n) lift(i + kLiftAhead);

@@ -189,6 +189,11 @@ class QueryEngine {
   struct FaceFrame {
     double l, cx, cy;
   };
+  // The ApproxLift a point of an approximate face uses; `heaviest` is its
+  // face vertex of largest weight.
+  const ApproxLift& ApproxLiftOf(const FaceLift& fl, int heaviest) const {
+    return approx_lifts_[fl.approx + (fl.anchors == 3 ? heaviest : 0)];
+  }
   // The ApproxLift of `face` anchored on the triangle of its vertex `k`.
   ApproxLift MakeApproxLift(const int32_t* face_vertices, const FaceFrame& frame, int k) const;
   FaceFrame FaceFrameOf(const int32_t* face_vertices) const;
@@ -217,10 +222,10 @@ class QueryEngine {
   std::span<const index::GeodesicTriangle> triangles_;
   int32_t num_samples_ = 0;
   PointLocator locator_;
-  std::vector<EdgeFrame> frames_;     // 3 per geodesic triangle, derived at load
+  std::vector<EdgeFrame> frames_;         // 3 per geodesic triangle, derived at load
   std::vector<FaceLift> face_lifts_;      // one per face, derived at load
   std::vector<ApproxLift> approx_lifts_;  // of the approximate faces
-  std::unique_ptr<mesh::Mesh> mesh_;  // only with exact_near_pairs
+  std::unique_ptr<mesh::Mesh> mesh_;      // only with exact_near_pairs
 };
 
 }  // namespace geodex::query

@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numeric>
 #include <random>
+#include <span>
 
 #include "absl/strings/str_format.h"
 #include "core/geodesic/exact_geodesic.h"
@@ -44,25 +46,27 @@ std::string AccuracyReport::ToMarkdownRow(const std::string& label) const {
       traced_path_ratio.count ? 1 + traced_path_ratio.p99 : 0.0);
 }
 
-std::vector<mesh::SurfacePoint> RandomSurfacePoints(const mesh::Mesh& mesh, int32_t count,
-                                                    uint64_t seed) {
-  std::vector<double> cumulative(mesh.num_faces());
+namespace {
+
+// `count` area-uniform random points of `faces`.
+std::vector<mesh::SurfacePoint> PointsOnFaces(const mesh::Mesh& mesh,
+                                              std::span<const int32_t> faces, int32_t count,
+                                              std::mt19937_64& rng) {
+  std::vector<double> cumulative;
   double total = 0;
-  for (int32_t f = 0; f < mesh.num_faces(); ++f) cumulative[f] = total += mesh.Area(f);
-  std::mt19937_64 rng(seed);
-  std::uniform_real_distribution<double> u(0, 1);
+  for (int32_t f : faces) cumulative.push_back(total += mesh.Area(f));
   std::vector<mesh::SurfacePoint> points;
+  if (faces.empty()) return points;
+  std::uniform_real_distribution<double> u(0, 1);
   for (int32_t k = 0; k < count; ++k) {
-    const auto it = std::lower_bound(cumulative.begin(), cumulative.end(), u(rng) * total);
-    const int32_t f = std::min<int32_t>(it - cumulative.begin(), mesh.num_faces() - 1);
+    const size_t i =
+        std::lower_bound(cumulative.begin(), cumulative.end(), u(rng) * total) - cumulative.begin();
     double a = u(rng), b = u(rng);
     if (a + b > 1) a = 1 - a, b = 1 - b;  // uniform on the triangle
-    points.push_back({f, {1 - a - b, a, b}});
+    points.push_back({faces[std::min(i, faces.size() - 1)], {1 - a - b, a, b}});
   }
   return points;
 }
-
-namespace {
 
 // Draws area-uniform points of the faces lifted into a geodesic triangle or
 // one of its neighbours.
@@ -83,20 +87,7 @@ class NearPointSampler {
     for (int32_t n : engine_.index().triangles()[t].neighbor) {
       if (n >= 0) faces.insert(faces.end(), faces_of_[n].begin(), faces_of_[n].end());
     }
-    std::vector<double> cumulative;
-    double total = 0;
-    for (int32_t f : faces) cumulative.push_back(total += mesh_.Area(f));
-    std::vector<mesh::SurfacePoint> out;
-    if (faces.empty()) return out;
-    std::uniform_real_distribution<double> u(0, 1);
-    for (int32_t k = 0; k < count; ++k) {
-      const size_t i = std::lower_bound(cumulative.begin(), cumulative.end(), u(rng) * total) -
-                       cumulative.begin();
-      double a = u(rng), b = u(rng);
-      if (a + b > 1) a = 1 - a, b = 1 - b;
-      out.push_back({faces[std::min(i, faces.size() - 1)], {1 - a - b, a, b}});
-    }
-    return out;
+    return PointsOnFaces(mesh_, faces, count, rng);
   }
 
  private:
@@ -106,6 +97,14 @@ class NearPointSampler {
 };
 
 }  // namespace
+
+std::vector<mesh::SurfacePoint> RandomSurfacePoints(const mesh::Mesh& mesh, int32_t count,
+                                                    uint64_t seed) {
+  std::vector<int32_t> faces(mesh.num_faces());
+  std::iota(faces.begin(), faces.end(), 0);
+  std::mt19937_64 rng(seed);
+  return PointsOnFaces(mesh, faces, count, rng);
+}
 
 AccuracyReport MeasureAccuracy(const mesh::Mesh& mesh, const query::QueryEngine& engine,
                                const query::QueryEngine* exact_engine,
@@ -121,8 +120,8 @@ AccuracyReport MeasureAccuracy(const mesh::Mesh& mesh, const query::QueryEngine&
   std::mt19937_64 near_rng(options.seed + 1);
   for (int32_t s = 0; s < sources; ++s) {
     if (!solver.Propagate({points[s]}).ok()) continue;
-    for (const mesh::SurfacePoint& q : near_sampler.Sample(points[s], options.num_near_points,
-                                                           near_rng)) {
+    for (const mesh::SurfacePoint& q :
+         near_sampler.Sample(points[s], options.num_near_points, near_rng)) {
       const double exact = solver.DistanceAt(q);
       if (!(exact > tiny) || !std::isfinite(exact) || !engine.IsNearPair(points[s], q)) continue;
       near.push_back((*engine.Distance(points[s], q) - exact) / exact);
