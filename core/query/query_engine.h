@@ -151,6 +151,10 @@ class QueryEngine {
   mesh::Vec3 Position(int32_t v) const {
     return {positions_[3 * v], positions_[3 * v + 1], positions_[3 * v + 2]};
   }
+  // Path restart chains for a valid point p: for each vertex one ring out
+  // from p's face, that vertex, a vertex of p's face sharing a face with it,
+  // then p; consecutive points share a face.
+  std::vector<std::vector<PathPoint>> RingChains(const SurfacePoint& p) const;
   // Approximate distance from a lifted point to sample `s` (case 2.1/2.2).
   double ToSample(const LiftedPoint& p, int32_t s) const;
   LiftedPoint VertexLift(int32_t v) const {
