@@ -121,7 +121,11 @@ class QueryEngine {
   double LinearInterpolationDistance(const SurfacePoint& p, const SurfacePoint& q) const;
 
   // Geodesic path from `from` to `to` by tracing the gradient of the
-  // approximate distance field of `from` backwards from `to` (§6.2). The
+  // approximate distance field of `from` backwards from `to` (§6.2), then
+  // straightened within the faces it crosses (see path_straightening.h). The
+  // trace of `to`'s field is tried too, and when the result is still 1%
+  // longer than the approximate distance, traces restarted from the vertices
+  // around either end; the shortest is returned. O(k) per trace. The
   // first point is `from`, the last `to`, exactly; consecutive points share
   // a mesh face. Errors: as Validate; NotFound between components.
   absl::StatusOr<std::vector<PathPoint>> Path(const SurfacePoint& from,
