@@ -8,13 +8,12 @@
 #include "absl/strings/str_format.h"
 #include "core/common/status_macros.h"
 #include "core/common/unfolding.h"
+#include "core/query/unfold_kernel.h"
 
 namespace geodex::query {
 namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
-// Relative rounding of squared float32 distances, with a margin.
-constexpr double kSameSideTolerance = 1e-6;
 
 // The face vertex of largest weight: the anchor of points of faces whose
 // vertices lie in three different triangles.
@@ -30,96 +29,10 @@ inline int Heaviest(const SurfacePoint& p) {
 // the rest of a query.
 inline double Norm2(double x, double y) { return std::sqrt(x * x + y * y); }
 
-// Place on an edge frame, with the division by 2 l precomputed.
-inline void PlaceOn(const EdgeFrame& e, double da, double db, double* x, double* y) {
-  *x = (e.l * e.l + da * da - db * db) * e.inv_2l;
-  *y = std::sqrt(std::max(da * da - *x * *x, 0.0));
-}
-
-// Places a point at distances (da, db) from the edge's ends and dc from the
-// third corner: like Place, on the side of the edge whose mirror image
-// matches dc better. Points beyond an edge of the triangle (common near mesh
-// boundaries and for far samples) thus land outside it, where one-side and
-// two-side unfolding would put them inside or on the wrong side.
-inline void PlaceSigned(const EdgeFrame& e, double da, double db, double dc, double* x, double* y) {
-  if (!(e.l > 0)) {
-    *x = 0;
-    *y = da;
-    return;
-  }
-  PlaceOn(e, da, db, x, y);
-  // Squared distances to the third corner from (x, +y) and (x, -y) differ by
-  // 4 y cy; pick the side whose value is nearer dc^2.
-  const double dx = *x - e.cx;
-  if (dc * dc > dx * dx + *y * *y + e.cy * e.cy) *y = -*y;
-}
-
-// A point of a geodesic triangle placed in the triangle's three edge frames.
-struct Placed {
-  double x[3], y[3];
-};
-
-// True when a placement at height y from distance d is almost on the edge's
-// line, where sqrt(d^2 - x^2) loses half its digits to cancellation (the
-// distances are float32).
-inline bool Weak(double y, double d, double limit = 1e-6) { return y * y < limit * d * d; }
-
-inline Placed PlaceInTriangle(const EdgeFrame* frames, const double* d) {
-  Placed out;
-  for (int i = 0; i < 3; ++i) {
-    const EdgeFrame& e = frames[i];
-    const double da = d[i], dc = d[(i + 2) % 3];
-    PlaceSigned(e, da, d[(i + 1) % 3], dc, &out.x[i], &out.y[i]);
-    if (Weak(out.y[i], da, 1e-4) && e.cy > 1e-3 * e.l) {
-      // Near the edge's line: take the height from the third corner instead
-      // (linear, conditioned by the triangle's height; the point is near).
-      out.y[i] = (e.cx * e.cx + e.cy * e.cy - 2 * out.x[i] * e.cx + da * da - dc * dc) / (2 * e.cy);
-    }
-  }
-  return out;
-}
-
-// Paper §5.2, case 2.2: the squared distance from a placed point to a point
-// outside its triangle at distances e[] from the corners, unfolded on the far
-// side of each edge (two-side unfolding); the smallest over the edges. On a
-// developable surface the edge the geodesic crosses gives the exact answer
-// and the others overestimate.
-inline double TwoSideToOutside2(const EdgeFrame* frames, const Placed& p, const double* e) {
-  // Weak placements of the other point (see Weak) only count when every
-  // edge gives one. Within 1% of the edge's line (in height over distance)
-  // a placement's float32 rounding is amplified a hundredfold; another edge
-  // then places the point better.
-  constexpr double kWeakOther = 1e-4;
-  double best = kInf, best_collinear = kInf;
-  for (int i = 0; i < 3; ++i) {
-    double xs, ys;
-    if (!(frames[i].l > 0)) continue;
-    if (p.y[i] >= 0) {
-      PlaceOn(frames[i], e[i], e[(i + 1) % 3], &xs, &ys);
-      // Mirror across the edge (two-side) unless the third distance says
-      // that the other point is on this side: no farther from the third
-      // corner than the same-side placement, to rounding. Exact agreement is
-      // what a developable surface gives for a point beside the triangle
-      // (round a shared corner); mirroring it there would put it too close.
-      const double dx = xs - frames[i].cx, dy = ys - frames[i].cy;
-      const double ek = e[(i + 2) % 3];
-      if (!(ek * ek * (1 - kSameSideTolerance) < dx * dx + dy * dy)) ys = -ys;
-    } else {
-      // The point itself lies beyond this edge (outside its triangle, as near
-      // mesh boundaries): mirroring the other point here would bring it
-      // closer, so place it on the side its distances say.
-      PlaceSigned(frames[i], e[i], e[(i + 1) % 3], e[(i + 2) % 3], &xs, &ys);
-    }
-    const double dx = p.x[i] - xs, dy = p.y[i] - ys;
-    const double d2 = dx * dx + dy * dy;
-    if (Weak(ys, e[i], kWeakOther)) {
-      best_collinear = std::min(best_collinear, d2);
-    } else {
-      best = std::min(best, d2);
-    }
-  }
-  return best < kInf ? best : best_collinear;
-}
+using kernel::Frame;
+using kernel::Placed;
+using kernel::PlaceInTriangle;
+using kernel::TwoSideToOutside2;
 
 // Distances from a point of a mesh face to the three corners of a geodesic
 // triangle, from the distances d[vertex][corner] of the face's vertices. The
@@ -211,7 +124,7 @@ QueryEngine::QueryEngine(std::shared_ptr<const index::Index> index, QueryOptions
     const int32_t* c = triangles_[t].corner;
     for (int i = 0; i < 3; ++i) {
       const int32_t a = c[i], b = c[(i + 1) % 3], o = c[(i + 2) % 3];
-      EdgeFrame& e = frames_[3 * t + i];
+      Frame<double>& e = frames_[3 * t + i];
       e.l = Matrix(a, b);
       if (e.l > 0) {
         Place(e.l, Matrix(a, o), Matrix(b, o), &e.cx, &e.cy);
@@ -284,7 +197,7 @@ double QueryEngine::ToSample(const LiftedPoint& p, int32_t s) const {
   for (int i = 0; i < 3; ++i) {
     if (p.corner[i] == s) return p.distance[i];  // paper §5.2, case 2.1
   }
-  const EdgeFrame* frames = &frames_[3 * p.triangle];
+  const Frame<double>* frames = &frames_[3 * p.triangle];
   const double e[3] = {Matrix(s, p.corner[0]), Matrix(s, p.corner[1]), Matrix(s, p.corner[2])};
   return std::sqrt(TwoSideToOutside2(frames, PlaceInTriangle(frames, p.distance.data()), e));
 }
@@ -301,8 +214,8 @@ bool QueryEngine::FaceDistances(const int32_t* f, const LiftedPoint& anchor,
     }
     exact = false;
     const LiftedPoint vi = VertexLift(f[i]);
-    const EdgeFrame* frames = &frames_[3 * vi.triangle];
-    const Placed placed = PlaceInTriangle(frames, vi.distance.data());
+    const Frame<double>* frames = &frames_[3 * vi.triangle];
+    const Placed<double> placed = PlaceInTriangle(frames, vi.distance.data());
     for (int c = 0; c < 3; ++c) {
       const int32_t s = anchor.corner[c];
       d[i][c] = -1;
@@ -424,6 +337,11 @@ LiftedPoint QueryEngine::Lift(const SurfacePoint& p) const {
   return out;
 }
 
+void QueryEngine::PrefetchFace(const SurfacePoint& p) const {
+  __builtin_prefetch(&faces_[3 * p.face]);
+  __builtin_prefetch(&face_lifts_[p.face]);
+}
+
 void QueryEngine::PrefetchLift(const SurfacePoint& p) const {
   const int k = Heaviest(p);
   const FaceLift& fl = face_lifts_[p.face];
@@ -459,9 +377,9 @@ double QueryEngine::LiftedDistance(const LiftedPoint& p0, const LiftedPoint& q0)
   if (p0.triangle == q0.triangle) {
     // Case 3.1: both placed in the triangle (each on the side its distances
     // say, which for points inside is the one-side unfolding).
-    const EdgeFrame* frames = &frames_[3 * p0.triangle];
-    const Placed p = PlaceInTriangle(frames, p0.distance.data());
-    const Placed q = PlaceInTriangle(frames, q0.distance.data());
+    const Frame<double>* frames = &frames_[3 * p0.triangle];
+    const Placed<double> p = PlaceInTriangle(frames, p0.distance.data());
+    const Placed<double> q = PlaceInTriangle(frames, q0.distance.data());
     double best = kInf;
     for (int i = 0; i < 3; ++i) {
       const double dx = p.x[i] - q.x[i], dy = p.y[i] - q.y[i];
@@ -469,30 +387,50 @@ double QueryEngine::LiftedDistance(const LiftedPoint& p0, const LiftedPoint& q0)
     }
     return std::sqrt(best);
   }
-  // Case 3.2, in a fixed order so that the result is symmetric: p's
-  // distances to q's corners by case 2.2, then case 2.2 again in q's triangle.
+  // Case 3.2, in a fixed order so that the result is symmetric.
   const bool swap = p0.triangle > q0.triangle;
   const LiftedPoint& p = swap ? q0 : p0;
   const LiftedPoint& q = swap ? p0 : q0;
   // Rows of q's corners: the entries DistanceBatch prefetches.
   if (!(Matrix(q.corner[0], p.corner[0]) < kInf)) return kInf;  // different components
-  const EdgeFrame* p_frames = &frames_[3 * p.triangle];
-  const Placed p_placed = PlaceInTriangle(p_frames, p.distance.data());
-  double to_corner[3];
+  return kernel::FarDistance(GatherFar(p, q));
+}
+
+kernel::FarPair QueryEngine::GatherFar(const LiftedPoint& p, const LiftedPoint& q) const {
+  kernel::FarPair pair;
+  pair.p_frames = &frames_[3 * p.triangle];
+  pair.q_frames = &frames_[3 * q.triangle];
+  pair.p_distance = p.distance.data();
+  pair.q_distance = q.distance.data();
   for (int j = 0; j < 3; ++j) {
     const int32_t s = q.corner[j];
-    to_corner[j] = -1;
+    pair.shared[j] = -1;
     for (int i = 0; i < 3; ++i) {
-      if (p.corner[i] == s) to_corner[j] = p.distance[i];  // case 2.1
-    }
-    if (to_corner[j] < 0) {
-      const double e[3] = {Matrix(s, p.corner[0]), Matrix(s, p.corner[1]), Matrix(s, p.corner[2])};
-      to_corner[j] = std::sqrt(TwoSideToOutside2(p_frames, p_placed, e));
+      pair.e[j][i] = Matrix(s, p.corner[i]);
+      if (p.corner[i] == s) pair.shared[j] = p.distance[i];  // case 2.1
     }
   }
-  const EdgeFrame* q_frames = &frames_[3 * q.triangle];
-  return std::sqrt(
-      TwoSideToOutside2(q_frames, PlaceInTriangle(q_frames, q.distance.data()), to_corner));
+  return pair;
+}
+
+void QueryEngine::LiftedDistanceLanes(const LiftedPoint* a, const LiftedPoint* b,
+                                      double* out) const {
+  // Each lane in the order of LiftedDistance's case 3.2; the other cases
+  // (same triangle, different components) are answered one at a time.
+  constexpr int W = kernel::kLanes;
+  kernel::FarPair pairs[W];
+  bool far[W];
+  for (int k = 0; k < W; ++k) {
+    const bool swap = a[k].triangle > b[k].triangle;
+    const LiftedPoint& p = swap ? b[k] : a[k];
+    const LiftedPoint& q = swap ? a[k] : b[k];
+    far[k] = p.triangle != q.triangle && Matrix(q.corner[0], p.corner[0]) < kInf;
+    pairs[k] = GatherFar(p, q);
+  }
+  kernel::FarDistances(pairs, out);
+  for (int k = 0; k < W; ++k) {
+    if (!far[k]) out[k] = LiftedDistance(a[k], b[k]);
+  }
 }
 
 double QueryEngine::DistanceUnchecked(const SurfacePoint& p, const SurfacePoint& q) const {
@@ -565,8 +503,11 @@ absl::Status QueryEngine::DistanceBatch(std::span<const SurfacePoint> a,
   // batch runs as a software pipeline: the faces 16 pairs ahead are
   // prefetched, what their lifts read next 12 ahead, the points 8 ahead are
   // lifted (and the frames and matrix entries their distance will read are
-  // prefetched), and the distance of pair i is computed from its lifts.
-  constexpr size_t kFaceAhead = 16, kLiftDataAhead = 12, kLiftAhead = 8, kRing = 8;
+  // prefetched), and the distances are computed from the lifts, kLanes pairs
+  // per instruction.
+  constexpr size_t kFaceAhead = 16, kLiftDataAhead = 12, kLiftAhead = 8, kRing = 16;
+  constexpr size_t W = kernel::kLanes;
+  static_assert(kLiftAhead % W == 0 && kRing % W == 0 && kRing >= kLiftAhead + W);
   LiftedPoint lift_a[kRing], lift_b[kRing];
   auto lift = [&](size_t j) {
     LiftedPoint& p = lift_a[j % kRing];
@@ -585,20 +526,24 @@ absl::Status QueryEngine::DistanceBatch(std::span<const SurfacePoint> a,
     }
   };
   for (size_t j = 0; j < std::min(n, kLiftAhead); ++j) lift(j);
-  for (size_t i = 0; i < n; ++i) {
-    if (i + kFaceAhead < n) {
-      __builtin_prefetch(&faces_[3 * a[i + kFaceAhead].face]);
-      __builtin_prefetch(&faces_[3 * b[i + kFaceAhead].face]);
-      __builtin_prefetch(&face_lifts_[a[i + kFaceAhead].face]);
-      __builtin_prefetch(&face_lifts_[b[i + kFaceAhead].face]);
+  size_t i = 0;
+  for (; i + W <= n; i += W) {
+    for (size_t k = i; k < i + W; ++k) {
+      if (k + kFaceAhead < n) {
+        PrefetchFace(a[k + kFaceAhead]);
+        PrefetchFace(b[k + kFaceAhead]);
+      }
+      if (k + kLiftDataAhead < n) {
+        PrefetchLift(a[k + kLiftDataAhead]);
+        PrefetchLift(b[k + kLiftDataAhead]);
+      }
     }
-    if (i + kLiftDataAhead < n) {
-      PrefetchLift(a[i + kLiftDataAhead]);
-      PrefetchLift(b[i + kLiftDataAhead]);
+    LiftedDistanceLanes(&lift_a[i % kRing], &lift_b[i % kRing], &out[i]);
+    for (size_t k = i; k < i + W; ++k) {
+      if (k + kLiftAhead < n) lift(k + kLiftAhead);
     }
-    out[i] = LiftedDistance(lift_a[i % kRing], lift_b[i % kRing]);
-    if (i + kLiftAhead < n) lift(i + kLiftAhead);
   }
+  for (; i < n; ++i) out[i] = LiftedDistance(lift_a[i % kRing], lift_b[i % kRing]);
   return absl::OkStatus();
 }
 

@@ -36,6 +36,7 @@
 #include "core/index/index.h"
 #include "core/mesh/mesh.h"
 #include "core/query/point_locator.h"
+#include "core/query/unfold_kernel.h"
 
 namespace geodex::query {
 
@@ -73,13 +74,6 @@ struct LiftedPoint {
 struct PathPoint {
   SurfacePoint point;
   mesh::Vec3 position;
-};
-
-// An unfolded geodesic triangle seen from one of its edges: corner i at the
-// origin, corner i+1 at (l, 0), the third corner at (cx, cy), cy >= 0.
-struct EdgeFrame {
-  double l, cx, cy;
-  double inv_2l;  // 1 / (2 l), or 0 for a degenerate edge
 };
 
 struct DistanceField {
@@ -159,6 +153,11 @@ class QueryEngine {
   // from p's face, that vertex, a vertex of p's face sharing a face with it,
   // then p; consecutive points share a face.
   std::vector<std::vector<PathPoint>> RingChains(const SurfacePoint& p) const;
+  // What case 3.2 reads for a pair, p in the triangle of smaller id.
+  kernel::FarPair GatherFar(const LiftedPoint& p, const LiftedPoint& q) const;
+  // out[k] = LiftedDistance(a[k], b[k]) for kernel::kLanes pairs, the far
+  // ones computed together.
+  void LiftedDistanceLanes(const LiftedPoint* a, const LiftedPoint* b, double* out) const;
   // Approximate distance from a lifted point to sample `s` (case 2.1/2.2).
   double ToSample(const LiftedPoint& p, int32_t s) const;
   LiftedPoint VertexLift(int32_t v) const {
@@ -211,7 +210,9 @@ class QueryEngine {
                      double (&d)[3][3]) const;
   // Appends the face's ApproxLifts to approx_lifts_ when it has any.
   FaceLift MakeFaceLift(int32_t face);
-  // Prefetches what Lift(p) will read after the face's FaceLift.
+  // Prefetch what Lift(p) reads: the face and its FaceLift, then (once
+  // those are in cache) the ApproxLift or vertex record.
+  void PrefetchFace(const SurfacePoint& p) const;
   void PrefetchLift(const SurfacePoint& p) const;
   // Lifts a point of a face without a FaceLift; `heaviest` is the face
   // vertex of largest weight (the anchor when the vertices share none).
@@ -230,7 +231,7 @@ class QueryEngine {
   std::span<const index::GeodesicTriangle> triangles_;
   int32_t num_samples_ = 0;
   PointLocator locator_;
-  std::vector<EdgeFrame> frames_;         // 3 per geodesic triangle, derived at load
+  std::vector<kernel::Frame<double>> frames_;         // 3 per geodesic triangle, derived at load
   std::vector<FaceLift> face_lifts_;      // one per face, derived at load
   std::vector<ApproxLift> approx_lifts_;  // of the approximate faces
   std::unique_ptr<mesh::Mesh> mesh_;      // only with exact_near_pairs

@@ -176,10 +176,31 @@ TEST(QueryEngineTest, SymmetricZeroOnTheDiagonalAndInfiniteAcrossComponents) {
 TEST(QueryEngineTest, BatchEqualsSingleAndValidatesEveryPoint) {
   const Mesh m = gen::Sphere(3, 1.0);
   auto engine = MakeEngine(m, 40);
-  const auto a = RandomPoints(m, 100, 1), b = RandomPoints(m, 100, 2);
+  // Far pairs (computed several at a time), pairs in one face (one at a
+  // time), points at vertices, and lengths that are not a multiple of the
+  // lanes: each answer is the single query's, to the bit.
+  auto a = RandomPoints(m, 1003, 1), b = RandomPoints(m, 1003, 2);
+  for (size_t i = 0; i < a.size(); i += 5) a[i].w = {0, 1, 0};
+  for (size_t i = 0; i < a.size(); i += 7) b[i] = {a[i].face, {0.1, 0.2, 0.7}};
+  for (size_t n : {size_t{1}, size_t{3}, size_t{5}, size_t{9}, a.size()}) {
+    std::vector<double> out(n);
+    ASSERT_TRUE(engine->DistanceBatch(std::span(a).first(n), std::span(b).first(n), out).ok());
+    for (size_t i = 0; i < n; ++i) ASSERT_EQ(out[i], *engine->Distance(a[i], b[i])) << i;
+  }
+  const Mesh two = gen::TwoComponents(10);
+  auto split = MakeEngine(two, 20);
+  const auto c = RandomPoints(two, 64, 3), d = RandomPoints(two, 64, 4);
+  std::vector<double> split_out(c.size());
+  ASSERT_TRUE(split->DistanceBatch(c, d, split_out).ok());
+  int infinite = 0;
+  for (size_t i = 0; i < c.size(); ++i) {
+    EXPECT_EQ(split_out[i], *split->Distance(c[i], d[i]));
+    infinite += std::isinf(split_out[i]);
+  }
+  EXPECT_GT(infinite, 0);
+  EXPECT_LT(infinite, static_cast<int>(c.size()));
+
   std::vector<double> out(a.size());
-  ASSERT_TRUE(engine->DistanceBatch(a, b, out).ok());
-  for (size_t i = 0; i < a.size(); ++i) EXPECT_EQ(out[i], *engine->Distance(a[i], b[i]));
 
   auto bad = b;
   bad[42] = {m.num_faces(), {1, 0, 0}};
