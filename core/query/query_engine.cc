@@ -427,7 +427,11 @@ void QueryEngine::LiftedDistanceLanes(const LiftedPoint* a, const LiftedPoint* b
     far[k] = p.triangle != q.triangle && Matrix(q.corner[0], p.corner[0]) < kInf;
     pairs[k] = GatherFar(p, q);
   }
-  kernel::FarDistances(pairs, out);
+  if (options_.vector_lanes) {
+    kernel::FarDistances(pairs, out);
+  } else {
+    kernel::FarDistancesOneByOne(pairs, out);
+  }
   for (int k = 0; k < W; ++k) {
     if (!far[k]) out[k] = LiftedDistance(a[k], b[k]);
   }

@@ -49,6 +49,10 @@ struct QueryOptions {
   // Straighten traced paths through the faces they cross (funnel algorithm,
   // see path_straightening.h). Off: the raw gradient trace of §6.2.
   bool straighten_paths = true;
+  // DistanceBatch computes far pairs four at a time with AVX2 when the CPU
+  // has it (kernel::FarDistances); off: one at a time. The answers are the
+  // same to the bit either way; the switch is for benchmarks.
+  bool vector_lanes = true;
   // Barycentric tolerance for validation (weights >= -tol, |sum - 1| <= tol).
   double weight_tolerance = 1e-6;
 };
