@@ -25,6 +25,16 @@ inline int Heaviest(const SurfacePoint& p) {
   return k;
 }
 
+// Loads the first and last byte of [p, p + size) and discards them: a
+// prefetch that works. On the CPU measured (AMD EPYC, Zen 4, under a
+// hypervisor) software prefetches of the ApproxLifts were still missing L1
+// four pairs later 97.5% of the time (rdtscp around the first load); after
+// a load here, 13%.
+inline void Touch(const void* p, size_t size) {
+  const char* c = static_cast<const char*>(p);
+  asm volatile("" : : "r"(c[0]), "r"(c[size - 1]));
+}
+
 // sqrt(x^2 + y^2) without std::hypot's overflow care, which costs more than
 // the rest of a query.
 inline double Norm2(double x, double y) { return std::sqrt(x * x + y * y); }
@@ -349,8 +359,7 @@ void QueryEngine::PrefetchLift(const SurfacePoint& p) const {
     __builtin_prefetch(&records_[faces_[3 * p.face + k]]);
   } else if (fl.approx >= 0) {
     const char* line = reinterpret_cast<const char*>(&ApproxLiftOf(fl, k));
-    __builtin_prefetch(line);
-    __builtin_prefetch(line + sizeof(ApproxLift) - 1);
+    Touch(line, sizeof(ApproxLift));
   }
 }
 

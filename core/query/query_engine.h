@@ -214,8 +214,9 @@ class QueryEngine {
                      double (&d)[3][3]) const;
   // Appends the face's ApproxLifts to approx_lifts_ when it has any.
   FaceLift MakeFaceLift(int32_t face);
-  // Prefetch what Lift(p) reads: the face and its FaceLift, then (once
-  // those are in cache) the ApproxLift or vertex record.
+  // Bring in what Lift(p) reads: the face and its FaceLift (prefetched),
+  // then, once those are in cache, the ApproxLift (loaded: see Touch in the
+  // .cc) or the vertex record (prefetched).
   void PrefetchFace(const SurfacePoint& p) const;
   void PrefetchLift(const SurfacePoint& p) const;
   // Lifts a point of a face without a FaceLift; `heaviest` is the face
