@@ -447,16 +447,31 @@ void QueryEngine::LiftedDistanceLanes(const LiftedPoint* a, const LiftedPoint* b
 }
 
 double QueryEngine::DistanceUnchecked(const SurfacePoint& p, const SurfacePoint& q) const {
-  return LiftedDistance(Lift(p), Lift(q));
+  const LiftedPoint a = Lift(p), b = Lift(q);
+  const double d = LiftedDistance(a, b);
+  return AreNear(a, b) ? AtLeastChord(p, q, d) : d;
 }
 
-bool QueryEngine::IsNearPair(const SurfacePoint& p, const SurfacePoint& q) const {
-  const LiftedPoint a = Lift(Canonical(p)), b = Lift(Canonical(q));
+bool QueryEngine::AreNear(const LiftedPoint& a, const LiftedPoint& b) const {
   if (a.triangle == b.triangle) return true;
   for (int i = 0; i < 3; ++i) {
     if (triangles_[a.triangle].neighbor[i] == b.triangle) return true;
   }
   return false;
+}
+
+bool QueryEngine::IsNearPair(const SurfacePoint& p, const SurfacePoint& q) const {
+  return AreNear(Lift(Canonical(p)), Lift(Canonical(q)));
+}
+
+mesh::Vec3 QueryEngine::PositionOf(const SurfacePoint& p) const {
+  mesh::Vec3 out(0, 0, 0);
+  for (int i = 0; i < 3; ++i) out += p.w[i] * Position(faces_[3 * p.face + i]);
+  return out;
+}
+
+double QueryEngine::AtLeastChord(const SurfacePoint& p, const SurfacePoint& q, double d) const {
+  return std::max(d, (PositionOf(p) - PositionOf(q)).norm());
 }
 
 double QueryEngine::ExactNearDistance(const SurfacePoint& p, const SurfacePoint& q,
@@ -553,10 +568,18 @@ absl::Status QueryEngine::DistanceBatch(std::span<const SurfacePoint> a,
     }
     LiftedDistanceLanes(&lift_a[i % kRing], &lift_b[i % kRing], &out[i]);
     for (size_t k = i; k < i + W; ++k) {
+      if (AreNear(lift_a[k % kRing], lift_b[k % kRing])) {
+        out[k] = AtLeastChord(Canonical(a[k]), Canonical(b[k]), out[k]);
+      }
       if (k + kLiftAhead < n) lift(k + kLiftAhead);
     }
   }
-  for (; i < n; ++i) out[i] = LiftedDistance(lift_a[i % kRing], lift_b[i % kRing]);
+  for (; i < n; ++i) {
+    const LiftedPoint& p = lift_a[i % kRing];
+    const LiftedPoint& q = lift_b[i % kRing];
+    out[i] = LiftedDistance(p, q);
+    if (AreNear(p, q)) out[i] = AtLeastChord(Canonical(a[i]), Canonical(b[i]), out[i]);
+  }
   return absl::OkStatus();
 }
 
@@ -579,12 +602,15 @@ double QueryEngine::LinearInterpolationDistance(const SurfacePoint& p0,
 absl::StatusOr<DistanceField> QueryEngine::Field(std::span<const SurfacePoint> sources) const {
   if (sources.empty()) return absl::InvalidArgumentError("no sources given");
   std::vector<LiftedPoint> lifted;
+  std::vector<mesh::Vec3> at;
   for (size_t s = 0; s < sources.size(); ++s) {
     const absl::Status status = Validate(sources[s]);
     if (!status.ok()) {
       return absl::Status(status.code(), absl::StrFormat("source %d: %s", s, status.message()));
     }
-    lifted.push_back(Lift(Canonical(sources[s])));
+    const SurfacePoint source = Canonical(sources[s]);
+    lifted.push_back(Lift(source));
+    at.push_back(PositionOf(source));
   }
   DistanceField field;
   const int32_t n = index_->num_vertices();
@@ -600,7 +626,8 @@ absl::StatusOr<DistanceField> QueryEngine::Field(std::span<const SurfacePoint> s
       x.distance[c] = r.distance[c];
     }
     for (size_t s = 0; s < lifted.size(); ++s) {
-      const double d = LiftedDistance(lifted[s], x);
+      double d = LiftedDistance(lifted[s], x);
+      if (AreNear(lifted[s], x)) d = std::max(d, (at[s] - Position(v)).norm());  // AtLeastChord
       if (d < field.distance[v]) {
         field.distance[v] = d;
         field.nearest[v] = static_cast<int32_t>(s);

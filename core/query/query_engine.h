@@ -109,7 +109,9 @@ class QueryEngine {
   absl::Status DistanceBatch(std::span<const SurfacePoint> a, std::span<const SurfacePoint> b,
                              std::span<double> out, QueryScratch* scratch = nullptr) const;
 
-  // The pure O(1) distance for valid points (no checks, no near-pair fix).
+  // The O(1) distance for valid points (no checks, no exact near pairs):
+  // the unfolding of §5, and for near pairs at least the straight-line
+  // distance between the points (no surface path is shorter).
   double DistanceUnchecked(const SurfacePoint& p, const SurfacePoint& q) const;
 
   // True when the points lift into the same or adjacent geodesic triangles.
@@ -134,7 +136,8 @@ class QueryEngine {
   absl::StatusOr<std::vector<PathPoint>> TracePath(const SurfacePoint& from,
                                                    const SurfacePoint& to) const;
 
-  // Distance from the nearest of `sources` to every vertex, O(l n).
+  // Distance from the nearest of `sources` to every vertex, O(l n): the
+  // minimum over sources of DistanceUnchecked (the O(1) mode).
   // Errors: as Validate (naming the source index); InvalidArgument if empty.
   absl::StatusOr<DistanceField> Field(std::span<const SurfacePoint> sources) const;
 
@@ -157,6 +160,13 @@ class QueryEngine {
   // from p's face, that vertex, a vertex of p's face sharing a face with it,
   // then p; consecutive points share a face.
   std::vector<std::vector<PathPoint>> RingChains(const SurfacePoint& p) const;
+  // True when the lifts share a geodesic triangle or are in adjacent ones.
+  bool AreNear(const LiftedPoint& a, const LiftedPoint& b) const;
+  // max(d, |p - q|) for near pairs: the unfolding is weakest there (§6.5)
+  // and can come out below the straight line; far pairs practically never
+  // do, so they skip the six position loads.
+  double AtLeastChord(const SurfacePoint& p, const SurfacePoint& q, double d) const;
+  mesh::Vec3 PositionOf(const SurfacePoint& p) const;
   // What case 3.2 reads for a pair, p in the triangle of smaller id.
   kernel::FarPair GatherFar(const LiftedPoint& p, const LiftedPoint& q) const;
   // out[k] = LiftedDistance(a[k], b[k]) for kernel::kLanes pairs, the far
