@@ -246,10 +246,10 @@ class QueryEngine {
   std::span<const index::GeodesicTriangle> triangles_;
   int32_t num_samples_ = 0;
   PointLocator locator_;
-  std::vector<kernel::Frame<double>> frames_;         // 3 per geodesic triangle, derived at load
-  std::vector<FaceLift> face_lifts_;      // one per face, derived at load
-  std::vector<ApproxLift> approx_lifts_;  // of the approximate faces
-  std::unique_ptr<mesh::Mesh> mesh_;      // only with exact_near_pairs
+  std::vector<kernel::Frame<double>> frames_;  // 3 per geodesic triangle, derived at load
+  std::vector<FaceLift> face_lifts_;           // one per face, derived at load
+  std::vector<ApproxLift> approx_lifts_;       // of the approximate faces
+  std::unique_ptr<mesh::Mesh> mesh_;           // only with exact_near_pairs
 };
 
 }  // namespace geodex::query

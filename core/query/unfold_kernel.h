@@ -207,15 +207,15 @@ inline T FarDistance(const Frame<T>* p_frames, const T* p_distance, const Frame<
   const Placed<T> p_placed = PlaceInTriangle(p_frames, p_distance);
   T to_corner[3];
   for (int j = 0; j < 3; ++j) {
-    to_corner[j] = Select(shared[j] >= 0.0, shared[j],
-                          Sqrt(TwoSideToOutside2(p_frames, p_placed, e[j])));
+    to_corner[j] =
+        Select(shared[j] >= 0.0, shared[j], Sqrt(TwoSideToOutside2(p_frames, p_placed, e[j])));
   }
   return Sqrt(TwoSideToOutside2(q_frames, PlaceInTriangle(q_frames, q_distance), to_corner));
 }
 
 inline double FarDistance(const FarPair& pair) {
-  return FarDistance<double>(pair.p_frames, pair.p_distance, pair.q_frames, pair.q_distance,
-                             pair.e, pair.shared);
+  return FarDistance<double>(pair.p_frames, pair.p_distance, pair.q_frames, pair.q_distance, pair.e,
+                             pair.shared);
 }
 
 }  // inline namespace

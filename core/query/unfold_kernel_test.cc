@@ -85,7 +85,7 @@ TEST(UnfoldKernelTest, Avx2LanesEqualOnePairAtATimeToTheBit) {
 TEST(UnfoldKernelTest, DevelopableCaseIsExact) {
   // Two triangles of one plane: p in the first, q in the second, far apart;
   // the unfolded distance is the planar one.
-  const double a[2] = {0, 0}, b[2] = {1, 0}, c[2] = {0.3, 0.9};  // p's triangle
+  const double a[2] = {0, 0}, b[2] = {1, 0}, c[2] = {0.3, 0.9};    // p's triangle
   const double d[2] = {5, 1}, e[2] = {6, 0.5}, f[2] = {5.6, 1.8};  // q's triangle
   const double p[2] = {0.4, 0.3}, q[2] = {5.5, 1.1};
   auto dist = [](const double* x, const double* y) { return std::hypot(x[0] - y[0], x[1] - y[1]); };

@@ -164,8 +164,8 @@ void Bench(const std::string& label, std::shared_ptr<const index::Index> ix, int
       "MiB) |\n",
       label.c_str(), ix->num_vertices(), ix->num_samples(), vertex_rate / 1e6, interior_rate / 1e6,
       batch_rate / 1e6, scalar_batch_rate / 1e6, gather_rate / 1e6, gather_rate / batch_rate,
-      linear_rate / 1e6,
-      packed_gather_rate / 1e6, m * m * 4 / (1 << 20), m * (m - 1) / 2 * 4 / (1 << 20));
+      linear_rate / 1e6, packed_gather_rate / 1e6, m * m * 4 / (1 << 20),
+      m * (m - 1) / 2 * 4 / (1 << 20));
 }
 
 }  // namespace
@@ -184,8 +184,8 @@ int main(int argc, char** argv) {
       "gather-only, packed matrix/s (full / packed size) |\n"
       "|---|---|---|---|---|---|---|---|---|---|---|\n");
   std::printf("(batch: far pairs %s)\n", geodex::query::kernel::HasAvx2Lanes()
-                                              ? "four at a time with AVX2"
-                                              : "one at a time: no AVX2 in this build or CPU");
+                                             ? "four at a time with AVX2"
+                                             : "one at a time: no AVX2 in this build or CPU");
   if (indexes.empty()) {
     std::printf("(no --index given: a generated sphere, m = 500)\n");
     geodex::build::BuildOptions options;
