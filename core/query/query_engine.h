@@ -17,8 +17,10 @@
 // distance once.
 //
 // Near pairs (the same or adjacent geodesic triangles, §6.5) are the method's
-// weak spot; with QueryOptions::exact_near_pairs they are answered by a local
-// exact propagation that stops as soon as the second point is reached.
+// weak spot; in the O(1) mode they are kept at least the straight-line
+// distance apart, and with QueryOptions::exact_near_pairs they are answered
+// by a local exact propagation that stops as soon as the second point is
+// reached.
 //
 // Thread safety: a QueryEngine is immutable; all const methods are safe from
 // any number of threads. Methods that need scratch space take a QueryScratch,
