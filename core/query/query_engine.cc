@@ -529,7 +529,8 @@ absl::Status QueryEngine::DistanceBatch(std::span<const SurfacePoint> a,
   // A query's loads depend on each other (face -> face lift -> approximate
   // lift or vertex record -> geodesic triangles -> sample matrix), so the
   // batch runs as a software pipeline: the faces 16 pairs ahead are
-  // prefetched, what their lifts read next 12 ahead, the points 8 ahead are
+  // prefetched, what their lifts read next is brought in 12 ahead (see
+  // PrefetchLift), the points 8 ahead are
   // lifted (and the frames and matrix entries their distance will read are
   // prefetched), and the distances are computed from the lifts, kLanes pairs
   // per instruction.
