@@ -465,9 +465,8 @@ bool QueryEngine::IsNearPair(const SurfacePoint& p, const SurfacePoint& q) const
 }
 
 mesh::Vec3 QueryEngine::PositionOf(const SurfacePoint& p) const {
-  mesh::Vec3 out(0, 0, 0);
-  for (int i = 0; i < 3; ++i) out += p.w[i] * Position(faces_[3 * p.face + i]);
-  return out;
+  const int32_t* f = &faces_[3 * p.face];
+  return p.w[0] * Position(f[0]) + p.w[1] * Position(f[1]) + p.w[2] * Position(f[2]);
 }
 
 double QueryEngine::AtLeastChord(const SurfacePoint& p, const SurfacePoint& q, double d) const {

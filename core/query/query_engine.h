@@ -168,6 +168,7 @@ class QueryEngine {
   // and can come out below the straight line; far pairs practically never
   // do, so they skip the six position loads.
   double AtLeastChord(const SurfacePoint& p, const SurfacePoint& q, double d) const;
+  // The 3D position of a surface point.
   mesh::Vec3 PositionOf(const SurfacePoint& p) const;
   // What case 3.2 reads for a pair, p in the triangle of smaller id.
   kernel::FarPair GatherFar(const LiftedPoint& p, const LiftedPoint& q) const;

@@ -179,13 +179,10 @@ std::vector<std::vector<PathPoint>> QueryEngine::RingChains(const SurfacePoint& 
     point.w[LocalIndex(faces_, f, v)] = 1;
     return PathPoint{point, Position(v)};
   };
-  const PathPoint tip{p, p.w[0] * Position(faces_[3 * p.face]) +
-                             p.w[1] * Position(faces_[3 * p.face + 1]) +
-                             p.w[2] * Position(faces_[3 * p.face + 2])};
+  const PathPoint tip{p, PositionOf(p)};
   Tracer tr{*this, positions_, faces_, twins_, {}, {}};
   std::vector<std::vector<PathPoint>> chains;
-  std::vector<int32_t> seen = {faces_[3 * p.face], faces_[3 * p.face + 1],
-                               faces_[3 * p.face + 2]};
+  std::vector<int32_t> seen = {faces_[3 * p.face], faces_[3 * p.face + 1], faces_[3 * p.face + 2]};
   for (int i = 0; i < 3; ++i) {
     const int32_t u = faces_[3 * p.face + i];
     for (int32_t g : tr.FacesAround(u, p.face)) {
@@ -220,9 +217,8 @@ absl::StatusOr<std::vector<PathPoint>> QueryEngine::TracePath(const SurfacePoint
     return true;  // the source is a vertex or edge point of f
   };
   auto point_at = [&](int32_t f, const std::array<double, 3>& b) {
-    SurfacePoint p{f, b};
-    return PathPoint{p, b[0] * Position(faces_[3 * f]) + b[1] * Position(faces_[3 * f + 1]) +
-                            b[2] * Position(faces_[3 * f + 2])};
+    const SurfacePoint p{f, b};
+    return PathPoint{p, PositionOf(p)};
   };
   auto vertex_point = [&](int32_t f, int32_t v) {
     std::array<double, 3> b = {0, 0, 0};

@@ -178,14 +178,14 @@ int main(int argc, char** argv) {
   app.add_option("--index", indexes, "Index files to measure");
   app.add_option("--pairs", pairs, "Pairs per measurement");
   CLI11_PARSE(app, argc, argv);
+  std::printf("(batch: far pairs %s)\n", geodex::query::kernel::HasAvx2Lanes()
+                                             ? "four at a time with AVX2"
+                                             : "one at a time: no AVX2 in this build or CPU");
   std::printf(
       "| index | vertices | m | vertex pairs/s | interior pairs/s | batch (validated) pairs/s | "
       "batch, one pair at a time/s | gather-only/s | gather/batch | linear baseline/s | "
       "gather-only, packed matrix/s (full / packed size) |\n"
       "|---|---|---|---|---|---|---|---|---|---|---|\n");
-  std::printf("(batch: far pairs %s)\n", geodex::query::kernel::HasAvx2Lanes()
-                                             ? "four at a time with AVX2"
-                                             : "one at a time: no AVX2 in this build or CPU");
   if (indexes.empty()) {
     std::printf("(no --index given: a generated sphere, m = 500)\n");
     geodex::build::BuildOptions options;
