@@ -78,7 +78,7 @@ absl::StatusOr<const query::QueryEngine*> ServedVersion::ExactEngine() const {
   if (exact_ != nullptr) return exact_.get();
   if (!exact_status_.ok()) return exact_status_;
   query::QueryOptions options;
-  options.exact_near_pairs = true;
+  options.near_pairs = query::NearPairs::kExact;
   auto engine = query::QueryEngine::Create(index_, options);
   if (!engine.ok()) {
     exact_status_ = engine.status();

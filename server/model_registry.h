@@ -73,7 +73,7 @@ struct FileId {
 // engine is built on first use (ExactEngine).
 class ServedVersion {
  public:
-  // Opens and validates `path` and builds the O(1) engine; with
+  // Opens and validates `path` and builds the default engine; with
   // `build_exact`, the exact-near-pairs engine too. Errors: those of
   // index::Index::Open and query::QueryEngine::Create.
   static absl::StatusOr<std::shared_ptr<const ServedVersion>> Load(int64_t version,
@@ -87,7 +87,8 @@ class ServedVersion {
   const index::Index& index() const { return *index_; }
   // Bytes of the mapped index file.
   int64_t mapped_bytes() const { return static_cast<int64_t>(index_->size_bytes()); }
-  // The pure O(1) engine.
+  // The default engine: far pairs in O(1), near pairs by the length of their
+  // path (query::NearPairs::kPath).
   const query::QueryEngine& engine() const { return *engine_; }
   // The engine answering near pairs by local exact propagation, built (once,
   // on the calling thread) on first use. Errors: QueryEngine::Create's.

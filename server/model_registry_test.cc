@@ -259,7 +259,7 @@ TEST_F(ModelRegistryTest, ExactEngineIsBuiltOnce) {
   auto e2 = resolved->version->ExactEngine();
   ASSERT_TRUE(e1.ok()) << e1.status();
   EXPECT_EQ(*e1, *e2);
-  EXPECT_TRUE((*e1)->options().exact_near_pairs);
+  EXPECT_EQ((*e1)->options().near_pairs, query::NearPairs::kExact);
 }
 
 }  // namespace

@@ -71,7 +71,7 @@ std::shared_ptr<const query::QueryEngine> ReferenceEngine(const std::string& byt
   auto index = index::Index::FromBytes(bytes);
   EXPECT_TRUE(index.ok()) << index.status();
   query::QueryOptions options;
-  options.exact_near_pairs = exact;
+  if (exact) options.near_pairs = query::NearPairs::kExact;
   auto engine = query::QueryEngine::Create(*index, options);
   EXPECT_TRUE(engine.ok()) << engine.status();
   return *engine;

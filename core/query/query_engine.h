@@ -17,10 +17,12 @@
 // distance once.
 //
 // Near pairs (the same or adjacent geodesic triangles, §6.5) are the method's
-// weak spot; in the O(1) mode they are kept at least the straight-line
-// distance apart, and with QueryOptions::exact_near_pairs they are answered
-// by a local exact propagation that stops as soon as the second point is
-// reached.
+// weak spot. By default they are answered by the length of a path between
+// them (the gradient traces of both points' fields, straightened, as Path
+// does first; O(k) in the faces crossed, a few dozen for a near pair): p99
+// 0.3% where the O(1) unfolding errs by 10% on a scanned bunny.
+// QueryOptions::near_pairs selects the pure O(1) unfolding instead, or a
+// local exact propagation (see NearPairs).
 //
 // Thread safety: a QueryEngine is immutable; all const methods are safe from
 // any number of threads. Methods that need scratch space take a QueryScratch,
@@ -44,10 +46,25 @@ namespace geodex::query {
 
 using mesh::SurfacePoint;
 
+// How Distance and DistanceBatch answer near pairs (points in the same or
+// adjacent geodesic triangles).
+enum class NearPairs {
+  // Pure O(1): the unfolding of §5, kept at least the straight-line distance
+  // apart (no surface path is shorter).
+  kUnfold,
+  // The length of the shorter of the straightened gradient traces of p's
+  // and q's fields (Path without its restarts, so Path can be shorter): a
+  // surface path, never below the geodesic distance; O(k) in the faces it
+  // crosses.
+  kPath,
+  // A local exact propagation from one point that stops when it reaches the
+  // other (needs a QueryScratch; without one, kUnfold). About 8x the cost of
+  // kPath.
+  kExact,
+};
+
 struct QueryOptions {
-  // Answer pairs in the same or adjacent geodesic triangles exactly, by a
-  // local propagation (not O(1); needs a QueryScratch). Off: pure O(1).
-  bool exact_near_pairs = false;
+  NearPairs near_pairs = NearPairs::kPath;
   // Straighten traced paths through the faces they cross (funnel algorithm,
   // see path_straightening.h). Off: the raw gradient trace of §6.2.
   bool straighten_paths = true;
@@ -90,7 +107,7 @@ struct DistanceField {
 class QueryEngine {
  public:
   // Errors: FailedPrecondition if the index has no triangles; errors of
-  // mesh::Mesh::Create when exact_near_pairs needs the mesh.
+  // mesh::Mesh::Create when NearPairs::kExact needs the mesh.
   static absl::StatusOr<std::shared_ptr<const QueryEngine>> Create(
       std::shared_ptr<const index::Index> index, QueryOptions options = {});
 
@@ -102,18 +119,21 @@ class QueryEngine {
   absl::Status Validate(const SurfacePoint& p) const;
 
   // Approximate geodesic distance; +inf between components. Validates both
-  // points. Symmetric: Distance(p, q) == Distance(q, p) exactly.
+  // points. Symmetric: Distance(p, q) == Distance(q, p) exactly. Near pairs
+  // are answered as options().near_pairs says.
   absl::StatusOr<double> Distance(const SurfacePoint& p, const SurfacePoint& q,
                                   QueryScratch* scratch = nullptr) const;
 
   // Batch: out[i] = Distance(a[i], b[i]). Validates everything first (the
-  // error names the pair index) and allocates nothing in the O(1) mode.
+  // error names the pair index). Far pairs allocate nothing; near pairs
+  // (rare: two random points are near with probability about 4 / number of
+  // geodesic triangles) allocate in the kPath and kExact modes.
   absl::Status DistanceBatch(std::span<const SurfacePoint> a, std::span<const SurfacePoint> b,
                              std::span<double> out, QueryScratch* scratch = nullptr) const;
 
-  // The O(1) distance for valid points (no checks, no exact near pairs):
-  // the unfolding of §5, and for near pairs at least the straight-line
-  // distance between the points (no surface path is shorter).
+  // The O(1) distance for valid points (no checks; near pairs as in the
+  // kUnfold mode): the unfolding of §5, and for near pairs at least the
+  // straight-line distance between the points.
   double DistanceUnchecked(const SurfacePoint& p, const SurfacePoint& q) const;
 
   // True when the points lift into the same or adjacent geodesic triangles.
@@ -139,7 +159,8 @@ class QueryEngine {
                                                    const SurfacePoint& to) const;
 
   // Distance from the nearest of `sources` to every vertex, O(l n): the
-  // minimum over sources of DistanceUnchecked (the O(1) mode).
+  // minimum over sources of DistanceUnchecked (the O(1) mode, whatever
+  // options().near_pairs says).
   // Errors: as Validate (naming the source index); InvalidArgument if empty.
   absl::StatusOr<DistanceField> Field(std::span<const SurfacePoint> sources) const;
 
@@ -235,8 +256,17 @@ class QueryEngine {
   // Lifts a point of a face without a FaceLift; `heaviest` is the face
   // vertex of largest weight (the anchor when the vertices share none).
   LiftedPoint SlowLift(const SurfacePoint& p, int heaviest) const;
+  // The answer for a near pair of canonical points whose unfolded distance
+  // is `unfolded`, by options_.near_pairs.
+  double NearDistance(const SurfacePoint& p, const SurfacePoint& q, double unfolded,
+                      QueryScratch* scratch) const;
   double ExactNearDistance(const SurfacePoint& p, const SurfacePoint& q,
                            QueryScratch* scratch) const;
+  double PathNearDistance(const SurfacePoint& p, const SurfacePoint& q) const;
+  // Path, with the restarts or without (then only the traces of both fields,
+  // straightened).
+  absl::StatusOr<std::vector<PathPoint>> ShortestTrace(const SurfacePoint& from,
+                                                       const SurfacePoint& to, bool restarts) const;
   SurfacePoint Canonical(const SurfacePoint& p) const;
 
   std::shared_ptr<const index::Index> index_;
@@ -252,7 +282,7 @@ class QueryEngine {
   std::vector<kernel::Frame<double>> frames_;  // 3 per geodesic triangle, derived at load
   std::vector<FaceLift> face_lifts_;           // one per face, derived at load
   std::vector<ApproxLift> approx_lifts_;       // of the approximate faces
-  std::unique_ptr<mesh::Mesh> mesh_;           // only with exact_near_pairs
+  std::unique_ptr<mesh::Mesh> mesh_;           // only with NearPairs::kExact
 };
 
 }  // namespace geodex::query

@@ -219,7 +219,7 @@ TEST(QueryEngineTest, BatchEqualsSingleAndValidatesEveryPoint) {
 TEST(QueryEngineTest, ExactNearPairsMatchTheExactEngine) {
   const Mesh m = gen::Sphere(4, 1.0);
   QueryOptions options;
-  options.exact_near_pairs = true;
+  options.near_pairs = NearPairs::kExact;
   auto engine = MakeEngine(m, 60, options);
   QueryScratch scratch;
   const auto points = RandomPoints(m, 400, 9);
@@ -231,6 +231,50 @@ TEST(QueryEngineTest, ExactNearPairsMatchTheExactEngine) {
     EXPECT_NEAR(*engine->Distance(points[i], points[i + 1], &scratch), exact, 1e-9 * (1 + exact));
   }
   EXPECT_GT(near, 0);
+}
+
+double PathLength(const std::vector<PathPoint>& path) {
+  double length = 0;
+  for (size_t k = 1; k < path.size(); ++k)
+    length += (path[k].position - path[k - 1].position).norm();
+  return length;
+}
+
+TEST(QueryEngineTest, NearPairsAreThePathLengthByDefault) {
+  const Mesh m = gen::Grid(30, 30, 1.0, 1.0, 0.2, 4);
+  auto engine = MakeEngine(m, 40);
+  QueryOptions unfold_options;
+  unfold_options.near_pairs = NearPairs::kUnfold;
+  auto unfold = MakeEngine(m, 40, unfold_options);
+  const auto points = RandomPoints(m, 800, 12);
+  int near = 0;
+  double worst = 0, worst_unfold = 0;
+  std::vector<SurfacePoint> a, b;
+  for (size_t i = 0; i + 1 < points.size(); i += 2) {
+    const SurfacePoint& p = points[i];
+    const SurfacePoint& q = points[i + 1];
+    if (!engine->IsNearPair(p, q)) continue;
+    ++near;
+    a.push_back(p);
+    b.push_back(q);
+    const double d = *engine->Distance(p, q);
+    EXPECT_EQ(d, *engine->Distance(q, p));
+    // A path's length: Path's own, or longer when Path's restarts found a
+    // shorter one.
+    auto path = engine->Path(p, q);
+    ASSERT_TRUE(path.ok());
+    EXPECT_GE(d, PathLength(*path) * (1 - 1e-12));
+    const double exact = Exact(m, p, q);
+    EXPECT_GE(d, exact * (1 - 1e-9));  // a surface path
+    worst = std::max(worst, (d - exact) / exact);
+    worst_unfold = std::max(worst_unfold, std::abs(*unfold->Distance(p, q) - exact) / exact);
+  }
+  EXPECT_GT(near, 10);
+  EXPECT_LT(worst, 0.01);
+  EXPECT_LT(worst, worst_unfold);
+  std::vector<double> out(a.size());
+  ASSERT_TRUE(engine->DistanceBatch(a, b, out).ok());
+  for (size_t i = 0; i < a.size(); ++i) EXPECT_EQ(out[i], *engine->Distance(a[i], b[i]));
 }
 
 TEST(QueryEngineTest, PathsStayOnTheSurfaceAndAreNearlyGeodesic) {
@@ -251,13 +295,6 @@ TEST(QueryEngineTest, PathsStayOnTheSurfaceAndAreNearlyGeodesic) {
     }
     EXPECT_LE(length, (a - b).norm() * 1.01 + 1e-9);
   }
-}
-
-double PathLength(const std::vector<PathPoint>& path) {
-  double length = 0;
-  for (size_t k = 1; k < path.size(); ++k)
-    length += (path[k].position - path[k - 1].position).norm();
-  return length;
 }
 
 // Consecutive points share a face of the mesh.
@@ -336,7 +373,7 @@ TEST(QueryEngineTest, FieldIsTheMinimumOverSources) {
     double best = 1e300;
     int32_t nearest = -1;
     for (int32_t s = 0; s < 3; ++s) {
-      const double d = *engine->Distance(sources[s], p);
+      const double d = engine->DistanceUnchecked(sources[s], p);
       if (d < best) best = d, nearest = s;
     }
     EXPECT_NEAR(field->distance[v], best, 1e-12);

@@ -123,6 +123,12 @@ int LocalIndex(std::span<const int32_t> faces, int32_t f, int32_t v) {
 
 absl::StatusOr<std::vector<PathPoint>> QueryEngine::Path(const SurfacePoint& from,
                                                          const SurfacePoint& to) const {
+  return ShortestTrace(from, to, /*restarts=*/true);
+}
+
+absl::StatusOr<std::vector<PathPoint>> QueryEngine::ShortestTrace(const SurfacePoint& from,
+                                                                  const SurfacePoint& to,
+                                                                  bool restarts) const {
   GEODEX_RETURN_IF_ERROR(Validate(from));
   GEODEX_RETURN_IF_ERROR(Validate(to));
   GEODEX_ASSIGN_OR_RETURN(std::vector<PathPoint> path, TracePath(from, to));
@@ -155,7 +161,7 @@ absl::StatusOr<std::vector<PathPoint>> QueryEngine::Path(const SurfacePoint& fro
   // Then trace again from each vertex one ring out from either end's face,
   // join the end along one or two mesh edges, straighten, and keep the
   // shortest. Starts that close fall on both sides of the cut locus.
-  if (!(best > kPathRestartRatio * DistanceUnchecked(from, to))) return path;
+  if (!restarts || !(best > kPathRestartRatio * DistanceUnchecked(from, to))) return path;
   for (int end = 0; end < 2; ++end) {
     const SurfacePoint& origin = end == 0 ? from : to;  // the traced field's source
     const SurfacePoint& tip = end == 0 ? to : from;

@@ -1,6 +1,6 @@
 // geodex-query: answers queries offline from an index file, without a server.
 //
-//   geodex-query INDEX --pairs FILE [--exact-near-pairs] [--linear-baseline]
+//   geodex-query INDEX --pairs FILE [--near-pairs path|unfold|exact] [--linear-baseline]
 //   geodex-query INDEX --paths FILE [--format xyz|json]
 //   geodex-query INDEX --field SOURCES [--nearest]
 //   geodex-query INDEX --locate POINTS
@@ -78,14 +78,16 @@ absl::Status CheckPairs(const query::QueryEngine& engine,
 }
 
 struct Args {
-  std::string index, pairs, paths, field, locate, format = "xyz";
+  std::string index, pairs, paths, field, locate, format = "xyz", near_pairs = "path";
   bool exact_near = false, baseline = false, nearest = false;
 };
 
 absl::Status Run(const Args& args) {
   GEODEX_ASSIGN_OR_RETURN(auto index, index::Index::Open(args.index));
   query::QueryOptions options;
-  options.exact_near_pairs = args.exact_near;
+  options.near_pairs = args.exact_near || args.near_pairs == "exact" ? query::NearPairs::kExact
+                       : args.near_pairs == "unfold"                  ? query::NearPairs::kUnfold
+                                                                      : query::NearPairs::kPath;
   GEODEX_ASSIGN_OR_RETURN(auto engine, query::QueryEngine::Create(index, options));
   std::string out;
   if (!args.pairs.empty() || !args.paths.empty()) {
@@ -171,8 +173,11 @@ int main(int argc, char** argv) {
   pairs->excludes(paths)->excludes(field)->excludes(locate);
   paths->excludes(field)->excludes(locate);
   field->excludes(locate);
-  app.add_flag("--exact-near-pairs", args.exact_near,
-               "Answer pairs in the same or adjacent geodesic triangles exactly (not O(1))");
+  app.add_option("--near-pairs", args.near_pairs,
+                 "Pairs in the same or adjacent geodesic triangles: path (the traced path's "
+                 "length, default), unfold (pure O(1)) or exact (local exact propagation)")
+      ->check(CLI::IsMember({"path", "unfold", "exact"}));
+  app.add_flag("--exact-near-pairs", args.exact_near, "Same as --near-pairs exact");
   app.add_flag("--linear-baseline", args.baseline, "The paper's linear interpolation (§6.3)");
   app.add_flag("--nearest", args.nearest, "With --field: also print the nearest source");
   app.add_option("--format", args.format, "Path output: xyz (blank line between paths) or json")

@@ -8,14 +8,17 @@
 // pairs (all, and the far ones), and over near pairs (the same or adjacent
 // geodesic triangles), which uniform pairs rarely are, so they are drawn on
 // purpose: area-uniform points of the faces of each source's geodesic
-// triangle and its neighbours; for the
-// pure O(1) mode, the exact-near-pairs mode and the paper's linear
-// interpolation baseline (§6.3); and path length / exact distance.
+// triangle and its neighbours; for each way of answering near pairs
+// (query::NearPairs: the pure O(1) unfolding, the path length, the local
+// exact propagation) and the paper's linear interpolation baseline (§6.3);
+// and path length / exact distance.
 
 #include <cstdint>
 #include <string>
 #include <vector>
 
+#include "absl/status/statusor.h"
+#include "core/index/index.h"
 #include "core/mesh/mesh.h"
 #include "core/query/query_engine.h"
 
@@ -28,10 +31,13 @@ struct ErrorStats {
 };
 
 struct AccuracyReport {
-  // all, far, all_exact_mode, baseline: area-uniform pairs; near,
-  // near_exact_mode: the near pairs drawn on purpose and the uniform ones
-  // that happen to be near.
-  ErrorStats all, far, near, near_exact_mode, all_exact_mode, baseline, path_ratio;
+  // all, far, all_*_mode, baseline: area-uniform pairs; near, near_*_mode:
+  // the near pairs drawn on purpose and the uniform ones that happen to be
+  // near. all, far and near are the pure O(1) mode (NearPairs::kUnfold); far
+  // pairs are the same in every mode.
+  ErrorStats all, far, near, baseline, path_ratio;
+  ErrorStats near_path_mode, all_path_mode;    // NearPairs::kPath (the default)
+  ErrorStats near_exact_mode, all_exact_mode;  // NearPairs::kExact
   ErrorStats traced_path_ratio;  // the gradient trace before straightening
   std::string ToMarkdownRow(const std::string& label) const;
   static std::string MarkdownHeader();
@@ -49,10 +55,14 @@ struct AccuracyOptions {
 std::vector<mesh::SurfacePoint> RandomSurfacePoints(const mesh::Mesh& mesh, int32_t count,
                                                     uint64_t seed);
 
-// `engine` must be built from `mesh`; `exact_engine`, built with
-// exact_near_pairs, may be null (then the exact-mode rows stay empty).
-AccuracyReport MeasureAccuracy(const mesh::Mesh& mesh, const query::QueryEngine& engine,
-                               const query::QueryEngine* exact_engine,
+// One engine per way of answering near pairs, over the same index.
+struct Engines {
+  std::shared_ptr<const query::QueryEngine> unfold, path, exact;
+};
+absl::StatusOr<Engines> MakeEngines(std::shared_ptr<const index::Index> index);
+
+// The engines must be built from an index of `mesh`.
+AccuracyReport MeasureAccuracy(const mesh::Mesh& mesh, const Engines& engines,
                                const AccuracyOptions& options);
 
 }  // namespace geodex::accuracy

@@ -49,11 +49,8 @@ absl::Status Run(const std::vector<std::string>& meshes, const std::vector<int32
         std::fprintf(stderr, "built %s: %s", file.c_str(), summary.ToText().c_str());
       }
       GEODEX_ASSIGN_OR_RETURN(auto index, index::Index::Open(file));
-      GEODEX_ASSIGN_OR_RETURN(auto engine, query::QueryEngine::Create(index));
-      query::QueryOptions exact_options;
-      exact_options.exact_near_pairs = true;
-      GEODEX_ASSIGN_OR_RETURN(auto exact_engine, query::QueryEngine::Create(index, exact_options));
-      const auto report = accuracy::MeasureAccuracy(m, *engine, exact_engine.get(), options);
+      GEODEX_ASSIGN_OR_RETURN(const accuracy::Engines engines, accuracy::MakeEngines(index));
+      const auto report = accuracy::MeasureAccuracy(m, engines, options);
       std::printf("%s", report.ToMarkdownRow(absl::StrFormat("%s m=%d", name, count)).c_str());
       std::fflush(stdout);
     }

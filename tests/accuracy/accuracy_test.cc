@@ -22,15 +22,13 @@ AccuracyReport Measure(const mesh::Mesh& m, int32_t samples, int32_t points, int
   EXPECT_TRUE(data.ok()) << data.status();
   auto index = index::Index::FromBytes(*index::SerializeIndex(*data));
   EXPECT_TRUE(index.ok());
-  auto engine = query::QueryEngine::Create(*index);
-  query::QueryOptions exact;
-  exact.exact_near_pairs = true;
-  auto exact_engine = query::QueryEngine::Create(*index, exact);
+  auto engines = MakeEngines(*index);
+  EXPECT_TRUE(engines.ok()) << engines.status();
   AccuracyOptions options;
   options.num_points = points;
   options.num_sources = sources;
   options.num_paths = 60;
-  const AccuracyReport report = MeasureAccuracy(m, **engine, exact_engine->get(), options);
+  const AccuracyReport report = MeasureAccuracy(m, *engines, options);
   std::printf("%s%s", AccuracyReport::MarkdownHeader().c_str(),
               report.ToMarkdownRow(m.name() + " m=" + std::to_string(samples)).c_str());
   return report;
@@ -46,6 +44,7 @@ TEST(AccuracyTest, DevelopableSurfacesAreExact) {
     EXPECT_LT(r.all.max, 1e-5);
     EXPECT_GT(r.near.count, 100);
     EXPECT_LT(r.near.max, 1e-5);
+    EXPECT_LT(r.near_path_mode.max, 1e-5);
   }
 }
 
@@ -56,6 +55,10 @@ TEST(AccuracyTest, Sphere) {
   EXPECT_LT(r.all.rms, 0.016);  // measured 1.26%
   EXPECT_LT(r.far.p99, 0.045);  // 3.54%
   EXPECT_LT(r.near_exact_mode.max, 1e-6);
+  // The default mode: near pairs by path length (p99 0.042%, max 0.551%;
+  // the O(1) unfolding: p99 1.01%).
+  EXPECT_LT(r.near_path_mode.p99, 0.001);
+  EXPECT_LT(r.near_path_mode.max, 0.008);
   EXPECT_LT(r.all.rms, 0.2 * r.baseline.rms);  // baseline 11.9%
   EXPECT_LT(r.path_ratio.p99, 0.001);          // 0.06%
 }
@@ -64,6 +67,7 @@ TEST(AccuracyTest, Torus) {
   const AccuracyReport r = Measure(gen::Torus(64, 32, 2.0, 0.7), 120, 240, 8);
   EXPECT_LT(r.all.rms, 0.034);  // measured 2.57%
   EXPECT_LT(r.near_exact_mode.max, 1e-6);
+  EXPECT_LT(r.near_path_mode.max, 0.001);  // 0.057%; the O(1) unfolding: p99 2.57%
   EXPECT_LT(r.all.rms, 0.2 * r.baseline.rms);  // baseline 19.2%
   EXPECT_LT(r.path_ratio.p99, 0.014);          // 1.09%; 5.2% before path restarts
 }

@@ -4,6 +4,12 @@
 // baseline (§6.3), all in the same run on the same pairs. Rates are per
 // CPU-second of the measuring thread.
 //
+// The batch runs in the default mode (near pairs by path length) and in the
+// pure O(1) mode; the share of random pairs that are near is printed with it.
+// Vertex and interior pairs/s are single DistanceUnchecked calls (O(1)). The
+// cost of one near pair in the path and exact modes is measured apart, on
+// near pairs drawn on purpose.
+//
 //   query_bench [--index FILE.gdx]... [--pairs N]
 //
 // Without --index it builds an index of a generated sphere (a note says so).
@@ -117,6 +123,35 @@ double Gather(const index::Index& ix, const Matrix& matrix, const mesh::SurfaceP
   return acc;
 }
 
+// Microseconds per near pair (the same or adjacent geodesic triangles) in a
+// near-pair mode, over `count` pairs drawn from faces close in the file.
+std::vector<std::pair<mesh::SurfacePoint, mesh::SurfacePoint>> NearPairs(
+    const index::Index& ix, const query::QueryEngine& engine, int count) {
+  const auto p = InteriorPoints(ix, 50 * count, 5), q = InteriorPoints(ix, 50 * count, 6);
+  std::vector<std::pair<mesh::SurfacePoint, mesh::SurfacePoint>> out;
+  for (size_t i = 0; i < p.size() && static_cast<int>(out.size()) < count; ++i) {
+    // Meshes are usually stored with neighbouring faces at nearby ids.
+    mesh::SurfacePoint near = q[i];
+    near.face = static_cast<int32_t>((p[i].face + q[i].face % 401 + ix.num_faces() - 200) %
+                                     ix.num_faces());
+    if (engine.IsNearPair(p[i], near)) out.push_back({p[i], near});
+  }
+  return out;
+}
+
+double MicrosecondsPerNearPair(std::shared_ptr<const index::Index> ix, query::NearPairs mode,
+                               const std::vector<std::pair<mesh::SurfacePoint, mesh::SurfacePoint>>&
+                                   pairs) {
+  query::QueryOptions options;
+  options.near_pairs = mode;
+  auto engine = *query::QueryEngine::Create(ix, options);
+  query::QueryScratch scratch;
+  volatile double sink = 0;
+  const double t0 = ThreadSeconds();
+  for (const auto& [p, q] : pairs) sink = sink + *engine->Distance(p, q, &scratch);
+  return 1e6 * (ThreadSeconds() - t0) / std::max<size_t>(1, pairs.size());
+}
+
 void Bench(const std::string& label, std::shared_ptr<const index::Index> ix, int n) {
   auto engine = *query::QueryEngine::Create(ix);
   const auto a = InteriorPoints(*ix, n, 1), b = InteriorPoints(*ix, n, 2);
@@ -135,6 +170,15 @@ void Bench(const std::string& label, std::shared_ptr<const index::Index> ix, int
     (void)engine->DistanceBatch(a, b, out);
     sink = sink + out[n - 1];
   });
+  query::QueryOptions unfold;
+  unfold.near_pairs = query::NearPairs::kUnfold;
+  auto unfold_engine = *query::QueryEngine::Create(ix, unfold);
+  const double unfold_batch_rate = Rate(n, [&] {
+    (void)unfold_engine->DistanceBatch(a, b, out);
+    sink = sink + out[n - 1];
+  });
+  int near = 0;
+  for (int i = 0; i < n; ++i) near += engine->IsNearPair(a[i], b[i]);
   query::QueryOptions one_by_one;
   one_by_one.vector_lanes = false;
   auto scalar_engine = *query::QueryEngine::Create(ix, one_by_one);
@@ -158,13 +202,17 @@ void Bench(const std::string& label, std::shared_ptr<const index::Index> ix, int
     for (int i = 0; i < n; ++i) acc += engine->LinearInterpolationDistance(a[i], b[i]);
     sink = sink + acc;
   });
+  const auto near_pairs = NearPairs(*ix, *engine, 1000);
+  const double path_us = MicrosecondsPerNearPair(ix, query::NearPairs::kPath, near_pairs);
+  const double exact_us = MicrosecondsPerNearPair(ix, query::NearPairs::kExact, near_pairs);
   const double m = ix->num_samples();
   std::printf(
-      "| %s | %d | %d | %.2fM | %.2fM | %.2fM | %.2fM | %.2fM | %.2f | %.2fM | %.2fM (%.1f / %.1f "
-      "MiB) |\n",
+      "| %s | %d | %d | %.2fM | %.2fM | %.2fM | %.2fM (%.2f%% near) | %.2fM | %.2fM | %.2f | "
+      "%.2fM | %.1f / %.1f us (%zu) | %.2fM (%.1f / %.1f MiB) |\n",
       label.c_str(), ix->num_vertices(), ix->num_samples(), vertex_rate / 1e6, interior_rate / 1e6,
-      batch_rate / 1e6, scalar_batch_rate / 1e6, gather_rate / 1e6, gather_rate / batch_rate,
-      linear_rate / 1e6, packed_gather_rate / 1e6, m * m * 4 / (1 << 20),
+      batch_rate / 1e6, unfold_batch_rate / 1e6, 100.0 * near / n, scalar_batch_rate / 1e6,
+      gather_rate / 1e6, gather_rate / batch_rate, linear_rate / 1e6, path_us, exact_us,
+      near_pairs.size(), packed_gather_rate / 1e6, m * m * 4 / (1 << 20),
       m * (m - 1) / 2 * 4 / (1 << 20));
 }
 
@@ -183,9 +231,10 @@ int main(int argc, char** argv) {
                                              : "one at a time: no AVX2 in this build or CPU");
   std::printf(
       "| index | vertices | m | vertex pairs/s | interior pairs/s | batch (validated) pairs/s | "
-      "batch, one pair at a time/s | gather-only/s | gather/batch | linear baseline/s | "
+      "batch, pure O(1)/s (near share) | batch, one pair at a time/s | gather-only/s | "
+      "gather/batch | linear baseline/s | one near pair: path / exact mode (pairs) | "
       "gather-only, packed matrix/s (full / packed size) |\n"
-      "|---|---|---|---|---|---|---|---|---|---|---|\n");
+      "|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
   if (indexes.empty()) {
     std::printf("(no --index given: a generated sphere, m = 500)\n");
     geodex::build::BuildOptions options;
