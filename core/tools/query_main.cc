@@ -86,8 +86,8 @@ absl::Status Run(const Args& args) {
   GEODEX_ASSIGN_OR_RETURN(auto index, index::Index::Open(args.index));
   query::QueryOptions options;
   options.near_pairs = args.exact_near || args.near_pairs == "exact" ? query::NearPairs::kExact
-                       : args.near_pairs == "unfold"                  ? query::NearPairs::kUnfold
-                                                                      : query::NearPairs::kPath;
+                       : args.near_pairs == "unfold"                 ? query::NearPairs::kUnfold
+                                                                     : query::NearPairs::kPath;
   GEODEX_ASSIGN_OR_RETURN(auto engine, query::QueryEngine::Create(index, options));
   std::string out;
   if (!args.pairs.empty() || !args.paths.empty()) {

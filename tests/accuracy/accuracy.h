@@ -38,15 +38,15 @@ struct AccuracyReport {
   ErrorStats all, far, near, baseline, path_ratio;
   ErrorStats near_path_mode, all_path_mode;    // NearPairs::kPath (the default)
   ErrorStats near_exact_mode, all_exact_mode;  // NearPairs::kExact
-  ErrorStats traced_path_ratio;  // the gradient trace before straightening
+  ErrorStats traced_path_ratio;                // the gradient trace before straightening
   std::string ToMarkdownRow(const std::string& label) const;
   static std::string MarkdownHeader();
 };
 
 struct AccuracyOptions {
-  int32_t num_points = 400;  // random points; pairs are (source, point)
-  int32_t num_sources = 20;  // exact propagations
-  int32_t num_paths = 100;   // pairs whose path length is measured
+  int32_t num_points = 400;      // random points; pairs are (source, point)
+  int32_t num_sources = 20;      // exact propagations
+  int32_t num_paths = 100;       // pairs whose path length is measured
   int32_t num_near_points = 40;  // near points drawn per source
   uint64_t seed = 1;
 };

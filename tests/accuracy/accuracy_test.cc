@@ -38,7 +38,7 @@ TEST(AccuracyTest, DevelopableSurfacesAreExact) {
   // m=120 on the finer sheet once gave a 25.7% error: a point beside the
   // triangle unfolded to the wrong side of an edge.
   const std::pair<mesh::Mesh, int32_t> cases[] = {{gen::FoldedSheet(32, 20, 2.0, 1.0, 1.1), 60},
-                                                 {gen::FoldedSheet(40, 24, 2.0, 1.0, 1.1), 120}};
+                                                  {gen::FoldedSheet(40, 24, 2.0, 1.0, 1.1), 120}};
   for (const auto& [m, samples] : cases) {
     const AccuracyReport r = Measure(m, samples, 200, 10);
     EXPECT_LT(r.all.max, 1e-5);
@@ -67,7 +67,7 @@ TEST(AccuracyTest, Torus) {
   const AccuracyReport r = Measure(gen::Torus(64, 32, 2.0, 0.7), 120, 240, 8);
   EXPECT_LT(r.all.rms, 0.034);  // measured 2.57%
   EXPECT_LT(r.near_exact_mode.max, 1e-6);
-  EXPECT_LT(r.near_path_mode.max, 0.001);  // 0.057%; the O(1) unfolding: p99 2.57%
+  EXPECT_LT(r.near_path_mode.max, 0.001);      // 0.057%; the O(1) unfolding: p99 2.57%
   EXPECT_LT(r.all.rms, 0.2 * r.baseline.rms);  // baseline 19.2%
   EXPECT_LT(r.path_ratio.p99, 0.014);          // 1.09%; 5.2% before path restarts
 }

@@ -132,16 +132,16 @@ std::vector<std::pair<mesh::SurfacePoint, mesh::SurfacePoint>> NearPairs(
   for (size_t i = 0; i < p.size() && static_cast<int>(out.size()) < count; ++i) {
     // Meshes are usually stored with neighbouring faces at nearby ids.
     mesh::SurfacePoint near = q[i];
-    near.face = static_cast<int32_t>((p[i].face + q[i].face % 401 + ix.num_faces() - 200) %
-                                     ix.num_faces());
+    near.face =
+        static_cast<int32_t>((p[i].face + q[i].face % 401 + ix.num_faces() - 200) % ix.num_faces());
     if (engine.IsNearPair(p[i], near)) out.push_back({p[i], near});
   }
   return out;
 }
 
-double MicrosecondsPerNearPair(std::shared_ptr<const index::Index> ix, query::NearPairs mode,
-                               const std::vector<std::pair<mesh::SurfacePoint, mesh::SurfacePoint>>&
-                                   pairs) {
+double MicrosecondsPerNearPair(
+    std::shared_ptr<const index::Index> ix, query::NearPairs mode,
+    const std::vector<std::pair<mesh::SurfacePoint, mesh::SurfacePoint>>& pairs) {
   query::QueryOptions options;
   options.near_pairs = mode;
   auto engine = *query::QueryEngine::Create(ix, options);
