@@ -21,6 +21,15 @@ using Clock = std::chrono::steady_clock;
 // Largest payload of one streamed Matrix block or DistanceField chunk.
 constexpr int64_t kChunkBytes = 1 << 20;
 
+// How a model answers near pairs: exactly when the request or the model's
+// configuration asks for it, else by the pure O(1) unfolding when the
+// configuration says so, else by path length (the engines' default).
+query::NearPairs NearPairsFor(const ModelSnapshot& model, bool exact_requested) {
+  if (exact_requested || model.config.exact_near_pairs()) return query::NearPairs::kExact;
+  if (model.config.unfold_near_pairs()) return query::NearPairs::kUnfold;
+  return query::NearPairs::kPath;
+}
+
 double SecondsSince(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
 }
@@ -140,10 +149,8 @@ absl::Status GeodexService::ComputeDistances(const ResolvedModel& model, const v
     return absl::InvalidArgumentError(
         absl::StrFormat("a has %d points but b has %d; they must pair up", na, nb));
   }
-  const query::QueryEngine* engine = &model.version->engine();
-  if (exact_near_pairs || model.model->config.exact_near_pairs()) {
-    GEODEX_ASSIGN_OR_RETURN(engine, model.version->ExactEngine());
-  }
+  GEODEX_ASSIGN_OR_RETURN(const query::QueryEngine* engine,
+                          model.version->EngineFor(NearPairsFor(*model.model, exact_near_pairs)));
   GEODEX_RETURN_IF_ERROR(PointsFromProto(a, "a", *engine, &worker.a));
   GEODEX_RETURN_IF_ERROR(PointsFromProto(b, "b", *engine, &worker.b));
   return engine->DistanceBatch(worker.a, worker.b, ResizeForOutput(out, na), &worker.scratch);
@@ -722,10 +729,7 @@ class GeodexService::MatrixStream final : public ChunkedWriteStream<v1::MatrixBl
       return absl::InvalidArgumentError(
           absl::StrFormat("block_rows is negative (%d)", request_->block_rows()));
     }
-    engine_ = &model_.version->engine();
-    if (model_.model->config.exact_near_pairs()) {
-      GEODEX_ASSIGN_OR_RETURN(engine_, model_.version->ExactEngine());
-    }
+    GEODEX_ASSIGN_OR_RETURN(engine_, model_.version->EngineFor(NearPairsFor(*model_.model, false)));
     GEODEX_RETURN_IF_ERROR(PointsFromProto(request_->sources(), "sources", *engine_, &sources_));
     GEODEX_RETURN_IF_ERROR(PointsFromProto(request_->targets(), "targets", *engine_, &targets_));
     // At most kChunkBytes a block, whole rows (at least one).

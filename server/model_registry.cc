@@ -73,19 +73,21 @@ absl::StatusOr<std::shared_ptr<const ServedVersion>> ServedVersion::Load(int64_t
   return std::shared_ptr<const ServedVersion>(std::move(served));
 }
 
-absl::StatusOr<const query::QueryEngine*> ServedVersion::ExactEngine() const {
-  std::lock_guard<std::mutex> lock(exact_mutex_);
-  if (exact_ != nullptr) return exact_.get();
-  if (!exact_status_.ok()) return exact_status_;
+absl::StatusOr<const query::QueryEngine*> ServedVersion::EngineFor(query::NearPairs mode) const {
+  if (mode == engine_->options().near_pairs) return engine_.get();
+  const int slot = mode == query::NearPairs::kExact ? 1 : 0;
+  std::lock_guard<std::mutex> lock(lazy_mutex_);
+  if (lazy_[slot] != nullptr) return lazy_[slot].get();
+  if (!lazy_status_[slot].ok()) return lazy_status_[slot];
   query::QueryOptions options;
-  options.near_pairs = query::NearPairs::kExact;
+  options.near_pairs = mode;
   auto engine = query::QueryEngine::Create(index_, options);
   if (!engine.ok()) {
-    exact_status_ = engine.status();
-    return exact_status_;
+    lazy_status_[slot] = engine.status();
+    return lazy_status_[slot];
   }
-  exact_ = *std::move(engine);
-  return exact_.get();
+  lazy_[slot] = *std::move(engine);
+  return lazy_[slot].get();
 }
 
 const char* LoadStateName(LoadState state) {

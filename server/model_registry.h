@@ -69,8 +69,8 @@ struct FileId {
   bool operator==(const FileId&) const = default;
 };
 
-// One loaded version of a model. Immutable, except that the exact-near-pairs
-// engine is built on first use (ExactEngine).
+// One loaded version of a model. Immutable, except that the engines of the
+// other near-pair modes are built on first use (EngineFor).
 class ServedVersion {
  public:
   // Opens and validates `path` and builds the default engine; with
@@ -90,9 +90,13 @@ class ServedVersion {
   // The default engine: far pairs in O(1), near pairs by the length of their
   // path (query::NearPairs::kPath).
   const query::QueryEngine& engine() const { return *engine_; }
-  // The engine answering near pairs by local exact propagation, built (once,
-  // on the calling thread) on first use. Errors: QueryEngine::Create's.
-  absl::StatusOr<const query::QueryEngine*> ExactEngine() const;
+  // The engine answering near pairs in `mode`: engine() for kPath; for the
+  // others built (once, on the calling thread) on first use. Errors:
+  // QueryEngine::Create's.
+  absl::StatusOr<const query::QueryEngine*> EngineFor(query::NearPairs mode) const;
+  absl::StatusOr<const query::QueryEngine*> ExactEngine() const {
+    return EngineFor(query::NearPairs::kExact);
+  }
 
  private:
   ServedVersion() = default;
@@ -102,9 +106,10 @@ class ServedVersion {
   FileId file_id_;
   std::shared_ptr<const index::Index> index_;
   std::shared_ptr<const query::QueryEngine> engine_;
-  mutable std::mutex exact_mutex_;
-  mutable std::shared_ptr<const query::QueryEngine> exact_;
-  mutable absl::Status exact_status_;
+  // The kUnfold and kExact engines, and the errors of building them.
+  mutable std::mutex lazy_mutex_;
+  mutable std::shared_ptr<const query::QueryEngine> lazy_[2];
+  mutable absl::Status lazy_status_[2];
 };
 
 enum class LoadState { kLoading, kServing, kFailed };

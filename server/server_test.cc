@@ -66,12 +66,12 @@ const std::string& WideSphereBytes() {
   return *bytes;
 }
 
-std::shared_ptr<const query::QueryEngine> ReferenceEngine(const std::string& bytes,
-                                                          bool exact = false) {
+std::shared_ptr<const query::QueryEngine> ReferenceEngine(
+    const std::string& bytes, query::NearPairs near_pairs = query::NearPairs::kPath) {
   auto index = index::Index::FromBytes(bytes);
   EXPECT_TRUE(index.ok()) << index.status();
   query::QueryOptions options;
-  if (exact) options.near_pairs = query::NearPairs::kExact;
+  options.near_pairs = near_pairs;
   auto engine = query::QueryEngine::Create(*index, options);
   EXPECT_TRUE(engine.ok()) << engine.status();
   return *engine;
@@ -342,7 +342,7 @@ TEST_P(RpcTest, DistanceMatchesTheEngine) {
 }
 
 TEST_P(RpcTest, ExactNearPairsMatchTheExactEngine) {
-  auto exact = ReferenceEngine(testing::SphereIndexBytes(), /*exact=*/true);
+  auto exact = ReferenceEngine(testing::SphereIndexBytes(), query::NearPairs::kExact);
   // Near pairs: b is a's point nudged within the same face.
   const int32_t faces = sphere_->index().num_faces();
   auto a = testing::RandomPoints(faces, 50, 7);
@@ -694,7 +694,7 @@ TEST(ServerTest, PerModelConfigLowersLimitsAndForcesExactNearPairs) {
                             "exact_near_pairs: true\nlimits { max_pairs_per_message: 10 }\n");
   ts.Rescan();
   auto stub = v1::Geodex::NewStub(ts.TcpChannel());
-  auto exact = ReferenceEngine(testing::SphereIndexBytes(), true);
+  auto exact = ReferenceEngine(testing::SphereIndexBytes(), query::NearPairs::kExact);
   const int32_t faces = exact->index().num_faces();
   auto a = testing::RandomPoints(faces, 10, 3);
   auto b = a;
@@ -717,6 +717,36 @@ TEST(ServerTest, PerModelConfigLowersLimitsAndForcesExactNearPairs) {
   grpc::Status s = stub->Distance(context.get(), request, &response);
   EXPECT_EQ(s.error_code(), grpc::StatusCode::RESOURCE_EXHAUSTED);
   EXPECT_THAT(s.error_message(), HasSubstr("limit of 10"));
+}
+
+TEST(ServerTest, NearPairsByPathLengthUnlessTheModelAsksForThePureO1Mode) {
+  TestServer ts;
+  auto stub = v1::Geodex::NewStub(ts.TcpChannel());
+  auto by_path = ReferenceEngine(testing::SphereIndexBytes());
+  auto unfold = ReferenceEngine(testing::SphereIndexBytes(), query::NearPairs::kUnfold);
+  const int32_t faces = by_path->index().num_faces();
+  // Near pairs: a point and another of the same face.
+  const auto a = testing::RandomPoints(faces, 40, 5);
+  auto b = testing::RandomPoints(faces, 40, 6);
+  for (size_t i = 0; i < b.size(); ++i) b[i].face = a[i].face;
+  v1::DistanceRequest request;
+  *request.mutable_model() = Ref("sphere");
+  *request.mutable_a() = ToProto(a);
+  *request.mutable_b() = ToProto(b);
+  auto answers = [&] {
+    v1::DistanceResponse response;
+    auto context = Context();
+    EXPECT_TRUE(stub->Distance(context.get(), request, &response).ok());
+    return std::vector<double>(response.distances().begin(), response.distances().end());
+  };
+  std::vector<double> expected_path(a.size()), expected_unfold(a.size());
+  ASSERT_TRUE(by_path->DistanceBatch(a, b, expected_path).ok());
+  ASSERT_TRUE(unfold->DistanceBatch(a, b, expected_unfold).ok());
+  ASSERT_NE(expected_path, expected_unfold);
+  EXPECT_EQ(answers(), expected_path);
+  testing::WriteModelConfig(ts.root(), "sphere", "unfold_near_pairs: true\n");
+  ts.Rescan();
+  EXPECT_EQ(answers(), expected_unfold);
 }
 
 TEST(ServerTest, DeadlineExpiredWhileQueuedIsNotComputed) {
