@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 #include <queue>
+#include <tuple>
 
 #include "absl/strings/str_format.h"
 #include "core/common/status_macros.h"
@@ -487,21 +488,6 @@ double QueryEngine::ExactNearDistance(const SurfacePoint& p, const SurfacePoint&
   options.stop_points = {to};
   if (!scratch->solver_->Propagate({from}, options).ok()) return DistanceUnchecked(p, q);
   return scratch->solver_->DistanceAt(to);
-}
-
-double QueryEngine::PathNearDistance(const SurfacePoint& p, const SurfacePoint& q) const {
-  // Trace in a fixed order so the answer is symmetric. Without Path's
-  // restarts: on bunny_closed_30k at m=1000 they take near pairs from p99
-  // 0.28% (max 1.6%) to 0.06% (0.4%), but double the cost (15 -> 33 us).
-  const bool swap = std::tie(q.face, q.w) < std::tie(p.face, p.w);
-  const absl::StatusOr<std::vector<PathPoint>> path =
-      swap ? ShortestTrace(q, p, /*restarts=*/false) : ShortestTrace(p, q, /*restarts=*/false);
-  if (!path.ok()) return DistanceUnchecked(p, q);
-  double length = 0;
-  for (size_t i = 1; i < path->size(); ++i) {
-    length += ((*path)[i].position - (*path)[i - 1].position).norm();
-  }
-  return length;
 }
 
 double QueryEngine::NearDistance(const SurfacePoint& p, const SurfacePoint& q, double unfolded,

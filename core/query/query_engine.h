@@ -55,7 +55,7 @@ enum class NearPairs {
   // The length of the shorter of the straightened gradient traces of p's
   // and q's fields (Path without its restarts, so Path can be shorter): a
   // surface path, never below the geodesic distance; O(k) in the faces it
-  // crosses.
+  // crosses. With straighten_paths off, the raw traces (longer).
   kPath,
   // A local exact propagation from one point that stops when it reaches the
   // other (needs a QueryScratch; without one, kUnfold). About 8x the cost of

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <queue>
+#include <tuple>
 #include <unordered_map>
 
 #include "absl/strings/str_format.h"
@@ -177,6 +178,17 @@ absl::StatusOr<std::vector<PathPoint>> QueryEngine::ShortestTrace(const SurfaceP
     }
   }
   return path;
+}
+
+double QueryEngine::PathNearDistance(const SurfacePoint& p, const SurfacePoint& q) const {
+  // Trace in a fixed order so the answer is symmetric. Without Path's
+  // restarts: on bunny_closed_30k at m=1000 they take near pairs from p99
+  // 0.28% (max 1.6%) to 0.06% (0.4%), but double the cost (15 -> 33 us).
+  const bool swap = std::tie(q.face, q.w) < std::tie(p.face, p.w);
+  const absl::StatusOr<std::vector<PathPoint>> path =
+      swap ? ShortestTrace(q, p, /*restarts=*/false) : ShortestTrace(p, q, /*restarts=*/false);
+  if (!path.ok()) return DistanceUnchecked(p, q);
+  return PathLength(*path);
 }
 
 std::vector<std::vector<PathPoint>> QueryEngine::RingChains(const SurfacePoint& p) const {
