@@ -68,6 +68,12 @@ struct QueryOptions {
   // Straighten traced paths through the faces they cross (funnel algorithm,
   // see path_straightening.h). Off: the raw gradient trace of §6.2.
   bool straighten_paths = true;
+  // When > 0, Path also solves exactly (the ICH engine) inside a corridor
+  // round the traced path, the faces at most this many edge steps from the
+  // faces it crosses, and returns the exact path when it is shorter. This
+  // finds the side of a bump that a trace of the approximate field can miss;
+  // it costs a propagation over the corridor (not O(k)). 0: off.
+  int32_t exact_path_corridor = 0;
   // DistanceBatch computes far pairs four at a time with AVX2 when the CPU
   // has it (kernel::FarDistances); off: one at a time. The answers are the
   // same to the bit either way; the switch is for benchmarks.
@@ -263,6 +269,11 @@ class QueryEngine {
   double ExactNearDistance(const SurfacePoint& p, const SurfacePoint& q,
                            QueryScratch* scratch) const;
   double PathNearDistance(const SurfacePoint& p, const SurfacePoint& q) const;
+  // The exact shortest path from `from` to `to` among the faces within
+  // `steps` edge steps of the faces `path` crosses, or an error (e.g. when
+  // that corridor is not a manifold mesh).
+  absl::StatusOr<std::vector<PathPoint>> CorridorPath(const std::vector<PathPoint>& path,
+                                                      int32_t steps) const;
   // Path, with the restarts or without (then only the traces of both fields,
   // straightened).
   absl::StatusOr<std::vector<PathPoint>> ShortestTrace(const SurfacePoint& from,

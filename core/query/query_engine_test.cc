@@ -344,6 +344,35 @@ TEST(QueryEngineTest, StraightenedPathsAreExactOnDevelopableSurfaces) {
 
 // The approximate field of a coarse index has local minima and flats; path
 // tracing must still always arrive, on the surface.
+TEST(QueryEngineTest, ExactCorridorPathsAreExactWhereTheTraceIsNot) {
+  const Mesh m = gen::Torus(48, 24, 2.0, 0.7);
+  auto traced = MakeEngine(m, 60);
+  QueryOptions options;
+  options.exact_path_corridor = 6;
+  auto corridor = MakeEngine(m, 60, options);
+  const auto points = RandomPoints(m, 80, 14);
+  double worst_traced = 0, worst_corridor = 0;
+  for (size_t i = 0; i + 1 < points.size(); i += 2) {
+    auto plain = traced->Path(points[i], points[i + 1]);
+    auto path = corridor->Path(points[i], points[i + 1]);
+    ASSERT_TRUE(plain.ok() && path.ok());
+    // The ends are the traced path's (Path gives them exactly as given).
+    EXPECT_EQ(path->front().position, plain->front().position);
+    EXPECT_EQ(path->back().position, plain->back().position);
+    EXPECT_LT((path->back().position - PositionOf(m, points[i + 1])).norm(), 1e-12);
+    EXPECT_TRUE(SharesFaces(m, *path)) << "pair " << i;
+    const double exact = Exact(m, points[i], points[i + 1]);
+    EXPECT_GE(PathLength(*path), exact * (1 - 1e-9));
+    EXPECT_LE(PathLength(*path), PathLength(*plain) * (1 + 1e-12));
+    worst_traced = std::max(worst_traced, PathLength(*plain) / exact);
+    worst_corridor = std::max(worst_corridor, PathLength(*path) / exact);
+  }
+  std::printf("path / exact, worst: traced %.5f, with the exact corridor %.5f\n", worst_traced,
+              worst_corridor);
+  EXPECT_GT(worst_traced, 1.001);
+  EXPECT_LT(worst_corridor, 1 + 1e-6);
+}
+
 TEST(QueryEngineTest, PathsAlwaysArriveOnACoarseCube) {
   const Mesh m = gen::Cube(12, 2.0);
   auto engine = MakeEngine(m, 40);

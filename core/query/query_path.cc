@@ -9,6 +9,7 @@
 
 #include "absl/strings/str_format.h"
 #include "core/common/status_macros.h"
+#include "core/geodesic/exact_geodesic.h"
 #include "core/query/path_straightening.h"
 #include "core/query/query_engine.h"
 
@@ -124,7 +125,92 @@ int LocalIndex(std::span<const int32_t> faces, int32_t f, int32_t v) {
 
 absl::StatusOr<std::vector<PathPoint>> QueryEngine::Path(const SurfacePoint& from,
                                                          const SurfacePoint& to) const {
-  return ShortestTrace(from, to, /*restarts=*/true);
+  GEODEX_ASSIGN_OR_RETURN(std::vector<PathPoint> path, ShortestTrace(from, to, /*restarts=*/true));
+  if (options_.exact_path_corridor <= 0) return path;
+  absl::StatusOr<std::vector<PathPoint>> exact = CorridorPath(path, options_.exact_path_corridor);
+  if (exact.ok() && PathLength(*exact) < PathLength(path)) {
+    exact->front() = path.front();
+    exact->back() = path.back();
+    return *std::move(exact);
+  }
+  return path;
+}
+
+absl::StatusOr<std::vector<PathPoint>> QueryEngine::CorridorPath(const std::vector<PathPoint>& path,
+                                                                 int32_t steps) const {
+  // The corridor: the faces the path touches, grown across edges.
+  std::vector<int32_t> faces;
+  std::unordered_map<int32_t, int32_t> local_face;
+  for (const PathPoint& p : path) {
+    if (local_face.try_emplace(p.point.face, faces.size()).second) faces.push_back(p.point.face);
+  }
+  for (size_t begin = 0, step = 0; step < static_cast<size_t>(steps); ++step) {
+    const size_t end = faces.size();
+    for (size_t i = begin; i < end; ++i) {
+      for (int k = 0; k < 3; ++k) {
+        const int32_t twin = twins_[3 * faces[i] + k];
+        if (twin < 0) continue;
+        const int32_t g = twin / 3;
+        if (local_face.try_emplace(g, faces.size()).second) faces.push_back(g);
+      }
+    }
+    begin = end;
+  }
+  // A vertex whose corridor faces form more than one fan would make the
+  // corridor non-manifold: such vertices get their whole star, until there
+  // are none.
+  const Tracer tr{*this, positions_, faces_, twins_, {}, {}};
+  for (bool pinched = true; pinched;) {
+    pinched = false;
+    std::unordered_map<int32_t, int32_t> a_face_of;  // corridor vertex -> a corridor face
+    for (int32_t f : faces) {
+      for (int k = 0; k < 3; ++k) a_face_of.try_emplace(faces_[3 * f + k], f);
+    }
+    for (const auto& [v, f] : a_face_of) {
+      const std::vector<int32_t> star = tr.FacesAround(v, f);
+      int fan_ends = 0;
+      for (int32_t g : star) {
+        if (!local_face.contains(g)) continue;
+        const int32_t h = 3 * g + LocalIndex(faces_, g, v);  // the edge leaving v in g
+        fan_ends += twins_[h] < 0 || !local_face.contains(twins_[h] / 3);
+      }
+      if (fan_ends <= 1) continue;
+      pinched = true;
+      for (int32_t g : star) {
+        if (local_face.try_emplace(g, faces.size()).second) faces.push_back(g);
+      }
+    }
+  }
+  // As a mesh of its own, vertex order kept in every face.
+  std::unordered_map<int32_t, int32_t> local_vertex;
+  std::vector<mesh::Vec3> positions;
+  std::vector<mesh::Triangle> triangles;
+  for (int32_t f : faces) {
+    mesh::Triangle t;
+    for (int k = 0; k < 3; ++k) {
+      const int32_t v = faces_[3 * f + k];
+      auto [it, added] = local_vertex.try_emplace(v, positions.size());
+      if (added) positions.push_back(Position(v));
+      t[k] = it->second;
+    }
+    triangles.push_back(t);
+  }
+  GEODEX_ASSIGN_OR_RETURN(
+      const mesh::Mesh corridor,
+      mesh::Mesh::Create(std::move(positions), std::move(triangles), "path corridor"));
+  auto local = [&](const SurfacePoint& p) { return SurfacePoint{local_face.at(p.face), p.w}; };
+  const SurfacePoint from = local(path.front().point), to = local(path.back().point);
+  geodesic::ExactGeodesicSolver solver(corridor);
+  geodesic::GeodesicOptions options;
+  options.stop_points = {to};
+  GEODEX_RETURN_IF_ERROR(solver.Propagate({from}, options));
+  GEODEX_ASSIGN_OR_RETURN(const std::vector<SurfacePoint> back, solver.PathTo(to));
+  std::vector<PathPoint> out;
+  for (auto it = back.rbegin(); it != back.rend(); ++it) {
+    const SurfacePoint p{faces[it->face], it->w};
+    out.push_back({p, PositionOf(p)});
+  }
+  return out;
 }
 
 absl::StatusOr<std::vector<PathPoint>> QueryEngine::ShortestTrace(const SurfacePoint& from,

@@ -1,7 +1,7 @@
 // geodex-query: answers queries offline from an index file, without a server.
 //
 //   geodex-query INDEX --pairs FILE [--near-pairs path|unfold|exact] [--linear-baseline]
-//   geodex-query INDEX --paths FILE [--format xyz|json]
+//   geodex-query INDEX --paths FILE [--format xyz|json] [--exact-path-corridor K]
 //   geodex-query INDEX --field SOURCES [--nearest]
 //   geodex-query INDEX --locate POINTS
 //
@@ -80,6 +80,7 @@ absl::Status CheckPairs(const query::QueryEngine& engine,
 struct Args {
   std::string index, pairs, paths, field, locate, format = "xyz", near_pairs = "path";
   bool exact_near = false, baseline = false, nearest = false;
+  int32_t exact_path_corridor = 0;
 };
 
 absl::Status Run(const Args& args) {
@@ -88,6 +89,7 @@ absl::Status Run(const Args& args) {
   options.near_pairs = args.exact_near || args.near_pairs == "exact" ? query::NearPairs::kExact
                        : args.near_pairs == "unfold"                 ? query::NearPairs::kUnfold
                                                                      : query::NearPairs::kPath;
+  options.exact_path_corridor = args.exact_path_corridor;
   GEODEX_ASSIGN_OR_RETURN(auto engine, query::QueryEngine::Create(index, options));
   std::string out;
   if (!args.pairs.empty() || !args.paths.empty()) {
@@ -178,6 +180,10 @@ int main(int argc, char** argv) {
                  "length, default), unfold (pure O(1)) or exact (local exact propagation)")
       ->check(CLI::IsMember({"path", "unfold", "exact"}));
   app.add_flag("--exact-near-pairs", args.exact_near, "Same as --near-pairs exact");
+  app.add_option("--exact-path-corridor", args.exact_path_corridor,
+                 "With --paths: also solve exactly within this many edge steps of the traced "
+                 "path and keep the shorter (not O(k); 0: off)")
+      ->check(CLI::Range(0, 64));
   app.add_flag("--linear-baseline", args.baseline, "The paper's linear interpolation (§6.3)");
   app.add_flag("--nearest", args.nearest, "With --field: also print the nearest source");
   app.add_option("--format", args.format, "Path output: xyz (blank line between paths) or json")

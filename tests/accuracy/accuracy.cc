@@ -110,12 +110,13 @@ std::vector<mesh::SurfacePoint> RandomSurfacePoints(const mesh::Mesh& mesh, int3
   return PointsOnFaces(mesh, faces, count, rng);
 }
 
-absl::StatusOr<Engines> MakeEngines(std::shared_ptr<const index::Index> index) {
+absl::StatusOr<Engines> MakeEngines(std::shared_ptr<const index::Index> index,
+                                    query::QueryOptions base) {
   Engines engines;
   for (auto [mode, engine] : {std::pair{query::NearPairs::kUnfold, &engines.unfold},
                               std::pair{query::NearPairs::kPath, &engines.path},
                               std::pair{query::NearPairs::kExact, &engines.exact}}) {
-    query::QueryOptions options;
+    query::QueryOptions options = base;
     options.near_pairs = mode;
     auto made = query::QueryEngine::Create(index, options);
     if (!made.ok()) return made.status();

@@ -59,7 +59,9 @@ std::vector<mesh::SurfacePoint> RandomSurfacePoints(const mesh::Mesh& mesh, int3
 struct Engines {
   std::shared_ptr<const query::QueryEngine> unfold, path, exact;
 };
-absl::StatusOr<Engines> MakeEngines(std::shared_ptr<const index::Index> index);
+// `base` gives every option but near_pairs.
+absl::StatusOr<Engines> MakeEngines(std::shared_ptr<const index::Index> index,
+                                    query::QueryOptions base = {});
 
 // The engines must be built from an index of `mesh`.
 AccuracyReport MeasureAccuracy(const mesh::Mesh& mesh, const Engines& engines,

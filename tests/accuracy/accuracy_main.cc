@@ -31,7 +31,7 @@ absl::StatusOr<mesh::Mesh> LoadInput(const std::string& path) {
 
 absl::Status Run(const std::vector<std::string>& meshes, const std::vector<int32_t>& samples,
                  const accuracy::AccuracyOptions& options, const std::string& index_dir,
-                 int threads) {
+                 int threads, const query::QueryOptions& engine_options) {
   std::printf("%s", accuracy::AccuracyReport::MarkdownHeader().c_str());
   for (const std::string& path : meshes) {
     GEODEX_ASSIGN_OR_RETURN(const mesh::Mesh m, LoadInput(path));
@@ -49,7 +49,8 @@ absl::Status Run(const std::vector<std::string>& meshes, const std::vector<int32
         std::fprintf(stderr, "built %s: %s", file.c_str(), summary.ToText().c_str());
       }
       GEODEX_ASSIGN_OR_RETURN(auto index, index::Index::Open(file));
-      GEODEX_ASSIGN_OR_RETURN(const accuracy::Engines engines, accuracy::MakeEngines(index));
+      GEODEX_ASSIGN_OR_RETURN(const accuracy::Engines engines,
+                              accuracy::MakeEngines(index, engine_options));
       const auto report = accuracy::MeasureAccuracy(m, engines, options);
       std::printf("%s", report.ToMarkdownRow(absl::StrFormat("%s m=%d", name, count)).c_str());
       std::fflush(stdout);
@@ -78,8 +79,12 @@ int main(int argc, char** argv) {
   app.add_option("--seed", options.seed, "Random seed");
   app.add_option("--index-dir", index_dir, "Cache built indexes here");
   app.add_option("--threads", threads, "Builder threads (0: all)");
+  geodex::query::QueryOptions engine_options;
+  app.add_option("--exact-path-corridor", engine_options.exact_path_corridor,
+                 "Paths: also solve exactly within this many edge steps of the trace (0: off)");
   CLI11_PARSE(app, argc, argv);
-  const absl::Status status = geodex::Run(meshes, samples, options, index_dir, threads);
+  const absl::Status status =
+      geodex::Run(meshes, samples, options, index_dir, threads, engine_options);
   if (!status.ok()) {
     std::fprintf(stderr, "geodex-accuracy: %s\n", status.ToString().c_str());
     return 1;

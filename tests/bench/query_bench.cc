@@ -8,7 +8,8 @@
 // pure O(1) mode; the share of random pairs that are near is printed with it.
 // Vertex and interior pairs/s are single DistanceUnchecked calls (O(1)). The
 // cost of one near pair in the path and exact modes is measured apart, on
-// near pairs drawn on purpose.
+// near pairs drawn on purpose. So is the time of one Path between random
+// interior points, traced (O(k)) and with an exact corridor of 8 steps.
 //
 //   query_bench [--index FILE.gdx]... [--pairs N]
 //
@@ -152,6 +153,8 @@ double MicrosecondsPerNearPair(
   return 1e6 * (ThreadSeconds() - t0) / std::max<size_t>(1, pairs.size());
 }
 
+constexpr int32_t kCorridorSteps = 8;
+
 void Bench(const std::string& label, std::shared_ptr<const index::Index> ix, int n) {
   auto engine = *query::QueryEngine::Create(ix);
   const auto a = InteriorPoints(*ix, n, 1), b = InteriorPoints(*ix, n, 2);
@@ -202,17 +205,32 @@ void Bench(const std::string& label, std::shared_ptr<const index::Index> ix, int
     for (int i = 0; i < n; ++i) acc += engine->LinearInterpolationDistance(a[i], b[i]);
     sink = sink + acc;
   });
+  // Paths between random interior points, traced (O(k)) and with the exact
+  // corridor (QueryOptions::exact_path_corridor).
+  query::QueryOptions corridor;
+  corridor.exact_path_corridor = kCorridorSteps;
+  auto corridor_engine = *query::QueryEngine::Create(ix, corridor);
+  const int num_paths = std::min(n, 100);
+  double path_ms[2];
+  for (int e = 0; e < 2; ++e) {
+    const double t0 = ThreadSeconds();
+    size_t points = 0;
+    for (int i = 0; i < num_paths; ++i)
+      points += (e ? corridor_engine : engine)->Path(a[i], b[i])->size();
+    path_ms[e] = 1e3 * (ThreadSeconds() - t0) / num_paths;
+    sink = sink + static_cast<double>(points);
+  }
   const auto near_pairs = NearPairs(*ix, *engine, 1000);
   const double path_us = MicrosecondsPerNearPair(ix, query::NearPairs::kPath, near_pairs);
   const double exact_us = MicrosecondsPerNearPair(ix, query::NearPairs::kExact, near_pairs);
   const double m = ix->num_samples();
   std::printf(
       "| %s | %d | %d | %.2fM | %.2fM | %.2fM | %.2fM (%.2f%% near) | %.2fM | %.2fM | %.2f | "
-      "%.2fM | %.1f / %.1f us (%zu) | %.2fM (%.1f / %.1f MiB) |\n",
+      "%.2fM | %.1f / %.1f us (%zu) | %.2f / %.2f ms | %.2fM (%.1f / %.1f MiB) |\n",
       label.c_str(), ix->num_vertices(), ix->num_samples(), vertex_rate / 1e6, interior_rate / 1e6,
       batch_rate / 1e6, unfold_batch_rate / 1e6, 100.0 * near / n, scalar_batch_rate / 1e6,
       gather_rate / 1e6, gather_rate / batch_rate, linear_rate / 1e6, path_us, exact_us,
-      near_pairs.size(), packed_gather_rate / 1e6, m * m * 4 / (1 << 20),
+      near_pairs.size(), path_ms[0], path_ms[1], packed_gather_rate / 1e6, m * m * 4 / (1 << 20),
       m * (m - 1) / 2 * 4 / (1 << 20));
 }
 
@@ -233,8 +251,8 @@ int main(int argc, char** argv) {
       "| index | vertices | m | vertex pairs/s | interior pairs/s | batch (validated) pairs/s | "
       "batch, pure O(1)/s (near share) | batch, one pair at a time/s | gather-only/s | "
       "gather/batch | linear baseline/s | one near pair: path / exact mode (pairs) | "
-      "gather-only, packed matrix/s (full / packed size) |\n"
-      "|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+      "one path: traced / exact corridor | gather-only, packed matrix/s (full / packed size) |\n"
+      "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
   if (indexes.empty()) {
     std::printf("(no --index given: a generated sphere, m = 500)\n");
     geodex::build::BuildOptions options;
