@@ -421,7 +421,8 @@ absl::StatusOr<DistanceMatrix> Client::Matrix(const ModelRef& model,
 }
 
 absl::StatusOr<std::vector<GeodesicPath>> Client::Path(const ModelRef& model,
-                                                       absl::Span<const PointPair> pairs) const {
+                                                       absl::Span<const PointPair> pairs,
+                                                       uint32_t exact_corridor) const {
   if (absl::Status s = CheckModel(model); !s.ok()) return s;
   std::vector<GeodesicPath> paths;
   paths.reserve(pairs.size());
@@ -431,6 +432,7 @@ absl::StatusOr<std::vector<GeodesicPath>> Client::Path(const ModelRef& model,
     v1::PathRequest request;
     *request.mutable_model() = ToProto(model);
     PairsToProto(pairs, begin, end, request.mutable_a(), request.mutable_b());
+    request.set_exact_corridor(exact_corridor);
     absl::StatusOr<v1::PathResponse> response = connection_->Path(request);
     if (!response.ok()) {
       return pairs.size() > chunk ? InPairs(response.status(), begin, end) : response.status();

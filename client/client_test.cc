@@ -576,6 +576,7 @@ TEST(ClientPath, SplitIntoCallsAndConverted) {
   int calls = 0;
   EXPECT_CALL(*mock, Path).Times(3).WillRepeatedly([&](const v1::PathRequest& r) {
     ++calls;
+    EXPECT_EQ(r.exact_corridor(), 5u);
     v1::PathResponse response;
     for (int i = 0; i < r.a().faces_size(); ++i) {
       v1::Polyline* line = response.add_paths();
@@ -591,7 +592,7 @@ TEST(ClientPath, SplitIntoCallsAndConverted) {
   ClientOptions options;
   options.path_batch_size = 4;
   Client client(mock, options);
-  absl::StatusOr<std::vector<GeodesicPath>> paths = client.Path("torus", NumberedPairs(10));
+  absl::StatusOr<std::vector<GeodesicPath>> paths = client.Path("torus", NumberedPairs(10), 5);
   ASSERT_TRUE(paths.ok()) << paths.status();
   ASSERT_EQ(paths->size(), 10u);
   EXPECT_EQ((*paths)[9].length, 9);

@@ -274,6 +274,15 @@ grpc::ServerUnaryReactor* GeodexService::Path(grpc::CallbackServerContext* conte
           return absl::InvalidArgumentError(
               absl::StrFormat("a has %d points but b has %d; they must pair up", na, nb));
         }
+        constexpr uint32_t kMaxCorridor = 64;
+        if (request->exact_corridor() > kMaxCorridor) {
+          return absl::InvalidArgumentError(absl::StrFormat(
+              "exact_corridor %d exceeds %d", request->exact_corridor(), kMaxCorridor));
+        }
+        const int32_t corridor =
+            request->exact_corridor() > 0
+                ? static_cast<int32_t>(request->exact_corridor())
+                : std::clamp<int32_t>(model.model->config.exact_path_corridor(), 0, kMaxCorridor);
         const query::QueryEngine& engine = model.version->engine();
         GEODEX_RETURN_IF_ERROR(PointsFromProto(request->a(), "a", engine, &worker.a));
         GEODEX_RETURN_IF_ERROR(PointsFromProto(request->b(), "b", engine, &worker.b));
@@ -281,7 +290,7 @@ grpc::ServerUnaryReactor* GeodexService::Path(grpc::CallbackServerContext* conte
         for (int64_t i = 0; i < na; ++i) {
           GEODEX_RETURN_IF_ERROR(CheckAlive(*context));
           absl::StatusOr<std::vector<query::PathPoint>> path =
-              engine.Path(worker.a[i], worker.b[i]);
+              engine.Path(worker.a[i], worker.b[i], corridor);
           if (path.ok()) {
             PathToProto(*path, response->add_paths());
           } else if (path.status().code() == absl::StatusCode::kNotFound) {

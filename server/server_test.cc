@@ -486,6 +486,43 @@ TEST_P(RpcTest, PathMatchesTheEngine) {
   }
 }
 
+TEST_P(RpcTest, PathWithAnExactCorridorMatchesTheEngine) {
+  const int32_t faces = sphere_->index().num_faces();
+  auto a = testing::RandomPoints(faces, 4, 13), b = testing::RandomPoints(faces, 4, 14);
+  v1::PathRequest request;
+  *request.mutable_model() = Ref("sphere");
+  *request.mutable_a() = ToProto(a);
+  *request.mutable_b() = ToProto(b);
+  request.set_exact_corridor(6);
+  v1::PathResponse response;
+  auto context = Context();
+  ASSERT_TRUE(stub_->Path(context.get(), request, &response).ok());
+  ASSERT_EQ(response.paths_size(), 4);
+  for (int i = 0; i < 4; ++i) {
+    auto path = sphere_->Path(a[i], b[i], 6);
+    ASSERT_TRUE(path.ok());
+    const v1::Polyline& line = response.paths(i);
+    ASSERT_EQ(line.points().faces_size(), static_cast<int>(path->size()));
+    for (size_t k = 0; k < path->size(); ++k) {
+      EXPECT_EQ(line.points().faces(k), (*path)[k].point.face);
+      for (int c = 0; c < 3; ++c)
+        EXPECT_EQ(line.positions().xyz(3 * k + c), (*path)[k].position[c]);
+    }
+    // No longer than the traced path.
+    auto traced = sphere_->Path(a[i], b[i]);
+    ASSERT_TRUE(traced.ok());
+    double traced_length = 0;
+    for (size_t k = 1; k < traced->size(); ++k)
+      traced_length += ((*traced)[k].position - (*traced)[k - 1].position).norm();
+    EXPECT_LE(line.length(), traced_length * (1 + 1e-12));
+  }
+  request.set_exact_corridor(65);
+  context = Context();
+  grpc::Status s = stub_->Path(context.get(), request, &response);
+  EXPECT_EQ(s.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_THAT(s.error_message(), HasSubstr("exact_corridor"));
+}
+
 TEST_P(RpcTest, DistanceFieldMatchesTheEngine) {
   const int32_t faces = sphere_->index().num_faces();
   auto sources = testing::RandomPoints(faces, 3, 21);

@@ -271,6 +271,7 @@ struct PathFlags {
   ModelFlags model;
   std::string pairs, format, out = "-";
   bool xyz = false;
+  uint32_t exact_corridor = 0;
 };
 
 absl::Status Path(const ConnectionFlags& conn, const PathFlags& flags) {
@@ -286,7 +287,8 @@ absl::Status Path(const ConnectionFlags& conn, const PathFlags& flags) {
   absl::StatusOr<std::vector<PointPair>> pairs =
       LoadPairs(*client, flags.model.ref(), flags.pairs, flags.xyz);
   if (!pairs.ok()) return pairs.status();
-  absl::StatusOr<std::vector<GeodesicPath>> paths = client->Path(flags.model.ref(), *pairs);
+  absl::StatusOr<std::vector<GeodesicPath>> paths =
+      client->Path(flags.model.ref(), *pairs, flags.exact_corridor);
   if (!paths.ok()) return paths.status();
   const std::string out = format == "obj"   ? PathsToObj(*paths)
                           : format == "ply" ? PathsToPly(*paths)
@@ -456,6 +458,10 @@ int Main(int argc, char** argv) {
                    "File of lines 'fa a0 a1 a2 fb b0 b1 b2' ('-': standard input)")
       ->required();
   path->add_flag("--xyz", path_flags.xyz, "Lines are 'xa ya za xb yb zb' (located first)");
+  path->add_option("--exact-corridor", path_flags.exact_corridor,
+                   "Also solve each path exactly within this many edge steps of the traced one "
+                   "(not O(k); 0: the model's default)")
+      ->check(CLI::Range(0, 64));
   path->add_option("--format", path_flags.format,
                    "obj (polylines), ply (vertices and edges) or json (surface points and "
                    "positions); default: from --out's extension, else json")

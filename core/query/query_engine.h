@@ -158,6 +158,9 @@ class QueryEngine {
   // a mesh face. Errors: as Validate; NotFound between components.
   absl::StatusOr<std::vector<PathPoint>> Path(const SurfacePoint& from,
                                               const SurfacePoint& to) const;
+  // Path with QueryOptions::exact_path_corridor = exact_corridor (0: off).
+  absl::StatusOr<std::vector<PathPoint>> Path(const SurfacePoint& from, const SurfacePoint& to,
+                                              int32_t exact_corridor) const;
 
   // The gradient trace of Path before straightening, for comparisons. The
   // points must be valid (see Validate).

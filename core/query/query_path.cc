@@ -125,9 +125,15 @@ int LocalIndex(std::span<const int32_t> faces, int32_t f, int32_t v) {
 
 absl::StatusOr<std::vector<PathPoint>> QueryEngine::Path(const SurfacePoint& from,
                                                          const SurfacePoint& to) const {
+  return Path(from, to, options_.exact_path_corridor);
+}
+
+absl::StatusOr<std::vector<PathPoint>> QueryEngine::Path(const SurfacePoint& from,
+                                                         const SurfacePoint& to,
+                                                         int32_t exact_corridor) const {
   GEODEX_ASSIGN_OR_RETURN(std::vector<PathPoint> path, ShortestTrace(from, to, /*restarts=*/true));
-  if (options_.exact_path_corridor <= 0) return path;
-  absl::StatusOr<std::vector<PathPoint>> exact = CorridorPath(path, options_.exact_path_corridor);
+  if (exact_corridor <= 0) return path;
+  absl::StatusOr<std::vector<PathPoint>> exact = CorridorPath(path, exact_corridor);
   if (exact.ok() && PathLength(*exact) < PathLength(path)) {
     exact->front() = path.front();
     exact->back() = path.back();

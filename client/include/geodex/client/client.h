@@ -130,9 +130,13 @@ class Client {
                                         absl::Span<const SurfacePoint> targets) const;
 
   // Geodesic paths for point pairs, in input order (ClientOptions::
-  // path_batch_size pairs per call).
+  // path_batch_size pairs per call). exact_corridor > 0 (at most 64) asks the
+  // server to also solve each path exactly within that many edge steps of
+  // the traced one (geodex.v1.PathRequest.exact_corridor); 0: the model's
+  // default.
   absl::StatusOr<std::vector<GeodesicPath>> Path(const ModelRef& model,
-                                                 absl::Span<const PointPair> pairs) const;
+                                                 absl::Span<const PointPair> pairs,
+                                                 uint32_t exact_corridor = 0) const;
 
   // Distance from the nearest source to every mesh vertex, assembled from the
   // streamed chunks. Errors: DATA_LOSS if the chunks do not cover every
