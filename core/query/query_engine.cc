@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <queue>
 #include <tuple>
 
@@ -474,34 +475,38 @@ double QueryEngine::AtLeastChord(const SurfacePoint& p, const SurfacePoint& q, d
   return std::max(d, (PositionOf(p) - PositionOf(q)).norm());
 }
 
-double QueryEngine::ExactNearDistance(const SurfacePoint& p, const SurfacePoint& q,
-                                      QueryScratch* scratch) const {
+std::optional<double> QueryEngine::ExactNearDistance(const SurfacePoint& from,
+                                                     const SurfacePoint& to,
+                                                     QueryScratch* scratch) const {
   if (scratch->solver_ == nullptr || scratch->mesh_ != mesh_.get()) {
     scratch->solver_ = std::make_unique<geodesic::ExactGeodesicSolver>(*mesh_);
     scratch->mesh_ = mesh_.get();
   }
-  // Propagate from the smaller point so the answer is symmetric.
-  const bool swap = std::tie(q.face, q.w) < std::tie(p.face, p.w);
-  const SurfacePoint& from = swap ? q : p;
-  const SurfacePoint& to = swap ? p : q;
   geodesic::GeodesicOptions options;
   options.stop_points = {to};
-  if (!scratch->solver_->Propagate({from}, options).ok()) return DistanceUnchecked(p, q);
+  if (!scratch->solver_->Propagate({from}, options).ok()) return std::nullopt;
   return scratch->solver_->DistanceAt(to);
 }
 
 double QueryEngine::NearDistance(const SurfacePoint& p, const SurfacePoint& q, double unfolded,
                                  QueryScratch* scratch) const {
+  // Both other modes work from one point to the other: from the smaller, so
+  // that the answer is symmetric.
+  const bool swap = std::tie(q.face, q.w) < std::tie(p.face, p.w);
+  const SurfacePoint& from = swap ? q : p;
+  const SurfacePoint& to = swap ? p : q;
+  std::optional<double> d;
   switch (options_.near_pairs) {
     case NearPairs::kPath:
-      return PathNearDistance(p, q);
+      d = PathNearDistance(from, to);
+      break;
     case NearPairs::kExact:
-      if (scratch != nullptr) return ExactNearDistance(p, q, scratch);
+      if (scratch != nullptr) d = ExactNearDistance(from, to, scratch);
       break;
     case NearPairs::kUnfold:
       break;
   }
-  return AtLeastChord(p, q, unfolded);
+  return d ? *d : AtLeastChord(p, q, unfolded);
 }
 
 absl::StatusOr<double> QueryEngine::Distance(const SurfacePoint& p, const SurfacePoint& q,

@@ -266,12 +266,14 @@ class QueryEngine {
   // vertex of largest weight (the anchor when the vertices share none).
   LiftedPoint SlowLift(const SurfacePoint& p, int heaviest) const;
   // The answer for a near pair of canonical points whose unfolded distance
-  // is `unfolded`, by options_.near_pairs.
+  // is `unfolded`, by options_.near_pairs; the unfolded one, kept at least
+  // the chord apart, in the kUnfold mode or when the other mode fails.
   double NearDistance(const SurfacePoint& p, const SurfacePoint& q, double unfolded,
                       QueryScratch* scratch) const;
-  double ExactNearDistance(const SurfacePoint& p, const SurfacePoint& q,
-                           QueryScratch* scratch) const;
-  double PathNearDistance(const SurfacePoint& p, const SurfacePoint& q) const;
+  // The near-pair modes from `from` to `to`; nullopt when they fail.
+  std::optional<double> ExactNearDistance(const SurfacePoint& from, const SurfacePoint& to,
+                                          QueryScratch* scratch) const;
+  std::optional<double> PathNearDistance(const SurfacePoint& from, const SurfacePoint& to) const;
   // The exact shortest path from `from` to `to` among the faces within
   // `steps` edge steps of the faces `path` crosses, or an error (e.g. when
   // that corridor is not a manifold mesh).

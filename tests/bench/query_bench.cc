@@ -124,9 +124,9 @@ double Gather(const index::Index& ix, const Matrix& matrix, const mesh::SurfaceP
   return acc;
 }
 
-// Microseconds per near pair (the same or adjacent geodesic triangles) in a
-// near-pair mode, over `count` pairs drawn from faces close in the file.
-std::vector<std::pair<mesh::SurfacePoint, mesh::SurfacePoint>> NearPairs(
+// `count` near pairs (the same or adjacent geodesic triangles), drawn from
+// faces close in the file.
+std::vector<std::pair<mesh::SurfacePoint, mesh::SurfacePoint>> DrawNearPairs(
     const index::Index& ix, const query::QueryEngine& engine, int count) {
   const auto p = InteriorPoints(ix, 50 * count, 5), q = InteriorPoints(ix, 50 * count, 6);
   std::vector<std::pair<mesh::SurfacePoint, mesh::SurfacePoint>> out;
@@ -140,6 +140,7 @@ std::vector<std::pair<mesh::SurfacePoint, mesh::SurfacePoint>> NearPairs(
   return out;
 }
 
+// Microseconds per near pair of Distance in a near-pair mode.
 double MicrosecondsPerNearPair(
     std::shared_ptr<const index::Index> ix, query::NearPairs mode,
     const std::vector<std::pair<mesh::SurfacePoint, mesh::SurfacePoint>>& pairs) {
@@ -220,7 +221,7 @@ void Bench(const std::string& label, std::shared_ptr<const index::Index> ix, int
     path_ms[e] = 1e3 * (ThreadSeconds() - t0) / num_paths;
     sink = sink + static_cast<double>(points);
   }
-  const auto near_pairs = NearPairs(*ix, *engine, 1000);
+  const auto near_pairs = DrawNearPairs(*ix, *engine, 1000);
   const double path_us = MicrosecondsPerNearPair(ix, query::NearPairs::kPath, near_pairs);
   const double exact_us = MicrosecondsPerNearPair(ix, query::NearPairs::kExact, near_pairs);
   const double m = ix->num_samples();
