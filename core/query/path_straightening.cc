@@ -5,10 +5,17 @@
 #include <cmath>
 #include <limits>
 
+#include "absl/container/inlined_vector.h"
+
 namespace geodex::query {
 namespace {
 
 constexpr double kZero = 1e-12;  // barycentric weights below this are on an edge
+
+// Per-pass working arrays: most straightened paths are short (a near pair
+// crosses a handful of faces), so they live on the stack until they grow.
+template <typename T>
+using Small = absl::InlinedVector<T, 16>;
 
 struct Vec2 {
   double x, y;
@@ -147,13 +154,13 @@ class Straightener {
   };
 
   // A face holding the point, and each face holding both it and `other`.
-  std::vector<int32_t> FacesOf(const SurfacePoint& p, const Support& s) const {
+  Small<int32_t> FacesOf(const SurfacePoint& p, const Support& s) const {
     if (s.count == 3) return {p.face};
     if (s.count == 2) {
       const int32_t g = Across(p.face, s.vertex[0], s.vertex[1]);
-      return g >= 0 ? std::vector<int32_t>{p.face, g} : std::vector<int32_t>{p.face};
+      return g >= 0 ? Small<int32_t>{p.face, g} : Small<int32_t>{p.face};
     }
-    std::vector<int32_t> out;
+    Small<int32_t> out;
     for (int dir = 0; dir < 2; ++dir) {
       for (int32_t f = p.face, guard = 0; guard < 4096; ++guard) {
         if (dir == 0 || f != p.face) out.push_back(f);
@@ -187,10 +194,10 @@ class Straightener {
   // The faces around v strictly after `from` up to `to`, on the side whose
   // angle at v is smaller (the side a shortest path hugs). False if neither
   // side connects them (boundary on both).
-  bool Fan(int32_t v, int32_t from, int32_t to, std::vector<int32_t>* fan) const {
+  bool Fan(int32_t v, int32_t from, int32_t to, Small<int32_t>* fan) const {
     double best = std::numeric_limits<double>::infinity();
     for (int dir = 0; dir < 2; ++dir) {
-      std::vector<int32_t> faces;
+      Small<int32_t> faces;
       double angle = 0;
       int32_t f = from;
       for (int guard = 0; guard < 4096 && f != to; ++guard) {
@@ -212,10 +219,10 @@ class Straightener {
   // False when the path is not a proper strip (then it is kept as is).
   bool Straighten(const std::vector<PathPoint>& run, std::vector<PathPoint>* out) const {
     const size_t k = run.size();
-    std::vector<Support> support(k);
+    Small<Support> support(k);
     for (size_t i = 0; i < k; ++i) support[i] = SupportOf(run[i].point);
     // Segment faces: segment i (run[i] -> run[i+1]) lies in face seg[i].
-    std::vector<int32_t> seg(k - 1, -1);
+    Small<int32_t> seg(k - 1, -1);
     for (size_t i = 0; i + 1 < k; ++i) {
       for (int32_t f : FacesOf(run[i].point, support[i])) {
         if (FaceHolds(f, support[i + 1])) {
@@ -226,8 +233,8 @@ class Straightener {
       if (seg[i] < 0) return false;
     }
     // The strip: faces in order and the edges (portals) between them.
-    std::vector<int32_t> strip = {seg[0]};
-    std::vector<std::array<int32_t, 2>> edges;
+    Small<int32_t> strip = {seg[0]};
+    Small<std::array<int32_t, 2>> edges;
     // Entering the face just left (back across the same edge) cancels out.
     auto push = [&](int32_t face, std::array<int32_t, 2> edge) {
       if (strip.size() >= 2 && strip[strip.size() - 2] == face) {
@@ -247,7 +254,7 @@ class Straightener {
         push(next, {a, b});
       } else if (support[i].count == 1) {
         const int32_t v = support[i].vertex[0];
-        std::vector<int32_t> fan;
+        Small<int32_t> fan;
         if (!Fan(v, prev, next, &fan)) return false;
         for (int32_t f : fan) {
           const int32_t from = strip.back();
@@ -264,8 +271,8 @@ class Straightener {
     }
     if (strip.size() > 1 && strip.back() != seg[k - 2]) return false;
     // Unfold the strip and collect its portals.
-    std::vector<Flat> flats = {FirstFlat(strip[0])};
-    std::vector<Portal> portals;
+    Small<Flat> flats = {FirstFlat(strip[0])};
+    Small<Portal> portals;
     const Vec2 start = Place(flats[0], support[0]);
     const int32_t start_id = support[0].count == 1 ? support[0].vertex[0] : -1;
     portals.push_back({start, start, start_id, start_id, strip[0]});
@@ -296,7 +303,7 @@ class Straightener {
       size_t portal;
       int side;
     };
-    std::vector<Apex> apexes = {{0, 0}};
+    Small<Apex> apexes = {{0, 0}};
     Vec2 apex = start, left = start, right = start;
     size_t apex_index = 0, left_index = 0, right_index = 0;
     const size_t n = portals.size();

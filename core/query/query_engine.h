@@ -52,10 +52,11 @@ enum class NearPairs {
   // Pure O(1): the unfolding of §5, kept at least the straight-line distance
   // apart (no surface path is shorter).
   kUnfold,
-  // The length of the shorter of the straightened gradient traces of p's
-  // and q's fields (Path without its restarts, so Path can be shorter): a
-  // surface path, never below the geodesic distance; O(k) in the faces it
-  // crosses. With straighten_paths off, the raw traces (longer).
+  // The length of the straightened gradient trace of p's field, and of
+  // q's when that one wraps round a vertex (Path without its restarts, so
+  // Path can be shorter): a surface path, never below the geodesic
+  // distance; O(k) in the faces it crosses. With straighten_paths off, the
+  // raw traces (longer).
   kPath,
   // A local exact propagation from one point that stops when it reaches the
   // other (needs a QueryScratch; without one, kUnfold). About 8x the cost of
@@ -279,10 +280,20 @@ class QueryEngine {
   // that corridor is not a manifold mesh).
   absl::StatusOr<std::vector<PathPoint>> CorridorPath(const std::vector<PathPoint>& path,
                                                       int32_t steps) const;
-  // Path, with the restarts or without (then only the traces of both fields,
-  // straightened).
+  // How far ShortestTrace looks beyond the first straightened trace.
+  enum class TraceSearch {
+    // Path: the trace of the other point's field too, then restarts while
+    // the path is still long.
+    kFull,
+    // Near pairs: the trace of the other point's field only when the first
+    // wraps round a vertex; no restarts.
+    kNearPair,
+  };
+  // The straightened trace of `from`'s field back from `to`, or a shorter
+  // one found as `search` says.
   absl::StatusOr<std::vector<PathPoint>> ShortestTrace(const SurfacePoint& from,
-                                                       const SurfacePoint& to, bool restarts) const;
+                                                       const SurfacePoint& to,
+                                                       TraceSearch search) const;
   SurfacePoint Canonical(const SurfacePoint& p) const;
 
   std::shared_ptr<const index::Index> index_;
