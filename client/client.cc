@@ -30,6 +30,20 @@ void AppendPoint(const SurfacePoint& p, v1::SurfacePoints* out) {
   out->add_weights(p.w[2]);
 }
 
+v1::NearPairs ToProto(NearPairs mode) {
+  switch (mode) {
+    case NearPairs::kPath:
+      return v1::NEAR_PAIRS_PATH;
+    case NearPairs::kUnfold:
+      return v1::NEAR_PAIRS_UNFOLD;
+    case NearPairs::kExact:
+      return v1::NEAR_PAIRS_EXACT;
+    case NearPairs::kModelDefault:
+      break;
+  }
+  return v1::NEAR_PAIRS_UNSPECIFIED;
+}
+
 v1::SurfacePoints ToProto(absl::Span<const SurfacePoint> points) {
   v1::SurfacePoints out;
   out.mutable_faces()->Reserve(points.size());
@@ -154,7 +168,7 @@ const char* StateName(ModelInfo::State state) {
 struct DistanceSession::State {
   std::unique_ptr<DistanceStream> stream;
   v1::ModelRef model;
-  bool exact_near_pairs = false;
+  v1::NearPairs near_pairs = v1::NEAR_PAIRS_UNSPECIFIED;
 
   absl::Mutex write_mu;
   uint64_t next_id ABSL_GUARDED_BY(write_mu) = 0;
@@ -187,7 +201,7 @@ absl::StatusOr<uint64_t> DistanceSession::Send(absl::Span<const PointPair> pairs
   batch.set_batch_id(id);
   // Only the first batch names the model; the server keeps it for the stream.
   if (id == 0) *batch.mutable_model() = state_->model;
-  batch.set_exact_near_pairs(state_->exact_near_pairs);
+  batch.set_near_pairs(state_->near_pairs);
   PairsToProto(pairs, 0, pairs.size(), batch.mutable_a(), batch.mutable_b());
   if (!state_->stream->Write(batch)) {
     state_->broken = true;
@@ -261,7 +275,7 @@ namespace {
 // `pairs`; advances *next_batch past every batch answered, writing the
 // answers into `out`.
 absl::Status StreamDistancesOnce(GeodexConnection& connection, const v1::ModelRef& model,
-                                 absl::Span<const PointPair> pairs, bool exact_near_pairs,
+                                 absl::Span<const PointPair> pairs, v1::NearPairs near_pairs,
                                  size_t batch_size, uint64_t* next_batch,
                                  std::vector<double>* out) {
   const uint64_t num_batches = (pairs.size() + batch_size - 1) / batch_size;
@@ -271,20 +285,20 @@ absl::Status StreamDistancesOnce(GeodexConnection& connection, const v1::ModelRe
   // The writer runs ahead of the reader; gRPC flow control bounds how far.
   // Reading on this thread while another writes is what keeps a large call
   // from deadlocking on full buffers in both directions.
-  WriterGuard writer(*stream, std::thread([&stream, &model, pairs, exact_near_pairs, batch_size,
-                                           first, num_batches] {
-    for (uint64_t k = first; k < num_batches; ++k) {
-      v1::DistanceBatch batch;
-      batch.set_batch_id(k);
-      if (k == first) *batch.mutable_model() = model;
-      batch.set_exact_near_pairs(exact_near_pairs);
-      const size_t begin = k * batch_size;
-      const size_t end = std::min(pairs.size(), begin + batch_size);
-      PairsToProto(pairs, begin, end, batch.mutable_a(), batch.mutable_b());
-      if (!stream->Write(batch)) return;  // broken: the reader finds out why
-    }
-    stream->WritesDone();
-  }));
+  WriterGuard writer(
+      *stream, std::thread([&stream, &model, pairs, near_pairs, batch_size, first, num_batches] {
+        for (uint64_t k = first; k < num_batches; ++k) {
+          v1::DistanceBatch batch;
+          batch.set_batch_id(k);
+          if (k == first) *batch.mutable_model() = model;
+          batch.set_near_pairs(near_pairs);
+          const size_t begin = k * batch_size;
+          const size_t end = std::min(pairs.size(), begin + batch_size);
+          PairsToProto(pairs, begin, end, batch.mutable_a(), batch.mutable_b());
+          if (!stream->Write(batch)) return;  // broken: the reader finds out why
+        }
+        stream->WritesDone();
+      }));
 
   absl::Status batch_error;
   v1::DistanceResult result;
@@ -325,7 +339,7 @@ absl::Status StreamDistancesOnce(GeodexConnection& connection, const v1::ModelRe
 
 absl::StatusOr<std::vector<double>> Client::Distance(const ModelRef& model,
                                                      absl::Span<const PointPair> pairs,
-                                                     bool exact_near_pairs) const {
+                                                     NearPairs near_pairs) const {
   if (absl::Status s = CheckModel(model); !s.ok()) return s;
   if (pairs.empty()) return std::vector<double>{};
   const size_t batch_size = options_.batch_size;
@@ -334,7 +348,7 @@ absl::StatusOr<std::vector<double>> Client::Distance(const ModelRef& model,
     // One batch: a unary call costs one round trip and no thread.
     v1::DistanceRequest request;
     *request.mutable_model() = ToProto(model);
-    request.set_exact_near_pairs(exact_near_pairs);
+    request.set_near_pairs(ToProto(near_pairs));
     PairsToProto(pairs, 0, pairs.size(), request.mutable_a(), request.mutable_b());
     absl::StatusOr<v1::DistanceResponse> response = connection_->Distance(request);
     if (!response.ok()) return response.status();
@@ -351,7 +365,7 @@ absl::StatusOr<std::vector<double>> Client::Distance(const ModelRef& model,
   int failures = 0;  // consecutive failed attempts without progress
   while (true) {
     const uint64_t before = next_batch;
-    const absl::Status status = StreamDistancesOnce(*connection_, ref, pairs, exact_near_pairs,
+    const absl::Status status = StreamDistancesOnce(*connection_, ref, pairs, ToProto(near_pairs),
                                                     batch_size, &next_batch, &out);
     if (status.ok()) return out;
     if (next_batch > before) failures = 0;  // a stream that made progress is not a repeat
@@ -368,13 +382,14 @@ DistanceSession Client::OpenDistanceSession(const ModelRef& model, SessionOption
   stream_options.deadline = options.deadline;
   state->stream = connection_->StreamDistances(stream_options);
   state->model = ToProto(model);
-  state->exact_near_pairs = options.exact_near_pairs;
+  state->near_pairs = ToProto(options.near_pairs);
   return DistanceSession(std::move(state));
 }
 
 absl::StatusOr<DistanceMatrix> Client::Matrix(const ModelRef& model,
                                               absl::Span<const SurfacePoint> sources,
-                                              absl::Span<const SurfacePoint> targets) const {
+                                              absl::Span<const SurfacePoint> targets,
+                                              NearPairs near_pairs) const {
   if (absl::Status s = CheckModel(model); !s.ok()) return s;
   DistanceMatrix matrix;
   matrix.rows = static_cast<int64_t>(sources.size());
@@ -385,6 +400,7 @@ absl::StatusOr<DistanceMatrix> Client::Matrix(const ModelRef& model,
   *request.mutable_model() = ToProto(model);
   *request.mutable_sources() = ToProto(sources);
   *request.mutable_targets() = ToProto(targets);
+  request.set_near_pairs(ToProto(near_pairs));
   absl::StatusOr<std::vector<v1::MatrixBlock>> blocks = connection_->Matrix(request);
   if (!blocks.ok()) return blocks.status();
 

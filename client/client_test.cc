@@ -150,7 +150,8 @@ TEST(ClientDistance, OneBatchIsOneUnaryCall) {
   EXPECT_CALL(*mock, Distance).WillOnce([](const v1::DistanceRequest& r) {
     EXPECT_EQ(r.model().name(), "torus");
     EXPECT_EQ(r.model().version(), 2);
-    EXPECT_TRUE(r.exact_near_pairs());
+    EXPECT_EQ(r.near_pairs(), v1::NEAR_PAIRS_UNFOLD);
+    EXPECT_FALSE(r.exact_near_pairs());  // deprecated: the client sends near_pairs
     EXPECT_THAT(r.a().faces(), ElementsAre(0, 1, 2));
     EXPECT_THAT(r.a().weights(), ElementsAre(0.5, 0.25, 0.25, 0.5, 0.25, 0.25, 0.5, 0.25, 0.25));
     EXPECT_THAT(r.b().faces(), ElementsAre(7, 7, 7));
@@ -160,7 +161,7 @@ TEST(ClientDistance, OneBatchIsOneUnaryCall) {
   });
   Client client(mock, SmallBatches(3));
   absl::StatusOr<std::vector<double>> d =
-      client.Distance(ModelRef("torus", 2), NumberedPairs(3), /*exact_near_pairs=*/true);
+      client.Distance(ModelRef("torus", 2), NumberedPairs(3), NearPairs::kUnfold);
   ASSERT_TRUE(d.ok()) << d.status();
   EXPECT_THAT(*d, ElementsAre(0.5, 1.5, 2.5));
 }
@@ -187,14 +188,14 @@ TEST(ClientDistance, BatchesAreSizedNumberedAndOnlyTheFirstNamesTheModel) {
     return std::make_unique<Proxy>(&fake);
   });
   Client client(mock, SmallBatches(100));
-  ASSERT_TRUE(client.Distance(ModelRef("torus", 4), NumberedPairs(250), true).ok());
+  ASSERT_TRUE(client.Distance(ModelRef("torus", 4), NumberedPairs(250), NearPairs::kExact).ok());
   const std::vector<v1::DistanceBatch> batches = fake.batches();
   ASSERT_EQ(batches.size(), 3u);
   EXPECT_EQ(batches[0].model().name(), "torus");
   EXPECT_EQ(batches[0].model().version(), 4);
   for (size_t k = 0; k < batches.size(); ++k) {
     EXPECT_EQ(batches[k].batch_id(), k);
-    EXPECT_TRUE(batches[k].exact_near_pairs());
+    EXPECT_EQ(batches[k].near_pairs(), v1::NEAR_PAIRS_EXACT);
     if (k > 0) {
       EXPECT_TRUE(batches[k].model().name().empty()) << k;
     }
@@ -398,6 +399,7 @@ TEST(ClientMatrix, BlocksAreAssembledByOffset) {
   EXPECT_CALL(*mock, Matrix).WillOnce([](const v1::MatrixRequest& r) {
     EXPECT_EQ(r.sources().faces_size(), 3);
     EXPECT_EQ(r.targets().faces_size(), 2);
+    EXPECT_EQ(r.near_pairs(), v1::NEAR_PAIRS_PATH);
     std::vector<v1::MatrixBlock> blocks(2);
     blocks[0].set_row_offset(2);
     blocks[0].set_rows(1);
@@ -413,7 +415,7 @@ TEST(ClientMatrix, BlocksAreAssembledByOffset) {
   });
   Client client(mock);
   std::vector<SurfacePoint> sources(3), targets(2);
-  absl::StatusOr<DistanceMatrix> m = client.Matrix("torus", sources, targets);
+  absl::StatusOr<DistanceMatrix> m = client.Matrix("torus", sources, targets, NearPairs::kPath);
   ASSERT_TRUE(m.ok()) << m.status();
   EXPECT_EQ(m->rows, 3);
   EXPECT_EQ(m->cols, 2);

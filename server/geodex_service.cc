@@ -21,11 +21,35 @@ using Clock = std::chrono::steady_clock;
 // Largest payload of one streamed Matrix block or DistanceField chunk.
 constexpr int64_t kChunkBytes = 1 << 20;
 
-// How a model answers near pairs: exactly when the request or the model's
-// configuration asks for it, else by the pure O(1) unfolding when the
-// configuration says so, else by path length (the engines' default).
-query::NearPairs NearPairsFor(const ModelSnapshot& model, bool exact_requested) {
-  if (exact_requested || model.config.exact_near_pairs()) return query::NearPairs::kExact;
+// How a request's near pairs are answered: as the request says (near_pairs,
+// or the deprecated exact_near_pairs), else as the model's configuration
+// says (exact_near_pairs, then unfold_near_pairs), else by path length (the
+// engines' default). Errors: InvalidArgument for an unknown mode or a
+// contradiction.
+absl::StatusOr<query::NearPairs> NearPairsFor(const ModelSnapshot& model, int requested,
+                                              bool exact_requested) {
+  if (!v1::NearPairs_IsValid(requested)) {
+    return absl::InvalidArgumentError(
+        absl::StrFormat("near_pairs has the unknown value %d", requested));
+  }
+  if (exact_requested && requested != v1::NEAR_PAIRS_UNSPECIFIED &&
+      requested != v1::NEAR_PAIRS_EXACT) {
+    return absl::InvalidArgumentError(
+        absl::StrFormat("exact_near_pairs contradicts near_pairs = %s",
+                        v1::NearPairs_Name(static_cast<v1::NearPairs>(requested))));
+  }
+  if (exact_requested) return query::NearPairs::kExact;
+  switch (static_cast<v1::NearPairs>(requested)) {
+    case v1::NEAR_PAIRS_PATH:
+      return query::NearPairs::kPath;
+    case v1::NEAR_PAIRS_UNFOLD:
+      return query::NearPairs::kUnfold;
+    case v1::NEAR_PAIRS_EXACT:
+      return query::NearPairs::kExact;
+    default:
+      break;
+  }
+  if (model.config.exact_near_pairs()) return query::NearPairs::kExact;
   if (model.config.unfold_near_pairs()) return query::NearPairs::kUnfold;
   return query::NearPairs::kPath;
 }
@@ -135,8 +159,8 @@ ServiceLimits GeodexService::LimitsFor(const ModelSnapshot& model) const {
 }
 
 absl::Status GeodexService::ComputeDistances(const ResolvedModel& model, const v1::SurfacePoints& a,
-                                             const v1::SurfacePoints& b, bool exact_near_pairs,
-                                             WorkerContext& worker,
+                                             const v1::SurfacePoints& b, int near_pairs,
+                                             bool exact_near_pairs, WorkerContext& worker,
                                              google::protobuf::RepeatedField<double>* out) const {
   const ServiceLimits limits = LimitsFor(*model.model);
   const int64_t na = PointCount(a), nb = PointCount(b);
@@ -149,8 +173,9 @@ absl::Status GeodexService::ComputeDistances(const ResolvedModel& model, const v
     return absl::InvalidArgumentError(
         absl::StrFormat("a has %d points but b has %d; they must pair up", na, nb));
   }
-  GEODEX_ASSIGN_OR_RETURN(const query::QueryEngine* engine,
-                          model.version->EngineFor(NearPairsFor(*model.model, exact_near_pairs)));
+  GEODEX_ASSIGN_OR_RETURN(const query::NearPairs mode,
+                          NearPairsFor(*model.model, near_pairs, exact_near_pairs));
+  GEODEX_ASSIGN_OR_RETURN(const query::QueryEngine* engine, model.version->EngineFor(mode));
   GEODEX_RETURN_IF_ERROR(PointsFromProto(a, "a", *engine, &worker.a));
   GEODEX_RETURN_IF_ERROR(PointsFromProto(b, "b", *engine, &worker.b));
   return engine->DistanceBatch(worker.a, worker.b, ResizeForOutput(out, na), &worker.scratch);
@@ -247,9 +272,9 @@ grpc::ServerUnaryReactor* GeodexService::Distance(grpc::CallbackServerContext* c
   return RunUnary(context, "Distance",
                   [this, request, response](Call& call, WorkerContext& worker) -> absl::Status {
                     GEODEX_ASSIGN_OR_RETURN(ResolvedModel model, Resolve(request->model(), call));
-                    GEODEX_RETURN_IF_ERROR(ComputeDistances(model, request->a(), request->b(),
-                                                            request->exact_near_pairs(), worker,
-                                                            response->mutable_distances()));
+                    GEODEX_RETURN_IF_ERROR(ComputeDistances(
+                        model, request->a(), request->b(), request->near_pairs(),
+                        request->exact_near_pairs(), worker, response->mutable_distances()));
                     call.pairs = PointCount(request->a());
                     response->set_version(model.version->version());
                     return absl::OkStatus();
@@ -536,9 +561,9 @@ class GeodexService::DistanceStream final
       if (model.ok()) {
         model_label = model->model->name;
         version = model->version->version();
-        status = service_->ComputeDistances(*model, slot->request.a(), slot->request.b(),
-                                            slot->request.exact_near_pairs(), worker,
-                                            slot->result.mutable_distances());
+        status = service_->ComputeDistances(
+            *model, slot->request.a(), slot->request.b(), slot->request.near_pairs(),
+            slot->request.exact_near_pairs(), worker, slot->result.mutable_distances());
       }
     }
     const int64_t pairs = status.ok() ? PointCount(slot->request.a()) : 0;
@@ -738,7 +763,9 @@ class GeodexService::MatrixStream final : public ChunkedWriteStream<v1::MatrixBl
       return absl::InvalidArgumentError(
           absl::StrFormat("block_rows is negative (%d)", request_->block_rows()));
     }
-    GEODEX_ASSIGN_OR_RETURN(engine_, model_.version->EngineFor(NearPairsFor(*model_.model, false)));
+    GEODEX_ASSIGN_OR_RETURN(const query::NearPairs mode,
+                            NearPairsFor(*model_.model, request_->near_pairs(), false));
+    GEODEX_ASSIGN_OR_RETURN(engine_, model_.version->EngineFor(mode));
     GEODEX_RETURN_IF_ERROR(PointsFromProto(request_->sources(), "sources", *engine_, &sources_));
     GEODEX_RETURN_IF_ERROR(PointsFromProto(request_->targets(), "targets", *engine_, &targets_));
     // At most kChunkBytes a block, whole rows (at least one).

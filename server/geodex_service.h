@@ -127,9 +127,11 @@ class GeodexService final : public v1::Geodex::CallbackService {
   absl::Status Busy() const;
   absl::StatusOr<ResolvedModel> Resolve(const v1::ModelRef& ref, Call& call) const;
   ServiceLimits LimitsFor(const ModelSnapshot& model) const;
-  // a[i], b[i] -> out[i] with the model's engine (validated, limited).
+  // a[i], b[i] -> out[i] with the model's engine for the near-pair mode the
+  // request asks for (a v1::NearPairs value, and the deprecated flag) or the
+  // model's configuration does (validated, limited).
   absl::Status ComputeDistances(const ResolvedModel& model, const v1::SurfacePoints& a,
-                                const v1::SurfacePoints& b, bool exact_near_pairs,
+                                const v1::SurfacePoints& b, int near_pairs, bool exact_near_pairs,
                                 WorkerContext& worker,
                                 google::protobuf::RepeatedField<double>* out) const;
   // Runs `fn(call, worker) -> absl::Status` on the pool and finishes the call

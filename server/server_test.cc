@@ -784,6 +784,75 @@ TEST(ServerTest, NearPairsByPathLengthUnlessTheModelAsksForThePureO1Mode) {
   testing::WriteModelConfig(ts.root(), "sphere", "unfold_near_pairs: true\n");
   ts.Rescan();
   EXPECT_EQ(answers(), expected_unfold);
+  // A request's own mode wins over the model's.
+  request.set_near_pairs(v1::NEAR_PAIRS_PATH);
+  EXPECT_EQ(answers(), expected_path);
+}
+
+TEST(ServerTest, EachRequestMayChooseItsNearPairMode) {
+  TestServer ts;
+  auto stub = v1::Geodex::NewStub(ts.TcpChannel());
+  query::QueryScratch scratch;
+  const int32_t faces = ReferenceEngine(testing::SphereIndexBytes())->index().num_faces();
+  const auto a = testing::RandomPoints(faces, 40, 5);
+  auto b = testing::RandomPoints(faces, 40, 6);
+  for (size_t i = 0; i < b.size(); ++i) b[i].face = a[i].face;  // near pairs
+  std::map<v1::NearPairs, std::vector<double>> expected;
+  for (auto [wire, mode] : {std::pair{v1::NEAR_PAIRS_PATH, query::NearPairs::kPath},
+                            std::pair{v1::NEAR_PAIRS_UNFOLD, query::NearPairs::kUnfold},
+                            std::pair{v1::NEAR_PAIRS_EXACT, query::NearPairs::kExact}}) {
+    auto engine = ReferenceEngine(testing::SphereIndexBytes(), mode);
+    expected[wire].resize(a.size());
+    ASSERT_TRUE(engine->DistanceBatch(a, b, expected[wire], &scratch).ok());
+  }
+  ASSERT_NE(expected[v1::NEAR_PAIRS_PATH], expected[v1::NEAR_PAIRS_UNFOLD]);
+  ASSERT_NE(expected[v1::NEAR_PAIRS_PATH], expected[v1::NEAR_PAIRS_EXACT]);
+  v1::DistanceRequest request;
+  *request.mutable_model() = Ref("sphere");
+  *request.mutable_a() = ToProto(a);
+  *request.mutable_b() = ToProto(b);
+  auto call = [&](std::vector<double>* out) {
+    v1::DistanceResponse response;
+    auto context = Context();
+    const grpc::Status status = stub->Distance(context.get(), request, &response);
+    out->assign(response.distances().begin(), response.distances().end());
+    return status;
+  };
+  std::vector<double> got;
+  for (const auto& [wire, want] : expected) {
+    request.set_near_pairs(wire);
+    ASSERT_TRUE(call(&got).ok()) << v1::NearPairs_Name(wire);
+    EXPECT_EQ(got, want) << v1::NearPairs_Name(wire);
+  }
+  // The deprecated flag is the exact mode, and contradicting it is an error.
+  request.set_near_pairs(v1::NEAR_PAIRS_UNSPECIFIED);
+  request.set_exact_near_pairs(true);
+  ASSERT_TRUE(call(&got).ok());
+  EXPECT_EQ(got, expected[v1::NEAR_PAIRS_EXACT]);
+  request.set_near_pairs(v1::NEAR_PAIRS_UNFOLD);
+  grpc::Status status = call(&got);
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_THAT(status.error_message(), HasSubstr("contradicts near_pairs = NEAR_PAIRS_UNFOLD"));
+  request.set_exact_near_pairs(false);
+  request.set_near_pairs(static_cast<v1::NearPairs>(7));
+  status = call(&got);
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_THAT(status.error_message(), HasSubstr("unknown value 7"));
+  // Matrix rows are DistanceBatch answers in the mode asked for.
+  v1::MatrixRequest matrix;
+  *matrix.mutable_model() = Ref("sphere");
+  *matrix.mutable_sources() = ToProto(std::vector<mesh::SurfacePoint>{a[0]});
+  *matrix.mutable_targets() = ToProto(std::vector<mesh::SurfacePoint>{b[0]});
+  matrix.set_near_pairs(v1::NEAR_PAIRS_UNFOLD);
+  auto context = Context();
+  auto reader = stub->Matrix(context.get(), matrix);
+  v1::MatrixBlock block;
+  ASSERT_TRUE(reader->Read(&block));
+  ASSERT_EQ(block.values_size(), 1);
+  EXPECT_EQ(block.values(0), expected[v1::NEAR_PAIRS_UNFOLD][0]);
+  while (reader->Read(&block)) {
+  }
+  EXPECT_TRUE(reader->Finish().ok());
 }
 
 TEST(ServerTest, DeadlineExpiredWhileQueuedIsNotComputed) {

@@ -54,7 +54,7 @@ void UnaryWorker(const Client& client, const BenchOptions& options,
     absl::Span<const PointPair> batch(pool.data() + offset, options.batch);
     offset += options.batch;
     const absl::StatusOr<std::vector<double>> d =
-        client.Distance(options.model, batch, options.exact_near_pairs);
+        client.Distance(options.model, batch, options.near_pairs);
     const absl::Time done = absl::Now();
     if (start < measure_from) continue;
     if (!d.ok()) {
@@ -70,7 +70,7 @@ void StreamWorker(const Client& client, const BenchOptions& options,
                   const std::vector<PointPair>& pool, int worker, absl::Time measure_from,
                   absl::Time end, WorkerStats* stats) {
   SessionOptions session_options;
-  session_options.exact_near_pairs = options.exact_near_pairs;
+  session_options.near_pairs = options.near_pairs;
   DistanceSession session = client.OpenDistanceSession(options.model, session_options);
   absl::Mutex mu;
   std::vector<absl::Time> sent;  // send time by batch id

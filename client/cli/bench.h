@@ -22,7 +22,7 @@ struct BenchOptions {
   // worker keeps `window` batches in flight on one StreamDistances session.
   std::string mode = "unary";
   int window = 4;
-  bool exact_near_pairs = false;
+  NearPairs near_pairs = NearPairs::kModelDefault;
   uint64_t seed = 1;
 };
 

@@ -2,11 +2,11 @@
 //
 //   geodex models                                   models the server knows
 //   geodex info --model M                           one model, with its build report
-//   geodex distance --model M --pairs FILE|- [--xyz]
+//   geodex distance --model M --pairs FILE|- [--xyz] [--near-pairs MODE]
 //   geodex path --model M --pairs FILE --format obj|ply|json --out F
 //   geodex field --model M --sources FILE --out field.txt|field.ply
 //   geodex locate --model M --points FILE
-//   geodex matrix --model M --sources FILE --targets FILE
+//   geodex matrix --model M --sources FILE --targets FILE [--near-pairs MODE]
 //   geodex bench --model M --concurrency C --duration S --batch B
 //
 // Every subcommand takes --server ADDR (default $GEODEX_SERVER, else
@@ -30,6 +30,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -216,6 +217,24 @@ struct ModelFlags {
   ModelRef ref() const { return ModelRef(name, version); }
 };
 
+// --near-pairs model|path|unfold|exact, and --exact-near-pairs for exact.
+void AddNearPairsFlags(CLI::App* app, NearPairs* mode) {
+  static const std::map<std::string, NearPairs> kModes = {{"model", NearPairs::kModelDefault},
+                                                          {"path", NearPairs::kPath},
+                                                          {"unfold", NearPairs::kUnfold},
+                                                          {"exact", NearPairs::kExact}};
+  CLI::Option* option =
+      app->add_option_function<std::string>(
+             "--near-pairs", [mode](const std::string& name) { *mode = kModes.at(name); },
+             "Pairs in the same or adjacent geodesic triangles: model (the model's "
+             "configuration, default), path (the traced path's length), unfold (pure O(1)) or "
+             "exact (local exact propagation)")
+          ->check(CLI::IsMember({"model", "path", "unfold", "exact"}));
+  app->add_flag_callback(
+         "--exact-near-pairs", [mode] { *mode = NearPairs::kExact; }, "Same as --near-pairs exact")
+      ->excludes(option);
+}
+
 void AddModelFlags(CLI::App* app, ModelFlags* flags) {
   app->add_option("-m,--model", flags->name, "Model name")->required();
   app->add_option("--model-version", flags->version, "Model version (0: the newest)")
@@ -248,7 +267,8 @@ absl::Status Info(const ConnectionFlags& conn, const ModelFlags& model) {
 struct DistanceFlags {
   ModelFlags model;
   std::string pairs, out = "-";
-  bool xyz = false, exact_near_pairs = false;
+  bool xyz = false;
+  NearPairs near_pairs = NearPairs::kModelDefault;
   int batch = 4096;
 };
 
@@ -259,7 +279,7 @@ absl::Status Distance(const ConnectionFlags& conn, const DistanceFlags& flags) {
       LoadPairs(*client, flags.model.ref(), flags.pairs, flags.xyz);
   if (!pairs.ok()) return pairs.status();
   absl::StatusOr<std::vector<double>> d =
-      client->Distance(flags.model.ref(), *pairs, flags.exact_near_pairs);
+      client->Distance(flags.model.ref(), *pairs, flags.near_pairs);
   if (!d.ok()) return d.status();
   std::string out;
   out.reserve(d->size() * 20);
@@ -371,7 +391,7 @@ absl::Status Locate(const ConnectionFlags& conn, const ModelFlags& model, const 
 
 absl::Status Matrix(const ConnectionFlags& conn, const ModelFlags& model,
                     const std::string& sources_path, const std::string& targets_path,
-                    const std::string& out_path) {
+                    NearPairs near_pairs, const std::string& out_path) {
   absl::StatusOr<Client> client = MakeClient(conn);
   if (!client.ok()) return client.status();
   absl::StatusOr<std::vector<SurfacePoint>> sources =
@@ -380,7 +400,8 @@ absl::Status Matrix(const ConnectionFlags& conn, const ModelFlags& model,
   absl::StatusOr<std::vector<SurfacePoint>> targets =
       LoadPoints(*client, model.ref(), targets_path);
   if (!targets.ok()) return targets.status();
-  absl::StatusOr<DistanceMatrix> matrix = client->Matrix(model.ref(), *sources, *targets);
+  absl::StatusOr<DistanceMatrix> matrix =
+      client->Matrix(model.ref(), *sources, *targets, near_pairs);
   if (!matrix.ok()) return matrix.status();
   std::string out;
   for (int64_t r = 0; r < matrix->rows; ++r) {
@@ -442,8 +463,7 @@ int Main(int argc, char** argv) {
       ->required();
   distance->add_flag("--xyz", distance_flags.xyz,
                      "Lines are 'xa ya za xb yb zb': 3D points, located on the surface first");
-  distance->add_flag("--exact-near-pairs", distance_flags.exact_near_pairs,
-                     "Answer pairs in the same or adjacent geodesic triangles exactly (not O(1))");
+  AddNearPairsFlags(distance, &distance_flags.near_pairs);
   distance->add_option("--batch", distance_flags.batch, "Pairs per streamed batch")
       ->check(CLI::Range(1, 1 << 20))
       ->capture_default_str();
@@ -508,9 +528,13 @@ int Main(int argc, char** argv) {
   AddModelFlags(matrix, &matrix_model);
   matrix->add_option("--sources", matrix_sources, "File of lines 'f w0 w1 w2'")->required();
   matrix->add_option("--targets", matrix_targets, "File of lines 'f w0 w1 w2'")->required();
+  NearPairs matrix_near_pairs = NearPairs::kModelDefault;
+  AddNearPairsFlags(matrix, &matrix_near_pairs);
   matrix->add_option("-o,--out", matrix_out, "Output file ('-': standard output)");
-  matrix->callback(
-      [&] { status = Matrix(conn, matrix_model, matrix_sources, matrix_targets, matrix_out); });
+  matrix->callback([&] {
+    status =
+        Matrix(conn, matrix_model, matrix_sources, matrix_targets, matrix_near_pairs, matrix_out);
+  });
 
   CLI::App* bench = app.add_subcommand(
       "bench", "Load generator: random pairs; prints throughput and latency percentiles");
@@ -538,8 +562,7 @@ int Main(int argc, char** argv) {
   bench->add_option("--window", bench_flags.options.window, "Stream mode: batches in flight")
       ->check(CLI::Range(1, 1024))
       ->capture_default_str();
-  bench->add_flag("--exact-near-pairs", bench_flags.options.exact_near_pairs,
-                  "Ask for exact answers of near pairs");
+  AddNearPairsFlags(bench, &bench_flags.options.near_pairs);
   bench->add_option("--seed", bench_flags.options.seed, "Random pairs seed")->capture_default_str();
   bench->callback([&] { status = Bench(conn, bench_flags); });
 

@@ -185,6 +185,14 @@ if [ $FAKE -eq 0 ]; then
   "$QUERY_BIN" models/cube/1/index.gdx --pairs pairs.txt > d_offline.txt 2> err.txt
   same_numbers d_offline.txt d_cli.txt && pass "distance equals geodex-query on the same index" ||
     fail "distance differs from geodex-query" d_offline.txt d_cli.txt err.txt
+  for mode in unfold exact; do
+    "$QUERY_BIN" models/cube/1/index.gdx --pairs pairs.txt --near-pairs $mode > d_offline.txt 2> err.txt
+    "$GEODEX" distance "${S[@]}" --model "$MODEL" --pairs pairs.txt --near-pairs $mode \
+      > d_mode.txt 2>> err.txt
+    same_numbers d_offline.txt d_mode.txt &&
+      pass "distance --near-pairs $mode equals geodex-query --near-pairs $mode" ||
+      fail "distance --near-pairs $mode differs from geodex-query" d_offline.txt d_mode.txt err.txt
+  done
 fi
 
 # Paths. Path tracing belongs to core (a pair it cannot trace is INTERNAL, and

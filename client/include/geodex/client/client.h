@@ -116,9 +116,9 @@ class Client {
   //
   // Each attempt (the unary call, or one stream) must end within
   // ConnectOptions::deadline; raise it for very large inputs.
-  absl::StatusOr<std::vector<double>> Distance(const ModelRef& model,
-                                               absl::Span<const PointPair> pairs,
-                                               bool exact_near_pairs = false) const;
+  absl::StatusOr<std::vector<double>> Distance(
+      const ModelRef& model, absl::Span<const PointPair> pairs,
+      NearPairs near_pairs = NearPairs::kModelDefault) const;
 
   // Opens a streaming session (see DistanceSession).
   DistanceSession OpenDistanceSession(const ModelRef& model, SessionOptions options = {}) const;
@@ -127,7 +127,8 @@ class Client {
   // Errors: DATA_LOSS if the blocks do not tile the matrix.
   absl::StatusOr<DistanceMatrix> Matrix(const ModelRef& model,
                                         absl::Span<const SurfacePoint> sources,
-                                        absl::Span<const SurfacePoint> targets) const;
+                                        absl::Span<const SurfacePoint> targets,
+                                        NearPairs near_pairs = NearPairs::kModelDefault) const;
 
   // Geodesic paths for point pairs, in input order (ClientOptions::
   // path_batch_size pairs per call). exact_corridor > 0 (at most 64) asks the

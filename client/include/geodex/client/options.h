@@ -6,6 +6,7 @@
 #include <string>
 
 #include "absl/time/time.h"
+#include "geodex/client/types.h"
 
 namespace geodex::client {
 
@@ -72,7 +73,7 @@ struct ClientOptions {
 
 // Options of one DistanceSession.
 struct SessionOptions {
-  bool exact_near_pairs = false;
+  NearPairs near_pairs = NearPairs::kModelDefault;
   // The whole stream must end by then; infinite: no deadline.
   absl::Duration deadline = absl::InfiniteDuration();
 };

@@ -47,6 +47,16 @@ struct ModelRef {
   int64_t version = 0;
 };
 
+// How the server answers pairs in the same or adjacent geodesic triangles
+// ("near pairs", where the O(1) unfolding is weakest; geodex.v1.NearPairs).
+// Far pairs are O(1) in every mode.
+enum class NearPairs {
+  kModelDefault,  // the model's configuration; unless it says otherwise, kPath
+  kPath,          // the length of a traced, straightened path (0.3% p99)
+  kUnfold,        // the pure O(1) unfolding (up to 10% p99 on near pairs)
+  kExact,         // a local exact propagation (0.2-1 ms a near pair)
+};
+
 // What the server knows about one model (geodex.v1.ModelInfo).
 struct ModelInfo {
   enum class State { kUnspecified, kLoading, kServing, kFailed };
