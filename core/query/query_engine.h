@@ -18,9 +18,10 @@
 //
 // Near pairs (the same or adjacent geodesic triangles, §6.5) are the method's
 // weak spot. By default they are answered by the length of a path between
-// them (the gradient traces of both points' fields, straightened, as Path
-// does first; O(k) in the faces crossed, a few dozen for a near pair): p99
-// 0.3% where the O(1) unfolding errs by 10% on a scanned bunny.
+// them (the gradient trace of one point's field, straightened, and of the
+// other's when the first wraps round a vertex; O(k) in the faces crossed,
+// a handful for a near pair, about 5 us): p99 0.3% where the O(1) unfolding
+// errs by 10% on a scanned bunny.
 // QueryOptions::near_pairs selects the pure O(1) unfolding instead, or a
 // local exact propagation (see NearPairs).
 //
