@@ -229,7 +229,7 @@ void AddNearPairsFlags(CLI::App* app, NearPairs* mode) {
              "Pairs in the same or adjacent geodesic triangles: model (the model's "
              "configuration, default), path (the traced path's length), unfold (pure O(1)) or "
              "exact (local exact propagation)")
-          ->check(CLI::IsMember({"model", "path", "unfold", "exact"}));
+          ->check(CLI::IsMember(kModes));
   app->add_flag_callback(
          "--exact-near-pairs", [mode] { *mode = NearPairs::kExact; }, "Same as --near-pairs exact")
       ->excludes(option);
