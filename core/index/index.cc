@@ -69,6 +69,7 @@ constexpr SectionSpec kSpecs[] = {
     {SectionId::kFaceBvh, sizeof(BvhNode), "face BVH", false},
     {SectionId::kBvhFaces, sizeof(int32_t), "BVH faces", false},
     {SectionId::kReport, 1, "report", false},
+    {SectionId::kAccuracy, sizeof(AccuracyRecord), "accuracy", false},
 };
 constexpr size_t kNumSpecs = std::size(kSpecs);
 
@@ -110,6 +111,7 @@ std::optional<uint64_t> ExpectedCount(SectionId id, const Counts& c) {
     case SectionId::kBvhFaces:
       return c.num_bvh_nodes > 0 ? c.num_faces : 0;
     case SectionId::kReport:
+    case SectionId::kAccuracy:
       return std::nullopt;
   }
   return std::nullopt;
@@ -152,6 +154,30 @@ struct Contents {
 bool InRange(int64_t x, int64_t lo, int64_t hi) { return x >= lo && x < hi; }
 // Non-negative and not NaN; +inf allowed.
 bool NonNegative(float x) { return x >= 0; }
+
+// The accuracy section: absent or one record of finite, non-negative figures.
+absl::Status CheckAccuracy(std::span<const AccuracyRecord> records, absl::StatusCode code) {
+  if (records.empty()) return absl::OkStatus();
+  if (records.size() > 1) {
+    return absl::Status(code, absl::StrFormat("accuracy: %d records, expected 1", records.size()));
+  }
+  const AccuracyRecord& r = records[0];
+  std::vector<float> values = {r.scale_length, r.uniform_rms, r.uniform_far_p99};
+  for (int b = 0; b < kAccuracyBins; ++b) {
+    values.insert(values.end(), {r.unfold_bound[0][b], r.unfold_bound[1][b], r.trace_bound[0][b],
+                                 r.trace_bound[1][b]});
+  }
+  for (int b = 0; b < 4; ++b) values.insert(values.end(), {r.rms[b], r.p99[b]});
+  for (float v : values) {
+    if (!(v >= 0) || !std::isfinite(v)) {
+      return absl::Status(code, "accuracy: a figure is negative, NaN or infinite");
+    }
+  }
+  if (!(r.scale_length > 0) || r.bound_quantile_permille > 1000) {
+    return absl::Status(code, "accuracy: bad scale length or quantile");
+  }
+  return absl::OkStatus();
+}
 
 absl::Status CheckContents(const Contents& c, absl::StatusCode code) {
   auto fail = [code](std::string message) { return absl::Status(code, message); };
@@ -330,6 +356,7 @@ absl::StatusOr<std::string> SerializeIndex(const IndexData& d) {
       CheckContents(Contents{counts, d.positions, d.faces, d.twins, d.samples, d.sample_distances,
                              d.vertices, d.triangles, d.bvh_nodes, d.bvh_faces},
                     absl::StatusCode::kInvalidArgument));
+  GEODEX_RETURN_IF_ERROR(CheckAccuracy(d.accuracy, absl::StatusCode::kInvalidArgument));
 
   // Every section is written, empty ones with size 0, in kSpecs order.
   struct Piece {
@@ -347,6 +374,7 @@ absl::StatusOr<std::string> SerializeIndex(const IndexData& d) {
       {d.bvh_nodes.data(), d.bvh_nodes.size() * sizeof(BvhNode)},
       {d.bvh_faces.data(), d.bvh_faces.size() * sizeof(int32_t)},
       {d.report.data(), d.report.size()},
+      {d.accuracy.data(), d.accuracy.size() * sizeof(AccuracyRecord)},
   };
   SectionEntry entries[kNumSpecs];
   std::memset(entries, 0, sizeof(entries));
@@ -616,10 +644,32 @@ absl::Status Index::Validate() {
   bvh_faces_ = SectionView<int32_t>(p, entry(SectionId::kBvhFaces));
   const std::span<const char> report = SectionView<char>(p, entry(SectionId::kReport));
   report_ = std::string_view(report.data(), report.size());
+  accuracy_ = SectionView<AccuracyRecord>(p, entry(SectionId::kAccuracy));
+  GEODEX_RETURN_IF_ERROR(CheckAccuracy(accuracy_, absl::StatusCode::kDataLoss));
 
   return CheckContents(Contents{counts, positions_, faces_, twins_, samples_, sample_distances_,
                                 vertices_, triangles_, bvh_nodes_, bvh_faces_},
                        absl::StatusCode::kDataLoss);
+}
+
+IndexData ToIndexData(const Index& index) {
+  IndexData d;
+  d.builder_version = index.builder_version();
+  d.mesh_hash = index.header().mesh_hash;
+  d.params = index.header().params;
+  auto copy = [](auto span) { return std::vector(span.begin(), span.end()); };
+  d.positions = copy(index.positions());
+  d.faces = copy(index.faces());
+  d.twins = copy(index.twins());
+  d.samples = copy(index.samples());
+  d.sample_distances = copy(index.sample_distances());
+  d.vertices = copy(index.vertices());
+  d.triangles = copy(index.triangles());
+  d.bvh_nodes = copy(index.bvh_nodes());
+  d.bvh_faces = copy(index.bvh_faces());
+  d.report = std::string(index.report());
+  if (index.accuracy() != nullptr) d.accuracy = {*index.accuracy()};
+  return d;
 }
 
 }  // namespace geodex::index

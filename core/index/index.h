@@ -38,6 +38,7 @@ struct IndexData {
   std::vector<BvhNode> bvh_nodes;
   std::vector<int32_t> bvh_faces;
   std::string report;
+  std::vector<AccuracyRecord> accuracy;  // empty, or one record (format 1.1)
 };
 
 // XXH64 of the positions and faces: identifies the source mesh.
@@ -57,6 +58,11 @@ absl::StatusOr<std::string> SerializeIndex(const IndexData& data);
 // InvalidArgument as SerializeIndex; Internal / PermissionDenied / NotFound on
 // I/O failures (naming the path).
 absl::Status WriteIndexFile(const IndexData& data, const std::string& path);
+
+class Index;
+// A copy of a loaded index's contents, e.g. to write it again with a section
+// added.
+IndexData ToIndexData(const Index& index);
 
 class Index {
  public:
@@ -93,6 +99,9 @@ class Index {
   std::span<const BvhNode> bvh_nodes() const { return bvh_nodes_; }
   std::span<const int32_t> bvh_faces() const { return bvh_faces_; }
   std::string_view report() const { return report_; }
+  // The accuracy calibration, or nullptr when the index has none (format 1.0,
+  // or built without it).
+  const AccuracyRecord* accuracy() const { return accuracy_.empty() ? nullptr : &accuracy_[0]; }
 
   // d(sample i, sample j) from the matrix.
   float SampleDistance(int32_t i, int32_t j) const {
@@ -123,6 +132,7 @@ class Index {
   std::span<const BvhNode> bvh_nodes_;
   std::span<const int32_t> bvh_faces_;
   std::string_view report_;
+  std::span<const AccuracyRecord> accuracy_;
 };
 
 }  // namespace geodex::index

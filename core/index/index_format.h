@@ -19,6 +19,9 @@
 // ignore, kFormatMajor for anything else):
 //   1.0  first version: mesh, samples, full float32 distance matrix, vertex
 //        records, geodesic triangles with adjacency, face BVH, build report.
+//   1.1  accuracy calibration (AccuracyRecord): absolute error bounds of the
+//        answers by distance scale, measured against held-out exact
+//        propagations. Optional; 1.0 readers ignore it.
 
 #include <cstdint>
 
@@ -26,7 +29,7 @@ namespace geodex::index {
 
 inline constexpr char kMagic[8] = {'G', 'E', 'O', 'D', 'E', 'X', 'I', 'X'};
 inline constexpr uint32_t kFormatMajor = 1;
-inline constexpr uint32_t kFormatMinor = 0;
+inline constexpr uint32_t kFormatMinor = 1;
 inline constexpr uint32_t kByteOrderMark = 0x01020304;  // reads 0x04030201 when swapped
 inline constexpr uint64_t kAlignment = 64;
 
@@ -42,6 +45,7 @@ enum class SectionId : uint32_t {
   kFaceBvh = 8,          // BvhNode[num_bvh_nodes]
   kBvhFaces = 9,         // int32[num_faces]: faces in BVH leaf order
   kReport = 10,          // UTF-8 text: the builder's summary (key = value lines)
+  kAccuracy = 11,        // AccuracyRecord[0 or 1] (1.1)
 };
 
 // Build parameters recorded in the header.
@@ -112,5 +116,36 @@ struct BvhNode {
   int32_t count;
 };
 static_assert(sizeof(BvhNode) == 32);
+
+// Bins of the accuracy calibration, by approximate distance in units of the
+// scale length L = sqrt(2 A / (sqrt(3) m)) (the edge of an equilateral
+// geodesic triangle when the m samples tile the surface's area A).
+inline constexpr int kAccuracyBins = 8;
+inline constexpr float kAccuracyBinUpper[kAccuracyBins] = {0.5f, 1, 2, 3, 5, 10, 20, 1e30f};
+
+// The accuracy of an index's answers, measured when it was built against
+// exact propagations from held-out surface points (not samples). A bound is
+// the absolute error that the answers of its kind and bin stayed within for
+// all but a small share of the held-out pairs (see core/validation).
+struct AccuracyRecord {
+  float scale_length;         // L, in mesh units
+  uint32_t num_sources;       // held-out exact propagations
+  uint32_t num_pairs;         // held-out pairs measured
+  uint32_t bound_quantile_permille;  // the bounds are this quantile of the errors (e.g. 995)
+  // Absolute error bounds by bin of the answered distance (kAccuracyBinUpper):
+  // the O(1) unfolding for pairs of mesh vertices [0] and other pairs [1];
+  // the length of the straightened trace (a surface path: never short), [0]
+  // a straight one (a local geodesic), [1] one that bends round a vertex.
+  float unfold_bound[2][kAccuracyBins];
+  float trace_bound[2][kAccuracyBins];
+  // Relative error of the default answer over the held-out pairs, by the
+  // exact distance's bin d < L, L-3L, 3L-10L, >= 10L: RMS and p99; and over
+  // area-uniform pairs: RMS, and p99 of those beyond 10L.
+  float rms[4];
+  float p99[4];
+  float uniform_rms;
+  float uniform_far_p99;
+};
+static_assert(sizeof(AccuracyRecord) == 16 + 4 * 4 * kAccuracyBins + 4 * 10);
 
 }  // namespace geodex::index

@@ -105,19 +105,25 @@ absl::StatusOr<std::shared_ptr<const QueryEngine>> QueryEngine::Create(
     return absl::FailedPreconditionError("the index has no geodesic triangles");
   }
   std::shared_ptr<QueryEngine> engine(new QueryEngine(std::move(index), options));
-  if (options.near_pairs == NearPairs::kExact) {
-    const index::Index& ix = *engine->index_;
+  return std::shared_ptr<const QueryEngine>(std::move(engine));
+}
+
+const mesh::Mesh* QueryEngine::ExactMesh() const {
+  std::call_once(mesh_once_, [this] {
+    const index::Index& ix = *index_;
     std::vector<mesh::Vec3> positions(ix.num_vertices());
-    for (int32_t v = 0; v < ix.num_vertices(); ++v) positions[v] = engine->Position(v);
+    for (int32_t v = 0; v < ix.num_vertices(); ++v) positions[v] = Position(v);
     std::vector<mesh::Triangle> faces(ix.num_faces());
     for (int32_t f = 0; f < ix.num_faces(); ++f) {
       faces[f] = {ix.faces()[3 * f], ix.faces()[3 * f + 1], ix.faces()[3 * f + 2]};
     }
-    GEODEX_ASSIGN_OR_RETURN(mesh::Mesh m,
-                            mesh::Mesh::Create(std::move(positions), std::move(faces), "index"));
-    engine->mesh_ = std::make_unique<mesh::Mesh>(std::move(m));
-  }
-  return std::shared_ptr<const QueryEngine>(std::move(engine));
+    // The index was made from a valid mesh; a failure here leaves exact
+    // refinement off (the callers fall back to the other answers).
+    absl::StatusOr<mesh::Mesh> m =
+        mesh::Mesh::Create(std::move(positions), std::move(faces), "index");
+    if (m.ok()) mesh_ = std::make_unique<mesh::Mesh>(*std::move(m));
+  });
+  return mesh_.get();
 }
 
 QueryEngine::QueryEngine(std::shared_ptr<const index::Index> index, QueryOptions options)
@@ -147,7 +153,13 @@ QueryEngine::QueryEngine(std::shared_ptr<const index::Index> index, QueryOptions
     }
   }
   face_lifts_.resize(index_->num_faces());
-  for (int32_t f = 0; f < index_->num_faces(); ++f) face_lifts_[f] = MakeFaceLift(f);
+  double area = 0;
+  for (int32_t f = 0; f < index_->num_faces(); ++f) {
+    face_lifts_[f] = MakeFaceLift(f);
+    const int32_t* v = &faces_[3 * f];
+    area += 0.5 * (Position(v[1]) - Position(v[0])).cross(Position(v[2]) - Position(v[0])).norm();
+  }
+  scale_length_ = std::sqrt(2 * area / (std::sqrt(3.0) * num_samples_));
 }
 
 absl::Status QueryEngine::Validate(const SurfacePoint& p) const {
@@ -478,9 +490,13 @@ double QueryEngine::AtLeastChord(const SurfacePoint& p, const SurfacePoint& q, d
 std::optional<double> QueryEngine::ExactNearDistance(const SurfacePoint& from,
                                                      const SurfacePoint& to,
                                                      QueryScratch* scratch) const {
-  if (scratch->solver_ == nullptr || scratch->mesh_ != mesh_.get()) {
-    scratch->solver_ = std::make_unique<geodesic::ExactGeodesicSolver>(*mesh_);
-    scratch->mesh_ = mesh_.get();
+  const mesh::Mesh* m = ExactMesh();
+  if (m == nullptr) return std::nullopt;
+  QueryScratch local;
+  if (scratch == nullptr) scratch = &local;
+  if (scratch->solver_ == nullptr || scratch->mesh_ != m) {
+    scratch->solver_ = std::make_unique<geodesic::ExactGeodesicSolver>(*m);
+    scratch->mesh_ = m;
   }
   geodesic::GeodesicOptions options;
   options.stop_points = {to};
@@ -488,44 +504,141 @@ std::optional<double> QueryEngine::ExactNearDistance(const SurfacePoint& from,
   return scratch->solver_->DistanceAt(to);
 }
 
-double QueryEngine::NearDistance(const SurfacePoint& p, const SurfacePoint& q, double unfolded,
-                                 QueryScratch* scratch) const {
-  // Both other modes work from one point to the other: from the smaller, so
+double QueryEngine::BoundOf(AnswerKind kind, bool vertex_pair, double d) const {
+  const index::AccuracyRecord* accuracy = index_->accuracy();
+  if (accuracy == nullptr) return std::numeric_limits<double>::quiet_NaN();
+  if (kind == AnswerKind::kExact || !(d < kInf)) return 0;
+  const double x = d / accuracy->scale_length;
+  int b = 0;
+  while (b + 1 < index::kAccuracyBins && x >= index::kAccuracyBinUpper[b]) ++b;
+  switch (kind) {
+    case AnswerKind::kUnfold:
+      return accuracy->unfold_bound[vertex_pair ? 0 : 1][b];
+    case AnswerKind::kTrace:
+      return accuracy->trace_bound[0][b];
+    case AnswerKind::kWrappedTrace:
+      return accuracy->trace_bound[1][b];
+    case AnswerKind::kExact:
+      break;
+  }
+  return 0;
+}
+
+double QueryEngine::Refine(const SurfacePoint& p, const SurfacePoint& q, double unfolded,
+                           bool near, const DistanceOptions& options, QueryScratch* scratch,
+                           double* bound) const {
+  if (!(unfolded < kInf)) {  // different components: exactly unreachable
+    if (bound != nullptr) *bound = BoundOf(AnswerKind::kExact, false, unfolded);
+    return unfolded;
+  }
+  // The refinements work from one point to the other: from the smaller, so
   // that the answer is symmetric.
   const bool swap = std::tie(q.face, q.w) < std::tie(p.face, p.w);
   const SurfacePoint& from = swap ? q : p;
   const SurfacePoint& to = swap ? p : q;
-  std::optional<double> d;
-  switch (options_.near_pairs) {
-    case NearPairs::kPath:
-      d = PathNearDistance(from, to);
-      break;
-    case NearPairs::kExact:
-      if (scratch != nullptr) d = ExactNearDistance(from, to, scratch);
-      break;
-    case NearPairs::kUnfold:
-      break;
+  auto at_vertex = [](const SurfacePoint& x) { return x.w[0] == 1 || x.w[1] == 1 || x.w[2] == 1; };
+  const bool vertex_pair = at_vertex(p) && at_vertex(q);
+  double d = near ? AtLeastChord(p, q, unfolded) : unfolded;
+  AnswerKind kind = AnswerKind::kUnfold;
+  auto trace = [&] {
+    const std::optional<Trace> t = PathNearDistance(from, to);
+    if (!t) return false;
+    d = t->length;
+    kind = t->wraps ? AnswerKind::kWrappedTrace : AnswerKind::kTrace;
+    return true;
+  };
+  auto exact = [&] {
+    const std::optional<double> e = ExactNearDistance(from, to, scratch);
+    if (!e) return false;
+    d = *e;
+    kind = AnswerKind::kExact;
+    return true;
+  };
+  if (near || unfolded < kRefineScale * scale_length_) {
+    switch (options.near_pairs) {
+      case NearPairs::kPath:
+        trace();
+        break;
+      case NearPairs::kExact:
+        exact();
+        break;
+      case NearPairs::kUnfold:
+        break;
+    }
   }
-  return d ? *d : AtLeastChord(p, q, unfolded);
+  if (options.tolerance > 0) {
+    auto within = [&] { return BoundOf(kind, vertex_pair, d) <= options.tolerance * d; };
+    if (kind == AnswerKind::kUnfold && !within() && !trace()) exact();
+    if (kind != AnswerKind::kExact && !within()) exact();
+  }
+  if (bound != nullptr) *bound = BoundOf(kind, vertex_pair, d);
+  return d;
 }
 
-absl::StatusOr<double> QueryEngine::Distance(const SurfacePoint& p, const SurfacePoint& q,
-                                             QueryScratch* scratch) const {
+absl::StatusOr<double> QueryEngine::TracedDistance(const SurfacePoint& p, const SurfacePoint& q,
+                                                   bool* wraps) const {
   GEODEX_RETURN_IF_ERROR(Validate(p));
   GEODEX_RETURN_IF_ERROR(Validate(q));
   const SurfacePoint a = Canonical(p), b = Canonical(q);
+  const bool swap = std::tie(b.face, b.w) < std::tie(a.face, a.w);
+  const std::optional<Trace> t = PathNearDistance(swap ? b : a, swap ? a : b);
+  if (!t) return absl::NotFoundError("no trace between the points");
+  if (wraps != nullptr) *wraps = t->wraps;
+  return t->length;
+}
+
+absl::Status QueryEngine::CheckOptions(const DistanceOptions& options, bool bounds) const {
+  if (!(options.tolerance >= 0) || !std::isfinite(options.tolerance)) {
+    return absl::InvalidArgumentError(
+        absl::StrFormat("tolerance must be finite and >= 0, not %g", options.tolerance));
+  }
+  if ((bounds || options.tolerance > 0) && index_->accuracy() == nullptr) {
+    return absl::FailedPreconditionError(
+        "the index has no accuracy calibration (error bounds, tolerance): rebuild it, or add one "
+        "with geodex-build calibrate");
+  }
+  return absl::OkStatus();
+}
+
+bool QueryEngine::NeedsRefine(const DistanceOptions& options, bool bounds, bool near,
+                              double unfolded) const {
+  return near || bounds || options.tolerance > 0 ||
+         (options.near_pairs != NearPairs::kUnfold && unfolded < kRefineScale * scale_length_);
+}
+
+absl::StatusOr<double> QueryEngine::Distance(const SurfacePoint& p, const SurfacePoint& q,
+                                             const DistanceOptions& options,
+                                             QueryScratch* scratch, double* bound) const {
+  GEODEX_RETURN_IF_ERROR(Validate(p));
+  GEODEX_RETURN_IF_ERROR(Validate(q));
+  GEODEX_RETURN_IF_ERROR(CheckOptions(options, bound != nullptr));
+  const SurfacePoint a = Canonical(p), b = Canonical(q);
   const LiftedPoint la = Lift(a), lb = Lift(b);
   const double d = LiftedDistance(la, lb);
-  return AreNear(la, lb) ? NearDistance(a, b, d, scratch) : d;
+  const bool near = AreNear(la, lb);
+  if (!NeedsRefine(options, bound != nullptr, near, d)) return d;
+  return Refine(a, b, d, near, options, scratch, bound);
 }
 
 absl::Status QueryEngine::DistanceBatch(std::span<const SurfacePoint> a,
                                         std::span<const SurfacePoint> b, std::span<double> out,
-                                        QueryScratch* scratch) const {
-  if (a.size() != b.size() || a.size() != out.size()) {
-    return absl::InvalidArgumentError(absl::StrFormat("batch arrays differ in length (%d, %d, %d)",
-                                                      a.size(), b.size(), out.size()));
+                                        const DistanceOptions& options, QueryScratch* scratch,
+                                        std::span<double> bounds) const {
+  if (a.size() != b.size() || a.size() != out.size() ||
+      (!bounds.empty() && bounds.size() != out.size())) {
+    return absl::InvalidArgumentError(
+        absl::StrFormat("batch arrays differ in length (%d, %d, %d, bounds %d)", a.size(),
+                        b.size(), out.size(), bounds.size()));
   }
+  const bool want_bounds = !bounds.empty();
+  GEODEX_RETURN_IF_ERROR(CheckOptions(options, want_bounds));
+  auto refine = [&](size_t k, const LiftedPoint& p, const LiftedPoint& q) {
+    const bool near = AreNear(p, q);
+    if (NeedsRefine(options, want_bounds, near, out[k])) {
+      out[k] = Refine(Canonical(a[k]), Canonical(b[k]), out[k], near, options, scratch,
+                      want_bounds ? &bounds[k] : nullptr);
+    }
+  };
   for (size_t i = 0; i < a.size(); ++i) {
     for (const SurfacePoint* p : {&a[i], &b[i]}) {
       const absl::Status status = Validate(*p);
@@ -580,9 +693,7 @@ absl::Status QueryEngine::DistanceBatch(std::span<const SurfacePoint> a,
     }
     LiftedDistanceLanes(&lift_a[i % kRing], &lift_b[i % kRing], &out[i]);
     for (size_t k = i; k < i + W; ++k) {
-      if (AreNear(lift_a[k % kRing], lift_b[k % kRing])) {
-        out[k] = NearDistance(Canonical(a[k]), Canonical(b[k]), out[k], scratch);
-      }
+      refine(k, lift_a[k % kRing], lift_b[k % kRing]);
       if (k + kLiftAhead < n) lift(k + kLiftAhead);
     }
   }
@@ -590,7 +701,7 @@ absl::Status QueryEngine::DistanceBatch(std::span<const SurfacePoint> a,
     const LiftedPoint& p = lift_a[i % kRing];
     const LiftedPoint& q = lift_b[i % kRing];
     out[i] = LiftedDistance(p, q);
-    if (AreNear(p, q)) out[i] = NearDistance(Canonical(a[i]), Canonical(b[i]), out[i], scratch);
+    refine(i, p, q);
   }
   return absl::OkStatus();
 }

@@ -16,14 +16,19 @@
 // This visits the same unfoldings as the paper's cases 4-5 but computes each
 // distance once.
 //
-// Near pairs (the same or adjacent geodesic triangles, §6.5) are the method's
-// weak spot. By default they are answered by the length of a path between
-// them (the gradient trace of one point's field, straightened, and of the
-// other's when the first wraps round a vertex; O(k) in the faces crossed,
-// a handful for a near pair, about 5 us): p99 0.3% where the O(1) unfolding
-// errs by 10% on a scanned bunny.
-// QueryOptions::near_pairs selects the pure O(1) unfolding instead, or a
-// local exact propagation (see NearPairs).
+// The absolute error of that O(1) answer is about the same at every distance,
+// so its relative error grows as the points get closer (§6.5): pairs closer
+// than kRefineScale geodesic-triangle edges, and pairs in the same or
+// adjacent geodesic triangles, are refined by default (DistanceOptions): by
+// the length of a path between them (the straightened gradient trace, O(k)
+// in the faces it crosses), or by a local exact propagation.
+//
+// Error bounds. An index built with its accuracy calibration
+// (index::AccuracyRecord) gives every answer an absolute error bound: the
+// error its kind of answer (O(1), traced, exact) at its distance stayed
+// within on all but a small share of held-out exact pairs; 0 for exact
+// answers. A caller's tolerance refines every pair whose bound exceeds
+// tolerance x distance, by the trace and then exactly.
 //
 // Thread safety: a QueryEngine is immutable; all const methods are safe from
 // any number of threads. Methods that need scratch space take a QueryScratch,
@@ -32,6 +37,7 @@
 #include <array>
 #include <cstdint>
 #include <memory>
+#include <mutex>
 #include <optional>
 #include <span>
 #include <vector>
@@ -47,11 +53,13 @@ namespace geodex::query {
 
 using mesh::SurfacePoint;
 
-// How Distance and DistanceBatch answer near pairs (points in the same or
-// adjacent geodesic triangles).
+// How Distance and DistanceBatch answer the pairs they refine by default:
+// near pairs (points in the same or adjacent geodesic triangles) and pairs
+// whose O(1) distance is below kRefineScale * scale_length().
 enum class NearPairs {
-  // Pure O(1): the unfolding of §5, kept at least the straight-line distance
-  // apart (no surface path is shorter).
+  // Pure O(1): the unfolding of §5, for near pairs kept at least the
+  // straight-line distance apart (no surface path is shorter). Nothing is
+  // refined.
   kUnfold,
   // The length of the straightened gradient trace of p's field, and of
   // q's when that one wraps round a vertex (Path without its restarts, so
@@ -60,13 +68,26 @@ enum class NearPairs {
   // raw traces (longer).
   kPath,
   // A local exact propagation from one point that stops when it reaches the
-  // other (needs a QueryScratch; without one, kUnfold). About 8x the cost of
-  // kPath.
+  // other.
   kExact,
 };
 
-struct QueryOptions {
+// Pairs whose O(1) distance is below this many scale lengths are refined by
+// default. The bins of §6.5's weak spot: the O(1) answer's relative error
+// grows fastest below 3L, where a trace crosses few faces.
+inline constexpr double kRefineScale = 3;
+
+// Per-call choices of Distance and DistanceBatch.
+struct DistanceOptions {
   NearPairs near_pairs = NearPairs::kPath;
+  // Relative error tolerance. > 0: every pair whose error bound exceeds
+  // tolerance x distance is refined further, by the straightened trace and
+  // then by a local exact propagation (bound 0), so that its bound meets the
+  // tolerance. Needs the index's accuracy calibration.
+  double tolerance = 0;
+};
+
+struct QueryOptions {
   // Straighten traced paths through the faces they cross (funnel algorithm,
   // see path_straightening.h). Off: the raw gradient trace of §6.2.
   bool straighten_paths = true;
@@ -84,7 +105,7 @@ struct QueryOptions {
   double weight_tolerance = 1e-6;
 };
 
-// Per-thread working memory for exact near pairs.
+// Per-thread working memory for exact refinement.
 class QueryScratch {
  public:
   QueryScratch() = default;
@@ -114,8 +135,7 @@ struct DistanceField {
 
 class QueryEngine {
  public:
-  // Errors: FailedPrecondition if the index has no triangles; errors of
-  // mesh::Mesh::Create when NearPairs::kExact needs the mesh.
+  // Errors: FailedPrecondition if the index has no triangles.
   static absl::StatusOr<std::shared_ptr<const QueryEngine>> Create(
       std::shared_ptr<const index::Index> index, QueryOptions options = {});
 
@@ -127,17 +147,37 @@ class QueryEngine {
   absl::Status Validate(const SurfacePoint& p) const;
 
   // Approximate geodesic distance; +inf between components. Validates both
-  // points. Symmetric: Distance(p, q) == Distance(q, p) exactly. Near pairs
-  // are answered as options().near_pairs says.
+  // points. Symmetric: Distance(p, q) == Distance(q, p) exactly. Pairs are
+  // refined as `options` says. With `bound`, *bound is the answer's absolute
+  // error bound (see the header comment). `scratch` (optional) keeps the
+  // exact solver between calls. Errors: as Validate; FailedPrecondition when
+  // a bound or a tolerance is asked of an index without calibration.
   absl::StatusOr<double> Distance(const SurfacePoint& p, const SurfacePoint& q,
-                                  QueryScratch* scratch = nullptr) const;
+                                  const DistanceOptions& options = {},
+                                  QueryScratch* scratch = nullptr, double* bound = nullptr) const;
 
-  // Batch: out[i] = Distance(a[i], b[i]). Validates everything first (the
-  // error names the pair index). Far pairs allocate nothing; near pairs
-  // (rare: two random points are near with probability about 4 / number of
-  // geodesic triangles) allocate in the kPath and kExact modes.
+  // Batch: out[i] = Distance(a[i], b[i]), and bounds[i] its bound when
+  // `bounds` is not empty (then of out's length). Validates everything first
+  // (the error names the pair index). Unrefined pairs allocate nothing.
   absl::Status DistanceBatch(std::span<const SurfacePoint> a, std::span<const SurfacePoint> b,
-                             std::span<double> out, QueryScratch* scratch = nullptr) const;
+                             std::span<double> out, const DistanceOptions& options = {},
+                             QueryScratch* scratch = nullptr,
+                             std::span<double> bounds = {}) const;
+
+  // The length of the straightened gradient trace between the points, as
+  // the refinement of Distance computes it (symmetric; a surface path, so
+  // never below the geodesic distance); O(k) in the faces it crosses. With
+  // `wraps`, whether the trace bends round a mesh vertex. Errors: as
+  // Validate; NotFound between components or when no trace reaches the
+  // other point.
+  absl::StatusOr<double> TracedDistance(const SurfacePoint& p, const SurfacePoint& q,
+                                        bool* wraps = nullptr) const;
+
+  // L = sqrt(2 A / (sqrt(3) m)): the edge of an equilateral geodesic
+  // triangle when the index's m samples tile the surface's area A.
+  double scale_length() const { return scale_length_; }
+  // True when the index carries its accuracy calibration (error bounds).
+  bool has_error_bounds() const { return index_->accuracy() != nullptr; }
 
   // The O(1) distance for valid points (no checks; near pairs as in the
   // kUnfold mode): the unfolding of §5, and for near pairs at least the
@@ -170,8 +210,7 @@ class QueryEngine {
                                                    const SurfacePoint& to) const;
 
   // Distance from the nearest of `sources` to every vertex, O(l n): the
-  // minimum over sources of DistanceUnchecked (the O(1) mode, whatever
-  // options().near_pairs says).
+  // minimum over sources of DistanceUnchecked (the O(1) mode).
   // Errors: as Validate (naming the source index); InvalidArgument if empty.
   absl::StatusOr<DistanceField> Field(std::span<const SurfacePoint> sources) const;
 
@@ -267,15 +306,34 @@ class QueryEngine {
   // Lifts a point of a face without a FaceLift; `heaviest` is the face
   // vertex of largest weight (the anchor when the vertices share none).
   LiftedPoint SlowLift(const SurfacePoint& p, int heaviest) const;
-  // The answer for a near pair of canonical points whose unfolded distance
-  // is `unfolded`, by options_.near_pairs; the unfolded one, kept at least
-  // the chord apart, in the kUnfold mode or when the other mode fails.
-  double NearDistance(const SurfacePoint& p, const SurfacePoint& q, double unfolded,
-                      QueryScratch* scratch) const;
+  // How an answer was obtained, for its bound.
+  enum class AnswerKind { kUnfold, kTrace, kWrappedTrace, kExact };
+  // The answer for a pair of canonical points, valid, whose O(1) distance is
+  // `unfolded` (near: their lifts are near), refined as `options` says; its
+  // bound in *bound when not null (NaN without calibration).
+  double Refine(const SurfacePoint& p, const SurfacePoint& q, double unfolded, bool near,
+                const DistanceOptions& options, QueryScratch* scratch, double* bound) const;
+  // The calibrated bound of an answer of `kind` at distance d (NaN without
+  // calibration).
+  double BoundOf(AnswerKind kind, bool vertex_pair, double d) const;
+  // InvalidArgument for a bad tolerance; FailedPrecondition for a bound or a
+  // tolerance without calibration.
+  absl::Status CheckOptions(const DistanceOptions& options, bool bounds) const;
+  // True when a pair's O(1) answer `unfolded` is not final under `options`.
+  bool NeedsRefine(const DistanceOptions& options, bool bounds, bool near, double unfolded) const;
+  // The mesh for exact propagations, made on first use.
+  const mesh::Mesh* ExactMesh() const;
   // The near-pair modes from `from` to `to`; nullopt when they fail.
   std::optional<double> ExactNearDistance(const SurfacePoint& from, const SurfacePoint& to,
                                           QueryScratch* scratch) const;
-  std::optional<double> PathNearDistance(const SurfacePoint& from, const SurfacePoint& to) const;
+  // A straightened trace's length; `wraps` when it bends round a mesh vertex
+  // (else it is a straight line through the faces it crosses: a local
+  // geodesic, practically always the shortest path between near points).
+  struct Trace {
+    double length;
+    bool wraps;
+  };
+  std::optional<Trace> PathNearDistance(const SurfacePoint& from, const SurfacePoint& to) const;
   // The exact shortest path from `from` to `to` among the faces within
   // `steps` edge steps of the faces `path` crosses, or an error (e.g. when
   // that corridor is not a manifold mesh).
@@ -310,7 +368,10 @@ class QueryEngine {
   std::vector<kernel::Frame<double>> frames_;  // 3 per geodesic triangle, derived at load
   std::vector<FaceLift> face_lifts_;           // one per face, derived at load
   std::vector<ApproxLift> approx_lifts_;       // of the approximate faces
-  std::unique_ptr<mesh::Mesh> mesh_;           // only with NearPairs::kExact
+  double scale_length_ = 0;
+  // The mesh for exact refinement, made on first use (ExactMesh).
+  mutable std::once_flag mesh_once_;
+  mutable std::unique_ptr<mesh::Mesh> mesh_;
 };
 
 }  // namespace geodex::query

@@ -295,15 +295,14 @@ absl::StatusOr<std::vector<PathPoint>> QueryEngine::ShortestTrace(const SurfaceP
   return path;
 }
 
-std::optional<double> QueryEngine::PathNearDistance(const SurfacePoint& from,
-                                                    const SurfacePoint& to) const {
-  // Without Path's restarts: on bunny_closed_30k at m=1000 they take near
-  // pairs from p99 0.28% (max 1.6%) to 0.06% (0.4%), but double the cost
-  // (15 -> 33 us).
+std::optional<QueryEngine::Trace> QueryEngine::PathNearDistance(const SurfacePoint& from,
+                                                                const SurfacePoint& to) const {
+  // Without Path's restarts, which double the cost of a near pair for a
+  // small gain (tests/bench/README.md).
   const absl::StatusOr<std::vector<PathPoint>> path =
       ShortestTrace(from, to, TraceSearch::kNearPair);
   if (!path.ok()) return std::nullopt;
-  return PathLength(*path);
+  return Trace{PathLength(*path), WrapsRoundAVertex(*path)};
 }
 
 std::vector<std::vector<PathPoint>> QueryEngine::RingChains(const SurfacePoint& p) const {

@@ -4,6 +4,7 @@
 //   geodex-build plan MESH --samples M [--seed S] [--threads N] [--edges-obj FILE] -o WORKDIR
 //   geodex-build rows WORKDIR --shard I/N [--threads T]
 //   geodex-build merge WORKDIR -o OUT.gdx
+//   geodex-build calibrate MESH INDEX.gdx -o OUT.gdx
 //
 // MESH is a .obj/.ply/.off file, or builtin:NAME for a generated demo mesh
 // (torus, sphere, cube, double-torus). --edges-obj writes the geodesic
@@ -28,6 +29,7 @@
 #include "core/index/index.h"
 #include "core/mesh/generators.h"
 #include "core/mesh/mesh_io.h"
+#include "core/validation/calibration.h"
 
 namespace geodex {
 namespace {
@@ -117,6 +119,25 @@ absl::Status WriteEdges(const mesh::Mesh& mesh, const build::Plan& plan, const s
   return absl::OkStatus();
 }
 
+// Measures the index against held-out exact propagations and stores its
+// accuracy calibration (error bounds) and the figures in its report.
+absl::Status AddCalibration(const mesh::Mesh& mesh, index::IndexData& data) {
+  const auto start = std::chrono::steady_clock::now();
+  GEODEX_RETURN_IF_ERROR(validation::AddCalibration(mesh, data));
+  const index::AccuracyRecord& r = data.accuracy[0];
+  data.report += validation::CalibrationText(r);
+  std::printf(
+      "  accuracy         relative error by scale (held-out pairs, default answer): RMS "
+      "%.3f%% / %.3f%% / %.3f%% / %.3f%%, p99 %.3f%% / %.3f%% / %.3f%% / %.3f%% "
+      "(d<L, L-3L, 3L-10L, >=10L; L = %.4g), calibrated in %s\n",
+      100 * r.rms[0], 100 * r.rms[1], 100 * r.rms[2], 100 * r.rms[3], 100 * r.p99[0],
+      100 * r.p99[1], 100 * r.p99[2], 100 * r.p99[3], r.scale_length,
+      FormatSeconds(
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count())
+          .c_str());
+  return absl::OkStatus();
+}
+
 absl::Status WriteAndReport(const index::IndexData& data, build::BuildSummary& summary,
                             const std::string& out) {
   GEODEX_RETURN_IF_ERROR(index::WriteIndexFile(data, out));
@@ -175,6 +196,18 @@ int main(int argc, char** argv) {
   CLI::App* merge_cmd = app.add_subcommand("merge", "Distributed build, step 3: the index");
   merge_cmd->add_option("workdir", workdir, "Work directory")->required();
   merge_cmd->add_option("-o,--output", out, "Output index file (.gdx)")->required();
+  bool no_calibration = false;
+  for (CLI::App* cmd : {&app, merge_cmd}) {
+    cmd->add_flag("--no-calibration", no_calibration,
+                  "Skip the accuracy calibration (no error bounds or tolerance in queries)");
+  }
+
+  std::string index_path;
+  CLI::App* calibrate_cmd = app.add_subcommand(
+      "calibrate", "Adds the accuracy calibration (error bounds) to an index built without it");
+  calibrate_cmd->add_option("mesh", mesh_path, "The mesh the index was built from")->required();
+  calibrate_cmd->add_option("index", index_path, "Index file (.gdx)")->required();
+  calibrate_cmd->add_option("-o,--output", out, "Output index file (.gdx)")->required();
 
   CLI11_PARSE(app, argc, argv);
 
@@ -222,8 +255,23 @@ int main(int argc, char** argv) {
       const auto& [mesh, plan] = loaded;
       GEODEX_ASSIGN_OR_RETURN(auto rows, build::LoadAllRows(plan, workdir));
       build::BuildSummary summary;
-      GEODEX_ASSIGN_OR_RETURN(const auto data, build::Merge(mesh, plan, std::move(rows), &summary));
+      GEODEX_ASSIGN_OR_RETURN(auto data, build::Merge(mesh, plan, std::move(rows), &summary));
+      if (!no_calibration) GEODEX_RETURN_IF_ERROR(AddCalibration(mesh, data));
       return WriteAndReport(data, summary, out);
+    }();
+  } else if (*calibrate_cmd) {
+    status = [&]() -> absl::Status {
+      GEODEX_ASSIGN_OR_RETURN(const mesh::Mesh mesh, LoadInput(mesh_path));
+      GEODEX_ASSIGN_OR_RETURN(auto index, index::Index::Open(index_path));
+      if (index->header().mesh_hash != build::HashMesh(mesh)) {
+        return absl::InvalidArgumentError(
+            absl::StrFormat("%s was not built from %s", index_path, mesh_path));
+      }
+      index::IndexData data = index::ToIndexData(*index);
+      GEODEX_RETURN_IF_ERROR(AddCalibration(mesh, data));
+      GEODEX_RETURN_IF_ERROR(index::WriteIndexFile(data, out));
+      std::printf("geodex-build calibrate: wrote %s\n", out.c_str());
+      return absl::OkStatus();
     }();
   } else {
     if (mesh_path.empty() || out.empty()) {
@@ -236,8 +284,8 @@ int main(int argc, char** argv) {
       GEODEX_ASSIGN_OR_RETURN(const build::Plan plan, build::MakePlan(mesh, options));
       GEODEX_RETURN_IF_ERROR(WriteEdges(mesh, plan, edges_obj));
       build::BuildSummary summary;
-      GEODEX_ASSIGN_OR_RETURN(const auto data,
-                              build::BuildIndexFromPlan(mesh, plan, options, &summary));
+      GEODEX_ASSIGN_OR_RETURN(auto data, build::BuildIndexFromPlan(mesh, plan, options, &summary));
+      if (!no_calibration) GEODEX_RETURN_IF_ERROR(AddCalibration(mesh, data));
       return WriteAndReport(data, summary, out);
     }();
   }

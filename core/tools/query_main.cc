@@ -1,6 +1,7 @@
 // geodex-query: answers queries offline from an index file, without a server.
 //
-//   geodex-query INDEX --pairs FILE [--near-pairs path|unfold|exact] [--linear-baseline]
+//   geodex-query INDEX --pairs FILE [--near-pairs path|unfold|exact] [--error-bounds]
+//                [--tolerance X] [--linear-baseline]
 //   geodex-query INDEX --paths FILE [--format xyz|json] [--exact-path-corridor K]
 //   geodex-query INDEX --field SOURCES [--nearest]
 //   geodex-query INDEX --locate POINTS
@@ -79,16 +80,20 @@ absl::Status CheckPairs(const query::QueryEngine& engine,
 
 struct Args {
   std::string index, pairs, paths, field, locate, format = "xyz", near_pairs = "path";
-  bool exact_near = false, baseline = false, nearest = false;
+  bool exact_near = false, baseline = false, nearest = false, error_bounds = false;
+  double tolerance = 0;
   int32_t exact_path_corridor = 0;
 };
 
 absl::Status Run(const Args& args) {
   GEODEX_ASSIGN_OR_RETURN(auto index, index::Index::Open(args.index));
   query::QueryOptions options;
-  options.near_pairs = args.exact_near || args.near_pairs == "exact" ? query::NearPairs::kExact
-                       : args.near_pairs == "unfold"                 ? query::NearPairs::kUnfold
-                                                                     : query::NearPairs::kPath;
+  query::DistanceOptions distance_options;
+  distance_options.near_pairs = args.exact_near || args.near_pairs == "exact"
+                                    ? query::NearPairs::kExact
+                                : args.near_pairs == "unfold" ? query::NearPairs::kUnfold
+                                                              : query::NearPairs::kPath;
+  distance_options.tolerance = args.tolerance;
   options.exact_path_corridor = args.exact_path_corridor;
   GEODEX_ASSIGN_OR_RETURN(auto engine, query::QueryEngine::Create(index, options));
   std::string out;
@@ -103,13 +108,21 @@ absl::Status Run(const Args& args) {
     for (size_t i = 0; i < pairs.size(); ++i) {
       const mesh::PointPair& pair = pairs[i];
       if (!paths) {
-        double d;
+        double d, bound = 0;
         if (args.baseline) {
           d = engine->LinearInterpolationDistance(pair.a, pair.b);
         } else {
-          GEODEX_ASSIGN_OR_RETURN(d, engine->Distance(pair.a, pair.b, &scratch));
+          auto answer = engine->Distance(pair.a, pair.b, distance_options, &scratch,
+                                         args.error_bounds ? &bound : nullptr);
+          if (!answer.ok()) {
+            return absl::Status(answer.status().code(), absl::StrFormat("line %d: %s", pair.line,
+                                                                        answer.status().message()));
+          }
+          d = *answer;
         }
-        out += mesh::FormatDistance(d) + "\n";
+        out += mesh::FormatDistance(d);
+        if (args.error_bounds) out += " " + mesh::FormatDistance(bound);
+        out += "\n";
         continue;
       }
       auto path = engine->Path(pair.a, pair.b);
@@ -176,10 +189,18 @@ int main(int argc, char** argv) {
   paths->excludes(field)->excludes(locate);
   field->excludes(locate);
   app.add_option("--near-pairs", args.near_pairs,
-                 "Pairs in the same or adjacent geodesic triangles: path (the traced path's "
-                 "length, default), unfold (pure O(1)) or exact (local exact propagation)")
+                 "Near pairs (the same or adjacent geodesic triangles, or closer than 3 scale "
+                 "lengths): path (the traced path's length, default), unfold (pure O(1)) or "
+                 "exact (local exact propagation)")
       ->check(CLI::IsMember({"path", "unfold", "exact"}));
   app.add_flag("--exact-near-pairs", args.exact_near, "Same as --near-pairs exact");
+  app.add_flag("--error-bounds", args.error_bounds,
+               "With --pairs: print 'distance bound' per line, bound = the answer's absolute "
+               "error bound (needs an index with its accuracy calibration)");
+  app.add_option("--tolerance", args.tolerance,
+                 "With --pairs: relative error tolerance (e.g. 0.005): refine every pair whose "
+                 "bound exceeds tolerance x distance (0: off)")
+      ->check(CLI::NonNegativeNumber);
   app.add_option("--exact-path-corridor", args.exact_path_corridor,
                  "With --paths: also solve exactly within this many edge steps of the traced "
                  "path and keep the shorter (not O(k); 0: off)")

@@ -1,28 +1,34 @@
 #pragma once
 
-// Accuracy measurement of the query engine against the exact geodesic engine
-// on area-uniform random surface point pairs.
+// Accuracy measurement of the query engine against the exact geodesic engine,
+// by distance scale: the pairs of core/validation/pair_sampling.h (bins d < L,
+// L-3L, 3L-10L, >= 10L; area-uniform pairs and pairs drawn in every bin on
+// purpose; vertex pairs and pairs inside faces apart), with a seed other
+// than the builder's calibration.
 //
-// Relative error e = (approx - exact) / exact per pair; reported as relative
-// RMS = sqrt(mean(e^2)), mean |e|, p99 |e| and max |e|: over area-uniform
-// pairs (all, and the far ones), and over near pairs (the same or adjacent
-// geodesic triangles), which uniform pairs rarely are, so they are drawn on
-// purpose: area-uniform points of the faces of each source's geodesic
-// triangle and its neighbours; for each way of answering near pairs
-// (query::NearPairs: the pure O(1) unfolding, the path length, the local
-// exact propagation) and the paper's linear interpolation baseline (§6.3);
-// and path length / exact distance.
+// Relative error e = (approx - exact) / exact per pair; reported per bin as
+// relative RMS, p99 |e| and max |e|, and, for answers that carry an absolute
+// error bound, its coverage (share of pairs with |approx - exact| <= bound),
+// the median bound and the 90th percentile of |approx - exact|.
 
+#include <array>
 #include <cstdint>
+#include <functional>
+#include <limits>
 #include <string>
 #include <vector>
 
 #include "absl/status/statusor.h"
-#include "core/index/index.h"
 #include "core/mesh/mesh.h"
 #include "core/query/query_engine.h"
+#include "core/validation/pair_sampling.h"
 
 namespace geodex::accuracy {
+
+using validation::ExactPair;
+using validation::kNumScaleBins;
+inline constexpr int kNumBins = kNumScaleBins;
+const char* BinName(int bin);  // validation::ScaleBinName
 
 struct ErrorStats {
   int64_t count = 0;
@@ -30,41 +36,43 @@ struct ErrorStats {
   static ErrorStats Of(std::vector<double> errors);  // relative errors (signed)
 };
 
-struct AccuracyReport {
-  // all, far, all_*_mode, baseline: area-uniform pairs; near, near_*_mode:
-  // the near pairs drawn on purpose and the uniform ones that happen to be
-  // near. all, far and near are the pure O(1) mode (NearPairs::kUnfold); far
-  // pairs are the same in every mode.
-  ErrorStats all, far, near, baseline, path_ratio;
-  ErrorStats near_path_mode, all_path_mode;    // NearPairs::kPath (the default)
-  ErrorStats near_exact_mode, all_exact_mode;  // NearPairs::kExact
-  ErrorStats traced_path_ratio;                // the gradient trace before straightening
-  std::string ToMarkdownRow(const std::string& label) const;
-  static std::string MarkdownHeader();
+// An answer: a distance and, when the mode gives one, an absolute error bound
+// (NaN otherwise).
+struct Answer {
+  double distance = 0;
+  double bound = std::numeric_limits<double>::quiet_NaN();
+};
+using AnswerFn = std::function<Answer(const mesh::SurfacePoint&, const mesh::SurfacePoint&)>;
+
+struct BinReport {
+  ErrorStats error;
+  // With bounds: share of pairs within their bound; median bound and 90th
+  // percentile of the true absolute error (NaN without bounds).
+  double coverage = std::numeric_limits<double>::quiet_NaN();
+  double median_bound = std::numeric_limits<double>::quiet_NaN();
+  double p90_abs_error = std::numeric_limits<double>::quiet_NaN();
 };
 
-struct AccuracyOptions {
-  int32_t num_points = 400;      // random points; pairs are (source, point)
-  int32_t num_sources = 20;      // exact propagations
-  int32_t num_paths = 100;       // pairs whose path length is measured
-  int32_t num_near_points = 40;  // near points drawn per source
-  uint64_t seed = 1;
+struct ModeReport {
+  std::array<BinReport, kNumBins> vertex, interior, all;
+  ErrorStats uniform;  // the area-uniform interior pairs only, every scale
+  // The bin (over vertex and interior) with the largest p99; its p99.
+  int worst_bin = 0;
+  double worst_p99 = 0;
 };
 
-// Area-uniform random surface points.
-std::vector<mesh::SurfacePoint> RandomSurfacePoints(const mesh::Mesh& mesh, int32_t count,
-                                                    uint64_t seed);
+ModeReport Evaluate(const std::vector<ExactPair>& pairs, const AnswerFn& answer);
 
-// One engine per way of answering near pairs, over the same index.
-struct Engines {
-  std::shared_ptr<const query::QueryEngine> unfold, path, exact;
+// Markdown: one row per bin and point kind, then a summary row.
+std::string MarkdownHeader();
+std::string MarkdownRows(const std::string& label, const ModeReport& report);
+
+// Path length / exact distance - 1 over area-uniform pairs: Path (traced,
+// straightened, restarted) and the raw gradient trace.
+struct PathReport {
+  ErrorStats path, traced;
 };
-// `base` gives every option but near_pairs.
-absl::StatusOr<Engines> MakeEngines(std::shared_ptr<const index::Index> index,
-                                    query::QueryOptions base = {});
-
-// The engines must be built from an index of `mesh`.
-AccuracyReport MeasureAccuracy(const mesh::Mesh& mesh, const Engines& engines,
-                               const AccuracyOptions& options);
+PathReport MeasurePaths(const mesh::Mesh& mesh, const query::QueryEngine& engine,
+                        int32_t num_sources, int32_t num_points, uint64_t seed);
 
 }  // namespace geodex::accuracy

@@ -1,13 +1,16 @@
-// geodex-accuracy: the full accuracy run.
+// geodex-accuracy: the full accuracy run, by distance scale.
 //
-//   geodex-accuracy MESH... --samples 250,500,1000,2000 [--points N] [--sources S]
-//                   [--index-dir DIR] [--threads T]
+//   geodex-accuracy MESH... --samples 250,500,1000,2000 [--sources S] [--points N]
+//                   [--per-bin N] [--index-dir DIR] [--threads T] [--modes unfold,default,...]
 //
 // For each mesh and each m: builds the index (or reuses DIR/<mesh>-m<M>.gdx),
-// then measures the query engine against exact geodesics on area-uniform
-// random point pairs and prints one Markdown row. MESH may be builtin:NAME.
+// draws pairs at every distance scale with their exact distances (see
+// accuracy.h), and prints per bin and point kind the error of each answer
+// mode, then a summary row with the worst bin. MESH may be builtin:NAME.
 
+#include <chrono>
 #include <cstdio>
+#include <limits>
 #include <filesystem>
 
 #include "CLI/CLI.hpp"
@@ -16,6 +19,7 @@
 #include "core/common/status_macros.h"
 #include "core/mesh/generators.h"
 #include "core/mesh/mesh_io.h"
+#include "core/validation/calibration.h"
 #include "tests/accuracy/accuracy.h"
 
 namespace geodex {
@@ -29,31 +33,85 @@ absl::StatusOr<mesh::Mesh> LoadInput(const std::string& path) {
   return mesh::LoadMesh(path);
 }
 
-absl::Status Run(const std::vector<std::string>& meshes, const std::vector<int32_t>& samples,
-                 const accuracy::AccuracyOptions& options, const std::string& index_dir,
-                 int threads, const query::QueryOptions& engine_options) {
-  std::printf("%s", accuracy::AccuracyReport::MarkdownHeader().c_str());
-  for (const std::string& path : meshes) {
+struct Flags {
+  std::vector<std::string> meshes;
+  std::vector<int32_t> samples = {1000};
+  validation::PairOptions pairs;
+  std::string index_dir;
+  int threads = 0;
+  std::vector<std::string> modes = {"unfold", "default", "bounds", "tol0.005"};
+  int32_t path_sources = 0, path_points = 0;
+};
+
+absl::Status Run(const Flags& flags) {
+  std::printf("%s", accuracy::MarkdownHeader().c_str());
+  for (const std::string& path : flags.meshes) {
     GEODEX_ASSIGN_OR_RETURN(const mesh::Mesh m, LoadInput(path));
     const std::string name = std::filesystem::path(path).stem().string();
-    for (int32_t count : samples) {
-      const std::string file =
-          absl::StrFormat("%s/%s-m%d.gdx", index_dir.empty() ? "/tmp" : index_dir, name, count);
-      if (index_dir.empty() || !std::filesystem::exists(file)) {
+    for (int32_t count : flags.samples) {
+      const std::string file = absl::StrFormat(
+          "%s/%s-m%d.gdx", flags.index_dir.empty() ? "/tmp" : flags.index_dir, name, count);
+      if (flags.index_dir.empty() || !std::filesystem::exists(file)) {
         build::BuildOptions build_options;
         build_options.num_samples = count;
-        build_options.threads = threads;
+        build_options.threads = flags.threads;
         build::BuildSummary summary;
         GEODEX_ASSIGN_OR_RETURN(const auto data, build::BuildIndex(m, build_options, &summary));
         GEODEX_RETURN_IF_ERROR(index::WriteIndexFile(data, file));
         std::fprintf(stderr, "built %s: %s", file.c_str(), summary.ToText().c_str());
       }
       GEODEX_ASSIGN_OR_RETURN(auto index, index::Index::Open(file));
-      GEODEX_ASSIGN_OR_RETURN(const accuracy::Engines engines,
-                              accuracy::MakeEngines(index, engine_options));
-      const auto report = accuracy::MeasureAccuracy(m, engines, options);
-      std::printf("%s", report.ToMarkdownRow(absl::StrFormat("%s m=%d", name, count)).c_str());
-      std::fflush(stdout);
+      if (index->accuracy() == nullptr) {
+        // An index without calibration: calibrate in memory as the builder
+        // would (its own seed), so that bounds can be measured.
+        GEODEX_ASSIGN_OR_RETURN(const index::AccuracyRecord record,
+                                validation::Calibrate(m, index));
+        std::fprintf(stderr, "calibrated %s in memory\n", file.c_str());
+        index::IndexData data = index::ToIndexData(*index);
+        data.accuracy = {record};
+        GEODEX_ASSIGN_OR_RETURN(std::string bytes, index::SerializeIndex(data));
+        GEODEX_ASSIGN_OR_RETURN(index, index::Index::FromBytes(std::move(bytes)));
+      }
+      const auto pairs = validation::DrawPairs(m, index->num_samples(), flags.pairs);
+      GEODEX_ASSIGN_OR_RETURN(auto engine, query::QueryEngine::Create(index));
+      for (const std::string& mode : flags.modes) {
+        query::DistanceOptions options;
+        bool bounds = false;
+        if (mode == "unfold") {
+          options.near_pairs = query::NearPairs::kUnfold;
+        } else if (mode == "exact") {
+          options.near_pairs = query::NearPairs::kExact;
+        } else if (mode == "bounds") {
+          bounds = true;
+        } else if (mode.rfind("tol", 0) == 0) {
+          options.tolerance = std::stod(mode.substr(3));
+          bounds = true;
+        } else if (mode != "default" && mode != "trace") {
+          return absl::InvalidArgumentError("unknown mode " + mode);
+        }
+        query::QueryScratch scratch;
+        int64_t failed = 0;
+        accuracy::AnswerFn answer = [&](const mesh::SurfacePoint& p, const mesh::SurfacePoint& q) {
+          accuracy::Answer a;
+          absl::StatusOr<double> d =
+              mode == "trace" ? engine->TracedDistance(p, q)
+                              : engine->Distance(p, q, options, &scratch, bounds ? &a.bound : nullptr);
+          if (!d.ok()) ++failed;
+          a.distance = d.value_or(std::numeric_limits<double>::quiet_NaN());
+          return a;
+        };
+        const auto start = std::chrono::steady_clock::now();
+        const accuracy::ModeReport report = accuracy::Evaluate(pairs, answer);
+        const double seconds =
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        std::fprintf(stderr, "%s %s: %.2f us per pair, %d failed\n", name.c_str(), mode.c_str(),
+                     1e6 * seconds / pairs.size(), failed);
+        std::printf("%s", accuracy::MarkdownRows(
+                              absl::StrFormat("%s m=%d %s", name, index->num_samples(), mode),
+                              report)
+                              .c_str());
+        std::fflush(stdout);
+      }
     }
   }
   return absl::OkStatus();
@@ -63,28 +121,23 @@ absl::Status Run(const std::vector<std::string>& meshes, const std::vector<int32
 }  // namespace geodex
 
 int main(int argc, char** argv) {
-  CLI::App app{"geodex-accuracy: query accuracy against exact geodesics."};
-  std::vector<std::string> meshes;
-  std::vector<int32_t> samples = {250, 500, 1000};
-  geodex::accuracy::AccuracyOptions options;
-  std::string index_dir;
-  int threads = 0;
-  app.add_option("meshes", meshes, "Mesh files or builtin:NAME")->required();
-  app.add_option("--samples", samples, "Values of m")->delimiter(',');
-  app.add_option("--points", options.num_points, "Random points");
-  app.add_option("--sources", options.num_sources, "Exact propagations (pairs = sources x points)");
-  app.add_option("--paths", options.num_paths, "Pairs whose paths are measured");
-  app.add_option("--near-points", options.num_near_points,
-                 "Points drawn per source in its own and the adjacent geodesic triangles");
-  app.add_option("--seed", options.seed, "Random seed");
-  app.add_option("--index-dir", index_dir, "Cache built indexes here");
-  app.add_option("--threads", threads, "Builder threads (0: all)");
-  geodex::query::QueryOptions engine_options;
-  app.add_option("--exact-path-corridor", engine_options.exact_path_corridor,
-                 "Paths: also solve exactly within this many edge steps of the trace (0: off)");
+  CLI::App app{"geodex-accuracy: query accuracy against exact geodesics, by distance scale."};
+  geodex::Flags flags;
+  app.add_option("meshes", flags.meshes, "Mesh files or builtin:NAME")->required();
+  app.add_option("--samples", flags.samples, "Values of m")->delimiter(',');
+  app.add_option("--sources", flags.pairs.num_sources,
+                 "Exact propagations, half from vertices, half from points inside faces");
+  app.add_option("--points", flags.pairs.uniform_points, "Area-uniform targets per source");
+  app.add_option("--per-bin", flags.pairs.per_bin_points,
+                 "Targets per source drawn in each distance bin");
+  app.add_option("--seed", flags.pairs.seed, "Random seed");
+  app.add_option("--index-dir", flags.index_dir, "Cache built indexes here");
+  app.add_option("--threads", flags.threads, "Builder threads (0: all)");
+  app.add_option("--modes", flags.modes,
+                 "Answer modes: unfold (pure O(1)), default, exact (near pairs exactly), bounds "
+                 "(default with error bounds), tolX (tolerance X, e.g. tol0.005), trace")->delimiter(',');
   CLI11_PARSE(app, argc, argv);
-  const absl::Status status =
-      geodex::Run(meshes, samples, options, index_dir, threads, engine_options);
+  const absl::Status status = geodex::Run(flags);
   if (!status.ok()) {
     std::fprintf(stderr, "geodex-accuracy: %s\n", status.ToString().c_str());
     return 1;

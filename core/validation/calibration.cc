@@ -1,0 +1,136 @@
+#include "core/validation/calibration.h"
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include "absl/strings/str_format.h"
+#include "core/common/status_macros.h"
+#include "core/query/query_engine.h"
+
+namespace geodex::validation {
+namespace {
+
+int AccuracyBinOf(double d, double scale_length) {
+  const double x = d / scale_length;
+  int b = 0;
+  while (b + 1 < index::kAccuracyBins && x >= index::kAccuracyBinUpper[b]) ++b;
+  return b;
+}
+
+double Quantile(std::vector<double> x, double q) {
+  if (x.empty()) return std::numeric_limits<double>::quiet_NaN();
+  std::sort(x.begin(), x.end());
+  return x[std::min(x.size() - 1, static_cast<size_t>(q * x.size()))];
+}
+
+// Quantiles by bin; a bin without errors takes the larger bound of its
+// nearest measured neighbours (bounds are not meant to be exact there, only
+// not vacuous).
+void FillBounds(const std::vector<double> (&errors)[index::kAccuracyBins], double quantile,
+                float* out) {
+  double q[index::kAccuracyBins];
+  for (int b = 0; b < index::kAccuracyBins; ++b) q[b] = Quantile(errors[b], quantile);
+  for (int b = 0; b < index::kAccuracyBins; ++b) {
+    if (!std::isnan(q[b])) {
+      out[b] = static_cast<float>(q[b]);
+      continue;
+    }
+    double fill = 0;
+    for (int o = b - 1; o >= 0; --o) {
+      if (!std::isnan(q[o])) {
+        fill = std::max(fill, q[o]);
+        break;
+      }
+    }
+    for (int o = b + 1; o < index::kAccuracyBins; ++o) {
+      if (!std::isnan(q[o])) {
+        fill = std::max(fill, q[o]);
+        break;
+      }
+    }
+    out[b] = static_cast<float>(fill);
+  }
+}
+
+double Rms(const std::vector<double>& x) {
+  double sum = 0;
+  for (double e : x) sum += e * e;
+  return x.empty() ? 0 : std::sqrt(sum / x.size());
+}
+
+}  // namespace
+
+absl::StatusOr<index::AccuracyRecord> Calibrate(const mesh::Mesh& mesh,
+                                                std::shared_ptr<const index::Index> index,
+                                                const CalibrationOptions& options) {
+  if (index->num_vertices() != mesh.num_vertices() || index->num_faces() != mesh.num_faces()) {
+    return absl::FailedPreconditionError("the index was not built from this mesh");
+  }
+  GEODEX_ASSIGN_OR_RETURN(auto engine, query::QueryEngine::Create(index));
+  const double scale = engine->scale_length();
+  const std::vector<ExactPair> pairs = DrawPairs(mesh, index->num_samples(), options.pairs);
+  std::vector<double> unfold[2][index::kAccuracyBins], trace[2][index::kAccuracyBins];
+  std::vector<double> relative[kNumScaleBins], uniform, uniform_far;
+  const query::DistanceOptions pure{.near_pairs = query::NearPairs::kUnfold};
+  for (const ExactPair& pair : pairs) {
+    const absl::StatusOr<double> u = engine->Distance(pair.p, pair.q, pure);
+    bool wraps = false;
+    const absl::StatusOr<double> t = engine->TracedDistance(pair.p, pair.q, &wraps);
+    const absl::StatusOr<double> d = engine->Distance(pair.p, pair.q);
+    if (!u.ok() || !d.ok()) continue;
+    unfold[pair.vertices ? 0 : 1][AccuracyBinOf(*u, scale)].push_back(std::abs(*u - pair.exact));
+    if (t.ok()) trace[wraps ? 1 : 0][AccuracyBinOf(*t, scale)].push_back(std::abs(*t - pair.exact));
+    const double e = (*d - pair.exact) / pair.exact;
+    relative[pair.bin].push_back(e);
+    if (pair.uniform && !pair.vertices) {
+      uniform.push_back(e);
+      if (pair.bin == kNumScaleBins - 1) uniform_far.push_back(std::abs(e));
+    }
+  }
+  if (uniform.empty()) return absl::InternalError("calibration: no pair could be measured");
+  index::AccuracyRecord r{};
+  r.scale_length = static_cast<float>(scale);
+  r.num_sources = options.pairs.num_sources;
+  r.num_pairs = static_cast<uint32_t>(pairs.size());
+  r.bound_quantile_permille = static_cast<uint32_t>(std::lround(1000 * options.quantile));
+  FillBounds(unfold[0], options.quantile, r.unfold_bound[0]);
+  FillBounds(unfold[1], options.quantile, r.unfold_bound[1]);
+  FillBounds(trace[0], options.quantile, r.trace_bound[0]);
+  FillBounds(trace[1], options.quantile, r.trace_bound[1]);
+  for (int b = 0; b < kNumScaleBins; ++b) {
+    r.rms[b] = static_cast<float>(Rms(relative[b]));
+    std::vector<double> abs = relative[b];
+    for (double& x : abs) x = std::abs(x);
+    r.p99[b] = relative[b].empty() ? 0 : static_cast<float>(Quantile(abs, 0.99));
+  }
+  r.uniform_rms = static_cast<float>(Rms(uniform));
+  r.uniform_far_p99 = uniform_far.empty() ? 0 : static_cast<float>(Quantile(uniform_far, 0.99));
+  return r;
+}
+
+absl::Status AddCalibration(const mesh::Mesh& mesh, index::IndexData& data,
+                            const CalibrationOptions& options) {
+  data.accuracy.clear();
+  GEODEX_ASSIGN_OR_RETURN(std::string bytes, index::SerializeIndex(data));
+  GEODEX_ASSIGN_OR_RETURN(auto index, index::Index::FromBytes(std::move(bytes)));
+  GEODEX_ASSIGN_OR_RETURN(const index::AccuracyRecord record,
+                          Calibrate(mesh, std::move(index), options));
+  data.accuracy = {record};
+  return absl::OkStatus();
+}
+
+std::string CalibrationText(const index::AccuracyRecord& r) {
+  std::string out = absl::StrFormat(
+      "accuracy_sources = %d\naccuracy_pairs = %d\nscale_length = %.6g\n"
+      "accuracy_uniform_rms = %.6g\naccuracy_uniform_far_p99 = %.6g\n",
+      r.num_sources, r.num_pairs, r.scale_length, r.uniform_rms, r.uniform_far_p99);
+  static const char* const kBin[kNumScaleBins] = {"below_L", "L_3L", "3L_10L", "beyond_10L"};
+  for (int b = 0; b < kNumScaleBins; ++b) {
+    out += absl::StrFormat("accuracy_rms_%s = %.6g\naccuracy_p99_%s = %.6g\n", kBin[b], r.rms[b],
+                           kBin[b], r.p99[b]);
+  }
+  return out;
+}
+
+}  // namespace geodex::validation
