@@ -10,7 +10,7 @@
 #include <stdexcept>
 
 #include "absl/strings/str_format.h"
-#include "core/build/builder.h"
+#include "core/builder/builder.h"
 #include "core/index/index.h"
 #include "core/mesh/generators.h"
 
@@ -18,11 +18,11 @@ namespace geodex::server::testing {
 namespace fs = std::filesystem;
 
 std::string BuildIndexBytes(const mesh::Mesh& mesh, int32_t samples) {
-  build::BuildOptions options;
+  builder::BuildOptions options;
   options.num_samples = samples;
   options.threads = 2;
-  build::BuildSummary summary;
-  auto data = build::BuildIndex(mesh, options, &summary);
+  builder::BuildSummary summary;
+  auto data = builder::BuildIndex(mesh, options, &summary);
   if (!data.ok()) throw std::runtime_error(data.status().ToString());
   auto bytes = index::SerializeIndex(*data);
   if (!bytes.ok()) throw std::runtime_error(bytes.status().ToString());

@@ -4,7 +4,7 @@
 #include <cmath>
 #include <random>
 
-#include "core/build/builder.h"
+#include "core/builder/builder.h"
 #include "core/mesh/generators.h"
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
@@ -18,11 +18,11 @@ using ::testing::HasSubstr;
 
 std::shared_ptr<const QueryEngine> MakeEngine(const Mesh& m, int32_t samples,
                                               QueryOptions options = {}) {
-  build::BuildOptions build_options;
+  builder::BuildOptions build_options;
   build_options.num_samples = samples;
   build_options.threads = 2;
-  build::BuildSummary summary;
-  auto data = build::BuildIndex(m, build_options, &summary);
+  builder::BuildSummary summary;
+  auto data = builder::BuildIndex(m, build_options, &summary);
   EXPECT_TRUE(data.ok()) << data.status();
   auto bytes = index::SerializeIndex(*data);
   EXPECT_TRUE(bytes.ok());

@@ -22,8 +22,8 @@
 #include "CLI/CLI.hpp"
 #include "absl/status/status.h"
 #include "absl/strings/str_format.h"
-#include "core/build/builder.h"
-#include "core/build/workdir.h"
+#include "core/builder/builder.h"
+#include "core/builder/workdir.h"
 #include "core/common/file_util.h"
 #include "core/common/status_macros.h"
 #include "core/index/index.h"
@@ -57,7 +57,7 @@ class ProgressPrinter {
  public:
   ProgressPrinter() : tty_(isatty(STDERR_FILENO)) {}
 
-  void operator()(const build::Progress& p) {
+  void operator()(const builder::Progress& p) {
     std::lock_guard<std::mutex> lock(mutex_);
     const auto now = std::chrono::steady_clock::now();
     auto [it, inserted] = phase_start_.try_emplace(p.phase, now);
@@ -90,7 +90,7 @@ std::string EdgeLine(int32_t edges, int32_t crossings, double total, double long
       edges, crossings, total, longest);
 }
 
-void PrintSummary(const build::BuildSummary& s, const std::string& out) {
+void PrintSummary(const builder::BuildSummary& s, const std::string& out) {
   std::printf(
       "geodex-build: wrote %s (%.1f MiB)\n"
       "  samples          %d requested, %d final (%s)\n"
@@ -112,7 +112,8 @@ void PrintSummary(const build::BuildSummary& s, const std::string& out) {
 }
 
 // Writes the plan's traced edges for --edges-obj (nothing when `path` is empty).
-absl::Status WriteEdges(const mesh::Mesh& mesh, const build::Plan& plan, const std::string& path) {
+absl::Status WriteEdges(const mesh::Mesh& mesh, const builder::Plan& plan,
+                        const std::string& path) {
   if (path.empty()) return absl::OkStatus();
   GEODEX_RETURN_IF_ERROR(AtomicWriteFile(path, triangulation::EdgesToObj(mesh, plan.edges)));
   std::printf("geodex-build: wrote %zu geodesic edges to %s\n", plan.edges.size(), path.c_str());
@@ -138,7 +139,7 @@ absl::Status AddCalibration(const mesh::Mesh& mesh, index::IndexData& data) {
   return absl::OkStatus();
 }
 
-absl::Status WriteAndReport(const index::IndexData& data, build::BuildSummary& summary,
+absl::Status WriteAndReport(const index::IndexData& data, builder::BuildSummary& summary,
                             const std::string& out) {
   GEODEX_RETURN_IF_ERROR(index::WriteIndexFile(data, out));
   GEODEX_ASSIGN_OR_RETURN(auto loaded, index::Index::Open(out));  // validate what we wrote
@@ -212,18 +213,18 @@ int main(int argc, char** argv) {
   CLI11_PARSE(app, argc, argv);
 
   ProgressPrinter printer;
-  build::BuildOptions options;
+  builder::BuildOptions options;
   options.num_samples = samples;
   options.seed = seed;
   options.threads = threads;
-  options.progress = [&printer](const build::Progress& p) { printer(p); };
+  options.progress = [&printer](const builder::Progress& p) { printer(p); };
 
   absl::Status status;
   if (*plan_cmd) {
     status = [&]() -> absl::Status {
       GEODEX_ASSIGN_OR_RETURN(const mesh::Mesh mesh, LoadInput(mesh_path));
-      GEODEX_ASSIGN_OR_RETURN(const build::Plan plan, build::MakePlan(mesh, options));
-      GEODEX_RETURN_IF_ERROR(build::SavePlan(mesh, plan, workdir));
+      GEODEX_ASSIGN_OR_RETURN(const builder::Plan plan, builder::MakePlan(mesh, options));
+      GEODEX_RETURN_IF_ERROR(builder::SavePlan(mesh, plan, workdir));
       std::printf("geodex-build plan: %d samples (%s), %zu triangles, edges %s, in %s\n",
                   plan.num_samples(), plan.repair.Summary().c_str(), plan.triangles.size(),
                   EdgeLine(plan.edge_stats.count, plan.repair.crossings_found,
@@ -241,21 +242,21 @@ int main(int argc, char** argv) {
         return absl::InvalidArgumentError(
             absl::StrFormat("--shard must be I/N with 0 <= I < N, got '%s'", shard_text));
       }
-      GEODEX_ASSIGN_OR_RETURN(auto loaded, build::LoadPlan(workdir));
+      GEODEX_ASSIGN_OR_RETURN(auto loaded, builder::LoadPlan(workdir));
       const auto& [mesh, plan] = loaded;
-      const std::vector<int32_t> ids = build::ShardSamples(plan.num_samples(), shard, num_shards);
-      GEODEX_ASSIGN_OR_RETURN(auto rows, build::ComputeRows(mesh, plan, ids, options));
-      GEODEX_RETURN_IF_ERROR(build::SaveRows(plan, rows, shard, num_shards, workdir));
+      const std::vector<int32_t> ids = builder::ShardSamples(plan.num_samples(), shard, num_shards);
+      GEODEX_ASSIGN_OR_RETURN(auto rows, builder::ComputeRows(mesh, plan, ids, options));
+      GEODEX_RETURN_IF_ERROR(builder::SaveRows(plan, rows, shard, num_shards, workdir));
       std::printf("geodex-build rows: shard %d/%d, %zu samples\n", shard, num_shards, ids.size());
       return absl::OkStatus();
     }();
   } else if (*merge_cmd) {
     status = [&]() -> absl::Status {
-      GEODEX_ASSIGN_OR_RETURN(auto loaded, build::LoadPlan(workdir));
+      GEODEX_ASSIGN_OR_RETURN(auto loaded, builder::LoadPlan(workdir));
       const auto& [mesh, plan] = loaded;
-      GEODEX_ASSIGN_OR_RETURN(auto rows, build::LoadAllRows(plan, workdir));
-      build::BuildSummary summary;
-      GEODEX_ASSIGN_OR_RETURN(auto data, build::Merge(mesh, plan, std::move(rows), &summary));
+      GEODEX_ASSIGN_OR_RETURN(auto rows, builder::LoadAllRows(plan, workdir));
+      builder::BuildSummary summary;
+      GEODEX_ASSIGN_OR_RETURN(auto data, builder::Merge(mesh, plan, std::move(rows), &summary));
       if (!no_calibration) GEODEX_RETURN_IF_ERROR(AddCalibration(mesh, data));
       return WriteAndReport(data, summary, out);
     }();
@@ -263,7 +264,7 @@ int main(int argc, char** argv) {
     status = [&]() -> absl::Status {
       GEODEX_ASSIGN_OR_RETURN(const mesh::Mesh mesh, LoadInput(mesh_path));
       GEODEX_ASSIGN_OR_RETURN(auto index, index::Index::Open(index_path));
-      if (index->header().mesh_hash != build::HashMesh(mesh)) {
+      if (index->header().mesh_hash != builder::HashMesh(mesh)) {
         return absl::InvalidArgumentError(
             absl::StrFormat("%s was not built from %s", index_path, mesh_path));
       }
@@ -281,10 +282,10 @@ int main(int argc, char** argv) {
     }
     status = [&]() -> absl::Status {
       GEODEX_ASSIGN_OR_RETURN(const mesh::Mesh mesh, LoadInput(mesh_path));
-      GEODEX_ASSIGN_OR_RETURN(const build::Plan plan, build::MakePlan(mesh, options));
+      GEODEX_ASSIGN_OR_RETURN(const builder::Plan plan, builder::MakePlan(mesh, options));
       GEODEX_RETURN_IF_ERROR(WriteEdges(mesh, plan, edges_obj));
-      build::BuildSummary summary;
-      GEODEX_ASSIGN_OR_RETURN(auto data, build::BuildIndexFromPlan(mesh, plan, options, &summary));
+      builder::BuildSummary summary;
+      GEODEX_ASSIGN_OR_RETURN(auto data, builder::BuildIndexFromPlan(mesh, plan, options, &summary));
       if (!no_calibration) GEODEX_RETURN_IF_ERROR(AddCalibration(mesh, data));
       return WriteAndReport(data, summary, out);
     }();

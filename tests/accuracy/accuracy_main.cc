@@ -15,7 +15,7 @@
 
 #include "CLI/CLI.hpp"
 #include "absl/strings/str_format.h"
-#include "core/build/builder.h"
+#include "core/builder/builder.h"
 #include "core/common/status_macros.h"
 #include "core/mesh/generators.h"
 #include "core/mesh/mesh_io.h"
@@ -52,11 +52,11 @@ absl::Status Run(const Flags& flags) {
       const std::string file = absl::StrFormat(
           "%s/%s-m%d.gdx", flags.index_dir.empty() ? "/tmp" : flags.index_dir, name, count);
       if (flags.index_dir.empty() || !std::filesystem::exists(file)) {
-        build::BuildOptions build_options;
+        builder::BuildOptions build_options;
         build_options.num_samples = count;
         build_options.threads = flags.threads;
-        build::BuildSummary summary;
-        GEODEX_ASSIGN_OR_RETURN(const auto data, build::BuildIndex(m, build_options, &summary));
+        builder::BuildSummary summary;
+        GEODEX_ASSIGN_OR_RETURN(const auto data, builder::BuildIndex(m, build_options, &summary));
         GEODEX_RETURN_IF_ERROR(index::WriteIndexFile(data, file));
         std::fprintf(stderr, "built %s: %s", file.c_str(), summary.ToText().c_str());
       }

@@ -4,7 +4,7 @@
 
 #include <utility>
 
-#include "core/build/builder.h"
+#include "core/builder/builder.h"
 #include "core/mesh/generators.h"
 #include "gtest/gtest.h"
 
@@ -14,11 +14,11 @@ namespace {
 namespace gen = mesh::gen;
 
 AccuracyReport Measure(const mesh::Mesh& m, int32_t samples, int32_t points, int32_t sources) {
-  build::BuildOptions build_options;
+  builder::BuildOptions build_options;
   build_options.num_samples = samples;
   build_options.threads = 2;
-  build::BuildSummary summary;
-  auto data = build::BuildIndex(m, build_options, &summary);
+  builder::BuildSummary summary;
+  auto data = builder::BuildIndex(m, build_options, &summary);
   EXPECT_TRUE(data.ok()) << data.status();
   auto index = index::Index::FromBytes(*index::SerializeIndex(*data));
   EXPECT_TRUE(index.ok());

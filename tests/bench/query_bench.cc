@@ -21,7 +21,7 @@
 
 #include "CLI/CLI.hpp"
 #include "absl/strings/str_format.h"
-#include "core/build/builder.h"
+#include "core/builder/builder.h"
 #include "core/mesh/generators.h"
 #include "core/query/query_engine.h"
 #include "core/query/unfold_kernel.h"
@@ -253,10 +253,10 @@ int main(int argc, char** argv) {
       "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
   if (indexes.empty()) {
     std::printf("(no --index given: a generated sphere, m = 500)\n");
-    geodex::build::BuildOptions options;
+    geodex::builder::BuildOptions options;
     options.num_samples = 500;
-    geodex::build::BuildSummary summary;
-    auto data = geodex::build::BuildIndex(geodex::mesh::gen::Sphere(5, 1.0), options, &summary);
+    geodex::builder::BuildSummary summary;
+    auto data = geodex::builder::BuildIndex(geodex::mesh::gen::Sphere(5, 1.0), options, &summary);
     auto ix = geodex::index::Index::FromBytes(*geodex::index::SerializeIndex(*data));
     geodex::Bench("sphere(5)", *ix, pairs);
     return 0;

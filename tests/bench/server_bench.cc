@@ -36,7 +36,7 @@
 
 #include "CLI/CLI.hpp"
 #include "absl/strings/str_format.h"
-#include "core/build/builder.h"
+#include "core/builder/builder.h"
 #include "core/index/index.h"
 #include "core/mesh/generators.h"
 #include "core/query/point_locator.h"

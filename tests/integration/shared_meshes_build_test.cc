@@ -8,7 +8,7 @@
 #include <cstdlib>
 #include <filesystem>
 
-#include "core/build/builder.h"
+#include "core/builder/builder.h"
 #include "core/mesh/mesh_io.h"
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
@@ -51,10 +51,10 @@ TEST_P(SharedMeshBuildTest, PlanIsValidAndSmallMeshesIndexCompletely) {
     GTEST_SKIP() << GetParam() << " has " << mesh->num_vertices()
                  << " vertices; set GEODEX_LARGE_TESTS=1 to include it (minutes)";
   }
-  build::BuildOptions options;
+  builder::BuildOptions options;
   options.num_samples = 150;
   options.threads = 2;
-  auto plan = build::MakePlan(*mesh, options);
+  auto plan = builder::MakePlan(*mesh, options);
   ASSERT_TRUE(plan.ok()) << plan.status();
   const auto dual = triangulation::CheckDual(*mesh, plan->nearest, plan->num_samples());
   EXPECT_TRUE(dual.violations.empty());
@@ -63,10 +63,10 @@ TEST_P(SharedMeshBuildTest, PlanIsValidAndSmallMeshesIndexCompletely) {
   if (mesh->num_vertices() > 7000) return;  // full rows cost minutes on big meshes
   std::vector<int32_t> all(plan->num_samples());
   for (int32_t a = 0; a < plan->num_samples(); ++a) all[a] = a;
-  auto rows = build::ComputeRows(*mesh, *plan, all, options);
+  auto rows = builder::ComputeRows(*mesh, *plan, all, options);
   ASSERT_TRUE(rows.ok()) << rows.status();
-  build::BuildSummary summary;
-  auto data = build::Merge(*mesh, *plan, std::move(*rows), &summary);
+  builder::BuildSummary summary;
+  auto data = builder::Merge(*mesh, *plan, std::move(*rows), &summary);
   ASSERT_TRUE(data.ok()) << data.status();
   EXPECT_EQ(summary.unassigned_vertices, 0);
   std::printf("%s", summary.ToText().c_str());

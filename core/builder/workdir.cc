@@ -1,4 +1,4 @@
-#include "core/build/workdir.h"
+#include "core/builder/workdir.h"
 
 #include <xxhash.h>
 
@@ -12,7 +12,7 @@
 #include "core/common/status_macros.h"
 #include "core/mesh/mesh_io.h"
 
-namespace geodex::build {
+namespace geodex::builder {
 namespace {
 
 // The last byte of a magic is the format version. Plan versions: 1 initial;
@@ -230,4 +230,4 @@ absl::StatusOr<std::vector<SampleRow>> LoadAllRows(const Plan& plan, const std::
   return rows;
 }
 
-}  // namespace geodex::build
+}  // namespace geodex::builder

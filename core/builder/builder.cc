@@ -1,4 +1,4 @@
-#include "core/build/builder.h"
+#include "core/builder/builder.h"
 
 #include <algorithm>
 #include <atomic>
@@ -15,7 +15,7 @@
 #include "core/query/point_locator.h"
 #include "core/sampling/farthest_point_sampling.h"
 
-namespace geodex::build {
+namespace geodex::builder {
 namespace {
 
 using mesh::kNone;
@@ -336,4 +336,4 @@ absl::StatusOr<index::IndexData> BuildIndexFromPlan(const Mesh& mesh, const Plan
   return data;
 }
 
-}  // namespace geodex::build
+}  // namespace geodex::builder

@@ -30,7 +30,7 @@
 #include "core/mesh/mesh.h"
 #include "core/triangulation/geodesic_triangulation.h"
 
-namespace geodex::build {
+namespace geodex::builder {
 
 inline constexpr char kBuilderVersion[] = "geodex-build 0.1.0";
 
@@ -132,4 +132,4 @@ absl::StatusOr<index::IndexData> BuildIndexFromPlan(const mesh::Mesh& mesh, cons
 
 uint64_t HashMesh(const mesh::Mesh& mesh);
 
-}  // namespace geodex::build
+}  // namespace geodex::builder

@@ -15,10 +15,10 @@
 #include <vector>
 
 #include "absl/status/statusor.h"
-#include "core/build/builder.h"
+#include "core/builder/builder.h"
 #include "core/mesh/mesh.h"
 
-namespace geodex::build {
+namespace geodex::builder {
 
 std::string PlanMeshPath(const std::string& workdir);
 
@@ -37,4 +37,4 @@ absl::Status SaveRows(const Plan& plan, const std::vector<SampleRow>& rows, int3
 // another plan.
 absl::StatusOr<std::vector<SampleRow>> LoadAllRows(const Plan& plan, const std::string& workdir);
 
-}  // namespace geodex::build
+}  // namespace geodex::builder

@@ -1,14 +1,14 @@
-#include "core/build/builder.h"
+#include "core/builder/builder.h"
 
 #include <filesystem>
 #include <fstream>
 
 #include "absl/strings/str_cat.h"
-#include "core/build/workdir.h"
+#include "core/builder/workdir.h"
 #include "core/mesh/generators.h"
 #include "gtest/gtest.h"
 
-namespace geodex::build {
+namespace geodex::builder {
 namespace {
 
 namespace gen = mesh::gen;
@@ -209,4 +209,4 @@ TEST(BuilderTest, MergeRejectsMissingRows) {
 }
 
 }  // namespace
-}  // namespace geodex::build
+}  // namespace geodex::builder
