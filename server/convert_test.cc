@@ -137,7 +137,7 @@ TEST(ConvertModelInfoTest, DescribesAServedVersion) {
   testing::TempDir dir;
   testing::WriteModelVersion(dir.path(), "sphere", 3, testing::SphereIndexBytes());
   const std::string path = dir.path() + "/sphere/3/index.gdx";
-  auto served = ServedVersion::Load(3, path, FileId{}, false);
+  auto served = ServedVersion::Load(3, path, FileId{});
   ASSERT_TRUE(served.ok()) << served.status();
   ModelSnapshot model;
   model.name = "sphere";

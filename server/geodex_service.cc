@@ -20,6 +20,8 @@
 namespace geodex::server {
 namespace service_internal {
 
+namespace {
+
 absl::StatusOr<query::NearPairs> NearPairsFor(const ModelSnapshot& model, int requested,
                                               bool exact_requested) {
   if (!v1::NearPairs_IsValid(requested)) {
@@ -48,6 +50,22 @@ absl::StatusOr<query::NearPairs> NearPairsFor(const ModelSnapshot& model, int re
   return query::NearPairs::kPath;
 }
 
+}  // namespace
+
+absl::StatusOr<query::DistanceOptions> DistanceOptionsFor(const ModelSnapshot& model,
+                                                          int near_pairs, bool exact_near_pairs,
+                                                          double tolerance) {
+  query::DistanceOptions options;
+  GEODEX_ASSIGN_OR_RETURN(options.near_pairs,
+                          NearPairsFor(model, near_pairs, exact_near_pairs));
+  if (!(tolerance >= 0) || !std::isfinite(tolerance)) {
+    return absl::InvalidArgumentError(
+        absl::StrFormat("tolerance must be finite and >= 0, not %g", tolerance));
+  }
+  options.tolerance = tolerance > 0 ? tolerance : model.config.tolerance();
+  return options;
+}
+
 double SecondsSince(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
 }
@@ -73,7 +91,7 @@ namespace {
 
 using service_internal::Clock;
 using service_internal::IsClientError;
-using service_internal::NearPairsFor;
+using service_internal::DistanceOptionsFor;
 using service_internal::SecondsSince;
 
 // A client-supplied request id is used when it is short and printable.
@@ -161,9 +179,10 @@ ServiceLimits GeodexService::LimitsFor(const ModelSnapshot& model) const {
 }
 
 absl::Status GeodexService::ComputeDistances(const ResolvedModel& model, const v1::SurfacePoints& a,
-                                             const v1::SurfacePoints& b, int near_pairs,
-                                             bool exact_near_pairs, WorkerContext& worker,
-                                             google::protobuf::RepeatedField<double>* out) const {
+                                             const v1::SurfacePoints& b,
+                                             const DistanceChoice& choice, WorkerContext& worker,
+                                             google::protobuf::RepeatedField<double>* out,
+                                             google::protobuf::RepeatedField<double>* bounds) const {
   const ServiceLimits limits = LimitsFor(*model.model);
   const int64_t na = PointCount(a), nb = PointCount(b);
   if (std::max(na, nb) > limits.max_pairs_per_message) {
@@ -175,12 +194,16 @@ absl::Status GeodexService::ComputeDistances(const ResolvedModel& model, const v
     return absl::InvalidArgumentError(
         absl::StrFormat("a has %d points but b has %d; they must pair up", na, nb));
   }
-  GEODEX_ASSIGN_OR_RETURN(const query::NearPairs mode,
-                          NearPairsFor(*model.model, near_pairs, exact_near_pairs));
-  GEODEX_ASSIGN_OR_RETURN(const query::QueryEngine* engine, model.version->EngineFor(mode));
-  GEODEX_RETURN_IF_ERROR(PointsFromProto(a, "a", *engine, &worker.a));
-  GEODEX_RETURN_IF_ERROR(PointsFromProto(b, "b", *engine, &worker.b));
-  return engine->DistanceBatch(worker.a, worker.b, ResizeForOutput(out, na), &worker.scratch);
+  GEODEX_ASSIGN_OR_RETURN(const query::DistanceOptions options,
+                          DistanceOptionsFor(*model.model, choice.near_pairs,
+                                             choice.exact_near_pairs, choice.tolerance));
+  const query::QueryEngine& engine = model.version->engine();
+  GEODEX_RETURN_IF_ERROR(PointsFromProto(a, "a", engine, &worker.a));
+  GEODEX_RETURN_IF_ERROR(PointsFromProto(b, "b", engine, &worker.b));
+  return engine.DistanceBatch(worker.a, worker.b, ResizeForOutput(out, na), options,
+                              &worker.scratch,
+                              choice.error_bounds ? ResizeForOutput(bounds, na)
+                                                  : std::span<double>());
 }
 
 // A unary call's reactor. It counts the call from its start until gRPC is
@@ -275,8 +298,8 @@ grpc::ServerUnaryReactor* GeodexService::Distance(grpc::CallbackServerContext* c
                   [this, request, response](Call& call, WorkerContext& worker) -> absl::Status {
                     GEODEX_ASSIGN_OR_RETURN(ResolvedModel model, Resolve(request->model(), call));
                     GEODEX_RETURN_IF_ERROR(ComputeDistances(
-                        model, request->a(), request->b(), request->near_pairs(),
-                        request->exact_near_pairs(), worker, response->mutable_distances()));
+                        model, request->a(), request->b(), DistanceChoice::Of(*request), worker,
+                        response->mutable_distances(), response->mutable_bounds()));
                     call.pairs = PointCount(request->a());
                     response->set_version(model.version->version());
                     return absl::OkStatus();

@@ -127,13 +127,25 @@ class GeodexService final : public v1::Geodex::CallbackService {
   absl::Status Busy() const;
   absl::StatusOr<ResolvedModel> Resolve(const v1::ModelRef& ref, Call& call) const;
   ServiceLimits LimitsFor(const ModelSnapshot& model) const;
-  // a[i], b[i] -> out[i] with the model's engine for the near-pair mode the
-  // request asks for (a v1::NearPairs value, and the deprecated flag) or the
-  // model's configuration does (validated, limited).
+  // What a distance request chooses (DistanceRequest, DistanceBatch and
+  // MatrixRequest carry the same fields).
+  struct DistanceChoice {
+    int near_pairs = 0;  // a v1::NearPairs value
+    bool exact_near_pairs = false;
+    double tolerance = 0;
+    bool error_bounds = false;
+    template <class Request>
+    static DistanceChoice Of(const Request& r) {
+      return {r.near_pairs(), r.exact_near_pairs(), r.tolerance(), r.error_bounds()};
+    }
+  };
+  // a[i], b[i] -> out[i] (and bounds[i] when the request asks) with the
+  // model's engine, near pairs and tolerance as the request or the model's
+  // configuration says (validated, limited).
   absl::Status ComputeDistances(const ResolvedModel& model, const v1::SurfacePoints& a,
-                                const v1::SurfacePoints& b, int near_pairs, bool exact_near_pairs,
-                                WorkerContext& worker,
-                                google::protobuf::RepeatedField<double>* out) const;
+                                const v1::SurfacePoints& b, const DistanceChoice& choice,
+                                WorkerContext& worker, google::protobuf::RepeatedField<double>* out,
+                                google::protobuf::RepeatedField<double>* bounds) const;
   // Runs `fn(call, worker) -> absl::Status` on the pool and finishes the call
   // with its status.
   template <class Fn>

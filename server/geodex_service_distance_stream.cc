@@ -111,8 +111,8 @@ class GeodexService::DistanceStream final
         model_label = model->model->name;
         version = model->version->version();
         status = service_->ComputeDistances(
-            *model, slot->request.a(), slot->request.b(), slot->request.near_pairs(),
-            slot->request.exact_near_pairs(), worker, slot->result.mutable_distances());
+            *model, slot->request.a(), slot->request.b(), DistanceChoice::Of(slot->request), worker,
+            slot->result.mutable_distances(), slot->result.mutable_bounds());
       }
     }
     const int64_t pairs = status.ok() ? PointCount(slot->request.a()) : 0;

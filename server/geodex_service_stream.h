@@ -23,13 +23,15 @@ double SecondsSince(Clock::time_point start);
 // Client mistakes are logged at info, the server's own trouble at warn.
 bool IsClientError(absl::StatusCode code);
 
-// How a request's near pairs are answered: as the request says (near_pairs,
-// or the deprecated exact_near_pairs), else as the model's configuration
-// says (exact_near_pairs, then unfold_near_pairs), else by path length (the
-// engines' default). Errors: InvalidArgument for an unknown mode or a
-// contradiction.
-absl::StatusOr<query::NearPairs> NearPairsFor(const ModelSnapshot& model, int requested,
-                                              bool exact_requested);
+// What a distance request asks of the engine: its near-pair mode (as the
+// request says: near_pairs, or the deprecated exact_near_pairs; else as the
+// model's configuration says: exact_near_pairs, then unfold_near_pairs; else
+// by path length) and its tolerance (the request's, else the model's).
+// Errors: InvalidArgument for an unknown mode, a contradiction or a bad
+// tolerance.
+absl::StatusOr<query::DistanceOptions> DistanceOptionsFor(const ModelSnapshot& model,
+                                                          int near_pairs, bool exact_near_pairs,
+                                                          double tolerance);
 
 }  // namespace service_internal
 

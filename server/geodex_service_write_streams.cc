@@ -19,7 +19,7 @@ constexpr int64_t kChunkBytes = 1 << 20;
 
 }  // namespace
 
-using service_internal::NearPairsFor;
+using service_internal::DistanceOptionsFor;
 
 // A server stream written one message at a time (Matrix, DistanceField,
 // GetMesh): a job on the pool computes the next message, the reactor writes
@@ -135,9 +135,10 @@ class GeodexService::MatrixStream final : public ChunkedWriteStream<v1::MatrixBl
       return absl::InvalidArgumentError(
           absl::StrFormat("block_rows is negative (%d)", request_->block_rows()));
     }
-    GEODEX_ASSIGN_OR_RETURN(const query::NearPairs mode,
-                            NearPairsFor(*model_.model, request_->near_pairs(), false));
-    GEODEX_ASSIGN_OR_RETURN(engine_, model_.version->EngineFor(mode));
+    GEODEX_ASSIGN_OR_RETURN(options_,
+                            DistanceOptionsFor(*model_.model, request_->near_pairs(), false,
+                                               request_->tolerance()));
+    engine_ = &model_.version->engine();
     GEODEX_RETURN_IF_ERROR(PointsFromProto(request_->sources(), "sources", *engine_, &sources_));
     GEODEX_RETURN_IF_ERROR(PointsFromProto(request_->targets(), "targets", *engine_, &targets_));
     // At most kChunkBytes a block, whole rows (at least one).
@@ -155,15 +156,20 @@ class GeodexService::MatrixStream final : public ChunkedWriteStream<v1::MatrixBl
     const int64_t t = static_cast<int64_t>(targets_.size());
     if (s == 0) return absl::OkStatus();  // no rows: nothing to stream
     rows_ = std::min(block_rows_, s - next_row_);
+    const bool bounds = request_->error_bounds();
     values_.resize(rows_ * t);
+    bounds_.resize(bounds ? rows_ * t : 0);
     worker.a.resize(t);
     for (int64_t r = 0; r < rows_; ++r) {
       GEODEX_RETURN_IF_ERROR(CheckAlive(*context_));
       std::fill(worker.a.begin(), worker.a.end(), sources_[next_row_ + r]);
       GEODEX_RETURN_IF_ERROR(engine_->DistanceBatch(
-          worker.a, targets_, std::span<double>(values_.data() + r * t, t), &worker.scratch));
+          worker.a, targets_, std::span<double>(values_.data() + r * t, t), options_,
+          &worker.scratch,
+          bounds ? std::span<double>(bounds_.data() + r * t, t) : std::span<double>()));
     }
     MatrixBlockToProto(next_row_, rows_, t, values_, model_.version->version(), &block_);
+    block_.mutable_bounds()->Assign(bounds_.begin(), bounds_.end());
     return absl::OkStatus();
   }
 
@@ -182,6 +188,8 @@ class GeodexService::MatrixStream final : public ChunkedWriteStream<v1::MatrixBl
   bool prepared_ = false;
   ResolvedModel model_;
   const query::QueryEngine* engine_ = nullptr;
+  query::DistanceOptions options_;
+  std::vector<double> bounds_;
   std::vector<mesh::SurfacePoint> sources_, targets_;
   int64_t block_rows_ = 1;
   int64_t next_row_ = 0;

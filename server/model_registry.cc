@@ -54,8 +54,7 @@ std::string JoinVersions(const std::vector<int64_t>& versions) {
 
 absl::StatusOr<std::shared_ptr<const ServedVersion>> ServedVersion::Load(int64_t version,
                                                                          const std::string& path,
-                                                                         FileId file_id,
-                                                                         bool build_exact) {
+                                                                         FileId file_id) {
   auto index = index::Index::Open(path);
   if (!index.ok()) return index.status();
   auto engine = query::QueryEngine::Create(*index, {});
@@ -66,28 +65,7 @@ absl::StatusOr<std::shared_ptr<const ServedVersion>> ServedVersion::Load(int64_t
   served->file_id_ = file_id;
   served->index_ = *std::move(index);
   served->engine_ = *std::move(engine);
-  if (build_exact) {
-    auto exact = served->ExactEngine();
-    if (!exact.ok()) return exact.status();
-  }
   return std::shared_ptr<const ServedVersion>(std::move(served));
-}
-
-absl::StatusOr<const query::QueryEngine*> ServedVersion::EngineFor(query::NearPairs mode) const {
-  if (mode == engine_->options().near_pairs) return engine_.get();
-  const int slot = mode == query::NearPairs::kExact ? 1 : 0;
-  std::lock_guard<std::mutex> lock(lazy_mutex_);
-  if (lazy_[slot] != nullptr) return lazy_[slot].get();
-  if (!lazy_status_[slot].ok()) return lazy_status_[slot];
-  query::QueryOptions options;
-  options.near_pairs = mode;
-  auto engine = query::QueryEngine::Create(index_, options);
-  if (!engine.ok()) {
-    lazy_status_[slot] = engine.status();
-    return lazy_status_[slot];
-  }
-  lazy_[slot] = *std::move(engine);
-  return lazy_[slot].get();
 }
 
 const char* LoadStateName(LoadState state) {
@@ -332,7 +310,7 @@ void ModelRegistry::ScanModel(ModelEntry& entry, const std::string& dir) {
       Publish(initial_scan_done_);
       if (options_.before_load) options_.before_load(path);
       const auto start = std::chrono::steady_clock::now();
-      auto loaded = ServedVersion::Load(next, path, ve.disk, entry.config.exact_near_pairs());
+      auto loaded = ServedVersion::Load(next, path, ve.disk);
       const double seconds =
           std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
       entry.loading_version = 0;

@@ -69,17 +69,14 @@ struct FileId {
   bool operator==(const FileId&) const = default;
 };
 
-// One loaded version of a model. Immutable, except that the engines of the
-// other near-pair modes are built on first use (EngineFor).
+// One loaded version of a model. Immutable.
 class ServedVersion {
  public:
-  // Opens and validates `path` and builds the default engine; with
-  // `build_exact`, the exact-near-pairs engine too. Errors: those of
+  // Opens and validates `path` and builds its engine. Errors: those of
   // index::Index::Open and query::QueryEngine::Create.
   static absl::StatusOr<std::shared_ptr<const ServedVersion>> Load(int64_t version,
                                                                    const std::string& path,
-                                                                   FileId file_id,
-                                                                   bool build_exact);
+                                                                   FileId file_id);
 
   int64_t version() const { return version_; }
   const std::string& path() const { return path_; }
@@ -87,16 +84,9 @@ class ServedVersion {
   const index::Index& index() const { return *index_; }
   // Bytes of the mapped index file.
   int64_t mapped_bytes() const { return static_cast<int64_t>(index_->size_bytes()); }
-  // The default engine: far pairs in O(1), near pairs by the length of their
-  // path (query::NearPairs::kPath).
+  // The engine; each call chooses how its pairs are refined
+  // (query::DistanceOptions).
   const query::QueryEngine& engine() const { return *engine_; }
-  // The engine answering near pairs in `mode`: engine() for kPath; for the
-  // others built (once, on the calling thread) on first use. Errors:
-  // QueryEngine::Create's.
-  absl::StatusOr<const query::QueryEngine*> EngineFor(query::NearPairs mode) const;
-  absl::StatusOr<const query::QueryEngine*> ExactEngine() const {
-    return EngineFor(query::NearPairs::kExact);
-  }
 
  private:
   ServedVersion() = default;
@@ -106,10 +96,6 @@ class ServedVersion {
   FileId file_id_;
   std::shared_ptr<const index::Index> index_;
   std::shared_ptr<const query::QueryEngine> engine_;
-  // The kUnfold and kExact engines, and the errors of building them.
-  mutable std::mutex lazy_mutex_;
-  mutable std::shared_ptr<const query::QueryEngine> lazy_[2];
-  mutable absl::Status lazy_status_[2];
 };
 
 enum class LoadState { kLoading, kServing, kFailed };

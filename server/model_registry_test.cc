@@ -250,16 +250,17 @@ TEST_F(ModelRegistryTest, ListenerSeesEveryPublishedState) {
   EXPECT_EQ(states.back(), LoadState::kServing);
 }
 
-TEST_F(ModelRegistryTest, ExactEngineIsBuiltOnce) {
+TEST_F(ModelRegistryTest, OneEngineAnswersEveryNearPairMode) {
   Write("a", 1, testing::SphereIndexBytes());
   Start();
   auto resolved = registry_->Resolve("a", 0);
   ASSERT_TRUE(resolved.ok());
-  auto e1 = resolved->version->ExactEngine();
-  auto e2 = resolved->version->ExactEngine();
-  ASSERT_TRUE(e1.ok()) << e1.status();
-  EXPECT_EQ(*e1, *e2);
-  EXPECT_EQ((*e1)->options().near_pairs, query::NearPairs::kExact);
+  const query::QueryEngine& engine = resolved->version->engine();
+  // A point and another of the same face: a near pair, answered by each mode.
+  const mesh::SurfacePoint p{0, {0.6, 0.2, 0.2}}, q{0, {0.1, 0.1, 0.8}};
+  for (auto mode : {query::NearPairs::kPath, query::NearPairs::kUnfold, query::NearPairs::kExact}) {
+    EXPECT_TRUE(engine.Distance(p, q, {.near_pairs = mode}).ok());
+  }
 }
 
 }  // namespace

@@ -89,8 +89,42 @@ TEST_P(RpcTest, DistanceMatchesTheEngine) {
   }
 }
 
+TEST_P(RpcTest, ErrorBoundsAndToleranceMatchTheEngine) {
+  v1::DistanceRequest request = SphereRequest(300, 1);
+  const int32_t faces = sphere_->index().num_faces();
+  auto a = testing::RandomPoints(faces, 300, 1), b = testing::RandomPoints(faces, 300, 1001);
+  for (double tolerance : {0.0, 0.005}) {
+    request.set_tolerance(tolerance);
+    request.set_error_bounds(true);
+    v1::DistanceResponse response;
+    ASSERT_TRUE(Distance(request, &response).ok());
+    ASSERT_EQ(response.bounds_size(), 300);
+    std::vector<double> expected(300), bounds(300);
+    ASSERT_TRUE(sphere_->DistanceBatch(a, b, expected, {.tolerance = tolerance}, nullptr, bounds)
+                    .ok());
+    for (int i = 0; i < 300; ++i) {
+      EXPECT_EQ(response.distances(i), expected[i]) << i;
+      EXPECT_EQ(response.bounds(i), bounds[i]) << i;
+      EXPECT_GE(bounds[i], 0);
+      if (tolerance > 0) EXPECT_LE(bounds[i], tolerance * expected[i]) << i;
+    }
+  }
+  // Without error_bounds, no bounds.
+  request.set_error_bounds(false);
+  v1::DistanceResponse response;
+  ASSERT_TRUE(Distance(request, &response).ok());
+  EXPECT_EQ(response.bounds_size(), 0);
+  for (double bad : {-0.1, std::numeric_limits<double>::quiet_NaN(),
+                     std::numeric_limits<double>::infinity()}) {
+    request.set_tolerance(bad);
+    grpc::Status s = Distance(request, &response);
+    EXPECT_EQ(s.error_code(), grpc::StatusCode::INVALID_ARGUMENT) << bad;
+    EXPECT_THAT(s.error_message(), HasSubstr("tolerance"));
+  }
+}
+
 TEST_P(RpcTest, ExactNearPairsMatchTheExactEngine) {
-  auto exact = ReferenceEngine(testing::SphereIndexBytes(), query::NearPairs::kExact);
+  auto exact = ReferenceEngine(testing::SphereIndexBytes());
   // Near pairs: b is a's point nudged within the same face.
   const int32_t faces = sphere_->index().num_faces();
   auto a = testing::RandomPoints(faces, 50, 7);
@@ -105,7 +139,7 @@ TEST_P(RpcTest, ExactNearPairsMatchTheExactEngine) {
   ASSERT_TRUE(Distance(request, &response).ok());
   query::QueryScratch scratch;
   std::vector<double> expected(a.size());
-  ASSERT_TRUE(exact->DistanceBatch(a, b, expected, &scratch).ok());
+  ASSERT_TRUE(exact->DistanceBatch(a, b, expected, {.near_pairs = query::NearPairs::kExact}, &scratch).ok());
   for (size_t i = 0; i < a.size(); ++i) EXPECT_EQ(response.distances(i), expected[i]) << i;
 }
 
@@ -327,7 +361,7 @@ TEST(ServerTest, PerModelConfigLowersLimitsAndForcesExactNearPairs) {
                             "exact_near_pairs: true\nlimits { max_pairs_per_message: 10 }\n");
   ts.Rescan();
   auto stub = v1::Geodex::NewStub(ts.TcpChannel());
-  auto exact = ReferenceEngine(testing::SphereIndexBytes(), query::NearPairs::kExact);
+  auto exact = ReferenceEngine(testing::SphereIndexBytes());
   const int32_t faces = exact->index().num_faces();
   auto a = testing::RandomPoints(faces, 10, 3);
   auto b = a;
@@ -341,7 +375,7 @@ TEST(ServerTest, PerModelConfigLowersLimitsAndForcesExactNearPairs) {
   ASSERT_TRUE(stub->Distance(context.get(), request, &response).ok());
   query::QueryScratch scratch;
   std::vector<double> expected(10);
-  ASSERT_TRUE(exact->DistanceBatch(a, b, expected, &scratch).ok());
+  ASSERT_TRUE(exact->DistanceBatch(a, b, expected, {.near_pairs = query::NearPairs::kExact}, &scratch).ok());
   for (int i = 0; i < 10; ++i) EXPECT_EQ(response.distances(i), expected[i]);
 
   *request.mutable_a() = ToProto(testing::RandomPoints(faces, 11, 3));
@@ -356,7 +390,7 @@ TEST(ServerTest, NearPairsByPathLengthUnlessTheModelAsksForThePureO1Mode) {
   TestServer ts;
   auto stub = v1::Geodex::NewStub(ts.TcpChannel());
   auto by_path = ReferenceEngine(testing::SphereIndexBytes());
-  auto unfold = ReferenceEngine(testing::SphereIndexBytes(), query::NearPairs::kUnfold);
+
   const int32_t faces = by_path->index().num_faces();
   // Near pairs: a point and another of the same face.
   const auto a = testing::RandomPoints(faces, 40, 5);
@@ -374,7 +408,9 @@ TEST(ServerTest, NearPairsByPathLengthUnlessTheModelAsksForThePureO1Mode) {
   };
   std::vector<double> expected_path(a.size()), expected_unfold(a.size());
   ASSERT_TRUE(by_path->DistanceBatch(a, b, expected_path).ok());
-  ASSERT_TRUE(unfold->DistanceBatch(a, b, expected_unfold).ok());
+  ASSERT_TRUE(
+      by_path->DistanceBatch(a, b, expected_unfold, {.near_pairs = query::NearPairs::kUnfold})
+          .ok());
   ASSERT_NE(expected_path, expected_unfold);
   EXPECT_EQ(answers(), expected_path);
   testing::WriteModelConfig(ts.root(), "sphere", "unfold_near_pairs: true\n");
@@ -383,6 +419,49 @@ TEST(ServerTest, NearPairsByPathLengthUnlessTheModelAsksForThePureO1Mode) {
   // A request's own mode wins over the model's.
   request.set_near_pairs(v1::NEAR_PAIRS_PATH);
   EXPECT_EQ(answers(), expected_path);
+}
+
+TEST(ServerTest, ModelToleranceAppliesAndBoundsNeedACalibratedIndex) {
+  TestServer ts;
+  auto stub = v1::Geodex::NewStub(ts.TcpChannel());
+  auto sphere = ReferenceEngine(testing::SphereIndexBytes());
+  const int32_t faces = sphere->index().num_faces();
+  const auto a = testing::RandomPoints(faces, 50, 5), b = testing::RandomPoints(faces, 50, 6);
+  v1::DistanceRequest request;
+  *request.mutable_model() = Ref("sphere");
+  *request.mutable_a() = ToProto(a);
+  *request.mutable_b() = ToProto(b);
+  request.set_error_bounds(true);
+  testing::WriteModelConfig(ts.root(), "sphere", "tolerance: 0.002\n");
+  ts.Rescan();
+  v1::DistanceResponse response;
+  auto context = Context();
+  ASSERT_TRUE(stub->Distance(context.get(), request, &response).ok());
+  std::vector<double> expected(50), bounds(50);
+  ASSERT_TRUE(sphere->DistanceBatch(a, b, expected, {.tolerance = 0.002}, nullptr, bounds).ok());
+  for (int i = 0; i < 50; ++i) {
+    EXPECT_EQ(response.distances(i), expected[i]);
+    EXPECT_EQ(response.bounds(i), bounds[i]);
+  }
+  // An index built without its calibration: bounds and tolerances are
+  // refused, plain distances still answered.
+  testing::WriteModelConfig(ts.root(), "sphere", "");
+  testing::WriteModelVersion(
+      ts.root(), "plain", 1,
+      testing::BuildIndexBytes(mesh::gen::Sphere(3, 1.0), 40, /*calibrate=*/false));
+  ts.Rescan();
+  *request.mutable_model() = Ref("plain");
+  context = Context();
+  grpc::Status s = stub->Distance(context.get(), request, &response);
+  EXPECT_EQ(s.error_code(), grpc::StatusCode::FAILED_PRECONDITION);
+  EXPECT_THAT(s.error_message(), HasSubstr("calibration"));
+  request.set_error_bounds(false);
+  context = Context();
+  EXPECT_TRUE(stub->Distance(context.get(), request, &response).ok());
+  request.set_tolerance(0.01);
+  context = Context();
+  EXPECT_EQ(stub->Distance(context.get(), request, &response).error_code(),
+            grpc::StatusCode::FAILED_PRECONDITION);
 }
 
 TEST(ServerTest, EachRequestMayChooseItsNearPairMode) {
@@ -397,9 +476,9 @@ TEST(ServerTest, EachRequestMayChooseItsNearPairMode) {
   for (auto [wire, mode] : {std::pair{v1::NEAR_PAIRS_PATH, query::NearPairs::kPath},
                             std::pair{v1::NEAR_PAIRS_UNFOLD, query::NearPairs::kUnfold},
                             std::pair{v1::NEAR_PAIRS_EXACT, query::NearPairs::kExact}}) {
-    auto engine = ReferenceEngine(testing::SphereIndexBytes(), mode);
+    auto engine = ReferenceEngine(testing::SphereIndexBytes());
     expected[wire].resize(a.size());
-    ASSERT_TRUE(engine->DistanceBatch(a, b, expected[wire], &scratch).ok());
+    ASSERT_TRUE(engine->DistanceBatch(a, b, expected[wire], {.near_pairs = mode}, &scratch).ok());
   }
   ASSERT_NE(expected[v1::NEAR_PAIRS_PATH], expected[v1::NEAR_PAIRS_UNFOLD]);
   ASSERT_NE(expected[v1::NEAR_PAIRS_PATH], expected[v1::NEAR_PAIRS_EXACT]);

@@ -151,6 +151,57 @@ TEST_P(RpcTest, StreamWithoutAModelGetsAnErrorPerBatch) {
   EXPECT_TRUE(stream->Finish().ok());
 }
 
+TEST_P(RpcTest, StreamAndMatrixReturnBoundsWhenAsked) {
+  const int32_t faces = sphere_->index().num_faces();
+  const auto a = testing::RandomPoints(faces, 60, 41), b = testing::RandomPoints(faces, 60, 42);
+  std::vector<double> expected(60), bounds(60);
+  ASSERT_TRUE(sphere_->DistanceBatch(a, b, expected, {.tolerance = 0.01}, nullptr, bounds).ok());
+  auto context = Context();
+  auto stream = stub_->StreamDistances(context.get());
+  v1::DistanceBatch batch;
+  batch.set_batch_id(1);
+  *batch.mutable_model() = Ref("sphere");
+  *batch.mutable_a() = ToProto(a);
+  *batch.mutable_b() = ToProto(b);
+  batch.set_tolerance(0.01);
+  batch.set_error_bounds(true);
+  ASSERT_TRUE(stream->Write(batch));
+  stream->WritesDone();
+  v1::DistanceResult result;
+  ASSERT_TRUE(stream->Read(&result));
+  ASSERT_EQ(result.error_code(), 0) << result.error_message();
+  ASSERT_EQ(result.bounds_size(), 60);
+  for (int i = 0; i < 60; ++i) {
+    EXPECT_EQ(result.distances(i), expected[i]);
+    EXPECT_EQ(result.bounds(i), bounds[i]);
+  }
+  EXPECT_TRUE(stream->Finish().ok());
+
+  v1::MatrixRequest request;
+  *request.mutable_model() = Ref("sphere");
+  *request.mutable_sources() = ToProto(std::span(a).first(3));
+  *request.mutable_targets() = ToProto(b);
+  request.set_error_bounds(true);
+  auto matrix_context = Context();
+  auto reader = stub_->Matrix(matrix_context.get(), request);
+  v1::MatrixBlock block;
+  int64_t rows = 0;
+  while (reader->Read(&block)) {
+    ASSERT_EQ(block.bounds_size(), block.values_size());
+    for (int64_t r = 0; r < block.rows(); ++r) {
+      for (int t = 0; t < 60; ++t) {
+        double bound = -1;
+        const double d = *sphere_->Distance(a[block.row_offset() + r], b[t], {}, nullptr, &bound);
+        EXPECT_EQ(block.values(r * 60 + t), d);
+        EXPECT_EQ(block.bounds(r * 60 + t), bound);
+      }
+    }
+    rows += block.rows();
+  }
+  EXPECT_EQ(rows, 3);
+  EXPECT_TRUE(reader->Finish().ok());
+}
+
 TEST_P(RpcTest, MatrixMatchesTheEngineInBlocks) {
   const int32_t faces = sphere_->index().num_faces();
   auto sources = testing::RandomPoints(faces, 23, 3), targets = testing::RandomPoints(faces, 40, 4);

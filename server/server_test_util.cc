@@ -9,13 +9,10 @@
 
 namespace geodex::server::testing {
 
-std::shared_ptr<const query::QueryEngine> ReferenceEngine(const std::string& bytes,
-                                                          query::NearPairs near_pairs) {
+std::shared_ptr<const query::QueryEngine> ReferenceEngine(const std::string& bytes) {
   auto index = index::Index::FromBytes(bytes);
   EXPECT_TRUE(index.ok()) << index.status();
-  query::QueryOptions options;
-  options.near_pairs = near_pairs;
-  auto engine = query::QueryEngine::Create(*index, options);
+  auto engine = query::QueryEngine::Create(*index);
   EXPECT_TRUE(engine.ok()) << engine.status();
   return *engine;
 }

@@ -24,8 +24,7 @@
 namespace geodex::server::testing {
 
 // The engine the server should agree with, over the same index bytes.
-std::shared_ptr<const query::QueryEngine> ReferenceEngine(
-    const std::string& bytes, query::NearPairs near_pairs = query::NearPairs::kPath);
+std::shared_ptr<const query::QueryEngine> ReferenceEngine(const std::string& bytes);
 
 // A loopback server on an ephemeral port, 2 workers, no polling (tests
 // rescan explicitly).

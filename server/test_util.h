@@ -21,8 +21,9 @@ const std::string& SphereIndexBytes();
 // Bytes of an index of a small torus with 40 samples (a second, different
 // model; built once per process; thread-safe).
 const std::string& TorusIndexBytes();
-// Bytes of an index of `mesh` with `samples` samples (seed 1, 2 threads).
-std::string BuildIndexBytes(const mesh::Mesh& mesh, int32_t samples);
+// Bytes of an index of `mesh` with `samples` samples (seed 1, 2 threads),
+// with its accuracy calibration unless `calibrate` is false.
+std::string BuildIndexBytes(const mesh::Mesh& mesh, int32_t samples, bool calibrate = true);
 
 // A fresh directory under $TMPDIR (or /tmp), removed with its contents.
 class TempDir {

@@ -164,8 +164,8 @@ absl::Status CheckAccuracy(std::span<const AccuracyRecord> records, absl::Status
   const AccuracyRecord& r = records[0];
   std::vector<float> values = {r.scale_length, r.uniform_rms, r.uniform_far_p99};
   for (int b = 0; b < kAccuracyBins; ++b) {
-    values.insert(values.end(), {r.unfold_bound[0][b], r.unfold_bound[1][b], r.trace_bound[0][b],
-                                 r.trace_bound[1][b]});
+    values.insert(values.end(), {r.unfold_bound[0][b], r.unfold_bound[1][b]});
+    for (int k = 0; k < 4; ++k) values.push_back(r.trace_bound[k][b]);
   }
   for (int b = 0; b < 4; ++b) values.insert(values.end(), {r.rms[b], r.p99[b]});
   for (float v : values) {

@@ -134,10 +134,11 @@ struct AccuracyRecord {
   uint32_t bound_quantile_permille;  // the bounds are this quantile of the errors (e.g. 995)
   // Absolute error bounds by bin of the answered distance (kAccuracyBinUpper):
   // the O(1) unfolding for pairs of mesh vertices [0] and other pairs [1];
-  // the length of the straightened trace (a surface path: never short), [0]
-  // a straight one (a local geodesic), [1] one that bends round a vertex.
+  // the length of the straightened trace (a surface path: never short),
+  // [2 * vertex pair + bends]: bends when it bends round a mesh vertex (else
+  // it is a straight line through the faces it crosses, a local geodesic).
   float unfold_bound[2][kAccuracyBins];
-  float trace_bound[2][kAccuracyBins];
+  float trace_bound[4][kAccuracyBins];
   // Relative error of the default answer over the held-out pairs, by the
   // exact distance's bin d < L, L-3L, 3L-10L, >= 10L: RMS and p99; and over
   // area-uniform pairs: RMS, and p99 of those beyond 10L.
@@ -146,6 +147,6 @@ struct AccuracyRecord {
   float uniform_rms;
   float uniform_far_p99;
 };
-static_assert(sizeof(AccuracyRecord) == 16 + 4 * 4 * kAccuracyBins + 4 * 10);
+static_assert(sizeof(AccuracyRecord) == 16 + 4 * 6 * kAccuracyBins + 4 * 10);
 
 }  // namespace geodex::index

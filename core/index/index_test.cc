@@ -262,6 +262,46 @@ TEST(IndexTest, RoundTripFromBytes) {
   EXPECT_EQ((*index)->header().format_minor, kFormatMinor);
 }
 
+AccuracyRecord SomeAccuracy() {
+  AccuracyRecord r{};
+  r.scale_length = 0.1f;
+  r.num_sources = 4;
+  r.num_pairs = 100;
+  r.bound_quantile_permille = 995;
+  for (int b = 0; b < kAccuracyBins; ++b) {
+    r.unfold_bound[0][b] = 0.01f * b;
+    r.unfold_bound[1][b] = 0.02f * b;
+    for (int k = 0; k < 4; ++k) r.trace_bound[k][b] = 0.001f * (k + b);
+  }
+  r.p99[3] = 0.01f;
+  return r;
+}
+
+TEST(IndexTest, AccuracyCalibrationRoundTripsAndIsOptional) {
+  IndexData d = MakeSphereIndex();
+  auto without = Index::FromBytes(Serialize(d));
+  ASSERT_TRUE(without.ok()) << without.status();
+  EXPECT_EQ((*without)->accuracy(), nullptr);
+  d.accuracy = {SomeAccuracy()};
+  auto with = Index::FromBytes(Serialize(d));
+  ASSERT_TRUE(with.ok()) << with.status();
+  ASSERT_NE((*with)->accuracy(), nullptr);
+  EXPECT_EQ(std::memcmp((*with)->accuracy(), &d.accuracy[0], sizeof(AccuracyRecord)), 0);
+  // ToIndexData keeps it: the same bytes again.
+  EXPECT_EQ(Serialize(ToIndexData(**with)), Serialize(d));
+}
+
+TEST(IndexTest, BadAccuracyCalibrationIsRefused) {
+  IndexData d = MakeSphereIndex();
+  d.accuracy = {SomeAccuracy(), SomeAccuracy()};
+  EXPECT_EQ(SerializeIndex(d).status().code(), absl::StatusCode::kInvalidArgument);
+  d.accuracy = {SomeAccuracy()};
+  d.accuracy[0].trace_bound[2][3] = std::numeric_limits<float>::quiet_NaN();
+  EXPECT_EQ(SerializeIndex(d).status().code(), absl::StatusCode::kInvalidArgument);
+  d.accuracy[0].trace_bound[2][3] = -1;
+  EXPECT_EQ(SerializeIndex(d).status().code(), absl::StatusCode::kInvalidArgument);
+}
+
 TEST(IndexTest, LayoutFollowsTheFormat) {
   const std::string bytes = Serialize(MakeSphereIndex());
   const Image image = Image::Parse(bytes);
@@ -270,7 +310,7 @@ TEST(IndexTest, LayoutFollowsTheFormat) {
   EXPECT_EQ(image.header.header_size, sizeof(FileHeader));
   EXPECT_EQ(image.header.section_table_offset, sizeof(FileHeader));
   EXPECT_EQ(image.header.file_size, bytes.size());
-  ASSERT_EQ(image.header.num_sections, 10u);
+  ASSERT_EQ(image.header.num_sections, 11u);
   for (const SectionEntry& e : image.entries) {
     EXPECT_EQ(e.offset % kAlignment, 0u) << e.id;
     EXPECT_EQ(e.checksum, XXH64(bytes.data() + e.offset, e.size, 0)) << e.id;

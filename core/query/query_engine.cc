@@ -515,9 +515,9 @@ double QueryEngine::BoundOf(AnswerKind kind, bool vertex_pair, double d) const {
     case AnswerKind::kUnfold:
       return accuracy->unfold_bound[vertex_pair ? 0 : 1][b];
     case AnswerKind::kTrace:
-      return accuracy->trace_bound[0][b];
+      return accuracy->trace_bound[vertex_pair ? 2 : 0][b];
     case AnswerKind::kWrappedTrace:
-      return accuracy->trace_bound[1][b];
+      return accuracy->trace_bound[vertex_pair ? 3 : 1][b];
     case AnswerKind::kExact:
       break;
   }

@@ -218,9 +218,8 @@ TEST(QueryEngineTest, BatchEqualsSingleAndValidatesEveryPoint) {
 
 TEST(QueryEngineTest, ExactNearPairsMatchTheExactEngine) {
   const Mesh m = gen::Sphere(4, 1.0);
-  QueryOptions options;
-  options.near_pairs = NearPairs::kExact;
-  auto engine = MakeEngine(m, 60, options);
+  auto engine = MakeEngine(m, 60);
+  const DistanceOptions options{.near_pairs = NearPairs::kExact};
   QueryScratch scratch;
   const auto points = RandomPoints(m, 400, 9);
   int near = 0;
@@ -228,7 +227,10 @@ TEST(QueryEngineTest, ExactNearPairsMatchTheExactEngine) {
     if (!engine->IsNearPair(points[i], points[i + 1])) continue;
     ++near;
     const double exact = Exact(m, points[i], points[i + 1]);
-    EXPECT_NEAR(*engine->Distance(points[i], points[i + 1], &scratch), exact, 1e-9 * (1 + exact));
+    EXPECT_NEAR(*engine->Distance(points[i], points[i + 1], options, &scratch), exact,
+                1e-9 * (1 + exact));
+    // Without a scratch, the same answer.
+    EXPECT_NEAR(*engine->Distance(points[i], points[i + 1], options), exact, 1e-9 * (1 + exact));
   }
   EXPECT_GT(near, 0);
 }
@@ -243,9 +245,7 @@ double PathLength(const std::vector<PathPoint>& path) {
 TEST(QueryEngineTest, NearPairsAreThePathLengthByDefault) {
   const Mesh m = gen::Grid(30, 30, 1.0, 1.0, 0.2, 4);
   auto engine = MakeEngine(m, 40);
-  QueryOptions unfold_options;
-  unfold_options.near_pairs = NearPairs::kUnfold;
-  auto unfold = MakeEngine(m, 40, unfold_options);
+  const DistanceOptions unfold{.near_pairs = NearPairs::kUnfold};
   const auto points = RandomPoints(m, 800, 12);
   int near = 0;
   double worst = 0, worst_unfold = 0;
@@ -267,7 +267,7 @@ TEST(QueryEngineTest, NearPairsAreThePathLengthByDefault) {
     const double exact = Exact(m, p, q);
     EXPECT_GE(d, exact * (1 - 1e-9));  // a surface path
     worst = std::max(worst, (d - exact) / exact);
-    worst_unfold = std::max(worst_unfold, std::abs(*unfold->Distance(p, q) - exact) / exact);
+    worst_unfold = std::max(worst_unfold, std::abs(*engine->Distance(p, q, unfold) - exact) / exact);
   }
   EXPECT_GT(near, 10);
   EXPECT_LT(worst, 0.01);

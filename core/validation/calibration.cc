@@ -70,7 +70,7 @@ absl::StatusOr<index::AccuracyRecord> Calibrate(const mesh::Mesh& mesh,
   GEODEX_ASSIGN_OR_RETURN(auto engine, query::QueryEngine::Create(index));
   const double scale = engine->scale_length();
   const std::vector<ExactPair> pairs = DrawPairs(mesh, index->num_samples(), options.pairs);
-  std::vector<double> unfold[2][index::kAccuracyBins], trace[2][index::kAccuracyBins];
+  std::vector<double> unfold[2][index::kAccuracyBins], trace[4][index::kAccuracyBins];
   std::vector<double> relative[kNumScaleBins], uniform, uniform_far;
   const query::DistanceOptions pure{.near_pairs = query::NearPairs::kUnfold};
   for (const ExactPair& pair : pairs) {
@@ -80,7 +80,10 @@ absl::StatusOr<index::AccuracyRecord> Calibrate(const mesh::Mesh& mesh,
     const absl::StatusOr<double> d = engine->Distance(pair.p, pair.q);
     if (!u.ok() || !d.ok()) continue;
     unfold[pair.vertices ? 0 : 1][AccuracyBinOf(*u, scale)].push_back(std::abs(*u - pair.exact));
-    if (t.ok()) trace[wraps ? 1 : 0][AccuracyBinOf(*t, scale)].push_back(std::abs(*t - pair.exact));
+    if (t.ok()) {
+      trace[2 * pair.vertices + wraps][AccuracyBinOf(*t, scale)].push_back(
+          std::abs(*t - pair.exact));
+    }
     const double e = (*d - pair.exact) / pair.exact;
     relative[pair.bin].push_back(e);
     if (pair.uniform && !pair.vertices) {
@@ -96,8 +99,7 @@ absl::StatusOr<index::AccuracyRecord> Calibrate(const mesh::Mesh& mesh,
   r.bound_quantile_permille = static_cast<uint32_t>(std::lround(1000 * options.quantile));
   FillBounds(unfold[0], options.quantile, r.unfold_bound[0]);
   FillBounds(unfold[1], options.quantile, r.unfold_bound[1]);
-  FillBounds(trace[0], options.quantile, r.trace_bound[0]);
-  FillBounds(trace[1], options.quantile, r.trace_bound[1]);
+  for (int k = 0; k < 4; ++k) FillBounds(trace[k], options.quantile, r.trace_bound[k]);
   for (int b = 0; b < kNumScaleBins; ++b) {
     r.rms[b] = static_cast<float>(Rms(relative[b]));
     std::vector<double> abs = relative[b];

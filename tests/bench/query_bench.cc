@@ -4,8 +4,8 @@
 // baseline (§6.3), all in the same run on the same pairs. Rates are per
 // CPU-second of the measuring thread.
 //
-// The batch runs in the default mode (near pairs by path length) and in the
-// pure O(1) mode; the share of random pairs that are near is printed with it.
+// The batch runs in the default mode (near and close pairs by path length)
+// and in the pure O(1) mode; the share of random pairs that are near is printed with it.
 // Vertex and interior pairs/s are single DistanceUnchecked calls (O(1)). The
 // cost of one near pair in the path and exact modes is measured apart, on
 // near pairs drawn on purpose. So is the time of one Path between random
@@ -13,11 +13,16 @@
 //
 //   query_bench [--index FILE.gdx]... [--pairs N]
 //
+// Then, per index with its accuracy calibration, the refinement table: the
+// default mode, the pure O(1) mode, the default with error bounds and with
+// a tolerance of 0.005, on uniform pairs and on pairs at each scale.
+//
 // Without --index it builds an index of a generated sphere (a note says so).
 
 #include <cstdio>
 #include <ctime>
 #include <random>
+#include <span>
 
 #include "CLI/CLI.hpp"
 #include "absl/strings/str_format.h"
@@ -142,19 +147,87 @@ std::vector<std::pair<mesh::SurfacePoint, mesh::SurfacePoint>> DrawNearPairs(
 
 // Microseconds per near pair of Distance in a near-pair mode.
 double MicrosecondsPerNearPair(
-    std::shared_ptr<const index::Index> ix, query::NearPairs mode,
+    const query::QueryEngine& engine, query::NearPairs mode,
     const std::vector<std::pair<mesh::SurfacePoint, mesh::SurfacePoint>>& pairs) {
-  query::QueryOptions options;
-  options.near_pairs = mode;
-  auto engine = *query::QueryEngine::Create(ix, options);
   query::QueryScratch scratch;
   volatile double sink = 0;
   const double t0 = ThreadSeconds();
-  for (const auto& [p, q] : pairs) sink = sink + *engine->Distance(p, q, &scratch);
+  for (const auto& [p, q] : pairs) sink = sink + *engine.Distance(p, q, {.near_pairs = mode}, &scratch);
   return 1e6 * (ThreadSeconds() - t0) / std::max<size_t>(1, pairs.size());
 }
 
 constexpr int32_t kCorridorSteps = 8;
+
+// Pairs/s of DistanceBatch over `a`, `b` with `options` (and bounds), per
+// CPU-second; slow modes run once over at most `cap` pairs.
+double BatchRate(const query::QueryEngine& engine, std::span<const mesh::SurfacePoint> a,
+                 std::span<const mesh::SurfacePoint> b, const query::DistanceOptions& options,
+                 bool bounds, size_t cap) {
+  const size_t n = std::min(a.size(), cap);
+  if (n == 0) return 0;
+  std::vector<double> out(n), bound(bounds ? n : 0);
+  query::QueryScratch scratch;
+  const int reps = cap < a.size() ? 1 : 3;
+  double best = 0;
+  for (int rep = 0; rep < reps; ++rep) {
+    const double start = ThreadSeconds();
+    const absl::Status status =
+        engine.DistanceBatch(a.first(n), b.first(n), out, options, &scratch, bound);
+    if (!status.ok()) return 0;
+    best = std::max(best, n / (ThreadSeconds() - start));
+  }
+  return best;
+}
+
+// The refinement table (DistanceOptions): the default mode, the pure O(1)
+// mode, the default with error bounds and a tolerance of 0.005, on
+// area-uniform interior pairs and on pairs at each scale (by their O(1)
+// distance in units of the scale length L).
+void BenchRefinement(const std::string& label, std::shared_ptr<const index::Index> ix, int n) {
+  if (ix->accuracy() == nullptr) {
+    std::printf("| %s | (no accuracy calibration in the index: run geodex-build calibrate) |\n",
+                label.c_str());
+    return;
+  }
+  auto engine = *query::QueryEngine::Create(ix);
+  const double scale = engine->scale_length();
+  const auto a = InteriorPoints(*ix, n, 1), b = InteriorPoints(*ix, n, 2);
+  // Pairs at every scale: uniform pairs, and pairs of faces close in the
+  // file (meshes usually store neighbouring faces at nearby ids), by bin.
+  constexpr double kEdges[] = {0, 1, 3, 10, 1e300};
+  const char* const kNames[] = {"d<L", "L-3L", "3L-10L", ">=10L"};
+  std::vector<mesh::SurfacePoint> bin_a[4], bin_b[4];
+  const auto p = InteriorPoints(*ix, 4 * n, 7), q = InteriorPoints(*ix, 4 * n, 8);
+  const size_t per_bin = std::max(1, n / 4);
+  for (size_t i = 0; i < p.size(); ++i) {
+    mesh::SurfacePoint other = q[i];
+    if (i % 2 == 0) {
+      const int32_t spread = 1 + static_cast<int32_t>(i % 7) * 50;
+      other.face = static_cast<int32_t>((p[i].face + q[i].face % (2 * spread + 1) +
+                                         ix->num_faces() - spread) % ix->num_faces());
+    }
+    const double d = engine->DistanceUnchecked(p[i], other) / scale;
+    int bin = 0;
+    while (bin < 3 && d >= kEdges[bin + 1]) ++bin;
+    if (bin_a[bin].size() < per_bin) {
+      bin_a[bin].push_back(p[i]);
+      bin_b[bin].push_back(other);
+    }
+  }
+  auto row = [&](const char* name, std::span<const mesh::SurfacePoint> x,
+                 std::span<const mesh::SurfacePoint> y) {
+    const size_t all = x.size();
+    const double def = BatchRate(*engine, x, y, {}, false, all);
+    const double pure =
+        BatchRate(*engine, x, y, {.near_pairs = query::NearPairs::kUnfold}, false, all);
+    const double bounds = BatchRate(*engine, x, y, {}, true, all);
+    const double tolerance = BatchRate(*engine, x, y, {.tolerance = 0.005}, true, 300);
+    std::printf("| %s | %s | %zu | %.3fM | %.3fM | %.2f | %.3fM | %.4fM |\n", label.c_str(), name,
+                all, def / 1e6, pure / 1e6, def / pure, bounds / 1e6, tolerance / 1e6);
+  };
+  row("uniform", a, b);
+  for (int bin = 0; bin < 4; ++bin) row(kNames[bin], bin_a[bin], bin_b[bin]);
+}
 
 void Bench(const std::string& label, std::shared_ptr<const index::Index> ix, int n) {
   auto engine = *query::QueryEngine::Create(ix);
@@ -174,11 +247,8 @@ void Bench(const std::string& label, std::shared_ptr<const index::Index> ix, int
     (void)engine->DistanceBatch(a, b, out);
     sink = sink + out[n - 1];
   });
-  query::QueryOptions unfold;
-  unfold.near_pairs = query::NearPairs::kUnfold;
-  auto unfold_engine = *query::QueryEngine::Create(ix, unfold);
   const double unfold_batch_rate = Rate(n, [&] {
-    (void)unfold_engine->DistanceBatch(a, b, out);
+    (void)engine->DistanceBatch(a, b, out, {.near_pairs = query::NearPairs::kUnfold});
     sink = sink + out[n - 1];
   });
   int near = 0;
@@ -219,8 +289,8 @@ void Bench(const std::string& label, std::shared_ptr<const index::Index> ix, int
     sink = sink + static_cast<double>(points);
   }
   const auto near_pairs = DrawNearPairs(*ix, *engine, 1000);
-  const double path_us = MicrosecondsPerNearPair(ix, query::NearPairs::kPath, near_pairs);
-  const double exact_us = MicrosecondsPerNearPair(ix, query::NearPairs::kExact, near_pairs);
+  const double path_us = MicrosecondsPerNearPair(*engine, query::NearPairs::kPath, near_pairs);
+  const double exact_us = MicrosecondsPerNearPair(*engine, query::NearPairs::kExact, near_pairs);
   const double m = ix->num_samples();
   std::printf(
       "| %s | %d | %d | %.2fM | %.2fM | %.2fM | %.2fM (%.2f%% near) | %.2fM | %.2fM | %.2f | "
@@ -261,13 +331,22 @@ int main(int argc, char** argv) {
     geodex::Bench("sphere(5)", *ix, pairs);
     return 0;
   }
+  std::vector<std::shared_ptr<const geodex::index::Index>> loaded;
   for (const std::string& path : indexes) {
     auto ix = geodex::index::Index::Open(path);
     if (!ix.ok()) {
       std::fprintf(stderr, "%s: %s\n", path.c_str(), ix.status().ToString().c_str());
       return 1;
     }
+    loaded.push_back(*ix);
     geodex::Bench(path, *ix, pairs);
+  }
+  std::printf(
+      "\nRefinement (DistanceOptions), batch pairs/s; tolerance: at most 300 pairs, once\n"
+      "| index | pairs | count | default/s | pure O(1)/s | default / pure | default + bounds/s | "
+      "tolerance 0.005/s |\n|---|---|---|---|---|---|---|---|\n");
+  for (size_t i = 0; i < loaded.size(); ++i) {
+    geodex::BenchRefinement(indexes[i], loaded[i], std::min(pairs, 200'000));
   }
   return 0;
 }
