@@ -275,9 +275,8 @@ namespace {
 // `pairs`; advances *next_batch past every batch answered, writing the
 // answers into `out`.
 absl::Status StreamDistancesOnce(GeodexConnection& connection, const v1::ModelRef& model,
-                                 absl::Span<const PointPair> pairs, v1::NearPairs near_pairs,
-                                 size_t batch_size, uint64_t* next_batch,
-                                 std::vector<double>* out) {
+                                 absl::Span<const PointPair> pairs, const DistanceQuery& query,
+                                 size_t batch_size, uint64_t* next_batch, Distances* out) {
   const uint64_t num_batches = (pairs.size() + batch_size - 1) / batch_size;
   const uint64_t first = *next_batch;
   std::unique_ptr<DistanceStream> stream = connection.StreamDistances(StreamOptions{});
@@ -286,12 +285,14 @@ absl::Status StreamDistancesOnce(GeodexConnection& connection, const v1::ModelRe
   // Reading on this thread while another writes is what keeps a large call
   // from deadlocking on full buffers in both directions.
   WriterGuard writer(
-      *stream, std::thread([&stream, &model, pairs, near_pairs, batch_size, first, num_batches] {
+      *stream, std::thread([&stream, &model, pairs, &query, batch_size, first, num_batches] {
         for (uint64_t k = first; k < num_batches; ++k) {
           v1::DistanceBatch batch;
           batch.set_batch_id(k);
           if (k == first) *batch.mutable_model() = model;
-          batch.set_near_pairs(near_pairs);
+          batch.set_near_pairs(ToProto(query.near_pairs));
+          batch.set_tolerance(query.tolerance);
+          batch.set_error_bounds(query.error_bounds);
           const size_t begin = k * batch_size;
           const size_t end = std::min(pairs.size(), begin + batch_size);
           PairsToProto(pairs, begin, end, batch.mutable_a(), batch.mutable_b());
@@ -316,12 +317,21 @@ absl::Status StreamDistancesOnce(GeodexConnection& connection, const v1::ModelRe
           InPairs(absl::DataLossError(absl::StrFormat("the server sent %d distances for %d pairs",
                                                       result.distances_size(), end - begin)),
                   begin, end);
+    } else if (query.error_bounds && result.bounds_size() != static_cast<int>(end - begin)) {
+      batch_error =
+          InPairs(absl::DataLossError(absl::StrFormat("the server sent %d bounds for %d pairs",
+                                                      result.bounds_size(), end - begin)),
+                  begin, end);
     }
     if (!batch_error.ok()) {
       stream->Cancel();
       break;
     }
-    std::copy(result.distances().begin(), result.distances().end(), out->begin() + begin);
+    std::copy(result.distances().begin(), result.distances().end(),
+              out->distance.begin() + begin);
+    if (query.error_bounds) {
+      std::copy(result.bounds().begin(), result.bounds().end(), out->bound.begin() + begin);
+    }
     *next_batch = k + 1;
   }
   writer.Join();
@@ -340,33 +350,50 @@ absl::Status StreamDistancesOnce(GeodexConnection& connection, const v1::ModelRe
 absl::StatusOr<std::vector<double>> Client::Distance(const ModelRef& model,
                                                      absl::Span<const PointPair> pairs,
                                                      NearPairs near_pairs) const {
+  absl::StatusOr<Distances> d = Distance(model, pairs, DistanceQuery{.near_pairs = near_pairs});
+  if (!d.ok()) return d.status();
+  return std::move(d->distance);
+}
+
+absl::StatusOr<Distances> Client::Distance(const ModelRef& model,
+                                           absl::Span<const PointPair> pairs,
+                                           const DistanceQuery& query) const {
   if (absl::Status s = CheckModel(model); !s.ok()) return s;
-  if (pairs.empty()) return std::vector<double>{};
+  if (pairs.empty()) return Distances{};
   const size_t batch_size = options_.batch_size;
 
   if (pairs.size() <= batch_size) {
     // One batch: a unary call costs one round trip and no thread.
     v1::DistanceRequest request;
     *request.mutable_model() = ToProto(model);
-    request.set_near_pairs(ToProto(near_pairs));
+    request.set_near_pairs(ToProto(query.near_pairs));
+    request.set_tolerance(query.tolerance);
+    request.set_error_bounds(query.error_bounds);
     PairsToProto(pairs, 0, pairs.size(), request.mutable_a(), request.mutable_b());
     absl::StatusOr<v1::DistanceResponse> response = connection_->Distance(request);
     if (!response.ok()) return response.status();
-    if (response->distances_size() != static_cast<int>(pairs.size())) {
-      return absl::DataLossError(absl::StrFormat("the server sent %d distances for %d pairs",
-                                                 response->distances_size(), pairs.size()));
+    if (response->distances_size() != static_cast<int>(pairs.size()) ||
+        (query.error_bounds && response->bounds_size() != static_cast<int>(pairs.size()))) {
+      return absl::DataLossError(
+          absl::StrFormat("the server sent %d distances and %d bounds for %d pairs",
+                          response->distances_size(), response->bounds_size(), pairs.size()));
     }
-    return std::vector<double>(response->distances().begin(), response->distances().end());
+    Distances out;
+    out.distance.assign(response->distances().begin(), response->distances().end());
+    if (query.error_bounds) out.bound.assign(response->bounds().begin(), response->bounds().end());
+    return out;
   }
 
-  std::vector<double> out(pairs.size(), std::numeric_limits<double>::quiet_NaN());
+  Distances out;
+  out.distance.assign(pairs.size(), std::numeric_limits<double>::quiet_NaN());
+  if (query.error_bounds) out.bound.assign(pairs.size(), std::numeric_limits<double>::quiet_NaN());
   const v1::ModelRef ref = ToProto(model);
   uint64_t next_batch = 0;
   int failures = 0;  // consecutive failed attempts without progress
   while (true) {
     const uint64_t before = next_batch;
-    const absl::Status status = StreamDistancesOnce(*connection_, ref, pairs, ToProto(near_pairs),
-                                                    batch_size, &next_batch, &out);
+    const absl::Status status =
+        StreamDistancesOnce(*connection_, ref, pairs, query, batch_size, &next_batch, &out);
     if (status.ok()) return out;
     if (next_batch > before) failures = 0;  // a stream that made progress is not a repeat
     ++failures;

@@ -166,6 +166,39 @@ TEST(ClientDistance, OneBatchIsOneUnaryCall) {
   EXPECT_THAT(*d, ElementsAre(0.5, 1.5, 2.5));
 }
 
+TEST(ClientDistance, ToleranceAndBoundsAreSentAndBoundsReturned) {
+  auto mock = std::make_shared<MockGeodexConnection>();
+  EXPECT_CALL(*mock, Distance).WillOnce([](const v1::DistanceRequest& r) {
+    EXPECT_EQ(r.tolerance(), 0.005);
+    EXPECT_TRUE(r.error_bounds());
+    EXPECT_EQ(r.near_pairs(), v1::NEAR_PAIRS_UNSPECIFIED);
+    v1::DistanceResponse response;
+    for (int f : r.a().faces()) {
+      response.add_distances(f + 0.5);
+      response.add_bounds(0.01 * f);
+    }
+    return response;
+  });
+  Client client(mock, SmallBatches(3));
+  absl::StatusOr<Distances> d =
+      client.Distance("torus", NumberedPairs(3), {.tolerance = 0.005, .error_bounds = true});
+  ASSERT_TRUE(d.ok()) << d.status();
+  EXPECT_THAT(d->distance, ElementsAre(0.5, 1.5, 2.5));
+  EXPECT_THAT(d->bound, ElementsAre(0, 0.01, 0.02));
+}
+
+TEST(ClientDistance, MissingBoundsAreDataLoss) {
+  auto mock = std::make_shared<MockGeodexConnection>();
+  EXPECT_CALL(*mock, Distance).WillOnce([](const v1::DistanceRequest& r) {
+    v1::DistanceResponse response;
+    for (int f : r.a().faces()) response.add_distances(f);
+    return response;
+  });
+  Client client(mock, SmallBatches(3));
+  EXPECT_EQ(client.Distance("torus", NumberedPairs(3), {.error_bounds = true}).status().code(),
+            absl::StatusCode::kDataLoss);
+}
+
 TEST(ClientDistance, ManyPairsAreBatchedOverOneStreamInInputOrder) {
   auto mock = std::make_shared<MockGeodexConnection>();
   EXPECT_CALL(*mock, Distance).Times(0);

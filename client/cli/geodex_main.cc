@@ -2,7 +2,8 @@
 //
 //   geodex models                                   models the server knows
 //   geodex info --model M                           one model, with its build report
-//   geodex distance --model M --pairs FILE|- [--xyz] [--near-pairs MODE]
+//   geodex distance --model M --pairs FILE|- [--xyz] [--near-pairs MODE] [--tolerance X]
+//                   [--error-bounds]
 //   geodex path --model M --pairs FILE --format obj|ply|json --out F
 //   geodex field --model M --sources FILE --out field.txt|field.ply
 //   geodex locate --model M --points FILE
@@ -268,7 +269,7 @@ struct DistanceFlags {
   ModelFlags model;
   std::string pairs, out = "-";
   bool xyz = false;
-  NearPairs near_pairs = NearPairs::kModelDefault;
+  DistanceQuery query;
   int batch = 4096;
 };
 
@@ -278,12 +279,15 @@ absl::Status Distance(const ConnectionFlags& conn, const DistanceFlags& flags) {
   absl::StatusOr<std::vector<PointPair>> pairs =
       LoadPairs(*client, flags.model.ref(), flags.pairs, flags.xyz);
   if (!pairs.ok()) return pairs.status();
-  absl::StatusOr<std::vector<double>> d =
-      client->Distance(flags.model.ref(), *pairs, flags.near_pairs);
+  absl::StatusOr<Distances> d = client->Distance(flags.model.ref(), *pairs, flags.query);
   if (!d.ok()) return d.status();
   std::string out;
-  out.reserve(d->size() * 20);
-  for (double v : *d) absl::StrAppend(&out, FormatDistance(v), "\n");
+  out.reserve(d->distance.size() * 20);
+  for (size_t i = 0; i < d->distance.size(); ++i) {
+    absl::StrAppend(&out, FormatDistance(d->distance[i]));
+    if (flags.query.error_bounds) absl::StrAppend(&out, " ", FormatDistance(d->bound[i]));
+    absl::StrAppend(&out, "\n");
+  }
   return WriteOutput(flags.out, out);
 }
 
@@ -463,7 +467,14 @@ int Main(int argc, char** argv) {
       ->required();
   distance->add_flag("--xyz", distance_flags.xyz,
                      "Lines are 'xa ya za xb yb zb': 3D points, located on the surface first");
-  AddNearPairsFlags(distance, &distance_flags.near_pairs);
+  AddNearPairsFlags(distance, &distance_flags.query.near_pairs);
+  distance
+      ->add_option("--tolerance", distance_flags.query.tolerance,
+                   "Relative error tolerance (e.g. 0.005): the server refines every pair whose "
+                   "error bound exceeds tolerance x distance (0: the model's)")
+      ->check(CLI::NonNegativeNumber);
+  distance->add_flag("--error-bounds", distance_flags.query.error_bounds,
+                     "Print 'distance bound' per line: bound = the absolute error bound");
   distance->add_option("--batch", distance_flags.batch, "Pairs per streamed batch")
       ->check(CLI::Range(1, 1 << 20))
       ->capture_default_str();

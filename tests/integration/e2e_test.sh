@@ -193,6 +193,15 @@ if [ $FAKE -eq 0 ]; then
       pass "distance --near-pairs $mode equals geodex-query --near-pairs $mode" ||
       fail "distance --near-pairs $mode differs from geodex-query" d_offline.txt d_mode.txt err.txt
   done
+  # Error bounds and a tolerance: "distance bound" lines, as geodex-query gives.
+  "$QUERY_BIN" models/cube/1/index.gdx --pairs pairs.txt --error-bounds --tolerance 0.005 \
+    > d_offline.txt 2> err.txt
+  "$GEODEX" distance "${S[@]}" --model "$MODEL" --pairs pairs.txt --error-bounds \
+    --tolerance 0.005 > d_bounds.txt 2>> err.txt
+  same_numbers d_offline.txt d_bounds.txt &&
+    [ "$(awk 'NF == 2 && $2 >= 0 && $2 <= 0.005 * $1 + 1e-12' d_bounds.txt | wc -l)" -eq 42 ] &&
+    pass "distance --error-bounds --tolerance 0.005 equals geodex-query; every bound meets it" ||
+    fail "distance with bounds differs from geodex-query" d_offline.txt d_bounds.txt err.txt
 fi
 
 # Paths. Path tracing belongs to core (a pair it cannot trace is INTERNAL, and

@@ -119,6 +119,12 @@ class Client {
   absl::StatusOr<std::vector<double>> Distance(
       const ModelRef& model, absl::Span<const PointPair> pairs,
       NearPairs near_pairs = NearPairs::kModelDefault) const;
+  // The same with a tolerance and error bounds (DistanceQuery). Errors as
+  // above; FAILED_PRECONDITION when a bound or tolerance is asked of a model
+  // whose index has no accuracy calibration, INVALID_ARGUMENT for a negative
+  // tolerance.
+  absl::StatusOr<Distances> Distance(const ModelRef& model, absl::Span<const PointPair> pairs,
+                                     const DistanceQuery& query) const;
 
   // Opens a streaming session (see DistanceSession).
   DistanceSession OpenDistanceSession(const ModelRef& model, SessionOptions options = {}) const;

@@ -47,14 +47,32 @@ struct ModelRef {
   int64_t version = 0;
 };
 
-// How the server answers pairs in the same or adjacent geodesic triangles
-// ("near pairs", where the O(1) unfolding is weakest; geodex.v1.NearPairs).
-// Far pairs are O(1) in every mode.
+// How the server answers near pairs: in the same or adjacent geodesic
+// triangles, or closer than three geodesic-triangle edges, where the O(1)
+// unfolding errs most (geodex.v1.NearPairs). Other pairs are O(1) in every
+// mode unless a tolerance refines them.
 enum class NearPairs {
   kModelDefault,  // the model's configuration; unless it says otherwise, kPath
-  kPath,          // the length of a traced, straightened path (0.3% p99)
-  kUnfold,        // the pure O(1) unfolding (up to 10% p99 on near pairs)
-  kExact,         // a local exact propagation (0.2-1 ms a near pair)
+  kPath,          // the length of a traced, straightened path
+  kUnfold,        // the pure O(1) unfolding: fastest, least accurate
+  kExact,         // a local exact propagation: exact, slowest
+};
+
+// What one Distance call asks for.
+struct DistanceQuery {
+  NearPairs near_pairs = NearPairs::kModelDefault;
+  // Relative error tolerance (e.g. 0.005): the server refines every pair
+  // whose error bound exceeds tolerance x distance. 0: the model's.
+  double tolerance = 0;
+  // Return each distance's absolute error bound.
+  bool error_bounds = false;
+};
+
+// Distances in input order, and with DistanceQuery::error_bounds their
+// absolute error bounds (geodex.v1.DistanceResponse.bounds).
+struct Distances {
+  std::vector<double> distance;
+  std::vector<double> bound;  // empty without error_bounds
 };
 
 // What the server knows about one model (geodex.v1.ModelInfo).
