@@ -19,6 +19,7 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "absl/strings/string_view.h"
+#include "core/common/file_util.h"
 #include "core/common/status_macros.h"
 #include "tiny_obj_loader.h"
 
@@ -874,39 +875,6 @@ std::string Extension(const std::string& path) {
   return Lowercase(std::string_view(path).substr(dot + 1));
 }
 
-absl::StatusOr<std::string> ReadFile(const std::string& path) {
-  std::FILE* file = std::fopen(path.c_str(), "rb");
-  if (file == nullptr) {
-    return absl::NotFoundError(absl::StrFormat("cannot open '%s': %s", path, std::strerror(errno)));
-  }
-  std::string contents;
-  char buffer[1 << 16];
-  size_t n;
-  while ((n = std::fread(buffer, 1, sizeof(buffer), file)) > 0) contents.append(buffer, n);
-  const bool failed = std::ferror(file) != 0;
-  const int error = errno;
-  std::fclose(file);
-  if (failed) {
-    return absl::NotFoundError(absl::StrFormat("cannot read '%s': %s", path, std::strerror(error)));
-  }
-  return contents;
-}
-
-absl::Status WriteFile(const std::string& path, std::string_view contents) {
-  std::FILE* file = std::fopen(path.c_str(), "wb");
-  if (file == nullptr) {
-    return absl::ErrnoToStatus(errno, absl::StrFormat("cannot open '%s' for writing", path));
-  }
-  const size_t written = std::fwrite(contents.data(), 1, contents.size(), file);
-  const int write_errno = errno;
-  const bool close_failed = std::fclose(file) != 0;
-  if (written != contents.size() || close_failed) {
-    return absl::ErrnoToStatus(close_failed ? errno : write_errno,
-                               absl::StrFormat("cannot write '%s'", path));
-  }
-  return absl::OkStatus();
-}
-
 template <typename T>
 void AppendLittleEndian(std::string* out, T value) {
   char bytes[sizeof(T)];
@@ -1063,7 +1031,7 @@ absl::StatusOr<LoadedMesh> LoadMeshFile(const std::string& path) {
     return absl::InvalidArgumentError(absl::StrFormat(
         "%s: unknown mesh file extension '%s' (expected .obj, .ply or .off)", path, extension));
   }
-  GEODEX_ASSIGN_OR_RETURN(const std::string contents, ReadFile(path));
+  GEODEX_ASSIGN_OR_RETURN(const std::string contents, ReadWholeFile(path));
   return parse(contents, path);
 }
 
@@ -1080,7 +1048,7 @@ absl::Status WriteObj(const Mesh& mesh, const std::string& path) {
   for (const Triangle& t : mesh.faces()) {
     absl::StrAppendFormat(&out, "f %d %d %d\n", t[0] + 1, t[1] + 1, t[2] + 1);
   }
-  return WriteFile(path, out);
+  return AtomicWriteFile(path, out);
 }
 
 absl::Status WritePly(const Mesh& mesh, const std::string& path) {
@@ -1104,7 +1072,7 @@ absl::Status WritePly(const Mesh& mesh, const std::string& path) {
     AppendLittleEndian<uint8_t>(&out, 3);
     for (int i = 0; i < 3; ++i) AppendLittleEndian<int32_t>(&out, t[i]);
   }
-  return WriteFile(path, out);
+  return AtomicWriteFile(path, out);
 }
 
 }  // namespace geodex::mesh
