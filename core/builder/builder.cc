@@ -9,6 +9,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
+#include "core/builder/mesh_arrays.h"
 #include "core/common/status_macros.h"
 #include "core/common/unfolding.h"
 #include "core/geodesic/exact_geodesic.h"
@@ -45,16 +46,6 @@ std::vector<int32_t> CellVertices(const Plan& plan, const std::vector<int32_t>& 
 
 }  // namespace
 
-uint64_t HashMesh(const Mesh& mesh) {
-  std::vector<double> positions;
-  positions.reserve(3 * mesh.num_vertices());
-  for (const auto& p : mesh.positions()) positions.insert(positions.end(), {p.x(), p.y(), p.z()});
-  std::vector<int32_t> faces;
-  faces.reserve(3 * mesh.num_faces());
-  for (const auto& f : mesh.faces()) faces.insert(faces.end(), f.begin(), f.end());
-  return index::MeshHash(positions, faces);
-}
-
 std::vector<std::vector<int32_t>> Plan::SampleNeighbors() const {
   std::vector<std::vector<int32_t>> out(num_samples());
   for (const auto& t : triangles) {
@@ -84,7 +75,7 @@ std::string BuildSummary::ToText() const {
 
 absl::StatusOr<Plan> MakePlan(const Mesh& mesh, const BuildOptions& options) {
   Plan plan;
-  plan.mesh_hash = HashMesh(mesh);
+  plan.mesh_hash = index::MeshHash(FlatPositions(mesh), FlatFaces(mesh));
   plan.requested_samples = options.num_samples;
   plan.seed = options.seed;
   auto start = std::chrono::steady_clock::now();
@@ -273,9 +264,8 @@ absl::StatusOr<index::IndexData> Merge(const Mesh& mesh, const Plan& plan,
   data.params.num_samples = m;
   data.params.seed = plan.seed;
   data.params.samples_added_by_repair = plan.repair.samples_added;
-  for (const auto& p : mesh.positions())
-    data.positions.insert(data.positions.end(), {p.x(), p.y(), p.z()});
-  for (const auto& f : mesh.faces()) data.faces.insert(data.faces.end(), f.begin(), f.end());
+  data.positions = FlatPositions(mesh);
+  data.faces = FlatFaces(mesh);
   for (int32_t h = 0; h < mesh.num_halfedges(); ++h) data.twins.push_back(mesh.Twin(h));
   data.samples = plan.samples;
   for (size_t t = 0; t < plan.triangles.size(); ++t) {

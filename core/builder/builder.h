@@ -130,6 +130,4 @@ absl::StatusOr<index::IndexData> BuildIndexFromPlan(const mesh::Mesh& mesh, cons
                                                     const BuildOptions& options,
                                                     BuildSummary* summary);
 
-uint64_t HashMesh(const mesh::Mesh& mesh);
-
 }  // namespace geodex::builder
