@@ -10,6 +10,7 @@
 #include <random>
 
 #include "absl/strings/str_format.h"
+#include "core/common/status_macros.h"
 
 namespace geodex {
 
@@ -74,15 +75,20 @@ absl::Status AtomicWriteFile(const std::string& path, std::string_view bytes) {
   return absl::OkStatus();
 }
 
-absl::StatusOr<std::string> ReadWholeFile(const std::string& path) {
+absl::StatusOr<int> OpenForReading(const std::string& path, struct stat* info) {
   const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
   if (fd < 0) return ErrnoError(errno, "cannot open", path);
-  struct stat info;
-  if (::fstat(fd, &info) != 0) {
+  if (::fstat(fd, info) != 0) {
     const int err = errno;
     ::close(fd);
     return ErrnoError(err, "cannot stat", path);
   }
+  return fd;
+}
+
+absl::StatusOr<std::string> ReadWholeFile(const std::string& path) {
+  struct stat info;
+  GEODEX_ASSIGN_OR_RETURN(const int fd, OpenForReading(path, &info));
   // open() accepts a directory; there is no file to read at that path.
   if (S_ISDIR(info.st_mode)) {
     ::close(fd);

@@ -3,6 +3,8 @@
 // The project's one whole-file reader and one atomic file writer, and the
 // byte encoders of the builder's work files and the index.
 
+#include <sys/stat.h>
+
 #include <cstdint>
 #include <cstring>
 #include <string>
@@ -29,6 +31,10 @@ absl::Status AtomicWriteFile(const std::string& path, std::string_view bytes);
 // NotFound (ENOENT, ENOTDIR), PermissionDenied (EACCES, EPERM, EROFS) or
 // Internal.
 absl::Status ErrnoError(int err, const std::string& what, const std::string& path);
+
+// Opens `path` read-only (close-on-exec) and fills `info` (fstat); returns the
+// descriptor, which the caller closes. Errors: ErrnoError's. Thread-safe.
+absl::StatusOr<int> OpenForReading(const std::string& path, struct stat* info);
 
 // Reads a whole file. Errors (naming the path and the reason): NotFound when
 // there is no file at `path` (missing, a path through a non-directory, or a

@@ -567,14 +567,8 @@ absl::Status WriteIndexFile(const IndexData& data, const std::string& path) {
 // The file must not shrink while mapped (SIGBUS): writers replace files by
 // rename (WriteIndexFile), which leaves this mapping on the old inode.
 absl::StatusOr<std::shared_ptr<const Index>> Index::Open(const std::string& path) {
-  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
-  if (fd < 0) return ErrnoError(errno, "cannot open", path);
   struct stat st;
-  if (::fstat(fd, &st) != 0) {
-    const int err = errno;
-    ::close(fd);
-    return ErrnoError(err, "cannot stat", path);
-  }
+  GEODEX_ASSIGN_OR_RETURN(const int fd, OpenForReading(path, &st));
   if (!S_ISREG(st.st_mode)) {
     ::close(fd);
     return absl::FailedPreconditionError(absl::StrCat(path, ": not a regular file"));
