@@ -101,37 +101,10 @@ TEST(ServerTest, ShutdownFinishesAnIdleStream) {
 
 // --- the geodex-server binary: flags, SIGHUP, SIGTERM -----------------------------------
 
-struct Process {
-  pid_t pid = -1;
-  int port = 0;
-};
-
-// Starts geodex-server with `args`; reads the port it prints on stdout.
-Process Spawn(std::vector<std::string> args) {
+// Starts geodex-server with `args`.
+testing::ServerProcess Spawn(std::vector<std::string> args) {
   args.insert(args.begin(), GEODEX_SERVER_BINARY);
-  int out[2];
-  if (pipe(out) != 0) return {};
-  const pid_t pid = fork();
-  if (pid == 0) {
-    dup2(out[1], STDOUT_FILENO);
-    close(out[0]);
-    close(out[1]);
-    std::vector<char*> argv;
-    for (std::string& a : args) argv.push_back(a.data());
-    argv.push_back(nullptr);
-    execv(argv[0], argv.data());
-    _exit(127);
-  }
-  close(out[1]);
-  Process p;
-  p.pid = pid;
-  FILE* in = fdopen(out[0], "r");
-  char line[256];
-  while (std::fgets(line, sizeof(line), in) != nullptr) {
-    if (std::sscanf(line, "listening on port %d", &p.port) == 1) break;
-  }
-  fclose(in);
-  return p;
+  return testing::SpawnServer(std::move(args));
 }
 
 int ExitCode(pid_t pid) {
@@ -141,7 +114,7 @@ int ExitCode(pid_t pid) {
 }
 
 TEST(ServerBinaryTest, BadFlagsExitWithTwo) {
-  Process p = Spawn({"--listen", "127.0.0.1:0"});  // no --models
+  testing::ServerProcess p = Spawn({"--listen", "127.0.0.1:0"});  // no --models
   EXPECT_EQ(ExitCode(p.pid), 2);
   p = Spawn({"--models", "/nonexistent/dir", "--listen", "127.0.0.1:0"});
   EXPECT_EQ(ExitCode(p.pid), 2);
@@ -153,8 +126,9 @@ TEST(ServerBinaryTest, BadFlagsExitWithTwo) {
 TEST(ServerBinaryTest, SighupRescansAndSigtermDrains) {
   testing::TempDir dir;
   testing::WriteModelVersion(dir.path(), "sphere", 1, testing::SphereIndexBytes());
-  Process p = Spawn({"--models", dir.path(), "--listen", "127.0.0.1:0", "--poll-seconds", "0",
-                     "--workers", "1", "--log-level", "warn"});
+  testing::ServerProcess p =
+      Spawn({"--models", dir.path(), "--listen", "127.0.0.1:0", "--poll-seconds", "0", "--workers",
+             "1", "--log-level", "warn"});
   ASSERT_GT(p.port, 0);
   auto stub = v1::Geodex::NewStub(grpc::CreateChannel(absl::StrFormat("127.0.0.1:%d", p.port),
                                                       grpc::InsecureChannelCredentials()));

@@ -115,4 +115,30 @@ void PointsToProto(std::span<const mesh::SurfacePoint> points, v1::SurfacePoints
   }
 }
 
+ServerProcess SpawnServer(std::vector<std::string> args) {
+  int out[2];
+  if (pipe(out) != 0) return {};
+  const pid_t pid = fork();
+  if (pid == 0) {
+    dup2(out[1], STDOUT_FILENO);
+    close(out[0]);
+    close(out[1]);
+    std::vector<char*> argv;
+    for (std::string& a : args) argv.push_back(a.data());
+    argv.push_back(nullptr);
+    execv(argv[0], argv.data());
+    _exit(127);
+  }
+  close(out[1]);
+  ServerProcess p;
+  p.pid = pid;
+  FILE* in = fdopen(out[0], "r");
+  char line[256];
+  while (std::fgets(line, sizeof(line), in) != nullptr) {
+    if (std::sscanf(line, "listening on port %d", &p.port) == 1) break;
+  }
+  fclose(in);
+  return p;
+}
+
 }  // namespace geodex::server::testing

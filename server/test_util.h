@@ -5,6 +5,8 @@
 //
 // Not thread-safe unless stated.
 
+#include <sys/types.h>
+
 #include <cstdint>
 #include <span>
 #include <string>
@@ -50,5 +52,15 @@ void RemoveModel(const std::string& root, const std::string& model);
 // barycentric weights summing to 1.
 std::vector<mesh::SurfacePoint> RandomPoints(int32_t num_faces, int count, uint32_t seed);
 void PointsToProto(std::span<const mesh::SurfacePoint> points, v1::SurfacePoints* proto);
+
+// A geodex-server child process.
+struct ServerProcess {
+  pid_t pid = -1;  // -1 if it could not be started
+  int port = 0;    // 0 if it exited before printing "listening on port N"
+};
+
+// Starts `args[0]` (a geodex-server binary) with the other `args` and reads
+// the port it prints on stdout. The caller waits for (or kills) the process.
+ServerProcess SpawnServer(std::vector<std::string> args);
 
 }  // namespace geodex::server::testing

@@ -1,10 +1,18 @@
 #!/usr/bin/env bash
-# Fails if a layer includes a layer it must not depend on:
-#   core/   nothing from gRPC, protobuf or generated code;
-#   client/ nothing from core/.
+# Fails if a layer depends on a layer it must not, by what it includes and by
+# what its CMake targets link (directly or through other targets):
+#   core/         nothing from gRPC, protobuf, generated, server or client code;
+#   core/builder  not the query engine (geodex_query);
+#   client/       nothing from core/ or server/;
+#   server/       not the client library.
+# The link graph is read from the target_link_libraries calls of the
+# CMakeLists.txt files of core/, proto/, client/ and server/; a target belongs
+# to the layer whose CMakeLists.txt adds it.
 set -uo pipefail
 root="${1:-$(dirname "$0")/..}"
 status=0
+
+# --- includes ------------------------------------------------------------------
 if grep -rnE '#include\s*[<"](grpc|grpcpp|google/protobuf)/|#include\s*[<"][^">]*\.pb\.h[">]|#include\s*[<"](server|client|proto)/' \
     "$root/core" 2>/dev/null; then
   echo "layering: core/ must not include gRPC, protobuf, generated, server or client code" >&2
@@ -14,5 +22,100 @@ if [ -d "$root/client" ] && grep -rnE '#include\s*[<"](core|server)/' "$root/cli
   echo "layering: client/ must depend on proto/ only" >&2
   status=1
 fi
+
+# --- links ---------------------------------------------------------------------
+# Prints "def TARGET LAYER" for add_library / add_executable and
+# "link TARGET DEPENDENCY" for every item of target_link_libraries (comments
+# dropped; a call may span lines).
+read -r -d '' links_awk <<'AWK'
+FNR == 1 { call = ""; depth = 0 }
+{
+  line = $0
+  sub(/#.*/, "", line)
+  if (depth == 0) {
+    if (!match(line, /(add_library|add_executable|target_link_libraries)[ \t]*\(/)) next
+    call = substr(line, RSTART)
+    depth = 1
+  } else {
+    call = call " " line
+  }
+  if (index(call, ")") == 0) next
+  call = substr(call, 1, index(call, ")") - 1)
+  gsub(/\(/, " ", call)
+  n = split(call, w, /[ \t]+/)
+  if (w[1] == "add_library" || w[1] == "add_executable") {
+    print "def", w[2], layer
+  } else {
+    for (i = 3; i <= n; i++) {
+      if (w[i] == "" || w[i] ~ /^(PUBLIC|PRIVATE|INTERFACE|LINK_PUBLIC|LINK_PRIVATE)$/) continue
+      print "link", w[2], w[i]
+    }
+  }
+  depth = 0
+  call = ""
+}
+AWK
+
+# Walks every target's links depth-first; prints each forbidden dependency
+# with the chain of links that makes it, and exits 1 if there is one.
+read -r -d '' check_awk <<'AWK'
+$1 == "def" { layer[$2] = $3; targets[++num_targets] = $2 }
+$1 == "link" { adj[$2] = adj[$2] " " $3 }
+function forbidden(from, to) {
+  if (from == "geodex_builder" && to == "geodex_query")
+    return "core/builder must not link the query engine"
+  if (layer[from] == "core" && (layer[to] ~ /^(proto|server|client)$/ || to ~ /^(gRPC|protobuf)::/))
+    return "core/ must not link gRPC, protobuf, generated, server or client code"
+  if (layer[from] == "client" && layer[to] ~ /^(core|server)$/)
+    return "client/ must depend on proto/ only"
+  if (layer[from] == "server" && layer[to] == "client")
+    return "server/ must not link the client library"
+  return ""
+}
+END {
+  failed = 0
+  for (i = 1; i <= num_targets; i++) {
+    start = targets[i]
+    split("", seen)
+    split("", parent)
+    top = 0
+    stack[++top] = start
+    seen[start] = 1
+    while (top > 0) {
+      node = stack[top--]
+      n = split(adj[node], deps, " ")
+      for (k = 1; k <= n; k++) {
+        dep = deps[k]
+        if (dep in seen) continue
+        seen[dep] = 1
+        parent[dep] = node
+        stack[++top] = dep
+        why = forbidden(start, dep)
+        if (why == "") continue
+        chain = dep
+        for (p = node; p != start; p = parent[p]) chain = p " -> " chain
+        printf "layering: %s links %s (%s -> %s): %s\n", start, dep, start, chain, why
+        failed = 1
+      }
+    }
+  }
+  exit failed
+}
+AWK
+
+graph=""
+for layer in core proto client server; do
+  file="$root/$layer/CMakeLists.txt"
+  [ -f "$file" ] || continue
+  graph+="$(awk -v layer="$layer" "$links_awk" "$file")"$'\n'
+done
+if ! grep -q '^def geodex_builder ' <<<"$graph"; then
+  echo "layering: no geodex_builder target found; update tests/check_layering.sh" >&2
+  status=1
+fi
+if ! awk "$check_awk" <<<"$graph" >&2; then
+  status=1
+fi
+
 [ $status -eq 0 ] && echo "layering: ok"
 exit $status

@@ -9,8 +9,9 @@
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
+#include "core/builder/mesh_arrays.h"
+#include "core/builder/vertex_assignment.h"
 #include "core/common/status_macros.h"
-#include "core/common/unfolding.h"
 #include "core/geodesic/exact_geodesic.h"
 #include "core/query/point_locator.h"
 #include "core/sampling/farthest_point_sampling.h"
@@ -43,17 +44,165 @@ std::vector<int32_t> CellVertices(const Plan& plan, const std::vector<int32_t>& 
   return out;
 }
 
-}  // namespace
+// Merge's steps.
 
-uint64_t HashMesh(const Mesh& mesh) {
-  std::vector<double> positions;
-  positions.reserve(3 * mesh.num_vertices());
-  for (const auto& p : mesh.positions()) positions.insert(positions.end(), {p.x(), p.y(), p.z()});
-  std::vector<int32_t> faces;
-  faces.reserve(3 * mesh.num_faces());
-  for (const auto& f : mesh.faces()) faces.insert(faces.end(), f.begin(), f.end());
-  return index::MeshHash(positions, faces);
+// Sorts the rows by sample and checks there is one per sample, each with a
+// distance to every sample. Errors: InvalidArgument.
+absl::Status SortAndCheckRows(int32_t num_samples, std::vector<SampleRow>* rows) {
+  if (static_cast<int32_t>(rows->size()) != num_samples) {
+    return absl::InvalidArgumentError(absl::StrFormat(
+        "merge needs the rows of all %d samples, got %d", num_samples, rows->size()));
+  }
+  std::sort(rows->begin(), rows->end(),
+            [](const SampleRow& x, const SampleRow& y) { return x.sample < y.sample; });
+  for (int32_t a = 0; a < num_samples; ++a) {
+    if ((*rows)[a].sample != a) {
+      return absl::InvalidArgumentError(absl::StrFormat("row of sample %d missing or repeated", a));
+    }
+    if (static_cast<int32_t>((*rows)[a].to_samples.size()) != num_samples) {
+      return absl::InvalidArgumentError(absl::StrFormat("row of sample %d has the wrong size", a));
+    }
+  }
+  return absl::OkStatus();
 }
+
+// d(a, b) between samples, from rows sorted by sample. The two propagations
+// agree to rounding; the shorter is kept (both are lengths of real paths), so
+// the matrix is symmetric.
+class SampleDistances {
+ public:
+  explicit SampleDistances(const std::vector<SampleRow>& rows) : rows_(&rows) {}
+
+  double operator()(int32_t a, int32_t b) const {
+    return std::min((*rows_)[a].to_samples[b], (*rows_)[b].to_samples[a]);
+  }
+
+  // The index's m x m matrix, row-major, 0 on the diagonal.
+  std::vector<float> Matrix() const {
+    const size_t m = rows_->size();
+    std::vector<float> matrix(m * m);
+    for (size_t a = 0; a < m; ++a) {
+      for (size_t b = 0; b < m; ++b) {
+        matrix[a * m + b] = a == b ? 0.0f : static_cast<float>((*this)(a, b));
+      }
+    }
+    return matrix;
+  }
+
+ private:
+  const std::vector<SampleRow>* rows_;
+};
+
+// d(v, b) for every vertex v and every sample b of v's cell or of a cell
+// next to it, gathered from the rows' to_cell_vertices.
+class CellDistances {
+ public:
+  // `neighbors`: plan.SampleNeighbors(); `rows` sorted by sample. Both must
+  // outlive the result. Errors: InvalidArgument for a row with the wrong
+  // number of cell distances.
+  static absl::StatusOr<CellDistances> FromRows(const Plan& plan,
+                                                const std::vector<std::vector<int32_t>>& neighbors,
+                                                const std::vector<SampleRow>& rows) {
+    CellDistances out(plan, neighbors);
+    for (int32_t a = 0; a < plan.num_samples(); ++a) {
+      const std::vector<int32_t> vertices = CellVertices(plan, neighbors[a], a);
+      if (vertices.size() != rows[a].to_cell_vertices.size()) {
+        return absl::InvalidArgumentError(
+            absl::StrFormat("row of sample %d has %d cell distances, expected %d", a,
+                            rows[a].to_cell_vertices.size(), vertices.size()));
+      }
+      for (size_t k = 0; k < vertices.size(); ++k) {
+        const int32_t slot = out.Slot(vertices[k], a);
+        if (slot != kNone) out.slots_[slot] = rows[a].to_cell_vertices[k];
+      }
+    }
+    return out;
+  }
+
+  // `b` must be v's cell or one next to it.
+  double operator()(int32_t v, int32_t b) const { return slots_[Slot(v, b)]; }
+
+ private:
+  // One slot per vertex for its own cell's sample, then one per neighbour.
+  CellDistances(const Plan& plan, const std::vector<std::vector<int32_t>>& neighbors)
+      : plan_(&plan), neighbors_(&neighbors) {
+    const int32_t nv = static_cast<int32_t>(plan.nearest.size());
+    slot_offset_.assign(nv + 1, 0);
+    for (int32_t v = 0; v < nv; ++v) {
+      const int32_t a = plan.nearest[v];
+      slot_offset_[v + 1] = slot_offset_[v] + (a == kNone ? 0 : 1 + neighbors[a].size());
+    }
+    slots_.assign(slot_offset_[nv], geodesic::kInfinity);
+  }
+
+  // The slot of d(v, b), or kNone when b is neither v's cell nor next to it.
+  int32_t Slot(int32_t v, int32_t b) const {
+    const int32_t a = plan_->nearest[v];
+    if (b == a) return slot_offset_[v];
+    const auto& list = (*neighbors_)[a];
+    const auto it = std::lower_bound(list.begin(), list.end(), b);
+    if (it == list.end() || *it != b) return kNone;
+    return slot_offset_[v] + 1 + static_cast<int32_t>(it - list.begin());
+  }
+
+  const Plan* plan_;
+  const std::vector<std::vector<int32_t>>* neighbors_;
+  std::vector<int32_t> slot_offset_;
+  std::vector<double> slots_;
+};
+
+// Everything of the index but the per-vertex records and the sample matrix:
+// the header fields, the mesh, the samples, the geodesic triangles and the
+// face BVH.
+void AddMeshAndTriangulation(const Mesh& mesh, const Plan& plan, index::IndexData* data) {
+  data->builder_version = kBuilderVersion;
+  data->mesh_hash = plan.mesh_hash;
+  data->params.requested_samples = plan.requested_samples;
+  data->params.num_samples = plan.num_samples();
+  data->params.seed = plan.seed;
+  data->params.samples_added_by_repair = plan.repair.samples_added;
+  data->positions = FlatPositions(mesh);
+  data->faces = FlatFaces(mesh);
+  for (int32_t h = 0; h < mesh.num_halfedges(); ++h) data->twins.push_back(mesh.Twin(h));
+  data->samples = plan.samples;
+  for (size_t t = 0; t < plan.triangles.size(); ++t) {
+    index::GeodesicTriangle tri;
+    for (int i = 0; i < 3; ++i) {
+      tri.corner[i] = plan.triangles[t][i];
+      tri.neighbor[i] = plan.neighbors[t][i];
+    }
+    data->triangles.push_back(tri);
+  }
+  query::BuildFaceBvh(data->positions, data->faces, &data->bvh_nodes, &data->bvh_faces);
+}
+
+// The summary's figures but merge_seconds.
+void Summarize(const Mesh& mesh, const Plan& plan, const SampleDistances& sample_distance,
+               const AssignmentCounts& counts, BuildSummary* summary) {
+  double longest = 0;
+  for (const auto& t : plan.triangles) {
+    for (int i = 0; i < 3; ++i) longest = std::max(longest, sample_distance(t[i], t[(i + 1) % 3]));
+  }
+  summary->sampling_seconds = plan.sampling_seconds;
+  summary->triangulation_seconds = plan.triangulation_seconds;
+  summary->requested_samples = plan.requested_samples;
+  summary->num_samples = plan.num_samples();
+  summary->repair = plan.repair.Summary();
+  summary->num_triangles = static_cast<int32_t>(plan.triangles.size());
+  summary->referenced_vertices = counts.referenced;
+  summary->unassigned_vertices = counts.unassigned;
+  summary->share_outside =
+      counts.referenced > 0 ? static_cast<double>(counts.outside) / counts.referenced : 0;
+  summary->longest_edge = longest;
+  summary->geodesic_edges = plan.edge_stats.count;
+  summary->edge_crossings_found = plan.repair.crossings_found;
+  summary->edge_length_total = plan.edge_stats.total_length;
+  summary->edge_length_max = plan.edge_stats.longest;
+  summary->edge_length_error = plan.edge_stats.max_relative_error;
+  summary->bbox_diagonal = mesh.BoundingBoxDiagonal();
+}
+
+}  // namespace
 
 std::vector<std::vector<int32_t>> Plan::SampleNeighbors() const {
   std::vector<std::vector<int32_t>> out(num_samples());
@@ -84,7 +233,7 @@ std::string BuildSummary::ToText() const {
 
 absl::StatusOr<Plan> MakePlan(const Mesh& mesh, const BuildOptions& options) {
   Plan plan;
-  plan.mesh_hash = HashMesh(mesh);
+  plan.mesh_hash = index::MeshHash(FlatPositions(mesh), FlatFaces(mesh));
   plan.requested_samples = options.num_samples;
   plan.seed = options.seed;
   auto start = std::chrono::steady_clock::now();
@@ -166,152 +315,22 @@ absl::StatusOr<std::vector<SampleRow>> ComputeRows(const Mesh& mesh, const Plan&
 absl::StatusOr<index::IndexData> Merge(const Mesh& mesh, const Plan& plan,
                                        std::vector<SampleRow> rows, BuildSummary* summary) {
   const auto start = std::chrono::steady_clock::now();
-  const int32_t m = plan.num_samples();
-  const int32_t nv = mesh.num_vertices();
-  if (static_cast<int32_t>(rows.size()) != m) {
-    return absl::InvalidArgumentError(
-        absl::StrFormat("merge needs the rows of all %d samples, got %d", m, rows.size()));
-  }
-  std::sort(rows.begin(), rows.end(),
-            [](const SampleRow& x, const SampleRow& y) { return x.sample < y.sample; });
+  GEODEX_RETURN_IF_ERROR(SortAndCheckRows(plan.num_samples(), &rows));
   const std::vector<std::vector<int32_t>> neighbors = plan.SampleNeighbors();
-  for (int32_t a = 0; a < m; ++a) {
-    if (rows[a].sample != a) {
-      return absl::InvalidArgumentError(absl::StrFormat("row of sample %d missing or repeated", a));
-    }
-    if (static_cast<int32_t>(rows[a].to_samples.size()) != m) {
-      return absl::InvalidArgumentError(absl::StrFormat("row of sample %d has the wrong size", a));
-    }
-  }
-
-  // Symmetric matrix: the two propagations agree to rounding; keep the
-  // shorter (both are lengths of real paths).
+  const SampleDistances sample_distance(rows);
+  GEODEX_ASSIGN_OR_RETURN(const CellDistances vertex_distance,
+                          CellDistances::FromRows(plan, neighbors, rows));
   index::IndexData data;
-  data.sample_distances.resize(static_cast<size_t>(m) * m);
-  auto matrix = [&](int32_t a, int32_t b) {
-    return std::min(rows[a].to_samples[b], rows[b].to_samples[a]);
-  };
-  for (int32_t a = 0; a < m; ++a) {
-    for (int32_t b = 0; b < m; ++b) {
-      data.sample_distances[static_cast<size_t>(a) * m + b] =
-          a == b ? 0.0f : static_cast<float>(matrix(a, b));
-    }
-  }
-
-  // Per vertex: distances to the samples of its cell and the neighbours.
-  std::vector<int32_t> slot_offset(nv + 1, 0);
-  for (int32_t v = 0; v < nv; ++v) {
-    const int32_t a = plan.nearest[v];
-    slot_offset[v + 1] = slot_offset[v] + (a == kNone ? 0 : 1 + neighbors[a].size());
-  }
-  std::vector<double> slots(slot_offset[nv], geodesic::kInfinity);
-  auto slot_index = [&](int32_t v, int32_t b) -> int32_t {
-    const int32_t a = plan.nearest[v];
-    if (b == a) return slot_offset[v];
-    const auto& list = neighbors[a];
-    const auto it = std::lower_bound(list.begin(), list.end(), b);
-    if (it == list.end() || *it != b) return kNone;
-    return slot_offset[v] + 1 + static_cast<int32_t>(it - list.begin());
-  };
-  for (int32_t a = 0; a < m; ++a) {
-    const std::vector<int32_t> vertices = CellVertices(plan, neighbors[a], a);
-    if (vertices.size() != rows[a].to_cell_vertices.size()) {
-      return absl::InvalidArgumentError(
-          absl::StrFormat("row of sample %d has %d cell distances, expected %d", a,
-                          rows[a].to_cell_vertices.size(), vertices.size()));
-    }
-    for (size_t k = 0; k < vertices.size(); ++k) {
-      const int32_t slot = slot_index(vertices[k], a);
-      if (slot != kNone) slots[slot] = rows[a].to_cell_vertices[k];
-    }
-  }
-
-  // Triangles around each sample.
-  std::vector<std::vector<int32_t>> incident(m);
-  for (int32_t t = 0; t < static_cast<int32_t>(plan.triangles.size()); ++t) {
-    for (int32_t a : plan.triangles[t]) incident[a].push_back(t);
-  }
-
-  data.vertices.resize(nv);
-  int64_t referenced = 0, unassigned = 0, outside = 0;
-  for (int32_t v = 0; v < nv; ++v) {
-    index::VertexRecord& record = data.vertices[v];
-    record = {kNone, {kNone, kNone, kNone}, {0, 0, 0}, 0};
-    const int32_t a = plan.nearest[v];
-    if (!mesh.IsReferenced(v) || a == kNone) continue;
-    ++referenced;
-    double best_score = -geodesic::kInfinity;
-    double best_max = 0;
-    for (int32_t t : incident[a]) {
-      const auto& corners = plan.triangles[t];
-      std::array<double, 3> d;
-      for (int i = 0; i < 3; ++i) d[i] = slots[slot_index(v, corners[i])];
-      const auto lambda =
-          UnfoldedBarycentric(matrix(corners[0], corners[1]), matrix(corners[1], corners[2]),
-                              matrix(corners[2], corners[0]), d);
-      const double score = std::min({lambda[0], lambda[1], lambda[2]});
-      if (score > best_score) {
-        best_score = score;
-        best_max = std::max({lambda[0], lambda[1], lambda[2]});
-        record.triangle = t;
-        for (int i = 0; i < 3; ++i) {
-          record.corner[i] = corners[i];
-          record.distance[i] = static_cast<float>(d[i]);
-        }
-      }
-    }
-    if (record.triangle == kNone) {
-      ++unassigned;
-    } else if (best_score < -0.01 || best_max > 1.01) {
-      ++outside;
-    }
-  }
-
-  data.builder_version = kBuilderVersion;
-  data.mesh_hash = plan.mesh_hash;
-  data.params.requested_samples = plan.requested_samples;
-  data.params.num_samples = m;
-  data.params.seed = plan.seed;
-  data.params.samples_added_by_repair = plan.repair.samples_added;
-  for (const auto& p : mesh.positions())
-    data.positions.insert(data.positions.end(), {p.x(), p.y(), p.z()});
-  for (const auto& f : mesh.faces()) data.faces.insert(data.faces.end(), f.begin(), f.end());
-  for (int32_t h = 0; h < mesh.num_halfedges(); ++h) data.twins.push_back(mesh.Twin(h));
-  data.samples = plan.samples;
-  for (size_t t = 0; t < plan.triangles.size(); ++t) {
-    index::GeodesicTriangle tri;
-    for (int i = 0; i < 3; ++i) {
-      tri.corner[i] = plan.triangles[t][i];
-      tri.neighbor[i] = plan.neighbors[t][i];
-    }
-    data.triangles.push_back(tri);
-  }
-  query::BuildFaceBvh(data.positions, data.faces, &data.bvh_nodes, &data.bvh_faces);
-
-  double longest = 0;
-  for (const auto& t : plan.triangles) {
-    for (int i = 0; i < 3; ++i) longest = std::max(longest, matrix(t[i], t[(i + 1) % 3]));
-  }
-  summary->sampling_seconds = plan.sampling_seconds;
-  summary->triangulation_seconds = plan.triangulation_seconds;
-  summary->requested_samples = plan.requested_samples;
-  summary->num_samples = m;
-  summary->repair = plan.repair.Summary();
-  summary->num_triangles = static_cast<int32_t>(plan.triangles.size());
-  summary->referenced_vertices = referenced;
-  summary->unassigned_vertices = unassigned;
-  summary->share_outside = referenced > 0 ? static_cast<double>(outside) / referenced : 0;
-  summary->longest_edge = longest;
-  summary->geodesic_edges = plan.edge_stats.count;
-  summary->edge_crossings_found = plan.repair.crossings_found;
-  summary->edge_length_total = plan.edge_stats.total_length;
-  summary->edge_length_max = plan.edge_stats.longest;
-  summary->edge_length_error = plan.edge_stats.max_relative_error;
-  summary->bbox_diagonal = mesh.BoundingBoxDiagonal();
+  data.sample_distances = sample_distance.Matrix();
+  const AssignmentCounts counts =
+      AssignVerticesToTriangles(mesh, plan, sample_distance, vertex_distance, &data.vertices);
+  AddMeshAndTriangulation(mesh, plan, &data);
+  Summarize(mesh, plan, sample_distance, counts, summary);
   summary->merge_seconds = SecondsSince(start);
-  if (unassigned > 0) {
+  if (counts.unassigned > 0) {
     return absl::InternalError(absl::StrFormat(
-        "%d referenced vertices have no geodesic triangle (a cell without triangles)", unassigned));
+        "%d referenced vertices have no geodesic triangle (a cell without triangles)",
+        counts.unassigned));
   }
   data.report = summary->ToText();
   return data;

@@ -110,15 +110,38 @@ struct BuildSummary {
   std::string ToText() const;
 };
 
+// Phase 1, the plan (paper §4.1): options.num_samples farthest-point samples
+// from options.seed, their geodesic Voronoi diagram and its dual triangulation,
+// repaired by adding samples until it is valid and, with options.check_edges,
+// its traced geodesic edges do not cross. The same mesh and options give the
+// same plan whatever options.threads (used to trace edges). Reports the
+// "sampling" and "repair" phases through options.progress, from the calling
+// thread.
+// Errors: InvalidArgument if num_samples < 1 or exceeds the mesh's
+// referenced vertices; FailedPrecondition when no valid triangulation is
+// reached within max_repair_rounds rounds or the sample limit; errors of the
+// exact propagation and of edge tracing.
+// Thread safety: reentrant; `mesh` is only read.
 absl::StatusOr<Plan> MakePlan(const mesh::Mesh& mesh, const BuildOptions& options);
 
-// Full propagations from `sample_ids` (indices into plan.samples).
+// Phase 2, the rows (paper §4.2's distances): one full exact propagation from
+// each sample of `sample_ids` (indices into plan.samples; any subset, e.g. a
+// shard), spread over options.threads threads. Returns the rows in the order
+// of `sample_ids`; a row does not depend on the thread count or on which
+// process computes it. Reports "rows" progress through options.progress from
+// the worker threads, one call at a time.
+// Errors: InvalidArgument for an id outside [0, plan.num_samples()); an error
+// of the exact propagation (then no rows are returned).
+// Thread safety: reentrant; `mesh` and `plan` are only read.
 absl::StatusOr<std::vector<SampleRow>> ComputeRows(const mesh::Mesh& mesh, const Plan& plan,
                                                    std::span<const int32_t> sample_ids,
                                                    const BuildOptions& options);
 
-// Assembles the index from the plan and the rows of every sample (any order).
-// Errors: InvalidArgument if rows are missing, repeated or of the wrong size.
+// Phase 3: assembles the index from the plan and the rows of every sample (any
+// order) and fills `summary` (vertex_assignment.h assigns the vertices).
+// Errors: InvalidArgument if rows are missing, repeated or of the wrong size;
+// Internal if a referenced vertex's cell has no geodesic triangle.
+// Thread safety: reentrant.
 absl::StatusOr<index::IndexData> Merge(const mesh::Mesh& mesh, const Plan& plan,
                                        std::vector<SampleRow> rows, BuildSummary* summary);
 
@@ -129,7 +152,5 @@ absl::StatusOr<index::IndexData> BuildIndex(const mesh::Mesh& mesh, const BuildO
 absl::StatusOr<index::IndexData> BuildIndexFromPlan(const mesh::Mesh& mesh, const Plan& plan,
                                                     const BuildOptions& options,
                                                     BuildSummary* summary);
-
-uint64_t HashMesh(const mesh::Mesh& mesh);
 
 }  // namespace geodex::builder

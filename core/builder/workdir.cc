@@ -8,6 +8,7 @@
 #include <regex>
 
 #include "absl/strings/str_format.h"
+#include "core/builder/mesh_arrays.h"
 #include "core/common/file_util.h"
 #include "core/common/status_macros.h"
 #include "core/mesh/mesh_io.h"
@@ -120,7 +121,7 @@ absl::StatusOr<std::pair<mesh::Mesh, Plan>> LoadPlan(const std::string& workdir)
   GEODEX_RETURN_IF_ERROR(r.Get(&plan.sampling_seconds));
   GEODEX_RETURN_IF_ERROR(r.Get(&plan.triangulation_seconds));
   if (!r.AtEnd()) return absl::DataLossError(absl::StrFormat("%s has trailing bytes", path));
-  if (HashMesh(mesh) != plan.mesh_hash) {
+  if (index::MeshHash(FlatPositions(mesh), FlatFaces(mesh)) != plan.mesh_hash) {
     return absl::FailedPreconditionError(
         absl::StrFormat("%s does not belong to %s", path, PlanMeshPath(workdir)));
   }

@@ -25,10 +25,24 @@ std::string PlanMeshPath(const std::string& workdir);
 // Samples of shard `shard` of `num_shards`: a with a % num_shards == shard.
 std::vector<int32_t> ShardSamples(int32_t num_samples, int32_t shard, int32_t num_shards);
 
+// Writes the mesh (PlanMeshPath, binary PLY) and the plan (plan.bin; the traced
+// edge paths are left out, their figures kept) into `workdir`, created if
+// missing. Each file is replaced atomically (AtomicWriteFile), the mesh first.
+// Errors: Internal if `workdir` cannot be created; AtomicWriteFile's errors
+// (NotFound, PermissionDenied, Internal), naming the file.
+// Thread safety: reentrant; concurrent saves into one `workdir` may leave the
+// mesh of one and the plan of the other (LoadPlan then fails
+// FailedPrecondition).
 absl::Status SavePlan(const mesh::Mesh& mesh, const Plan& plan, const std::string& workdir);
 // Loads the mesh and plan of a work directory.
 absl::StatusOr<std::pair<mesh::Mesh, Plan>> LoadPlan(const std::string& workdir);
 
+// Writes the rows of shard `shard` of `num_shards` (those of ShardSamples) as
+// `workdir`/rows-SHARD-of-NUM.bin, atomically, stamped with the plan's mesh
+// hash so that LoadAllRows rejects rows of another plan.
+// Errors: AtomicWriteFile's errors (NotFound if `workdir` does not exist,
+// PermissionDenied, Internal), naming the file.
+// Thread safety: reentrant; different shards may be saved at once.
 absl::Status SaveRows(const Plan& plan, const std::vector<SampleRow>& rows, int32_t shard,
                       int32_t num_shards, const std::string& workdir);
 // Loads the rows of every shard. Errors: NotFound / InvalidArgument if shards

@@ -1,16 +1,16 @@
 #include "core/common/file_util.h"
 
 #include <fcntl.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <cerrno>
 #include <cstring>
-#include <fstream>
 #include <random>
-#include <sstream>
 
 #include "absl/strings/str_format.h"
+#include "core/common/status_macros.h"
 
 namespace geodex {
 
@@ -75,13 +75,41 @@ absl::Status AtomicWriteFile(const std::string& path, std::string_view bytes) {
   return absl::OkStatus();
 }
 
+absl::StatusOr<int> OpenForReading(const std::string& path, struct stat* info) {
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd < 0) return ErrnoError(errno, "cannot open", path);
+  if (::fstat(fd, info) != 0) {
+    const int err = errno;
+    ::close(fd);
+    return ErrnoError(err, "cannot stat", path);
+  }
+  return fd;
+}
+
 absl::StatusOr<std::string> ReadWholeFile(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return absl::NotFoundError(absl::StrFormat("cannot open %s", path));
-  std::ostringstream buffer;
-  buffer << in.rdbuf();
-  if (in.bad()) return absl::InternalError(absl::StrFormat("cannot read %s", path));
-  return buffer.str();
+  struct stat info;
+  GEODEX_ASSIGN_OR_RETURN(const int fd, OpenForReading(path, &info));
+  // open() accepts a directory; there is no file to read at that path.
+  if (S_ISDIR(info.st_mode)) {
+    ::close(fd);
+    return absl::NotFoundError(absl::StrFormat("cannot read %s: it is a directory", path));
+  }
+  std::string contents;
+  if (S_ISREG(info.st_mode)) contents.reserve(static_cast<size_t>(info.st_size));
+  char buffer[1 << 16];
+  while (true) {
+    const ssize_t n = ::read(fd, buffer, sizeof(buffer));
+    if (n == 0) break;
+    if (n < 0) {
+      if (errno == EINTR) continue;
+      const int err = errno;
+      ::close(fd);
+      return ErrnoError(err, "cannot read", path);
+    }
+    contents.append(buffer, static_cast<size_t>(n));
+  }
+  ::close(fd);
+  return contents;
 }
 
 absl::Status ByteReader::Truncated() const {

@@ -1,6 +1,9 @@
 #pragma once
 
-// Small file helpers shared by the builder and the index writer.
+// The project's one whole-file reader and one atomic file writer, and the
+// byte encoders of the builder's work files and the index.
+
+#include <sys/stat.h>
 
 #include <cstdint>
 #include <cstring>
@@ -16,7 +19,12 @@ namespace geodex {
 
 // Writes `bytes` to `path` atomically: a temporary file in the same directory,
 // fsync, rename over `path`, fsync of the directory. Readers see the old file
-// or the new one, never a partial one. Errors name the path and the reason.
+// or the new one, never a partial one; on failure the temporary file is
+// removed and an existing `path` is left as it was. Errors (ErrnoError, naming
+// the path and the reason): NotFound when the directory does not exist,
+// PermissionDenied when it may not be written (read-only, no access),
+// Internal otherwise. Thread-safe: concurrent writers of one path each use
+// their own temporary file, and the last rename wins.
 absl::Status AtomicWriteFile(const std::string& path, std::string_view bytes);
 
 // An error for a failed system call: "<what> <path>: <strerror(err)>", as
@@ -24,7 +32,14 @@ absl::Status AtomicWriteFile(const std::string& path, std::string_view bytes);
 // Internal.
 absl::Status ErrnoError(int err, const std::string& what, const std::string& path);
 
-// Reads a whole file. Errors: NotFound, or Internal on read failure.
+// Opens `path` read-only (close-on-exec) and fills `info` (fstat); returns the
+// descriptor, which the caller closes. Errors: ErrnoError's. Thread-safe.
+absl::StatusOr<int> OpenForReading(const std::string& path, struct stat* info);
+
+// Reads a whole file. Errors (naming the path and the reason): NotFound when
+// there is no file at `path` (missing, a path through a non-directory, or a
+// directory); PermissionDenied when it may not be read; Internal when reading
+// fails. Thread-safe.
 absl::StatusOr<std::string> ReadWholeFile(const std::string& path);
 
 // Appends plain values and arrays to a byte string (host byte order, which the

@@ -297,6 +297,169 @@ absl::Status WithPath(const absl::Status& status, const std::string& path) {
   return absl::Status(status.code(), absl::StrCat(path, ": ", status.message()));
 }
 
+// Validate's steps. Every check happens before the bytes it guards are used;
+// sizes are compared by subtraction so that no sum can overflow.
+
+// The fixed header of an image of `n` bytes: magic, byte order, major
+// version, header size and checksum, and the file size it records.
+absl::StatusOr<FileHeader> ValidateHeader(const uint8_t* p, size_t n) {
+  constexpr size_t kHeaderSize = sizeof(FileHeader);
+  if (n < kHeaderSize) {
+    const size_t k = std::min(n, sizeof(kMagic));
+    if (k == 0 || std::memcmp(p, kMagic, k) == 0) {
+      return absl::DataLossError(absl::StrFormat(
+          "truncated: expected at least %d bytes (the header), found %d", kHeaderSize, n));
+    }
+    return absl::FailedPreconditionError("not a geodex index (bad magic)");
+  }
+  FileHeader h;
+  std::memcpy(&h, p, sizeof(h));
+  if (std::memcmp(h.magic, kMagic, sizeof(kMagic)) != 0) {
+    return absl::FailedPreconditionError("not a geodex index (bad magic)");
+  }
+  if (h.byte_order_mark != kByteOrderMark) {
+    if (h.byte_order_mark == __builtin_bswap32(kByteOrderMark)) {
+      return absl::FailedPreconditionError(
+          "byte order mismatch: the file was written on a host of the other byte order");
+    }
+    return absl::FailedPreconditionError(
+        absl::StrFormat("bad byte order mark 0x%08x", h.byte_order_mark));
+  }
+  if (h.format_major != kFormatMajor) {
+    return absl::FailedPreconditionError(absl::StrFormat(
+        "index format version %d.%d is not supported by this reader (version %d.%d)",
+        h.format_major, h.format_minor, kFormatMajor, kFormatMinor));
+  }
+  if (h.header_size < kHeaderSize || h.header_size % 8 != 0) {
+    return absl::DataLossError(absl::StrFormat("bad header size %d", h.header_size));
+  }
+  if (h.header_size > n) {
+    return absl::DataLossError(absl::StrFormat(
+        "truncated: expected at least %d bytes (the header), found %d", h.header_size, n));
+  }
+  if (HeaderChecksum(p, h.header_size) != h.header_checksum) {
+    return absl::DataLossError("header checksum mismatch");
+  }
+  if (h.file_size != n) {
+    if (h.file_size > n) {
+      return absl::DataLossError(
+          absl::StrFormat("truncated: expected %d bytes, found %d", h.file_size, n));
+    }
+    return absl::DataLossError(absl::StrFormat(
+        "size mismatch: expected %d bytes, found %d (trailing data)", h.file_size, n));
+  }
+  return h;
+}
+
+// The header's element counts, within the int32 id range.
+absl::StatusOr<Counts> HeaderCounts(const FileHeader& h) {
+  Counts counts;
+  counts.num_vertices = h.num_vertices;
+  counts.num_faces = h.num_faces;
+  counts.num_samples = h.num_samples;
+  counts.num_triangles = h.num_triangles;
+  counts.num_bvh_nodes = h.num_bvh_nodes;
+  if (counts.num_vertices > kInt32Max || 3 * counts.num_faces > kInt32Max ||
+      counts.num_samples > kInt32Max || counts.num_triangles > kInt32Max ||
+      counts.num_bvh_nodes > kInt32Max) {
+    return absl::DataLossError("header counts exceed the int32 id range");
+  }
+  if (h.params.num_samples != h.num_samples) {
+    return absl::DataLossError(absl::StrFormat("header: params.num_samples %d != num_samples %d",
+                                               h.params.num_samples, h.num_samples));
+  }
+  return counts;
+}
+
+// A byte range [first, first + second) of the image.
+using ByteRange = std::pair<uint64_t, uint64_t>;
+
+// The sections of the image, by kSpecs index (unknown ids of a later minor
+// version are skipped). Each must fit, be aligned, match its checksum and
+// hold the elements `counts` implies; the required ones must be there.
+// Appends the byte ranges of the table and of every section to `used`.
+absl::Status FindSections(const uint8_t* p, size_t n, const FileHeader& h, const Counts& counts,
+                          std::optional<SectionEntry> (&found)[kNumSpecs],
+                          std::vector<ByteRange>* used) {
+  const uint64_t table_offset = h.section_table_offset;
+  const uint64_t table_bytes = uint64_t{h.num_sections} * sizeof(SectionEntry);
+  if (table_offset < h.header_size || table_offset % alignof(SectionEntry) != 0) {
+    return absl::DataLossError(absl::StrFormat("bad section table offset %d", table_offset));
+  }
+  if (table_offset > n || table_bytes > n - table_offset) {
+    return absl::DataLossError(
+        absl::StrFormat("section table (%d entries at offset %d) does not fit in %d bytes",
+                        h.num_sections, table_offset, n));
+  }
+  if (Checksum(p + table_offset, table_bytes) != h.table_checksum) {
+    return absl::DataLossError("section table checksum mismatch");
+  }
+  std::vector<SectionEntry> entries(h.num_sections);
+  if (table_bytes > 0) std::memcpy(entries.data(), p + table_offset, table_bytes);
+  used->emplace_back(table_offset, table_bytes);
+
+  for (size_t i = 0; i < entries.size(); ++i) {
+    const SectionEntry& e = entries[i];
+    const int spec = SpecIndex(e.id);
+    const std::string name = spec >= 0 ? kSpecs[spec].name : absl::StrCat("with id ", e.id);
+    if (e.offset % kAlignment != 0) {
+      return absl::DataLossError(
+          absl::StrFormat("section %s: offset %d is not 64-byte aligned", name, e.offset));
+    }
+    if (e.offset > n || e.size > n - e.offset) {
+      return absl::DataLossError(
+          absl::StrFormat("section %s: %d bytes at offset %d do not fit in the file (%d bytes)",
+                          name, e.size, e.offset, n));
+    }
+    if (Checksum(p + e.offset, e.size) != e.checksum) {
+      return absl::DataLossError(absl::StrFormat("section %s: checksum mismatch", name));
+    }
+    if (e.size > 0) used->emplace_back(e.offset, e.size);
+    if (spec < 0) continue;  // from a later minor version: ignored
+    if (found[spec].has_value()) {
+      return absl::DataLossError(absl::StrFormat("section %s appears twice", name));
+    }
+    if (e.element_size != kSpecs[spec].element_size) {
+      return absl::DataLossError(absl::StrFormat("section %s: element size %d, expected %d", name,
+                                                 e.element_size, kSpecs[spec].element_size));
+    }
+    const std::optional<uint64_t> count = ExpectedCount(kSpecs[spec].id, counts);
+    if (count.has_value() && e.size != *count * e.element_size) {
+      return absl::DataLossError(
+          absl::StrFormat("section %s: %d bytes, expected %d (%d elements of %d bytes)", name,
+                          e.size, *count * e.element_size, *count, e.element_size));
+    }
+    found[spec] = e;
+  }
+  for (size_t s = 0; s < kNumSpecs; ++s) {
+    const std::optional<uint64_t> count = ExpectedCount(kSpecs[s].id, counts);
+    if (!found[s].has_value() && (kSpecs[s].required || count.value_or(0) > 0)) {
+      return absl::DataLossError(absl::StrFormat("missing section: %s", kSpecs[s].name));
+    }
+  }
+  return absl::OkStatus();
+}
+
+// Every byte of an image of `n` bytes outside the `used` ranges (which must
+// not overlap) is zero padding.
+absl::Status CheckPadding(const uint8_t* p, size_t n, std::vector<ByteRange> used) {
+  std::sort(used.begin(), used.end());
+  uint64_t end = 0;
+  for (const auto& [offset, size] : used) {
+    if (offset < end) {
+      return absl::DataLossError(absl::StrFormat("overlapping sections at byte %d", offset));
+    }
+    for (uint64_t b = end; b < offset; ++b) {
+      if (p[b] != 0) return absl::DataLossError(absl::StrFormat("non-zero padding at byte %d", b));
+    }
+    end = offset + size;
+  }
+  for (uint64_t b = end; b < n; ++b) {
+    if (p[b] != 0) return absl::DataLossError(absl::StrFormat("non-zero padding at byte %d", b));
+  }
+  return absl::OkStatus();
+}
+
 }  // namespace
 
 uint64_t MeshHash(std::span<const double> positions, std::span<const int32_t> faces) {
@@ -432,14 +595,8 @@ absl::Status WriteIndexFile(const IndexData& data, const std::string& path) {
 // The file must not shrink while mapped (SIGBUS): writers replace files by
 // rename (WriteIndexFile), which leaves this mapping on the old inode.
 absl::StatusOr<std::shared_ptr<const Index>> Index::Open(const std::string& path) {
-  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
-  if (fd < 0) return ErrnoError(errno, "cannot open", path);
   struct stat st;
-  if (::fstat(fd, &st) != 0) {
-    const int err = errno;
-    ::close(fd);
-    return ErrnoError(err, "cannot stat", path);
-  }
+  GEODEX_ASSIGN_OR_RETURN(const int fd, OpenForReading(path, &st));
   if (!S_ISREG(st.st_mode)) {
     ::close(fd);
     return absl::FailedPreconditionError(absl::StrCat(path, ": not a regular file"));
@@ -483,149 +640,17 @@ std::string Index::builder_version() const {
   return std::string(v, strnlen(v, sizeof(header_->builder_version)));
 }
 
-// Every check happens before the bytes it guards are used; sizes are compared
-// by subtraction so that no sum can overflow. Every byte of a valid file is
-// covered by a checksum or must be zero padding, so any corruption is seen.
+// Every byte of a valid file is covered by a checksum or must be zero
+// padding, so any corruption is seen.
 absl::Status Index::Validate() {
   const uint8_t* p = base_;
   const size_t n = size_;
-  constexpr size_t kHeaderSize = sizeof(FileHeader);
-  if (n < kHeaderSize) {
-    const size_t k = std::min(n, sizeof(kMagic));
-    if (k == 0 || std::memcmp(p, kMagic, k) == 0) {
-      return absl::DataLossError(absl::StrFormat(
-          "truncated: expected at least %d bytes (the header), found %d", kHeaderSize, n));
-    }
-    return absl::FailedPreconditionError("not a geodex index (bad magic)");
-  }
-  FileHeader h;
-  std::memcpy(&h, p, sizeof(h));
-  if (std::memcmp(h.magic, kMagic, sizeof(kMagic)) != 0) {
-    return absl::FailedPreconditionError("not a geodex index (bad magic)");
-  }
-  if (h.byte_order_mark != kByteOrderMark) {
-    if (h.byte_order_mark == __builtin_bswap32(kByteOrderMark)) {
-      return absl::FailedPreconditionError(
-          "byte order mismatch: the file was written on a host of the other byte order");
-    }
-    return absl::FailedPreconditionError(
-        absl::StrFormat("bad byte order mark 0x%08x", h.byte_order_mark));
-  }
-  if (h.format_major != kFormatMajor) {
-    return absl::FailedPreconditionError(absl::StrFormat(
-        "index format version %d.%d is not supported by this reader (version %d.%d)",
-        h.format_major, h.format_minor, kFormatMajor, kFormatMinor));
-  }
-  if (h.header_size < kHeaderSize || h.header_size % 8 != 0) {
-    return absl::DataLossError(absl::StrFormat("bad header size %d", h.header_size));
-  }
-  if (h.header_size > n) {
-    return absl::DataLossError(absl::StrFormat(
-        "truncated: expected at least %d bytes (the header), found %d", h.header_size, n));
-  }
-  if (HeaderChecksum(p, h.header_size) != h.header_checksum) {
-    return absl::DataLossError("header checksum mismatch");
-  }
-  if (h.file_size != n) {
-    if (h.file_size > n) {
-      return absl::DataLossError(
-          absl::StrFormat("truncated: expected %d bytes, found %d", h.file_size, n));
-    }
-    return absl::DataLossError(absl::StrFormat(
-        "size mismatch: expected %d bytes, found %d (trailing data)", h.file_size, n));
-  }
-
-  Counts counts;
-  counts.num_vertices = h.num_vertices;
-  counts.num_faces = h.num_faces;
-  counts.num_samples = h.num_samples;
-  counts.num_triangles = h.num_triangles;
-  counts.num_bvh_nodes = h.num_bvh_nodes;
-  if (counts.num_vertices > kInt32Max || 3 * counts.num_faces > kInt32Max ||
-      counts.num_samples > kInt32Max || counts.num_triangles > kInt32Max ||
-      counts.num_bvh_nodes > kInt32Max) {
-    return absl::DataLossError("header counts exceed the int32 id range");
-  }
-  if (h.params.num_samples != h.num_samples) {
-    return absl::DataLossError(absl::StrFormat("header: params.num_samples %d != num_samples %d",
-                                               h.params.num_samples, h.num_samples));
-  }
-
-  // Section table.
-  const uint64_t table_offset = h.section_table_offset;
-  const uint64_t table_bytes = uint64_t{h.num_sections} * sizeof(SectionEntry);
-  if (table_offset < h.header_size || table_offset % alignof(SectionEntry) != 0) {
-    return absl::DataLossError(absl::StrFormat("bad section table offset %d", table_offset));
-  }
-  if (table_offset > n || table_bytes > n - table_offset) {
-    return absl::DataLossError(
-        absl::StrFormat("section table (%d entries at offset %d) does not fit in %d bytes",
-                        h.num_sections, table_offset, n));
-  }
-  if (Checksum(p + table_offset, table_bytes) != h.table_checksum) {
-    return absl::DataLossError("section table checksum mismatch");
-  }
-  std::vector<SectionEntry> entries(h.num_sections);
-  if (table_bytes > 0) std::memcpy(entries.data(), p + table_offset, table_bytes);
-
-  // Byte ranges in use, to check that everything else is zero padding.
-  std::vector<std::pair<uint64_t, uint64_t>> used = {{0, h.header_size},
-                                                     {table_offset, table_bytes}};
+  GEODEX_ASSIGN_OR_RETURN(const FileHeader h, ValidateHeader(p, n));
+  GEODEX_ASSIGN_OR_RETURN(const Counts counts, HeaderCounts(h));
   std::optional<SectionEntry> found[kNumSpecs];
-  for (size_t i = 0; i < entries.size(); ++i) {
-    const SectionEntry& e = entries[i];
-    const int spec = SpecIndex(e.id);
-    const std::string name = spec >= 0 ? kSpecs[spec].name : absl::StrCat("with id ", e.id);
-    if (e.offset % kAlignment != 0) {
-      return absl::DataLossError(
-          absl::StrFormat("section %s: offset %d is not 64-byte aligned", name, e.offset));
-    }
-    if (e.offset > n || e.size > n - e.offset) {
-      return absl::DataLossError(
-          absl::StrFormat("section %s: %d bytes at offset %d do not fit in the file (%d bytes)",
-                          name, e.size, e.offset, n));
-    }
-    if (Checksum(p + e.offset, e.size) != e.checksum) {
-      return absl::DataLossError(absl::StrFormat("section %s: checksum mismatch", name));
-    }
-    if (e.size > 0) used.emplace_back(e.offset, e.size);
-    if (spec < 0) continue;  // from a later minor version: ignored
-    if (found[spec].has_value()) {
-      return absl::DataLossError(absl::StrFormat("section %s appears twice", name));
-    }
-    if (e.element_size != kSpecs[spec].element_size) {
-      return absl::DataLossError(absl::StrFormat("section %s: element size %d, expected %d", name,
-                                                 e.element_size, kSpecs[spec].element_size));
-    }
-    const std::optional<uint64_t> count = ExpectedCount(kSpecs[spec].id, counts);
-    if (count.has_value() && e.size != *count * e.element_size) {
-      return absl::DataLossError(
-          absl::StrFormat("section %s: %d bytes, expected %d (%d elements of %d bytes)", name,
-                          e.size, *count * e.element_size, *count, e.element_size));
-    }
-    found[spec] = e;
-  }
-  for (size_t s = 0; s < kNumSpecs; ++s) {
-    const std::optional<uint64_t> count = ExpectedCount(kSpecs[s].id, counts);
-    if (!found[s].has_value() && (kSpecs[s].required || count.value_or(0) > 0)) {
-      return absl::DataLossError(absl::StrFormat("missing section: %s", kSpecs[s].name));
-    }
-  }
-
-  std::sort(used.begin(), used.end());
-  uint64_t end = 0;
-  for (const auto& [offset, size] : used) {
-    if (offset < end) {
-      return absl::DataLossError(absl::StrFormat("overlapping sections at byte %d", offset));
-    }
-    for (uint64_t b = end; b < offset; ++b) {
-      if (p[b] != 0) return absl::DataLossError(absl::StrFormat("non-zero padding at byte %d", b));
-    }
-    end = offset + size;
-  }
-  for (uint64_t b = end; b < n; ++b) {
-    if (p[b] != 0) return absl::DataLossError(absl::StrFormat("non-zero padding at byte %d", b));
-  }
+  std::vector<ByteRange> used = {{0, h.header_size}};
+  GEODEX_RETURN_IF_ERROR(FindSections(p, n, h, counts, found, &used));
+  GEODEX_RETURN_IF_ERROR(CheckPadding(p, n, std::move(used)));
 
   // Sections are 64-byte aligned in a 64-byte aligned image: typed views are
   // properly aligned.

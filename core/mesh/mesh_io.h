@@ -9,9 +9,12 @@
 // consecutive triangle ids. For a file of triangles only, triangle id = face id
 // of the file. `LoadedMesh::input_face` maps triangle ids back to file faces.
 //
-// Errors: NotFound if the file cannot be opened; InvalidArgument for a
-// malformed, truncated or garbage file (naming file and line or element) and
-// for anything Mesh::Create rejects.
+// Errors: InvalidArgument for a malformed, truncated or garbage file (naming
+// file and line or element) and for anything Mesh::Create rejects; reading a
+// file fails as ReadWholeFile does (core/common/file_util.h): NotFound when
+// there is no file (or a directory), PermissionDenied, Internal.
+//
+// Thread safety: every function is reentrant.
 
 #include <cstdint>
 #include <string>
@@ -29,8 +32,11 @@ struct LoadedMesh {
   std::vector<int32_t> input_face;
 };
 
-// Loads by extension (.obj, .ply, .off; case-insensitive).
+// Loads the mesh file at `path` with the reader its extension names (.obj,
+// .ply, .off; case-insensitive), keeping the map from triangles to file faces.
+// Errors: InvalidArgument for another extension, and those above.
 absl::StatusOr<LoadedMesh> LoadMeshFile(const std::string& path);
+// LoadMeshFile without the face map: what most callers need.
 absl::StatusOr<Mesh> LoadMesh(const std::string& path);
 
 // Parse in-memory file contents; `name` is used in error messages.
@@ -38,7 +44,10 @@ absl::StatusOr<LoadedMesh> ParseObj(std::string_view contents, const std::string
 absl::StatusOr<LoadedMesh> ParsePly(std::string_view contents, const std::string& name);
 absl::StatusOr<LoadedMesh> ParseOff(std::string_view contents, const std::string& name);
 
-// Writes an ASCII OBJ (v and f lines) / binary little-endian PLY.
+// Writes an ASCII OBJ (v and f lines, 17 significant digits) / binary
+// little-endian PLY (double coordinates, int indices): both read back to the
+// same mesh. The file is replaced atomically (AtomicWriteFile, with its
+// errors: NotFound, PermissionDenied, Internal, naming the path).
 absl::Status WriteObj(const Mesh& mesh, const std::string& path);
 absl::Status WritePly(const Mesh& mesh, const std::string& path);
 

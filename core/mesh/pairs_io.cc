@@ -2,12 +2,11 @@
 
 #include <charconv>
 #include <cmath>
-#include <fstream>
 #include <iostream>
 #include <iterator>
-#include <sstream>
 
 #include "absl/strings/str_format.h"
+#include "core/common/file_util.h"
 #include "core/common/status_macros.h"
 
 namespace geodex::mesh {
@@ -98,11 +97,7 @@ absl::StatusOr<std::string> ReadFileOrStdin(const std::string& path) {
   if (path == "-") {
     return std::string(std::istreambuf_iterator<char>(std::cin), {});
   }
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return absl::NotFoundError(absl::StrFormat("cannot open %s", path));
-  std::ostringstream buffer;
-  buffer << in.rdbuf();
-  return buffer.str();
+  return ReadWholeFile(path);
 }
 
 std::string FormatDistance(double d) {

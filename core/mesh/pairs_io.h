@@ -34,7 +34,8 @@ absl::StatusOr<std::vector<PointPair>> ParsePairs(std::string_view contents);
 // Errors: the first failure, its message prefixed with "line N: ".
 absl::Status ValidatePairs(const Mesh& mesh, const std::vector<PointPair>& pairs);
 
-// Reads a whole file, or standard input for "-". Errors: NotFound.
+// Reads a whole file (ReadWholeFile, with its errors), or standard input for
+// "-".
 absl::StatusOr<std::string> ReadFileOrStdin(const std::string& path);
 
 // Formats a distance as printed by the tools: shortest round-trip decimal,

@@ -5,6 +5,7 @@
 #include "core/geodesic/exact_geodesic.h"
 #include "core/mesh/generators.h"
 #include "core/triangulation/geodesic_triangulation.h"
+#include "core/triangulation/test_shapes.h"
 #include "gtest/gtest.h"
 
 namespace geodex::triangulation {
@@ -39,24 +40,6 @@ GeodesicEdge Geodesic(const mesh::Mesh& m, const std::vector<int32_t>& samples, 
   return edge;
 }
 
-struct Shape {
-  const char* name;
-  mesh::Mesh mesh;
-  int32_t samples;
-};
-
-std::vector<Shape> Shapes() {
-  std::vector<Shape> shapes;
-  shapes.push_back({"grid", gen::Grid(24, 24, 3.0, 3.0, 0.3, 7), 40});
-  shapes.push_back({"sphere", gen::Sphere(4, 1.0), 60});
-  shapes.push_back({"torus", gen::Torus(64, 32, 2.0, 0.7), 60});
-  shapes.push_back({"cube", gen::Cube(12, 2.0), 50});
-  shapes.push_back({"double_torus", gen::DoubleTorus(12, 4.0), 80});
-  shapes.push_back({"square_with_hole", gen::SquareWithHole(24, 3.0), 40});
-  shapes.push_back({"folded_sheet", gen::FoldedSheet(20, 12, 2.0, 1.0, 1.0), 20});
-  return shapes;
-}
-
 TEST(GeodesicEdgesTest, DelaunayEdgesAreUniqueSortedPairs) {
   const std::vector<std::array<int32_t, 3>> triangles = {{0, 1, 2}, {2, 1, 3}};
   const auto edges = DelaunayEdges(triangles);
@@ -69,7 +52,7 @@ TEST(GeodesicEdgesTest, DelaunayEdgesAreUniqueSortedPairs) {
 // (length = d(a, b) of an independent full propagation), run from sample to
 // sample, and do not cross.
 TEST(GeodesicEdgesTest, TracedEdgesAreExactAndDoNotCrossOnEveryShape) {
-  for (Shape& shape : Shapes()) {
+  for (TestShape& shape : TestShapes()) {
     SCOPED_TRACE(shape.name);
     const mesh::Mesh& m = shape.mesh;
     auto set = sampling::FarthestPointSampling(m, shape.samples, 1);

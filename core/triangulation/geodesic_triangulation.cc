@@ -29,6 +29,240 @@ std::array<int32_t, 3> Canonical(std::array<int32_t, 3> t) {
 static_assert(static_cast<int>(ViolationKind::kEdgesCross) + 1 == kNumViolationKinds,
               "kNumViolationKinds must count every ViolationKind");
 
+void Violate(DualComplex* out, ViolationKind kind, std::vector<int32_t> cells) {
+  out->violations.push_back({kind, std::move(cells)});
+}
+
+// CheckDual's steps, in its order.
+
+// 1. Voronoi vertices: faces with three different labels. Each triple of
+// cells meeting at such faces is one dual triangle; its faces must form one
+// edge-connected cluster and agree on its orientation. Fills out->triangles,
+// sorted.
+void FindVoronoiVertices(const Mesh& mesh, const std::vector<int32_t>& nearest, DualComplex* out) {
+  const int32_t nf = mesh.num_faces();
+  std::vector<std::pair<std::array<int32_t, 3>, int32_t>> keyed;  // (sorted labels, face)
+  for (int32_t f = 0; f < nf; ++f) {
+    const auto& t = mesh.face(f);
+    std::array<int32_t, 3> l = {nearest[t[0]], nearest[t[1]], nearest[t[2]]};
+    if (l[0] == kNone || l[1] == kNone || l[2] == kNone) continue;
+    if (l[0] == l[1] || l[1] == l[2] || l[0] == l[2]) continue;
+    std::sort(l.begin(), l.end());
+    keyed.push_back({l, f});
+  }
+  std::sort(keyed.begin(), keyed.end());
+  for (size_t i = 0; i < keyed.size();) {
+    size_t j = i;
+    while (j < keyed.size() && keyed[j].first == keyed[i].first) ++j;
+    const std::array<int32_t, 3> key = keyed[i].first;
+    // Faces of this triple must form one edge-connected cluster.
+    std::vector<int32_t> group;
+    for (size_t k = i; k < j; ++k) group.push_back(keyed[k].second);
+    std::vector<int32_t> parent(group.size());
+    std::iota(parent.begin(), parent.end(), 0);
+    for (size_t k = 0; k < group.size(); ++k) {
+      for (int e = 0; e < 3; ++e) {
+        const int32_t twin = mesh.Twin(3 * group[k] + e);
+        if (twin == kNone) continue;
+        const auto it = std::lower_bound(group.begin(), group.end(), Mesh::FaceOf(twin));
+        if (it != group.end() && *it == Mesh::FaceOf(twin)) {
+          parent[Find(parent, static_cast<int32_t>(k))] =
+              Find(parent, static_cast<int32_t>(it - group.begin()));
+        }
+      }
+    }
+    int clusters = 0;
+    for (size_t k = 0; k < group.size(); ++k)
+      clusters += Find(parent, k) == static_cast<int32_t>(k);
+    if (clusters > 1) Violate(out, ViolationKind::kRepeatedVoronoiVertex, {key[0], key[1], key[2]});
+    // Orientation of each face's labels.
+    std::array<int32_t, 3> oriented{};
+    bool consistent = true;
+    for (size_t k = 0; k < group.size(); ++k) {
+      const auto& t = mesh.face(group[k]);
+      const auto c = Canonical({nearest[t[0]], nearest[t[1]], nearest[t[2]]});
+      if (k == 0) {
+        oriented = c;
+      } else if (c != oriented) {
+        consistent = false;
+      }
+    }
+    if (!consistent) Violate(out, ViolationKind::kOrientation, {key[0], key[1], key[2]});
+    out->triangles.push_back(oriented);
+    i = j;
+  }
+  std::sort(out->triangles.begin(), out->triangles.end());
+}
+
+// Cells with a vertex on the mesh boundary (1) or not (0).
+std::vector<uint8_t> BoundaryCells(const Mesh& mesh, const std::vector<int32_t>& nearest,
+                                   int32_t num_samples) {
+  std::vector<uint8_t> on_boundary(num_samples, 0);
+  for (int32_t v = 0; v < mesh.num_vertices(); ++v) {
+    if (mesh.IsBoundaryVertex(v) && nearest[v] != kNone) on_boundary[nearest[v]] = 1;
+  }
+  return on_boundary;
+}
+
+// A side of a dual triangle, keyed by its pair of cells.
+struct DualSide {
+  int32_t a, b;  // a < b
+  int32_t triangle;
+  int8_t side;
+  bool forward;  // the triangle runs a -> b
+  bool operator<(const DualSide& o) const {
+    return std::tie(a, b, triangle, side) < std::tie(o.a, o.b, o.triangle, o.side);
+  }
+};
+
+// 2. Dual edges: every pair of touching cells must be an edge of one or two
+// triangles, used in opposite directions. Fills out->neighbors; returns the
+// triangles' sides sorted by their pair of cells.
+std::vector<DualSide> CheckDualEdges(const Mesh& mesh, const std::vector<int32_t>& nearest,
+                                     const std::vector<uint8_t>& on_boundary, DualComplex* out) {
+  const int32_t nt = static_cast<int32_t>(out->triangles.size());
+  std::vector<DualSide> sides;
+  sides.reserve(3 * nt);
+  for (int32_t t = 0; t < nt; ++t) {
+    for (int8_t s = 0; s < 3; ++s) {
+      const int32_t x = out->triangles[t][s], y = out->triangles[t][(s + 1) % 3];
+      sides.push_back({std::min(x, y), std::max(x, y), t, s, x < y});
+    }
+  }
+  std::sort(sides.begin(), sides.end());
+  out->neighbors.assign(nt, {kNone, kNone, kNone});
+  std::vector<std::pair<int32_t, int32_t>> touching;
+  for (int32_t h = 0; h < mesh.num_halfedges(); ++h) {
+    const int32_t twin = mesh.Twin(h);
+    if (twin != kNone && twin < h) continue;
+    const int32_t a = nearest[mesh.Origin(h)], b = nearest[mesh.Dest(h)];
+    if (a == kNone || b == kNone || a == b) continue;
+    touching.push_back({std::min(a, b), std::max(a, b)});
+  }
+  std::sort(touching.begin(), touching.end());
+  touching.erase(std::unique(touching.begin(), touching.end()), touching.end());
+  for (const auto& [a, b] : touching) {
+    const auto it = std::lower_bound(sides.begin(), sides.end(), DualSide{a, b, -1, -1, false});
+    if (it == sides.end() || it->a != a || it->b != b) {
+      Violate(out, ViolationKind::kArcWithoutVertex, {a, b});
+    }
+  }
+  for (size_t i = 0; i < sides.size();) {
+    size_t j = i;
+    while (j < sides.size() && sides[j].a == sides[i].a && sides[j].b == sides[i].b) ++j;
+    const int32_t a = sides[i].a, b = sides[i].b;
+    if (j - i > 2) {
+      Violate(out, ViolationKind::kEdgeInManyTriangles, {a, b});
+    } else if (j - i == 2) {
+      if (sides[i].forward == sides[i + 1].forward) {
+        Violate(out, ViolationKind::kOrientation, {a, b});
+      }
+      out->neighbors[sides[i].triangle][sides[i].side] = sides[i + 1].triangle;
+      out->neighbors[sides[i + 1].triangle][sides[i + 1].side] = sides[i].triangle;
+    } else if (!(on_boundary[a] && on_boundary[b])) {
+      Violate(out, ViolationKind::kOpenEdgeInside, {a, b});
+    }
+    i = j;
+  }
+  return sides;
+}
+
+// 3. The triangles around each sample must form one fan: a cycle inside,
+// a path for a cell on the boundary.
+void CheckCellsAreDisks(int32_t num_samples, const std::vector<uint8_t>& on_boundary,
+                        DualComplex* out) {
+  std::vector<std::vector<std::pair<int32_t, int32_t>>> link(num_samples);
+  for (const auto& t : out->triangles) {
+    for (int s = 0; s < 3; ++s) link[t[s]].push_back({t[(s + 1) % 3], t[(s + 2) % 3]});
+  }
+  for (int32_t a = 0; a < num_samples; ++a) {
+    auto& edges = link[a];
+    bool disk = !edges.empty();
+    std::map<int32_t, int32_t> next;
+    std::map<int32_t, int> in_degree;
+    for (const auto& [x, y] : edges) {
+      if (!next.emplace(x, y).second) disk = false;
+      if (++in_degree[y] > 1) disk = false;
+    }
+    if (disk) {
+      int32_t start = edges.front().first;
+      int starts = 0;
+      for (const auto& [x, y] : edges) {
+        if (!in_degree.count(x)) {
+          start = x;
+          ++starts;
+        }
+      }
+      size_t walked = 0;
+      int32_t x = start;
+      for (auto it = next.find(x); it != next.end() && walked <= edges.size(); it = next.find(x)) {
+        x = it->second;
+        ++walked;
+        if (x == start) break;
+      }
+      disk = walked == edges.size() && starts <= 1 && (starts == 1) == (on_boundary[a] != 0);
+    }
+    if (!disk) Violate(out, ViolationKind::kCellNotDisk, {a});
+  }
+}
+
+// 4. Each cell must be connected.
+void CheckCellsAreConnected(const Mesh& mesh, const std::vector<int32_t>& nearest,
+                            int32_t num_samples, DualComplex* out) {
+  std::vector<int32_t> parent(mesh.num_vertices());
+  std::iota(parent.begin(), parent.end(), 0);
+  for (int32_t h = 0; h < mesh.num_halfedges(); ++h) {
+    const int32_t u = mesh.Origin(h), v = mesh.Dest(h);
+    if (nearest[u] == nearest[v]) parent[Find(parent, u)] = Find(parent, v);
+  }
+  std::vector<int32_t> pieces(num_samples, 0);
+  for (int32_t v = 0; v < mesh.num_vertices(); ++v) {
+    if (mesh.IsReferenced(v) && nearest[v] != kNone && Find(parent, v) == v) ++pieces[nearest[v]];
+  }
+  for (int32_t a = 0; a < num_samples; ++a) {
+    if (pieces[a] > 1) Violate(out, ViolationKind::kCellDisconnected, {a});
+  }
+}
+
+// 5. Same Euler characteristic as the mesh, component by component. `sides`:
+// CheckDualEdges' result.
+void CheckEulerCharacteristic(const Mesh& mesh, const std::vector<int32_t>& nearest,
+                              int32_t num_samples, const std::vector<DualSide>& sides,
+                              DualComplex* out) {
+  const int32_t nf = mesh.num_faces();
+  const int32_t nc = mesh.num_components();
+  std::vector<int64_t> mesh_chi(nc, 0), dual_chi(nc, 0);
+  for (int32_t v = 0; v < mesh.num_vertices(); ++v) {
+    if (mesh.IsReferenced(v)) ++mesh_chi[mesh.VertexComponent(v)];
+  }
+  for (int32_t h = 0; h < mesh.num_halfedges(); ++h) {
+    if (mesh.Twin(h) == kNone || mesh.Twin(h) > h) --mesh_chi[mesh.FaceComponent(Mesh::FaceOf(h))];
+  }
+  for (int32_t f = 0; f < nf; ++f) ++mesh_chi[mesh.FaceComponent(f)];
+  std::vector<int32_t> sample_component(num_samples, kNone);
+  for (int32_t v = 0; v < mesh.num_vertices(); ++v) {
+    if (nearest[v] != kNone) sample_component[nearest[v]] = mesh.VertexComponent(v);
+  }
+  for (int32_t a = 0; a < num_samples; ++a) {
+    if (sample_component[a] != kNone) ++dual_chi[sample_component[a]];
+  }
+  for (size_t i = 0; i < sides.size(); ++i) {
+    if (i == 0 || sides[i].a != sides[i - 1].a || sides[i].b != sides[i - 1].b) {
+      --dual_chi[sample_component[sides[i].a]];
+    }
+  }
+  for (const auto& t : out->triangles) ++dual_chi[sample_component[t[0]]];
+  for (int32_t c = 0; c < nc; ++c) {
+    if (mesh_chi[c] != dual_chi[c]) {
+      std::vector<int32_t> cells;
+      for (int32_t a = 0; a < num_samples; ++a) {
+        if (sample_component[a] == c) cells.push_back(a);
+      }
+      Violate(out, ViolationKind::kEulerCharacteristic, std::move(cells));
+    }
+  }
+}
+
 }  // namespace
 
 const char* ViolationName(ViolationKind kind) {
@@ -68,212 +302,13 @@ std::string RepairReport::Summary() const {
 
 DualComplex CheckDual(const Mesh& mesh, const std::vector<int32_t>& nearest, int32_t num_samples) {
   DualComplex out;
-  auto violate = [&](ViolationKind kind, std::vector<int32_t> cells) {
-    out.violations.push_back({kind, std::move(cells)});
-  };
-  const int32_t nf = mesh.num_faces();
-
-  // 1. Voronoi vertices: faces with three different labels.
-  std::vector<std::pair<std::array<int32_t, 3>, int32_t>> keyed;  // (sorted labels, face)
-  for (int32_t f = 0; f < nf; ++f) {
-    const auto& t = mesh.face(f);
-    std::array<int32_t, 3> l = {nearest[t[0]], nearest[t[1]], nearest[t[2]]};
-    if (l[0] == kNone || l[1] == kNone || l[2] == kNone) continue;
-    if (l[0] == l[1] || l[1] == l[2] || l[0] == l[2]) continue;
-    std::sort(l.begin(), l.end());
-    keyed.push_back({l, f});
-  }
-  std::sort(keyed.begin(), keyed.end());
-  for (size_t i = 0; i < keyed.size();) {
-    size_t j = i;
-    while (j < keyed.size() && keyed[j].first == keyed[i].first) ++j;
-    const std::array<int32_t, 3> key = keyed[i].first;
-    // Faces of this triple must form one edge-connected cluster.
-    std::vector<int32_t> group;
-    for (size_t k = i; k < j; ++k) group.push_back(keyed[k].second);
-    std::vector<int32_t> parent(group.size());
-    std::iota(parent.begin(), parent.end(), 0);
-    for (size_t k = 0; k < group.size(); ++k) {
-      for (int e = 0; e < 3; ++e) {
-        const int32_t twin = mesh.Twin(3 * group[k] + e);
-        if (twin == kNone) continue;
-        const auto it = std::lower_bound(group.begin(), group.end(), Mesh::FaceOf(twin));
-        if (it != group.end() && *it == Mesh::FaceOf(twin)) {
-          parent[Find(parent, static_cast<int32_t>(k))] =
-              Find(parent, static_cast<int32_t>(it - group.begin()));
-        }
-      }
-    }
-    int clusters = 0;
-    for (size_t k = 0; k < group.size(); ++k)
-      clusters += Find(parent, k) == static_cast<int32_t>(k);
-    if (clusters > 1) violate(ViolationKind::kRepeatedVoronoiVertex, {key[0], key[1], key[2]});
-    // Orientation of each face's labels.
-    std::array<int32_t, 3> oriented{};
-    bool consistent = true;
-    for (size_t k = 0; k < group.size(); ++k) {
-      const auto& t = mesh.face(group[k]);
-      const auto c = Canonical({nearest[t[0]], nearest[t[1]], nearest[t[2]]});
-      if (k == 0) {
-        oriented = c;
-      } else if (c != oriented) {
-        consistent = false;
-      }
-    }
-    if (!consistent) violate(ViolationKind::kOrientation, {key[0], key[1], key[2]});
-    out.triangles.push_back(oriented);
-    i = j;
-  }
-  std::sort(out.triangles.begin(), out.triangles.end());
-  const int32_t nt = static_cast<int32_t>(out.triangles.size());
-
-  // Cells on the mesh boundary.
-  std::vector<uint8_t> on_boundary(num_samples, 0);
-  for (int32_t v = 0; v < mesh.num_vertices(); ++v) {
-    if (mesh.IsBoundaryVertex(v) && nearest[v] != kNone) on_boundary[nearest[v]] = 1;
-  }
-
-  // 2. Dual edges: every pair of touching cells must be an edge of one or two
-  // triangles, used in opposite directions.
-  struct Side {
-    int32_t a, b;  // a < b
-    int32_t triangle;
-    int8_t side;
-    bool forward;  // the triangle runs a -> b
-    bool operator<(const Side& o) const {
-      return std::tie(a, b, triangle, side) < std::tie(o.a, o.b, o.triangle, o.side);
-    }
-  };
-  std::vector<Side> sides;
-  sides.reserve(3 * nt);
-  for (int32_t t = 0; t < nt; ++t) {
-    for (int8_t s = 0; s < 3; ++s) {
-      const int32_t x = out.triangles[t][s], y = out.triangles[t][(s + 1) % 3];
-      sides.push_back({std::min(x, y), std::max(x, y), t, s, x < y});
-    }
-  }
-  std::sort(sides.begin(), sides.end());
-  out.neighbors.assign(nt, {kNone, kNone, kNone});
-  std::vector<std::pair<int32_t, int32_t>> touching;
-  for (int32_t h = 0; h < mesh.num_halfedges(); ++h) {
-    const int32_t twin = mesh.Twin(h);
-    if (twin != kNone && twin < h) continue;
-    const int32_t a = nearest[mesh.Origin(h)], b = nearest[mesh.Dest(h)];
-    if (a == kNone || b == kNone || a == b) continue;
-    touching.push_back({std::min(a, b), std::max(a, b)});
-  }
-  std::sort(touching.begin(), touching.end());
-  touching.erase(std::unique(touching.begin(), touching.end()), touching.end());
-  for (const auto& [a, b] : touching) {
-    const auto it = std::lower_bound(sides.begin(), sides.end(), Side{a, b, -1, -1, false});
-    if (it == sides.end() || it->a != a || it->b != b) {
-      violate(ViolationKind::kArcWithoutVertex, {a, b});
-    }
-  }
-  for (size_t i = 0; i < sides.size();) {
-    size_t j = i;
-    while (j < sides.size() && sides[j].a == sides[i].a && sides[j].b == sides[i].b) ++j;
-    const int32_t a = sides[i].a, b = sides[i].b;
-    if (j - i > 2) {
-      violate(ViolationKind::kEdgeInManyTriangles, {a, b});
-    } else if (j - i == 2) {
-      if (sides[i].forward == sides[i + 1].forward) {
-        violate(ViolationKind::kOrientation, {a, b});
-      }
-      out.neighbors[sides[i].triangle][sides[i].side] = sides[i + 1].triangle;
-      out.neighbors[sides[i + 1].triangle][sides[i + 1].side] = sides[i].triangle;
-    } else if (!(on_boundary[a] && on_boundary[b])) {
-      violate(ViolationKind::kOpenEdgeInside, {a, b});
-    }
-    i = j;
-  }
-
-  // 3. The triangles around each sample must form one fan: a cycle inside,
-  // a path for a cell on the boundary.
-  std::vector<std::vector<std::pair<int32_t, int32_t>>> link(num_samples);
-  for (const auto& t : out.triangles) {
-    for (int s = 0; s < 3; ++s) link[t[s]].push_back({t[(s + 1) % 3], t[(s + 2) % 3]});
-  }
-  for (int32_t a = 0; a < num_samples; ++a) {
-    auto& edges = link[a];
-    bool disk = !edges.empty();
-    std::map<int32_t, int32_t> next;
-    std::map<int32_t, int> in_degree;
-    for (const auto& [x, y] : edges) {
-      if (!next.emplace(x, y).second) disk = false;
-      if (++in_degree[y] > 1) disk = false;
-    }
-    if (disk) {
-      int32_t start = edges.front().first;
-      int starts = 0;
-      for (const auto& [x, y] : edges) {
-        if (!in_degree.count(x)) {
-          start = x;
-          ++starts;
-        }
-      }
-      size_t walked = 0;
-      int32_t x = start;
-      for (auto it = next.find(x); it != next.end() && walked <= edges.size(); it = next.find(x)) {
-        x = it->second;
-        ++walked;
-        if (x == start) break;
-      }
-      disk = walked == edges.size() && starts <= 1 && (starts == 1) == (on_boundary[a] != 0);
-    }
-    if (!disk) violate(ViolationKind::kCellNotDisk, {a});
-  }
-
-  // 4. Each cell must be connected.
-  std::vector<int32_t> parent(mesh.num_vertices());
-  std::iota(parent.begin(), parent.end(), 0);
-  for (int32_t h = 0; h < mesh.num_halfedges(); ++h) {
-    const int32_t u = mesh.Origin(h), v = mesh.Dest(h);
-    if (nearest[u] == nearest[v]) parent[Find(parent, u)] = Find(parent, v);
-  }
-  std::vector<int32_t> pieces(num_samples, 0);
-  for (int32_t v = 0; v < mesh.num_vertices(); ++v) {
-    if (mesh.IsReferenced(v) && nearest[v] != kNone && Find(parent, v) == v) ++pieces[nearest[v]];
-  }
-  for (int32_t a = 0; a < num_samples; ++a) {
-    if (pieces[a] > 1) violate(ViolationKind::kCellDisconnected, {a});
-  }
-
-  // 5. Same Euler characteristic as the mesh, component by component.
-  if (out.violations.empty()) {
-    const int32_t nc = mesh.num_components();
-    std::vector<int64_t> mesh_chi(nc, 0), dual_chi(nc, 0);
-    for (int32_t v = 0; v < mesh.num_vertices(); ++v) {
-      if (mesh.IsReferenced(v)) ++mesh_chi[mesh.VertexComponent(v)];
-    }
-    for (int32_t h = 0; h < mesh.num_halfedges(); ++h) {
-      if (mesh.Twin(h) == kNone || mesh.Twin(h) > h)
-        --mesh_chi[mesh.FaceComponent(Mesh::FaceOf(h))];
-    }
-    for (int32_t f = 0; f < nf; ++f) ++mesh_chi[mesh.FaceComponent(f)];
-    std::vector<int32_t> sample_component(num_samples, kNone);
-    for (int32_t v = 0; v < mesh.num_vertices(); ++v) {
-      if (nearest[v] != kNone) sample_component[nearest[v]] = mesh.VertexComponent(v);
-    }
-    for (int32_t a = 0; a < num_samples; ++a) {
-      if (sample_component[a] != kNone) ++dual_chi[sample_component[a]];
-    }
-    for (size_t i = 0; i < sides.size(); ++i) {
-      if (i == 0 || sides[i].a != sides[i - 1].a || sides[i].b != sides[i - 1].b) {
-        --dual_chi[sample_component[sides[i].a]];
-      }
-    }
-    for (const auto& t : out.triangles) ++dual_chi[sample_component[t[0]]];
-    for (int32_t c = 0; c < nc; ++c) {
-      if (mesh_chi[c] != dual_chi[c]) {
-        std::vector<int32_t> cells;
-        for (int32_t a = 0; a < num_samples; ++a) {
-          if (sample_component[a] == c) cells.push_back(a);
-        }
-        violate(ViolationKind::kEulerCharacteristic, std::move(cells));
-      }
-    }
-  }
+  FindVoronoiVertices(mesh, nearest, &out);
+  const std::vector<uint8_t> on_boundary = BoundaryCells(mesh, nearest, num_samples);
+  const std::vector<DualSide> sides = CheckDualEdges(mesh, nearest, on_boundary, &out);
+  CheckCellsAreDisks(num_samples, on_boundary, &out);
+  CheckCellsAreConnected(mesh, nearest, num_samples, &out);
+  // The Euler characteristic is only compared once everything else holds.
+  if (out.violations.empty()) CheckEulerCharacteristic(mesh, nearest, num_samples, sides, &out);
   return out;
 }
 

@@ -4,6 +4,7 @@
 #include <string>
 
 #include "core/mesh/generators.h"
+#include "core/triangulation/test_shapes.h"
 #include "gtest/gtest.h"
 
 namespace geodex::triangulation {
@@ -11,26 +12,8 @@ namespace {
 
 namespace gen = mesh::gen;
 
-struct Shape {
-  const char* name;
-  mesh::Mesh mesh;
-  int32_t samples;
-};
-
-std::vector<Shape> Shapes() {
-  std::vector<Shape> shapes;
-  shapes.push_back({"sphere", gen::Sphere(4, 1.0), 60});
-  shapes.push_back({"torus", gen::Torus(64, 32, 2.0, 0.7), 60});
-  shapes.push_back({"cube", gen::Cube(12, 2.0), 50});
-  shapes.push_back({"double_torus", gen::DoubleTorus(12, 4.0), 80});
-  shapes.push_back({"square_with_hole", gen::SquareWithHole(24, 3.0), 40});
-  shapes.push_back({"two_components", gen::TwoComponents(16), 30});
-  shapes.push_back({"folded_sheet", gen::FoldedSheet(20, 12, 2.0, 1.0, 1.0), 20});
-  return shapes;
-}
-
 TEST(GeodesicTriangulationTest, RepairReachesAValidTriangulationOnEveryShape) {
-  for (Shape& shape : Shapes()) {
+  for (TestShape& shape : TestShapes()) {
     SCOPED_TRACE(shape.name);
     auto set = sampling::FarthestPointSampling(shape.mesh, shape.samples, 1);
     ASSERT_TRUE(set.ok());

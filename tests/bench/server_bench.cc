@@ -159,34 +159,13 @@ index::IndexData FlatSheetIndex(int cells, int fine) {
 
 // --- child server processes ------------------------------------------------------
 
-struct Child {
-  pid_t pid = -1;
-  int port = 0;
-};
+using Child = server::testing::ServerProcess;
 
-// Starts geodex-server and reads the port it prints.
+// Starts geodex-server over `models`, one worker, no polling.
 Child StartServer(const std::string& binary, const std::string& models) {
-  int out[2];
-  if (pipe(out) != 0) return {};
-  const pid_t pid = fork();
-  if (pid == 0) {
-    dup2(out[1], STDOUT_FILENO);
-    close(out[0]);
-    close(out[1]);
-    execl(binary.c_str(), binary.c_str(), "--models", models.c_str(), "--listen", "127.0.0.1:0",
-          "--workers", "1", "--poll-seconds", "0", "--log-level", "warn", nullptr);
-    _exit(127);
-  }
-  close(out[1]);
-  Child child;
-  child.pid = pid;
-  FILE* in = fdopen(out[0], "r");
-  char line[256];
-  while (std::fgets(line, sizeof(line), in) != nullptr) {
-    if (std::sscanf(line, "listening on port %d", &child.port) == 1) break;
-  }
-  fclose(in);
-  return child;
+  return server::testing::SpawnServer({binary, "--models", models, "--listen", "127.0.0.1:0",
+                                       "--workers", "1", "--poll-seconds", "0", "--log-level",
+                                       "warn"});
 }
 
 void StopServer(const Child& child) {
