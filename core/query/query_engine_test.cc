@@ -113,8 +113,10 @@ TEST(QueryEngineTest, ClosedCylinderErrorIsBoundedByTheCutLocus) {
   const Mesh m = gen::Cylinder(48, 16, 1.0, 3.0);
   auto coarse = MakeEngine(m, 40), fine = MakeEngine(m, 160);
   const double e_coarse = MaxRelativeError(m, *coarse, 60), e_fine = MaxRelativeError(m, *fine, 60);
-  std::printf("closed cylinder max relative error: m=40 %.3g, m=160 %.3g\n", e_coarse, e_fine);
-  EXPECT_LT(e_fine, 0.2);
+  // Measured 0.117 (m=40) and 0.061 (m=160): about twice that as the bound.
+  EXPECT_LT(e_coarse, 0.25);
+  EXPECT_LT(e_fine, 0.15);
+  EXPECT_LT(e_fine, e_coarse);
 }
 
 TEST(QueryEngineTest, SphereRelativeErrorIsSmallAndFallsWithSamples) {

@@ -23,6 +23,7 @@
 #include "absl/status/status.h"
 #include "absl/strings/str_format.h"
 #include "core/builder/builder.h"
+#include "core/builder/mesh_arrays.h"
 #include "core/builder/workdir.h"
 #include "core/common/file_util.h"
 #include "core/common/status_macros.h"
@@ -264,7 +265,8 @@ int main(int argc, char** argv) {
     status = [&]() -> absl::Status {
       GEODEX_ASSIGN_OR_RETURN(const mesh::Mesh mesh, LoadInput(mesh_path));
       GEODEX_ASSIGN_OR_RETURN(auto index, index::Index::Open(index_path));
-      if (index->header().mesh_hash != builder::HashMesh(mesh)) {
+      if (index->header().mesh_hash !=
+          index::MeshHash(builder::FlatPositions(mesh), builder::FlatFaces(mesh))) {
         return absl::InvalidArgumentError(
             absl::StrFormat("%s was not built from %s", index_path, mesh_path));
       }
