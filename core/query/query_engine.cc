@@ -554,10 +554,18 @@ double QueryEngine::Refine(const SurfacePoint& p, const SurfacePoint& q, double 
     kind = AnswerKind::kExact;
     return true;
   };
+  // A trace is a surface path, never shorter than the geodesic; one longer
+  // than the O(1) answer plus that answer's bound has settled in a wrong
+  // corridor (round the wrong side of a feature), and is answered exactly.
+  // Needs the calibration (else the bound is NaN and no trace is doubted).
+  auto wrong_corridor = [&] {
+    return (kind == AnswerKind::kTrace || kind == AnswerKind::kWrappedTrace) &&
+           d > unfolded + BoundOf(AnswerKind::kUnfold, vertex_pair, unfolded);
+  };
   if (near || unfolded < kRefineScale * scale_length_) {
     switch (options.near_pairs) {
       case NearPairs::kPath:
-        trace();
+        if (trace() && wrong_corridor()) exact();
         break;
       case NearPairs::kExact:
         exact();
@@ -569,7 +577,7 @@ double QueryEngine::Refine(const SurfacePoint& p, const SurfacePoint& q, double 
   if (options.tolerance > 0) {
     auto within = [&] { return BoundOf(kind, vertex_pair, d) <= options.tolerance * d; };
     if (kind == AnswerKind::kUnfold && !within() && !trace()) exact();
-    if (kind != AnswerKind::kExact && !within()) exact();
+    if (kind != AnswerKind::kExact && (!within() || wrong_corridor())) exact();
   }
   if (bound != nullptr) *bound = BoundOf(kind, vertex_pair, d);
   return d;
