@@ -5,6 +5,7 @@
 //   geodex-query INDEX --paths FILE [--format xyz|json] [--exact-path-corridor K]
 //   geodex-query INDEX --field SOURCES [--nearest]
 //   geodex-query INDEX --locate POINTS
+//   geodex-query INDEX --info
 //
 // FILE holds lines "fa a0 a1 a2 fb b0 b1 b2" (core/mesh/pairs_io.h); SOURCES
 // lines "f w0 w1 w2"; POINTS lines "x y z". "-" reads standard input. Output
@@ -80,13 +81,28 @@ absl::Status CheckPairs(const query::QueryEngine& engine,
 
 struct Args {
   std::string index, pairs, paths, field, locate, format = "xyz", near_pairs = "path";
-  bool exact_near = false, baseline = false, nearest = false, error_bounds = false;
+  bool exact_near = false, baseline = false, nearest = false, error_bounds = false, info = false;
   double tolerance = 0;
   int32_t exact_path_corridor = 0;
 };
 
 absl::Status Run(const Args& args) {
   GEODEX_ASSIGN_OR_RETURN(auto index, index::Index::Open(args.index));
+  if (args.info) {
+    // The header's counts, then the builder's report (with the accuracy
+    // calibration's figures when the index has one).
+    const index::FileHeader& h = index->header();
+    std::string out = absl::StrFormat(
+        "format = %d.%d\nbuilder = %s\nvertices = %d\nfaces = %d\nsamples = %d\n"
+        "requested_samples = %d\ntriangles = %d\nbytes = %d\nerror_bounds = %s\n",
+        h.format_major, h.format_minor, index->builder_version(), index->num_vertices(),
+        index->num_faces(), index->num_samples(), h.params.requested_samples,
+        index->num_triangles(), index->size_bytes(),
+        index->accuracy() != nullptr ? "yes" : "no (geodex-build calibrate adds them)");
+    out += index->report();
+    std::fwrite(out.data(), 1, out.size(), stdout);
+    return absl::OkStatus();
+  }
   query::QueryOptions options;
   query::DistanceOptions distance_options;
   distance_options.near_pairs = args.exact_near || args.near_pairs == "exact"
@@ -185,7 +201,9 @@ int main(int argc, char** argv) {
   auto* paths = app.add_option("--paths", args.paths, "Paths for lines 'fa a0 a1 a2 fb b0 b1 b2'");
   auto* field = app.add_option("--field", args.field, "Distance field from lines 'f w0 w1 w2'");
   auto* locate = app.add_option("--locate", args.locate, "Closest surface points to lines 'x y z'");
-  pairs->excludes(paths)->excludes(field)->excludes(locate);
+  auto* info = app.add_flag("--info", args.info,
+                            "The index's counts and build report, with its accuracy figures");
+  pairs->excludes(paths)->excludes(field)->excludes(locate)->excludes(info);
   paths->excludes(field)->excludes(locate);
   field->excludes(locate);
   app.add_option("--near-pairs", args.near_pairs,

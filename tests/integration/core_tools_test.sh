@@ -44,6 +44,20 @@ check "distance to itself is 0" test "$(sed -n 3p "$work/exact.txt")" = "0"
 check "geodex-query exits 0" test $? -eq 0
 check "geodex-query agrees within 5%" awk 'NR==FNR {e[FNR]=$1; next} {d=$1-e[FNR]; if (d<0) d=-d; if (e[FNR]>0 && d/e[FNR]>0.05) exit 1}' "$work/exact.txt" "$work/approx.txt"
 
+# Error bounds and tolerance (the index carries its calibration by default).
+"$tools/geodex-query" "$work/one.gdx" --pairs "$work/pairs.txt" --error-bounds --tolerance 0.005 \
+  >"$work/bounded.txt" 2>&1
+check "geodex-query --error-bounds prints distance and bound" \
+  awk 'NF != 2 || $2 < 0 || $2 > 0.005 * $1 + 1e-12 { exit 1 }' "$work/bounded.txt"
+check "geodex-query --tolerance 0.005 is within 0.5% of exact" awk 'NR==FNR {e[FNR]=$1; next} {d=$1-e[FNR]; if (d<0) d=-d; if (e[FNR]>0 && d/e[FNR]>0.005) exit 1}' "$work/exact.txt" "$work/bounded.txt"
+"$tools/geodex-query" "$work/one.gdx" --info >"$work/info.txt" 2>&1
+check "geodex-query --info shows the accuracy figures" grep -q "accuracy_p99_3L_10L" "$work/info.txt"
+"$tools/geodex-build" builtin:sphere -o "$work/plain.gdx" --samples 40 --threads 2 --no-calibration >/dev/null 2>&1
+"$tools/geodex-query" "$work/plain.gdx" --pairs "$work/pairs.txt" --error-bounds >/dev/null 2>"$work/err"
+check "bounds without calibration exit 1, naming the remedy" grep -q "geodex-build calibrate" "$work/err"
+"$tools/geodex-build" calibrate builtin:sphere "$work/plain.gdx" -o "$work/calibrated.gdx" >/dev/null 2>&1
+check "geodex-build calibrate gives the index a one-process build gives" cmp -s "$work/one.gdx" "$work/calibrated.gdx"
+
 printf '0 1 0 0 5 0 1 0\n0 1 0 0 5 0 1\n' >"$work/bad.txt"
 "$tools/geodex-geodesic" "$mesh" --pairs "$work/bad.txt" >"$work/out" 2>"$work/err"
 check "bad line exits 2" test $? -eq 2

@@ -1,0 +1,71 @@
+#include "core/validation/calibration.h"
+
+#include "core/builder/builder.h"
+#include "core/mesh/generators.h"
+#include "core/query/query_engine.h"
+#include "gtest/gtest.h"
+
+namespace geodex::validation {
+namespace {
+
+index::IndexData BuildSphere(const mesh::Mesh& m) {
+  builder::BuildOptions options;
+  options.num_samples = 80;
+  options.threads = 2;
+  builder::BuildSummary summary;
+  auto data = builder::BuildIndex(m, options, &summary);
+  EXPECT_TRUE(data.ok()) << data.status();
+  return *std::move(data);
+}
+
+TEST(CalibrationTest, BoundsAreSaneAndDeterministic) {
+  const mesh::Mesh m = mesh::gen::Sphere(4, 1.0);
+  index::IndexData data = BuildSphere(m);
+  ASSERT_TRUE(AddCalibration(m, data).ok());
+  ASSERT_EQ(data.accuracy.size(), 1u);
+  const index::AccuracyRecord& r = data.accuracy[0];
+  EXPECT_NEAR(r.scale_length, ScaleLength(4 * M_PI, 80), 0.02);  // a fine sphere's area
+  EXPECT_EQ(r.num_sources, 64u);
+  EXPECT_GT(r.num_pairs, 1000u);
+  for (int b = 0; b < index::kAccuracyBins; ++b) {
+    for (int k = 0; k < 2; ++k) EXPECT_GE(r.unfold_bound[k][b], 0);
+    for (int k = 0; k < 4; ++k) EXPECT_GE(r.trace_bound[k][b], 0);
+  }
+  // Far O(1) answers err by more than nothing, and by less than the sphere.
+  EXPECT_GT(r.unfold_bound[1][5], 0);
+  EXPECT_LT(r.unfold_bound[1][5], 0.5);
+  // The same input gives the same record (threads do not matter: one pass).
+  index::IndexData again = BuildSphere(m);
+  ASSERT_TRUE(AddCalibration(m, again).ok());
+  EXPECT_EQ(std::memcmp(&again.accuracy[0], &r, sizeof(r)), 0);
+}
+
+TEST(CalibrationTest, BoundsCoverHeldOutPairsOfAnotherSeed) {
+  const mesh::Mesh m = mesh::gen::Sphere(4, 1.0);
+  index::IndexData data = BuildSphere(m);
+  ASSERT_TRUE(AddCalibration(m, data).ok());
+  auto index = index::Index::FromBytes(*index::SerializeIndex(data));
+  ASSERT_TRUE(index.ok());
+  auto engine = query::QueryEngine::Create(*index);
+  ASSERT_TRUE(engine.ok());
+  const auto pairs = DrawPairs(m, 80, {.num_sources = 10, .uniform_points = 80, .seed = 99});
+  int covered = 0;
+  for (const ExactPair& pair : pairs) {
+    double bound = -1;
+    const double d = *(*engine)->Distance(pair.p, pair.q, {}, nullptr, &bound);
+    covered += std::abs(d - pair.exact) <= bound + 1e-9 * pair.exact;
+  }
+  EXPECT_GT(covered, 0.97 * pairs.size());
+}
+
+TEST(CalibrationTest, RefusesAnIndexOfAnotherMesh) {
+  const mesh::Mesh m = mesh::gen::Sphere(4, 1.0);
+  index::IndexData data = BuildSphere(m);
+  auto index = index::Index::FromBytes(*index::SerializeIndex(data));
+  ASSERT_TRUE(index.ok());
+  EXPECT_EQ(Calibrate(mesh::gen::Sphere(3, 1.0), *index).status().code(),
+            absl::StatusCode::kFailedPrecondition);
+}
+
+}  // namespace
+}  // namespace geodex::validation
