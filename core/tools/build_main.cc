@@ -1,6 +1,7 @@
 // geodex-build: the offline builder job (mesh -> .gdx index).
 //
 //   geodex-build MESH -o OUT.gdx --samples M [--threads N] [--seed S] [--edges-obj FILE]
+//   geodex-build MESH -o OUT.gdx --target-error E [--samples M0] [--max-samples CAP]
 //   geodex-build plan MESH --samples M [--seed S] [--threads N] [--edges-obj FILE] -o WORKDIR
 //   geodex-build rows WORKDIR --shard I/N [--threads T]
 //   geodex-build merge WORKDIR -o OUT.gdx
@@ -31,6 +32,7 @@
 #include "core/mesh/generators.h"
 #include "core/mesh/mesh_io.h"
 #include "core/validation/calibration.h"
+#include "core/validation/target_error.h"
 
 namespace geodex {
 namespace {
@@ -175,7 +177,18 @@ int main(int argc, char** argv) {
   int threads = 0;
   app.add_option("mesh", mesh_path, "Mesh file (.obj/.ply/.off) or builtin:NAME");
   app.add_option("-o,--output", out, "Output index file (.gdx)");
-  app.add_option("--samples", samples, "Number of samples m")->check(CLI::PositiveNumber);
+  app.add_option("--samples", samples,
+                 "Number of samples m (with --target-error: the first round's)")
+      ->check(CLI::PositiveNumber);
+  double target_error = 0;
+  int32_t max_samples = 0;
+  app.add_option("--target-error", target_error,
+                 "Build until the held-out relative RMS is at most this (e.g. 0.005) and the "
+                 "p99 beyond 10L at most 4x it, growing m by 1.5x per round")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--max-samples", max_samples,
+                 "With --target-error: the cap on m (default: half the vertices)")
+      ->check(CLI::PositiveNumber);
   app.add_option("--seed", seed, "Sampling seed");
   app.add_option("--threads", threads, "Worker threads (0: all cores)")
       ->check(CLI::NonNegativeNumber);
@@ -284,6 +297,30 @@ int main(int argc, char** argv) {
     }
     status = [&]() -> absl::Status {
       GEODEX_ASSIGN_OR_RETURN(const mesh::Mesh mesh, LoadInput(mesh_path));
+      if (target_error > 0) {
+        validation::TargetErrorOptions target;
+        target.target_rms = target_error;
+        target.max_samples = max_samples;
+        target.round_done = [&](int32_t round, int32_t m, double rms, double far_p99) {
+          std::fprintf(stderr,
+                       "[target-error] round %d: m = %d, relative RMS %.3f%% (target %.3f%%), "
+                       "p99 beyond 10L %.3f%% (target %.3f%%)\n",
+                       round + 1, m, 100 * rms, 100 * target_error, 100 * far_p99,
+                       400 * target_error);
+        };
+        GEODEX_ASSIGN_OR_RETURN(auto result,
+                                validation::BuildForTargetError(mesh, options, target));
+        result.data.report += absl::StrFormat(
+            "target_error = %.6g\ntarget_error_reached = %s\ntarget_error_rounds = %d\n",
+            target_error, result.reached ? "yes" : "no (sample cap)", result.rounds.size());
+        result.data.report += validation::CalibrationText(result.data.accuracy[0]);
+        if (!result.reached) {
+          std::fprintf(stderr, "geodex-build: the target error was not reached at the cap of %d "
+                               "samples; writing the last round's index\n",
+                       result.rounds.back().samples);
+        }
+        return WriteAndReport(result.data, result.summary, out);
+      }
       GEODEX_ASSIGN_OR_RETURN(const builder::Plan plan, builder::MakePlan(mesh, options));
       GEODEX_RETURN_IF_ERROR(WriteEdges(mesh, plan, edges_obj));
       builder::BuildSummary summary;

@@ -1,4 +1,5 @@
 #include "core/validation/calibration.h"
+#include "core/validation/target_error.h"
 
 #include "core/builder/builder.h"
 #include "core/mesh/generators.h"
@@ -65,6 +66,48 @@ TEST(CalibrationTest, RefusesAnIndexOfAnotherMesh) {
   ASSERT_TRUE(index.ok());
   EXPECT_EQ(Calibrate(mesh::gen::Sphere(3, 1.0), *index).status().code(),
             absl::StatusCode::kFailedPrecondition);
+}
+
+}  // namespace
+}  // namespace geodex::validation
+
+namespace geodex::validation {
+namespace {
+
+TEST(TargetErrorTest, GrowsTheSamplesUntilTheTargetIsMet) {
+  const mesh::Mesh m = mesh::gen::Sphere(3, 1.0);
+  builder::BuildOptions build;
+  build.num_samples = 20;
+  build.threads = 2;
+  TargetErrorOptions options;
+  options.target_rms = 0.012;
+  auto result = BuildForTargetError(m, build, options);
+  ASSERT_TRUE(result.ok()) << result.status();
+  ASSERT_TRUE(result->reached);
+  ASSERT_GE(result->rounds.size(), 2u);  // 20 samples are not enough
+  EXPECT_LE(result->rounds.back().rms, 0.012);
+  EXPECT_GT(result->rounds.front().rms, 0.012);
+  ASSERT_EQ(result->data.accuracy.size(), 1u);
+  EXPECT_EQ(result->data.samples.size(), static_cast<size_t>(result->rounds.back().samples));
+  for (size_t k = 1; k < result->rounds.size(); ++k) {
+    EXPECT_GT(result->rounds[k].samples, result->rounds[k - 1].samples);
+  }
+}
+
+TEST(TargetErrorTest, StopsAtTheCapAndSaysSo) {
+  const mesh::Mesh m = mesh::gen::Sphere(3, 1.0);
+  builder::BuildOptions build;
+  build.num_samples = 20;
+  TargetErrorOptions options;
+  options.target_rms = 1e-6;
+  options.max_samples = 30;
+  auto result = BuildForTargetError(m, build, options);
+  ASSERT_TRUE(result.ok()) << result.status();
+  EXPECT_FALSE(result->reached);
+  EXPECT_EQ(result->rounds.size(), 2u);  // 20, then 30
+  options.target_rms = -1;
+  EXPECT_EQ(BuildForTargetError(m, build, options).status().code(),
+            absl::StatusCode::kInvalidArgument);
 }
 
 }  // namespace

@@ -1,0 +1,54 @@
+#pragma once
+
+// Builds an index to a target error instead of a sample count: builds,
+// measures the index against held-out exact propagations (calibration.h),
+// and rebuilds with more samples until the area-uniform pairs' relative RMS
+// is at most the target and their p99 beyond 10L at most four times it, or
+// until the sample cap.
+//
+// New samples come from farthest-point sampling with a larger m (every
+// round rebuilds from scratch); placing them where the validation errs most
+// is not done here.
+//
+// Thread safety: reentrant. Deterministic for a seed, whatever the thread
+// count.
+
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "absl/status/statusor.h"
+#include "core/builder/builder.h"
+#include "core/index/index.h"
+#include "core/mesh/mesh.h"
+
+namespace geodex::validation {
+
+struct TargetErrorOptions {
+  double target_rms = 0.005;  // relative RMS over area-uniform held-out pairs
+  int32_t max_samples = 0;    // cap on m; 0: half the mesh's vertices
+  double growth = 1.5;        // m grows by this factor per round
+  // Called after each round with its m and measured error.
+  std::function<void(int32_t round, int32_t samples, double rms, double far_p99)> round_done;
+};
+
+struct TargetErrorRound {
+  int32_t samples = 0;  // after repair
+  double rms = 0, far_p99 = 0;
+};
+
+struct TargetErrorResult {
+  index::IndexData data;  // with its calibration
+  builder::BuildSummary summary;
+  std::vector<TargetErrorRound> rounds;
+  bool reached = false;  // false: stopped at the cap
+};
+
+// `build.num_samples` is the first round's m. Errors: those of the builder
+// and of calibration; InvalidArgument for a target that is not positive.
+absl::StatusOr<TargetErrorResult> BuildForTargetError(const mesh::Mesh& mesh,
+                                                      builder::BuildOptions build,
+                                                      const TargetErrorOptions& options);
+
+}  // namespace geodex::validation
