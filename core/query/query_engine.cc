@@ -556,8 +556,11 @@ double QueryEngine::Refine(const SurfacePoint& p, const SurfacePoint& q, double 
   };
   // A trace is a surface path, never shorter than the geodesic; one longer
   // than the O(1) answer plus that answer's bound has settled in a wrong
-  // corridor (round the wrong side of a feature), and is answered exactly.
-  // Needs the calibration (else the bound is NaN and no trace is doubted).
+  // corridor (round the wrong side of a feature). Under a tolerance it is
+  // answered exactly; by default it stays (an exact propagation per such
+  // pair halved the default mode's throughput for little gain:
+  // tests/bench/README.md). Needs the calibration (else the bound is NaN and
+  // no trace is doubted).
   auto wrong_corridor = [&] {
     return (kind == AnswerKind::kTrace || kind == AnswerKind::kWrappedTrace) &&
            d > unfolded + BoundOf(AnswerKind::kUnfold, vertex_pair, unfolded);
@@ -565,7 +568,7 @@ double QueryEngine::Refine(const SurfacePoint& p, const SurfacePoint& q, double 
   if (near || unfolded < kRefineScale * scale_length_) {
     switch (options.near_pairs) {
       case NearPairs::kPath:
-        if (trace() && wrong_corridor()) exact();
+        trace();
         break;
       case NearPairs::kExact:
         exact();
