@@ -163,28 +163,7 @@ QueryEngine::QueryEngine(std::shared_ptr<const index::Index> index, QueryOptions
 }
 
 absl::Status QueryEngine::Validate(const SurfacePoint& p) const {
-  if (p.face < 0 || p.face >= index_->num_faces()) {
-    return absl::OutOfRangeError(
-        absl::StrFormat("face id %d out of range [0, %d)", p.face, index_->num_faces()));
-  }
-  const double tol = options_.weight_tolerance;
-  double sum = 0;
-  for (int i = 0; i < 3; ++i) {
-    if (!std::isfinite(p.w[i])) {
-      return absl::InvalidArgumentError(
-          absl::StrFormat("barycentric weight %d of face %d is not finite", i, p.face));
-    }
-    if (p.w[i] < -tol) {
-      return absl::InvalidArgumentError(
-          absl::StrFormat("barycentric weight %d of face %d is negative (%g)", i, p.face, p.w[i]));
-    }
-    sum += p.w[i];
-  }
-  if (std::abs(sum - 1) > tol) {
-    return absl::InvalidArgumentError(absl::StrFormat(
-        "barycentric weights of face %d sum to %.17g, not 1 (tolerance %g)", p.face, sum, tol));
-  }
-  return absl::OkStatus();
+  return mesh::ValidateSurfacePoint(index_->num_faces(), p, options_.weight_tolerance);
 }
 
 SurfacePoint QueryEngine::Canonical(const SurfacePoint& p) const {
@@ -524,8 +503,8 @@ double QueryEngine::BoundOf(AnswerKind kind, bool vertex_pair, double d) const {
   return 0;
 }
 
-double QueryEngine::Refine(const SurfacePoint& p, const SurfacePoint& q, double unfolded,
-                           bool near, const DistanceOptions& options, QueryScratch* scratch,
+double QueryEngine::Refine(const SurfacePoint& p, const SurfacePoint& q, double unfolded, bool near,
+                           const DistanceOptions& options, QueryScratch* scratch,
                            double* bound) const {
   if (!(unfolded < kInf)) {  // different components: exactly unreachable
     if (bound != nullptr) *bound = BoundOf(AnswerKind::kExact, false, unfolded);
@@ -607,8 +586,8 @@ bool QueryEngine::NeedsRefine(const DistanceOptions& options, bool bounds, bool 
 }
 
 absl::StatusOr<double> QueryEngine::Distance(const SurfacePoint& p, const SurfacePoint& q,
-                                             const DistanceOptions& options,
-                                             QueryScratch* scratch, double* bound) const {
+                                             const DistanceOptions& options, QueryScratch* scratch,
+                                             double* bound) const {
   GEODEX_RETURN_IF_ERROR(Validate(p));
   GEODEX_RETURN_IF_ERROR(Validate(q));
   GEODEX_RETURN_IF_ERROR(CheckOptions(options, bound != nullptr));
@@ -627,8 +606,8 @@ absl::Status QueryEngine::DistanceBatch(std::span<const SurfacePoint> a,
   if (a.size() != b.size() || a.size() != out.size() ||
       (!bounds.empty() && bounds.size() != out.size())) {
     return absl::InvalidArgumentError(
-        absl::StrFormat("batch arrays differ in length (%d, %d, %d, bounds %d)", a.size(),
-                        b.size(), out.size(), bounds.size()));
+        absl::StrFormat("batch arrays differ in length (%d, %d, %d, bounds %d)", a.size(), b.size(),
+                        out.size(), bounds.size()));
   }
   const bool want_bounds = !bounds.empty();
   GEODEX_RETURN_IF_ERROR(CheckOptions(options, want_bounds));

@@ -142,8 +142,10 @@ class QueryEngine {
   const index::Index& index() const { return *index_; }
   const QueryOptions& options() const { return options_; }
 
-  // Validates a point: OutOfRange for a face id past the end,
-  // InvalidArgument for NaN/Inf/negative weights or weights not summing to 1.
+  // Validates a point (mesh::ValidateSurfacePoint with the index's face
+  // count and QueryOptions::weight_tolerance): OutOfRange for a face id past
+  // the end, InvalidArgument for NaN/Inf/negative weights or weights not
+  // summing to 1.
   absl::Status Validate(const SurfacePoint& p) const;
 
   // Approximate geodesic distance; +inf between components. Validates both
@@ -161,8 +163,7 @@ class QueryEngine {
   // (the error names the pair index). Unrefined pairs allocate nothing.
   absl::Status DistanceBatch(std::span<const SurfacePoint> a, std::span<const SurfacePoint> b,
                              std::span<double> out, const DistanceOptions& options = {},
-                             QueryScratch* scratch = nullptr,
-                             std::span<double> bounds = {}) const;
+                             QueryScratch* scratch = nullptr, std::span<double> bounds = {}) const;
 
   // The length of the straightened gradient trace between the points, as
   // the refinement of Distance computes it (symmetric; a surface path, so
