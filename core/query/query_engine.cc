@@ -28,10 +28,9 @@ inline int Heaviest(const SurfacePoint& p) {
 }
 
 // Loads the first and last byte of [p, p + size) and discards them: a
-// prefetch that works. On the CPU measured (AMD EPYC, Zen 4, under a
-// hypervisor) software prefetches of the ApproxLifts were still missing L1
-// four pairs later 97.5% of the time (rdtscp around the first load); after
-// a load here, 13%.
+// prefetch that works. Software prefetches of the ApproxLifts were found to
+// be dropped (still missing L1 several pairs later, on a virtualised Zen 4);
+// a load is not. The figures: tests/bench/README.md.
 inline void Touch(const void* p, size_t size) {
   const char* c = static_cast<const char*>(p);
   asm volatile("" : : "r"(c[0]), "r"(c[size - 1]));

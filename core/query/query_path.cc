@@ -106,8 +106,9 @@ struct Tracer {
 };
 
 // Path restarts are tried when the straightened path is longer than the
-// approximate distance by more than this factor. Approximate distances err by
-// 0.6% RMS at m=1000 on bunny; paths in a wrong corridor exceed it by 2%.
+// approximate distance by more than this factor: above the approximate
+// distance's usual error, below the excess of a path in a wrong corridor
+// (figures: tests/bench/README.md).
 constexpr double kPathRestartRatio = 1.01;
 
 // True when a point strictly inside the path is a mesh vertex: there the
@@ -253,11 +254,10 @@ absl::StatusOr<std::vector<PathPoint>> QueryEngine::ShortestTrace(const SurfaceP
   };
   // A near pair's straightened trace that wraps round no vertex is a
   // straight line through the unfolded faces it crosses, a local geodesic;
-  // between points this close, practically the shortest path. On 1,500 near
-  // pairs each of bunny_closed_30k and bunny_35k (m=1000), camelhead,
-  // rocker_arm, kitten and fandisk (m=250), such traces (79-97% of them)
-  // were within 0.07% of exact at p99 (max 0.8%), while traces that wrapped
-  // were 7-52% off at p99 and needed the other trace.
+  // between points this close, practically the shortest path. On scanned
+  // and CAD meshes most near-pair traces are such, and close to exact, while
+  // traces that wrapped were far off and needed the other trace (figures:
+  // tests/bench/README.md).
   if (search == TraceSearch::kNearPair && !WrapsRoundAVertex(path)) return path;
   // The trace of the other point's field may run in a better corridor (the
   // two approximate fields err differently).
@@ -269,7 +269,7 @@ absl::StatusOr<std::vector<PathPoint>> QueryEngine::ShortestTrace(const SurfaceP
   }
   // Restarts. Beside a cut locus of the approximate field, the trace can
   // settle in a corridor round the wrong side of a feature: a local
-  // geodesic, but 1-2% longer than the shortest path, so the straightened
+  // geodesic, but longer than the shortest path, so the straightened
   // length exceeds the approximate distance by more than its usual error.
   // Then trace again from each vertex one ring out from either end's face,
   // join the end along one or two mesh edges, straighten, and keep the
