@@ -10,6 +10,7 @@
 #include "absl/strings/str_format.h"
 #include "core/common/status_macros.h"
 #include "core/common/unfolding.h"
+#include "core/query/face_lift.h"
 #include "core/query/unfold_kernel.h"
 
 namespace geodex::query {
@@ -105,6 +106,12 @@ absl::StatusOr<std::shared_ptr<const QueryEngine>> QueryEngine::Create(
   }
   std::shared_ptr<QueryEngine> engine(new QueryEngine(std::move(index), options));
   return std::shared_ptr<const QueryEngine>(std::move(engine));
+}
+
+QueryEngine::~QueryEngine() = default;
+
+const QueryEngine::ApproxLift& QueryEngine::ApproxLiftOf(const FaceLift& fl, int heaviest) const {
+  return approx_lifts_[fl.approx + (fl.anchors == 3 ? heaviest : 0)];
 }
 
 const mesh::Mesh* QueryEngine::ExactMesh() const {
