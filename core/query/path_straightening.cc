@@ -6,6 +6,7 @@
 #include <limits>
 
 #include "absl/container/inlined_vector.h"
+#include "core/geometry/unfolding.h"
 
 namespace geodex::query {
 namespace {
@@ -131,8 +132,8 @@ class Straightener {
     }
     const double l = (P(b) - P(a)).norm();
     const double da = (P(c) - P(a)).norm(), db = (P(c) - P(b)).norm();
-    const double x = (l * l + da * da - db * db) / (2 * l);
-    const double y = std::sqrt(std::max(da * da - x * x, 0.0));
+    double x, y;
+    geometry::Place(l, da, db, &x, &y);
     const Vec2 ux = (pb - pa) * (1 / l);
     Vec2 uy{-ux.y, ux.x};
     if (Cross(pb - pa, prev.At(behind) - pa) > 0) uy = uy * -1;  // away from prev

@@ -9,7 +9,7 @@
 
 #include "absl/strings/str_format.h"
 #include "core/common/status_macros.h"
-#include "core/common/unfolding.h"
+#include "core/geometry/unfolding.h"
 #include "core/query/face_lift.h"
 #include "core/query/unfold_kernel.h"
 
@@ -41,6 +41,9 @@ inline void Touch(const void* p, size_t size) {
 // the rest of a query.
 inline double Norm2(double x, double y) { return std::sqrt(x * x + y * y); }
 
+using geometry::Place;
+using geometry::Trilaterate;
+using geometry::TwoSideDistance2;
 using kernel::Frame;
 using kernel::Placed;
 using kernel::PlaceInTriangle;
@@ -49,16 +52,9 @@ using kernel::TwoSideToOutside2;
 // Distances from a point of a mesh face to the three corners of a geodesic
 // triangle, from the distances d[vertex][corner] of the face's vertices. The
 // face lies in its plane (vertex 0 at the origin, vertex 1 at (l, 0), vertex 2
-// at (cx, cy)), the point at (px, py).
-// Exact distances d0, d1, d2 of one field at the three corners of a face fix
-// the unfolded source of the field in the face's plane: trilaterate it
-// (linear, no square roots).
-inline void Trilaterate(double l, double cx, double cy, double d0, double d1, double d2, double* sx,
-                        double* sy) {
-  *sx = (l * l + d0 * d0 - d1 * d1) / (2 * l);
-  *sy = (cx * cx + cy * cy - 2 * *sx * cx + d0 * d0 - d2 * d2) / (2 * cy);
-}
-
+// at (cx, cy)), the point at (px, py). Exact distances of one field at the
+// face's corners fix the field's unfolded source in that plane
+// (Trilaterate).
 inline void LiftInFace(double l, double cx, double cy, double px, double py, bool exact,
                        const double (&d)[3][3], std::array<double, 3>* out) {
   if (exact && cy > 1e-3 * l) {
@@ -89,8 +85,7 @@ inline void LiftInFace(double l, double cx, double cy, double px, double py, boo
       }
       double xq, yq;
       Place(edge[i], d[i][c], d[j][c], &xq, &yq);
-      const double dx = xp[i] - xq, dy = yp[i] + yq;
-      best = std::min(best, dx * dx + dy * dy);
+      best = std::min(best, TwoSideDistance2(xp[i], yp[i], xq, yq));
     }
     (*out)[c] = std::sqrt(best);
   }
@@ -696,8 +691,9 @@ double QueryEngine::LinearInterpolationDistance(const SurfacePoint& p0,
   const LiftedPoint p = Lift(Canonical(p0)), q = Lift(Canonical(q0));
   if (!(Matrix(p.corner[0], q.corner[0]) < kInf)) return kInf;
   auto lambda = [&](const LiftedPoint& x) {
-    return UnfoldedBarycentric(Matrix(x.corner[0], x.corner[1]), Matrix(x.corner[1], x.corner[2]),
-                               Matrix(x.corner[2], x.corner[0]), x.distance);
+    return geometry::UnfoldedBarycentric(Matrix(x.corner[0], x.corner[1]),
+                                         Matrix(x.corner[1], x.corner[2]),
+                                         Matrix(x.corner[2], x.corner[0]), x.distance);
   };
   const auto lp = lambda(p), lq = lambda(q);
   double d = 0;

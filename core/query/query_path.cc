@@ -12,6 +12,7 @@
 #include "absl/strings/str_format.h"
 #include "core/common/status_macros.h"
 #include "core/geodesic/exact_geodesic.h"
+#include "core/geometry/unfolding.h"
 #include "core/query/path_straightening.h"
 #include "core/query/query_engine.h"
 
@@ -68,8 +69,8 @@ struct Tracer {
     const double cx = e2.dot(ux), cy = e2.dot(uy);
     bool planar = false;
     if (cy > 1e-6 * l) {
-      const double sx = (l * l + d[0] * d[0] - d[1] * d[1]) / (2 * l);
-      const double sy = (cx * cx + cy * cy - 2 * sx * cx + d[0] * d[0] - d[2] * d[2]) / (2 * cy);
+      double sx, sy;
+      geometry::Trilaterate(l, cx, cy, d[0], d[1], d[2], &sx, &sy);
       const double r0 = std::sqrt(sx * sx + sy * sy);
       planar = std::abs(r0 - d[0]) < 1e-3 * (d[0] + l);
       if (planar) {
