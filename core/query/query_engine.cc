@@ -113,7 +113,7 @@ const mesh::Mesh* QueryEngine::ExactMesh() const {
   std::call_once(mesh_once_, [this] {
     const index::Index& ix = *index_;
     std::vector<mesh::Vec3> positions(ix.num_vertices());
-    for (int32_t v = 0; v < ix.num_vertices(); ++v) positions[v] = Position(v);
+    for (int32_t v = 0; v < ix.num_vertices(); ++v) positions[v] = view_.Position(v);
     std::vector<mesh::Triangle> faces(ix.num_faces());
     for (int32_t f = 0; f < ix.num_faces(); ++f) {
       faces[f] = {ix.faces()[3 * f], ix.faces()[3 * f + 1], ix.faces()[3 * f + 2]};
@@ -130,9 +130,7 @@ const mesh::Mesh* QueryEngine::ExactMesh() const {
 QueryEngine::QueryEngine(std::shared_ptr<const index::Index> index, QueryOptions options)
     : index_(std::move(index)),
       options_(options),
-      positions_(index_->positions()),
-      faces_(index_->faces()),
-      twins_(index_->twins()),
+      view_{index_->positions(), index_->faces(), index_->twins()},
       matrix_(index_->sample_distances()),
       records_(index_->vertices()),
       triangles_(index_->triangles()),
@@ -157,8 +155,10 @@ QueryEngine::QueryEngine(std::shared_ptr<const index::Index> index, QueryOptions
   double area = 0;
   for (int32_t f = 0; f < index_->num_faces(); ++f) {
     face_lifts_[f] = MakeFaceLift(f);
-    const int32_t* v = &faces_[3 * f];
-    area += 0.5 * (Position(v[1]) - Position(v[0])).cross(Position(v[2]) - Position(v[0])).norm();
+    const int32_t* v = &view_.faces[3 * f];
+    area += 0.5 * (view_.Position(v[1]) - view_.Position(v[0]))
+                      .cross(view_.Position(v[2]) - view_.Position(v[0]))
+                      .norm();
   }
   scale_length_ = std::sqrt(2 * area / (std::sqrt(3.0) * num_samples_));
 }
@@ -186,7 +186,7 @@ SurfacePoint QueryEngine::Canonical(const SurfacePoint& p) const {
   }
   if (zeros == 1) {
     const int32_t h = 3 * c.face + (zero + 1) % 3;  // the edge opposite the zero weight
-    const int32_t g = twins_[h];
+    const int32_t g = view_.twins[h];
     if (g >= 0 && g / 3 < c.face) {
       SurfacePoint t{g / 3, {0, 0, 0}};
       t.w[g % 3] = c.w[(zero + 2) % 3];            // Origin(g) = Dest(h)
@@ -238,7 +238,8 @@ bool QueryEngine::FaceDistances(const int32_t* f, const LiftedPoint& anchor,
 
 QueryEngine::FaceFrame QueryEngine::FaceFrameOf(const int32_t* f) const {
   // The face in its own plane: v0 at the origin, v1 on the x axis.
-  const mesh::Vec3 v0 = Position(f[0]), e1 = Position(f[1]) - v0, e2 = Position(f[2]) - v0;
+  const mesh::Vec3 v0 = view_.Position(f[0]), e1 = view_.Position(f[1]) - v0,
+                   e2 = view_.Position(f[2]) - v0;
   const double l = e1.norm();
   return {l, e1.dot(e2) / l, e1.cross(e2).norm() / l};
 }
@@ -247,7 +248,7 @@ QueryEngine::FaceFrame QueryEngine::FaceFrameOf(const int32_t* f) const {
 // approximate distances); when all three differ, on the triangle of the
 // point's heaviest vertex (three ApproxLifts).
 QueryEngine::FaceLift QueryEngine::MakeFaceLift(int32_t face) {
-  const int32_t* f = &faces_[3 * face];
+  const int32_t* f = &view_.faces[3 * face];
   FaceLift out;
   const FaceFrame frame = FaceFrameOf(f);
   const double edge[3] = {frame.l, std::hypot(frame.cx - frame.l, frame.cy),
@@ -314,7 +315,7 @@ QueryEngine::ApproxLift QueryEngine::MakeApproxLift(const int32_t* f, const Face
 
 LiftedPoint QueryEngine::Lift(const SurfacePoint& p) const {
   const int k = Heaviest(p);
-  if (p.w[k] >= 1.0) return VertexLift(faces_[3 * p.face + k]);  // at a vertex: exact record
+  if (p.w[k] >= 1.0) return VertexLift(view_.faces[3 * p.face + k]);  // at a vertex: exact record
   const FaceLift& fl = face_lifts_[p.face];
   if (fl.triangle < 0) return SlowLift(p, k);
   const double px = p.w[1] * fl.l + p.w[2] * fl.cx, py = p.w[2] * fl.cy;
@@ -342,7 +343,7 @@ LiftedPoint QueryEngine::Lift(const SurfacePoint& p) const {
 }
 
 void QueryEngine::PrefetchFace(const SurfacePoint& p) const {
-  __builtin_prefetch(&faces_[3 * p.face]);
+  __builtin_prefetch(&view_.faces[3 * p.face]);
   __builtin_prefetch(&face_lifts_[p.face]);
 }
 
@@ -350,7 +351,7 @@ void QueryEngine::PrefetchLift(const SurfacePoint& p) const {
   const int k = Heaviest(p);
   const FaceLift& fl = face_lifts_[p.face];
   if (p.w[k] >= 1.0 || fl.triangle < 0) {
-    __builtin_prefetch(&records_[faces_[3 * p.face + k]]);
+    __builtin_prefetch(&records_[view_.faces[3 * p.face + k]]);
   } else if (fl.approx >= 0) {
     const char* line = reinterpret_cast<const char*>(&ApproxLiftOf(fl, k));
     Touch(line, sizeof(ApproxLift));
@@ -358,7 +359,7 @@ void QueryEngine::PrefetchLift(const SurfacePoint& p) const {
 }
 
 LiftedPoint QueryEngine::SlowLift(const SurfacePoint& p, int heaviest) const {
-  const int32_t* f = &faces_[3 * p.face];
+  const int32_t* f = &view_.faces[3 * p.face];
   const int32_t t0 = records_[f[0]].triangle, t1 = records_[f[1]].triangle,
                 t2 = records_[f[2]].triangle;
   int k = heaviest;
@@ -459,8 +460,9 @@ bool QueryEngine::IsNearPair(const SurfacePoint& p, const SurfacePoint& q) const
 }
 
 mesh::Vec3 QueryEngine::PositionOf(const SurfacePoint& p) const {
-  const int32_t* f = &faces_[3 * p.face];
-  return p.w[0] * Position(f[0]) + p.w[1] * Position(f[1]) + p.w[2] * Position(f[2]);
+  const int32_t* f = &view_.faces[3 * p.face];
+  return p.w[0] * view_.Position(f[0]) + p.w[1] * view_.Position(f[1]) +
+         p.w[2] * view_.Position(f[2]);
 }
 
 double QueryEngine::AtLeastChord(const SurfacePoint& p, const SurfacePoint& q, double d) const {
@@ -731,7 +733,8 @@ absl::StatusOr<DistanceField> QueryEngine::Field(std::span<const SurfacePoint> s
     }
     for (size_t s = 0; s < lifted.size(); ++s) {
       double d = LiftedDistance(lifted[s], x);
-      if (AreNear(lifted[s], x)) d = std::max(d, (at[s] - Position(v)).norm());  // AtLeastChord
+      if (AreNear(lifted[s], x))
+        d = std::max(d, (at[s] - view_.Position(v)).norm());  // AtLeastChord
       if (d < field.distance[v]) {
         field.distance[v] = d;
         field.nearest[v] = static_cast<int32_t>(s);

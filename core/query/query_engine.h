@@ -46,6 +46,7 @@
 #include "core/geodesic/exact_geodesic.h"
 #include "core/index/index.h"
 #include "core/mesh/mesh.h"
+#include "core/query/mesh_view.h"
 #include "core/query/point_locator.h"
 #include "core/query/unfold_kernel.h"
 
@@ -257,9 +258,6 @@ class QueryEngine {
   double Matrix(int32_t a, int32_t b) const {
     return static_cast<double>(matrix_[static_cast<size_t>(a) * num_samples_ + b]);
   }
-  mesh::Vec3 Position(int32_t v) const {
-    return {positions_[3 * v], positions_[3 * v + 1], positions_[3 * v + 2]};
-  }
   // Path restart chains for a valid point p: for each vertex one ring out
   // from p's face, that vertex, a vertex of p's face sharing a face with it,
   // then p; consecutive points share a face.
@@ -356,9 +354,7 @@ class QueryEngine {
 
   std::shared_ptr<const index::Index> index_;
   QueryOptions options_;
-  std::span<const double> positions_;
-  std::span<const int32_t> faces_;
-  std::span<const int32_t> twins_;
+  MeshView view_;  // the index's positions, faces and twins
   std::span<const float> matrix_;
   std::span<const index::VertexRecord> records_;
   std::span<const index::GeodesicTriangle> triangles_;
