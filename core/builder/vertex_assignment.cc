@@ -3,8 +3,8 @@
 #include <algorithm>
 #include <array>
 
-#include "core/common/unfolding.h"
 #include "core/geodesic/exact_geodesic.h"
+#include "core/geometry/unfolding.h"
 
 namespace geodex::builder {
 
@@ -36,9 +36,9 @@ AssignmentCounts AssignVerticesToTriangles(
       const auto& corners = plan.triangles[t];
       std::array<double, 3> d;
       for (int i = 0; i < 3; ++i) d[i] = vertex_distance(v, corners[i]);
-      const auto lambda = UnfoldedBarycentric(sample_distance(corners[0], corners[1]),
-                                              sample_distance(corners[1], corners[2]),
-                                              sample_distance(corners[2], corners[0]), d);
+      const auto lambda = geometry::UnfoldedBarycentric(sample_distance(corners[0], corners[1]),
+                                                        sample_distance(corners[1], corners[2]),
+                                                        sample_distance(corners[2], corners[0]), d);
       const double score = std::min({lambda[0], lambda[1], lambda[2]});
       if (score > best_score) {
         best_score = score;

@@ -250,9 +250,13 @@ Vec3 PositionOf(const Mesh& mesh, const SurfacePoint& p) {
 }
 
 absl::Status ValidateSurfacePoint(const Mesh& mesh, const SurfacePoint& p, double tolerance) {
-  if (p.face < 0 || p.face >= mesh.num_faces()) {
+  return ValidateSurfacePoint(mesh.num_faces(), p, tolerance);
+}
+
+absl::Status ValidateSurfacePoint(int32_t num_faces, const SurfacePoint& p, double tolerance) {
+  if (p.face < 0 || p.face >= num_faces) {
     return absl::OutOfRangeError(
-        absl::StrFormat("face id %d out of range [0, %d)", p.face, mesh.num_faces()));
+        absl::StrFormat("face id %d out of range [0, %d)", p.face, num_faces));
   }
   double sum = 0;
   for (int i = 0; i < 3; ++i) {

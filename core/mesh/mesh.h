@@ -127,6 +127,10 @@ Vec3 PositionOf(const Mesh& mesh, const SurfacePoint& p);
 // weights sum to 1 within `tolerance`. Errors: OutOfRange for a bad face id,
 // InvalidArgument otherwise; messages name the offending value.
 absl::Status ValidateSurfacePoint(const Mesh& mesh, const SurfacePoint& p, double tolerance = 1e-6);
+// The same checks against a face count, for holders of a mesh's arrays
+// without a Mesh (a loaded index).
+absl::Status ValidateSurfacePoint(int32_t num_faces, const SurfacePoint& p,
+                                  double tolerance = 1e-6);
 
 // The surface point at vertex `v` (in its first incident face). Errors:
 // OutOfRange for a bad id, FailedPrecondition for an unreferenced vertex.

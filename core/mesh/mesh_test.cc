@@ -309,6 +309,12 @@ TEST(SurfacePointTest, ValidateSurfacePointErrors) {
   EXPECT_EQ(status.code(), absl::StatusCode::kInvalidArgument);
   EXPECT_THAT(std::string(status.message()),
               HasSubstr("barycentric weights of face 1 sum to 1.5, not 1"));
+
+  // The face-count form (a loaded index) answers the same.
+  EXPECT_TRUE(ValidateSurfacePoint(2, {1, {0.2, 0.3, 0.5}}).ok());
+  EXPECT_EQ(ValidateSurfacePoint(2, {1, {0.5, 0.5, 0.5}}),
+            ValidateSurfacePoint(mesh, {1, {0.5, 0.5, 0.5}}));
+  EXPECT_EQ(ValidateSurfacePoint(2, {2, {1, 0, 0}}), ValidateSurfacePoint(mesh, {2, {1, 0, 0}}));
 }
 
 TEST(SurfacePointTest, VertexPoint) {

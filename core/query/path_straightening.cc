@@ -6,11 +6,14 @@
 #include <limits>
 
 #include "absl/container/inlined_vector.h"
+#include "core/geometry/unfolding.h"
 
 namespace geodex::query {
 namespace {
 
 constexpr double kZero = 1e-12;  // barycentric weights below this are on an edge
+// Steps a walk round a vertex takes at most (a guard against broken twins).
+constexpr int kMaxFanSteps = 4096;
 
 // Per-pass working arrays: most straightened paths are short (a near pair
 // crosses a handful of faces), so they live on the stack until they grow.
@@ -34,7 +37,7 @@ struct Support {
 
 class Straightener {
  public:
-  explicit Straightener(const MeshArrays& mesh) : mesh_(mesh) {}
+  explicit Straightener(const MeshView& mesh) : mesh_(mesh) {}
 
   // Where the funnel wraps around a vertex, the path becomes a vertex point;
   // the next pass releases it to the vertex's narrower side, which may hold
@@ -53,19 +56,15 @@ class Straightener {
   }
 
  private:
-  mesh::Vec3 P(int32_t v) const {
-    return {mesh_.positions[3 * v], mesh_.positions[3 * v + 1], mesh_.positions[3 * v + 2]};
-  }
-  int32_t V(int32_t f, int i) const { return mesh_.faces[3 * f + i]; }
   bool HasVertex(int32_t f, int32_t v) const {
-    return V(f, 0) == v || V(f, 1) == v || V(f, 2) == v;
+    return mesh_.Vertex(f, 0) == v || mesh_.Vertex(f, 1) == v || mesh_.Vertex(f, 2) == v;
   }
 
   Support SupportOf(const SurfacePoint& p) const {
     Support s;
     for (int i = 0; i < 3; ++i) {
       if (p.w[i] > kZero) {
-        s.vertex[s.count] = V(p.face, i);
+        s.vertex[s.count] = mesh_.Vertex(p.face, i);
         s.weight[s.count] = p.w[i];
         ++s.count;
       }
@@ -81,7 +80,7 @@ class Straightener {
   // The face across the edge (a, b) of face f, or -1.
   int32_t Across(int32_t f, int32_t a, int32_t b) const {
     for (int i = 0; i < 3; ++i) {
-      const int32_t u = V(f, i), w = V(f, (i + 1) % 3);
+      const int32_t u = mesh_.Vertex(f, i), w = mesh_.Vertex(f, (i + 1) % 3);
       if ((u == a && w == b) || (u == b && w == a)) {
         const int32_t t = mesh_.twins[3 * f + i];
         return t < 0 ? -1 : t / 3;
@@ -110,8 +109,9 @@ class Straightener {
   };
 
   Flat FirstFlat(int32_t f) const {
-    Flat flat{f, {V(f, 0), V(f, 1), V(f, 2)}, {}};
-    const mesh::Vec3 a = P(flat.v[0]), e1 = P(flat.v[1]) - a, e2 = P(flat.v[2]) - a;
+    Flat flat{f, {mesh_.Vertex(f, 0), mesh_.Vertex(f, 1), mesh_.Vertex(f, 2)}, {}};
+    const mesh::Vec3 a = mesh_.Position(flat.v[0]), e1 = mesh_.Position(flat.v[1]) - a,
+                     e2 = mesh_.Position(flat.v[2]) - a;
     const double l = e1.norm();
     const double cx = e1.dot(e2) / l;
     const double cy = std::sqrt(std::max(e2.squaredNorm() - cx * cx, 0.0));
@@ -122,17 +122,18 @@ class Straightener {
   // Face g unfolded across its edge (a, b) shared with `prev`, on the other
   // side of that edge from prev's third vertex.
   Flat NextFlat(const Flat& prev, int32_t g, int32_t a, int32_t b) const {
-    Flat flat{g, {V(g, 0), V(g, 1), V(g, 2)}, {}};
+    Flat flat{g, {mesh_.Vertex(g, 0), mesh_.Vertex(g, 1), mesh_.Vertex(g, 2)}, {}};
     const Vec2 pa = prev.At(a), pb = prev.At(b);
     int32_t c = -1, behind = -1;
     for (int i = 0; i < 3; ++i) {
       if (flat.v[i] != a && flat.v[i] != b) c = flat.v[i];
       if (prev.v[i] != a && prev.v[i] != b) behind = prev.v[i];
     }
-    const double l = (P(b) - P(a)).norm();
-    const double da = (P(c) - P(a)).norm(), db = (P(c) - P(b)).norm();
-    const double x = (l * l + da * da - db * db) / (2 * l);
-    const double y = std::sqrt(std::max(da * da - x * x, 0.0));
+    const double l = (mesh_.Position(b) - mesh_.Position(a)).norm();
+    const double da = (mesh_.Position(c) - mesh_.Position(a)).norm(),
+                 db = (mesh_.Position(c) - mesh_.Position(b)).norm();
+    double x, y;
+    geometry::Place(l, da, db, &x, &y);
     const Vec2 ux = (pb - pa) * (1 / l);
     Vec2 uy{-ux.y, ux.x};
     if (Cross(pb - pa, prev.At(behind) - pa) > 0) uy = uy * -1;  // away from prev
@@ -161,33 +162,15 @@ class Straightener {
       return g >= 0 ? Small<int32_t>{p.face, g} : Small<int32_t>{p.face};
     }
     Small<int32_t> out;
-    for (int dir = 0; dir < 2; ++dir) {
-      for (int32_t f = p.face, guard = 0; guard < 4096; ++guard) {
-        if (dir == 0 || f != p.face) out.push_back(f);
-        const int32_t h = Turn(f, s.vertex[0], dir);
-        if (h < 0) break;
-        f = h;
-        if (f == p.face) return out;
-      }
-    }
+    mesh_.FacesAround(s.vertex[0], p.face, kMaxFanSteps, &out);
     return out;
-  }
-
-  // The face across the edge of f that leaves vertex v (dir 0) or enters it
-  // (dir 1): one step around v. -1 at the boundary.
-  int32_t Turn(int32_t f, int32_t v, int dir) const {
-    int k = 0;
-    while (k < 3 && V(f, k) != v) ++k;
-    if (k == 3) return -1;
-    const int32_t h = dir == 0 ? 3 * f + k : 3 * f + (k + 2) % 3;
-    const int32_t t = mesh_.twins[h];
-    return t < 0 ? -1 : t / 3;
   }
 
   double AngleAt(int32_t f, int32_t v) const {
     int k = 0;
-    while (V(f, k) != v) ++k;
-    const mesh::Vec3 a = P(V(f, (k + 1) % 3)) - P(v), b = P(V(f, (k + 2) % 3)) - P(v);
+    while (mesh_.Vertex(f, k) != v) ++k;
+    const mesh::Vec3 a = mesh_.Position(mesh_.Vertex(f, (k + 1) % 3)) - mesh_.Position(v),
+                     b = mesh_.Position(mesh_.Vertex(f, (k + 2) % 3)) - mesh_.Position(v);
     return std::atan2(a.cross(b).norm(), a.dot(b));
   }
 
@@ -200,8 +183,8 @@ class Straightener {
       Small<int32_t> faces;
       double angle = 0;
       int32_t f = from;
-      for (int guard = 0; guard < 4096 && f != to; ++guard) {
-        f = Turn(f, v, dir);
+      for (int guard = 0; guard < kMaxFanSteps && f != to; ++guard) {
+        f = mesh_.Turn(f, v, dir);
         if (f < 0 || f == from) break;
         faces.push_back(f);
         if (f != to) angle += AngleAt(f, v);
@@ -260,7 +243,8 @@ class Straightener {
           const int32_t from = strip.back();
           int32_t u = -1;  // the other end of the edge shared with f
           for (int c = 0; c < 3; ++c) {
-            if (V(from, c) != v && HasVertex(f, V(from, c))) u = V(from, c);
+            if (mesh_.Vertex(from, c) != v && HasVertex(f, mesh_.Vertex(from, c)))
+              u = mesh_.Vertex(from, c);
           }
           if (u < 0) return false;
           push(f, {v, u});
@@ -366,31 +350,32 @@ class Straightener {
         const double t = std::clamp(Cross(dir, pa - portal.right) / denom, 0.0, 1.0);
         SurfacePoint point{portal.face, {0, 0, 0}};
         for (int c = 0; c < 3; ++c) {
-          const int32_t v = V(portal.face, c);
+          const int32_t v = mesh_.Vertex(portal.face, c);
           if (v == portal.right_id) point.w[c] = 1 - t;
           if (v == portal.left_id) point.w[c] = t;
         }
-        out->push_back({point, (1 - t) * P(portal.right_id) + t * P(portal.left_id)});
+        out->push_back({point, (1 - t) * mesh_.Position(portal.right_id) +
+                                   t * mesh_.Position(portal.left_id)});
       }
       if (s + 2 < apexes.size()) {
         if (vb < 0) return false;
         SurfacePoint point{portals[b.portal].face, {0, 0, 0}};
         for (int c = 0; c < 3; ++c) {
-          if (V(point.face, c) == vb) point.w[c] = 1;
+          if (mesh_.Vertex(point.face, c) == vb) point.w[c] = 1;
         }
-        out->push_back({point, P(vb)});
+        out->push_back({point, mesh_.Position(vb)});
       }
     }
     out->push_back(run.back());
     return true;
   }
 
-  const MeshArrays& mesh_;
+  const MeshView& mesh_;
 };
 
 }  // namespace
 
-std::vector<PathPoint> StraightenPath(const MeshArrays& mesh, std::vector<PathPoint> path) {
+std::vector<PathPoint> StraightenPath(const MeshView& mesh, std::vector<PathPoint> path) {
   return Straightener(mesh).Run(std::move(path));
 }
 

@@ -18,21 +18,14 @@
 #include <span>
 #include <vector>
 
+#include "core/query/mesh_view.h"
 #include "core/query/query_engine.h"
 
 namespace geodex::query {
 
-// Mesh arrays as stored in the index: xyz per vertex, 3 vertex ids per face,
-// the twin of each half-edge (3 f + i: from corner i to corner i+1) or -1.
-struct MeshArrays {
-  std::span<const double> positions;
-  std::span<const int32_t> faces;
-  std::span<const int32_t> twins;
-};
-
 // Returns the straightened path; the endpoints are kept exactly. Consecutive
 // input points must share a face (as QueryEngine::Path produces); runs that
 // do not are returned unchanged.
-std::vector<PathPoint> StraightenPath(const MeshArrays& mesh, std::vector<PathPoint> path);
+std::vector<PathPoint> StraightenPath(const MeshView& mesh, std::vector<PathPoint> path);
 
 }  // namespace geodex::query

@@ -9,7 +9,8 @@
 
 #include "absl/strings/str_format.h"
 #include "core/common/status_macros.h"
-#include "core/common/unfolding.h"
+#include "core/geometry/unfolding.h"
+#include "core/query/face_lift.h"
 #include "core/query/unfold_kernel.h"
 
 namespace geodex::query {
@@ -28,10 +29,9 @@ inline int Heaviest(const SurfacePoint& p) {
 }
 
 // Loads the first and last byte of [p, p + size) and discards them: a
-// prefetch that works. On the CPU measured (AMD EPYC, Zen 4, under a
-// hypervisor) software prefetches of the ApproxLifts were still missing L1
-// four pairs later 97.5% of the time (rdtscp around the first load); after
-// a load here, 13%.
+// prefetch that works. Software prefetches of the ApproxLifts were found to
+// be dropped (still missing L1 several pairs later, on a virtualised Zen 4);
+// a load is not. The figures: tests/bench/README.md.
 inline void Touch(const void* p, size_t size) {
   const char* c = static_cast<const char*>(p);
   asm volatile("" : : "r"(c[0]), "r"(c[size - 1]));
@@ -41,6 +41,9 @@ inline void Touch(const void* p, size_t size) {
 // the rest of a query.
 inline double Norm2(double x, double y) { return std::sqrt(x * x + y * y); }
 
+using geometry::Place;
+using geometry::Trilaterate;
+using geometry::TwoSideDistance2;
 using kernel::Frame;
 using kernel::Placed;
 using kernel::PlaceInTriangle;
@@ -49,16 +52,9 @@ using kernel::TwoSideToOutside2;
 // Distances from a point of a mesh face to the three corners of a geodesic
 // triangle, from the distances d[vertex][corner] of the face's vertices. The
 // face lies in its plane (vertex 0 at the origin, vertex 1 at (l, 0), vertex 2
-// at (cx, cy)), the point at (px, py).
-// Exact distances d0, d1, d2 of one field at the three corners of a face fix
-// the unfolded source of the field in the face's plane: trilaterate it
-// (linear, no square roots).
-inline void Trilaterate(double l, double cx, double cy, double d0, double d1, double d2, double* sx,
-                        double* sy) {
-  *sx = (l * l + d0 * d0 - d1 * d1) / (2 * l);
-  *sy = (cx * cx + cy * cy - 2 * *sx * cx + d0 * d0 - d2 * d2) / (2 * cy);
-}
-
+// at (cx, cy)), the point at (px, py). Exact distances of one field at the
+// face's corners fix the field's unfolded source in that plane
+// (Trilaterate).
 inline void LiftInFace(double l, double cx, double cy, double px, double py, bool exact,
                        const double (&d)[3][3], std::array<double, 3>* out) {
   if (exact && cy > 1e-3 * l) {
@@ -89,8 +85,7 @@ inline void LiftInFace(double l, double cx, double cy, double px, double py, boo
       }
       double xq, yq;
       Place(edge[i], d[i][c], d[j][c], &xq, &yq);
-      const double dx = xp[i] - xq, dy = yp[i] + yq;
-      best = std::min(best, dx * dx + dy * dy);
+      best = std::min(best, TwoSideDistance2(xp[i], yp[i], xq, yq));
     }
     (*out)[c] = std::sqrt(best);
   }
@@ -108,11 +103,17 @@ absl::StatusOr<std::shared_ptr<const QueryEngine>> QueryEngine::Create(
   return std::shared_ptr<const QueryEngine>(std::move(engine));
 }
 
+QueryEngine::~QueryEngine() = default;
+
+const QueryEngine::ApproxLift& QueryEngine::ApproxLiftOf(const FaceLift& fl, int heaviest) const {
+  return approx_lifts_[fl.approx + (fl.anchors == 3 ? heaviest : 0)];
+}
+
 const mesh::Mesh* QueryEngine::ExactMesh() const {
   std::call_once(mesh_once_, [this] {
     const index::Index& ix = *index_;
     std::vector<mesh::Vec3> positions(ix.num_vertices());
-    for (int32_t v = 0; v < ix.num_vertices(); ++v) positions[v] = Position(v);
+    for (int32_t v = 0; v < ix.num_vertices(); ++v) positions[v] = view_.Position(v);
     std::vector<mesh::Triangle> faces(ix.num_faces());
     for (int32_t f = 0; f < ix.num_faces(); ++f) {
       faces[f] = {ix.faces()[3 * f], ix.faces()[3 * f + 1], ix.faces()[3 * f + 2]};
@@ -129,9 +130,7 @@ const mesh::Mesh* QueryEngine::ExactMesh() const {
 QueryEngine::QueryEngine(std::shared_ptr<const index::Index> index, QueryOptions options)
     : index_(std::move(index)),
       options_(options),
-      positions_(index_->positions()),
-      faces_(index_->faces()),
-      twins_(index_->twins()),
+      view_{index_->positions(), index_->faces(), index_->twins()},
       matrix_(index_->sample_distances()),
       records_(index_->vertices()),
       triangles_(index_->triangles()),
@@ -156,35 +155,16 @@ QueryEngine::QueryEngine(std::shared_ptr<const index::Index> index, QueryOptions
   double area = 0;
   for (int32_t f = 0; f < index_->num_faces(); ++f) {
     face_lifts_[f] = MakeFaceLift(f);
-    const int32_t* v = &faces_[3 * f];
-    area += 0.5 * (Position(v[1]) - Position(v[0])).cross(Position(v[2]) - Position(v[0])).norm();
+    const int32_t* v = &view_.faces[3 * f];
+    area += 0.5 * (view_.Position(v[1]) - view_.Position(v[0]))
+                      .cross(view_.Position(v[2]) - view_.Position(v[0]))
+                      .norm();
   }
   scale_length_ = std::sqrt(2 * area / (std::sqrt(3.0) * num_samples_));
 }
 
 absl::Status QueryEngine::Validate(const SurfacePoint& p) const {
-  if (p.face < 0 || p.face >= index_->num_faces()) {
-    return absl::OutOfRangeError(
-        absl::StrFormat("face id %d out of range [0, %d)", p.face, index_->num_faces()));
-  }
-  const double tol = options_.weight_tolerance;
-  double sum = 0;
-  for (int i = 0; i < 3; ++i) {
-    if (!std::isfinite(p.w[i])) {
-      return absl::InvalidArgumentError(
-          absl::StrFormat("barycentric weight %d of face %d is not finite", i, p.face));
-    }
-    if (p.w[i] < -tol) {
-      return absl::InvalidArgumentError(
-          absl::StrFormat("barycentric weight %d of face %d is negative (%g)", i, p.face, p.w[i]));
-    }
-    sum += p.w[i];
-  }
-  if (std::abs(sum - 1) > tol) {
-    return absl::InvalidArgumentError(absl::StrFormat(
-        "barycentric weights of face %d sum to %.17g, not 1 (tolerance %g)", p.face, sum, tol));
-  }
-  return absl::OkStatus();
+  return mesh::ValidateSurfacePoint(index_->num_faces(), p, options_.weight_tolerance);
 }
 
 SurfacePoint QueryEngine::Canonical(const SurfacePoint& p) const {
@@ -206,7 +186,7 @@ SurfacePoint QueryEngine::Canonical(const SurfacePoint& p) const {
   }
   if (zeros == 1) {
     const int32_t h = 3 * c.face + (zero + 1) % 3;  // the edge opposite the zero weight
-    const int32_t g = twins_[h];
+    const int32_t g = view_.twins[h];
     if (g >= 0 && g / 3 < c.face) {
       SurfacePoint t{g / 3, {0, 0, 0}};
       t.w[g % 3] = c.w[(zero + 2) % 3];            // Origin(g) = Dest(h)
@@ -258,7 +238,8 @@ bool QueryEngine::FaceDistances(const int32_t* f, const LiftedPoint& anchor,
 
 QueryEngine::FaceFrame QueryEngine::FaceFrameOf(const int32_t* f) const {
   // The face in its own plane: v0 at the origin, v1 on the x axis.
-  const mesh::Vec3 v0 = Position(f[0]), e1 = Position(f[1]) - v0, e2 = Position(f[2]) - v0;
+  const mesh::Vec3 v0 = view_.Position(f[0]), e1 = view_.Position(f[1]) - v0,
+                   e2 = view_.Position(f[2]) - v0;
   const double l = e1.norm();
   return {l, e1.dot(e2) / l, e1.cross(e2).norm() / l};
 }
@@ -267,7 +248,7 @@ QueryEngine::FaceFrame QueryEngine::FaceFrameOf(const int32_t* f) const {
 // approximate distances); when all three differ, on the triangle of the
 // point's heaviest vertex (three ApproxLifts).
 QueryEngine::FaceLift QueryEngine::MakeFaceLift(int32_t face) {
-  const int32_t* f = &faces_[3 * face];
+  const int32_t* f = &view_.faces[3 * face];
   FaceLift out;
   const FaceFrame frame = FaceFrameOf(f);
   const double edge[3] = {frame.l, std::hypot(frame.cx - frame.l, frame.cy),
@@ -334,7 +315,7 @@ QueryEngine::ApproxLift QueryEngine::MakeApproxLift(const int32_t* f, const Face
 
 LiftedPoint QueryEngine::Lift(const SurfacePoint& p) const {
   const int k = Heaviest(p);
-  if (p.w[k] >= 1.0) return VertexLift(faces_[3 * p.face + k]);  // at a vertex: exact record
+  if (p.w[k] >= 1.0) return VertexLift(view_.faces[3 * p.face + k]);  // at a vertex: exact record
   const FaceLift& fl = face_lifts_[p.face];
   if (fl.triangle < 0) return SlowLift(p, k);
   const double px = p.w[1] * fl.l + p.w[2] * fl.cx, py = p.w[2] * fl.cy;
@@ -362,7 +343,7 @@ LiftedPoint QueryEngine::Lift(const SurfacePoint& p) const {
 }
 
 void QueryEngine::PrefetchFace(const SurfacePoint& p) const {
-  __builtin_prefetch(&faces_[3 * p.face]);
+  __builtin_prefetch(&view_.faces[3 * p.face]);
   __builtin_prefetch(&face_lifts_[p.face]);
 }
 
@@ -370,7 +351,7 @@ void QueryEngine::PrefetchLift(const SurfacePoint& p) const {
   const int k = Heaviest(p);
   const FaceLift& fl = face_lifts_[p.face];
   if (p.w[k] >= 1.0 || fl.triangle < 0) {
-    __builtin_prefetch(&records_[faces_[3 * p.face + k]]);
+    __builtin_prefetch(&records_[view_.faces[3 * p.face + k]]);
   } else if (fl.approx >= 0) {
     const char* line = reinterpret_cast<const char*>(&ApproxLiftOf(fl, k));
     Touch(line, sizeof(ApproxLift));
@@ -378,7 +359,7 @@ void QueryEngine::PrefetchLift(const SurfacePoint& p) const {
 }
 
 LiftedPoint QueryEngine::SlowLift(const SurfacePoint& p, int heaviest) const {
-  const int32_t* f = &faces_[3 * p.face];
+  const int32_t* f = &view_.faces[3 * p.face];
   const int32_t t0 = records_[f[0]].triangle, t1 = records_[f[1]].triangle,
                 t2 = records_[f[2]].triangle;
   int k = heaviest;
@@ -479,8 +460,9 @@ bool QueryEngine::IsNearPair(const SurfacePoint& p, const SurfacePoint& q) const
 }
 
 mesh::Vec3 QueryEngine::PositionOf(const SurfacePoint& p) const {
-  const int32_t* f = &faces_[3 * p.face];
-  return p.w[0] * Position(f[0]) + p.w[1] * Position(f[1]) + p.w[2] * Position(f[2]);
+  const int32_t* f = &view_.faces[3 * p.face];
+  return p.w[0] * view_.Position(f[0]) + p.w[1] * view_.Position(f[1]) +
+         p.w[2] * view_.Position(f[2]);
 }
 
 double QueryEngine::AtLeastChord(const SurfacePoint& p, const SurfacePoint& q, double d) const {
@@ -524,8 +506,8 @@ double QueryEngine::BoundOf(AnswerKind kind, bool vertex_pair, double d) const {
   return 0;
 }
 
-double QueryEngine::Refine(const SurfacePoint& p, const SurfacePoint& q, double unfolded,
-                           bool near, const DistanceOptions& options, QueryScratch* scratch,
+double QueryEngine::Refine(const SurfacePoint& p, const SurfacePoint& q, double unfolded, bool near,
+                           const DistanceOptions& options, QueryScratch* scratch,
                            double* bound) const {
   if (!(unfolded < kInf)) {  // different components: exactly unreachable
     if (bound != nullptr) *bound = BoundOf(AnswerKind::kExact, false, unfolded);
@@ -618,8 +600,8 @@ bool QueryEngine::NeedsRefine(const DistanceOptions& options, bool bounds, bool 
 }
 
 absl::StatusOr<double> QueryEngine::Distance(const SurfacePoint& p, const SurfacePoint& q,
-                                             const DistanceOptions& options,
-                                             QueryScratch* scratch, double* bound) const {
+                                             const DistanceOptions& options, QueryScratch* scratch,
+                                             double* bound) const {
   GEODEX_RETURN_IF_ERROR(Validate(p));
   GEODEX_RETURN_IF_ERROR(Validate(q));
   GEODEX_RETURN_IF_ERROR(CheckOptions(options, bound != nullptr));
@@ -638,8 +620,8 @@ absl::Status QueryEngine::DistanceBatch(std::span<const SurfacePoint> a,
   if (a.size() != b.size() || a.size() != out.size() ||
       (!bounds.empty() && bounds.size() != out.size())) {
     return absl::InvalidArgumentError(
-        absl::StrFormat("batch arrays differ in length (%d, %d, %d, bounds %d)", a.size(),
-                        b.size(), out.size(), bounds.size()));
+        absl::StrFormat("batch arrays differ in length (%d, %d, %d, bounds %d)", a.size(), b.size(),
+                        out.size(), bounds.size()));
   }
   const bool want_bounds = !bounds.empty();
   GEODEX_RETURN_IF_ERROR(CheckOptions(options, want_bounds));
@@ -722,8 +704,9 @@ double QueryEngine::LinearInterpolationDistance(const SurfacePoint& p0,
   const LiftedPoint p = Lift(Canonical(p0)), q = Lift(Canonical(q0));
   if (!(Matrix(p.corner[0], q.corner[0]) < kInf)) return kInf;
   auto lambda = [&](const LiftedPoint& x) {
-    return UnfoldedBarycentric(Matrix(x.corner[0], x.corner[1]), Matrix(x.corner[1], x.corner[2]),
-                               Matrix(x.corner[2], x.corner[0]), x.distance);
+    return geometry::UnfoldedBarycentric(Matrix(x.corner[0], x.corner[1]),
+                                         Matrix(x.corner[1], x.corner[2]),
+                                         Matrix(x.corner[2], x.corner[0]), x.distance);
   };
   const auto lp = lambda(p), lq = lambda(q);
   double d = 0;
@@ -761,7 +744,8 @@ absl::StatusOr<DistanceField> QueryEngine::Field(std::span<const SurfacePoint> s
     }
     for (size_t s = 0; s < lifted.size(); ++s) {
       double d = LiftedDistance(lifted[s], x);
-      if (AreNear(lifted[s], x)) d = std::max(d, (at[s] - Position(v)).norm());  // AtLeastChord
+      if (AreNear(lifted[s], x))
+        d = std::max(d, (at[s] - view_.Position(v)).norm());  // AtLeastChord
       if (d < field.distance[v]) {
         field.distance[v] = d;
         field.nearest[v] = static_cast<int32_t>(s);

@@ -46,12 +46,19 @@
 #include "core/geodesic/exact_geodesic.h"
 #include "core/index/index.h"
 #include "core/mesh/mesh.h"
+#include "core/query/mesh_view.h"
 #include "core/query/point_locator.h"
 #include "core/query/unfold_kernel.h"
 
 namespace geodex::query {
 
 using mesh::SurfacePoint;
+
+namespace internal {  // core/query/face_lift.h
+struct FaceLift;
+struct ApproxLift;
+struct FaceFrame;
+}  // namespace internal
 
 // How Distance and DistanceBatch answer the pairs they refine by default:
 // near pairs (points in the same or adjacent geodesic triangles) and pairs
@@ -133,17 +140,38 @@ struct DistanceField {
   std::vector<int32_t> nearest;  // per vertex: index of the nearest source (-1 if none)
 };
 
+// QueryEngine answers approximate geodesic queries over one loaded index:
+// distances (O(1), refined near pairs as DistanceOptions says, with error
+// bounds when the index is calibrated), batches of them, distance fields,
+// traced paths and point location (see the header comment for how a
+// distance is answered). It is immutable once made: every const method is
+// thread-safe and may be called from any number of threads at once; the only
+// lazily made state (the mesh for exact refinement) is built once under a
+// std::once_flag. Scratch space is explicit (QueryScratch, one per thread).
+// It shares ownership of the index, which thus lives as long as the engine.
+//
+//   GEODEX_ASSIGN_OR_RETURN(std::shared_ptr<const index::Index> index,
+//                           index::Index::Open(path));
+//   GEODEX_ASSIGN_OR_RETURN(std::shared_ptr<const QueryEngine> engine,
+//                           QueryEngine::Create(std::move(index)));
+//   absl::StatusOr<double> d = engine->Distance(p, q);  // p, q: SurfacePoints
 class QueryEngine {
  public:
-  // Errors: FailedPrecondition if the index has no triangles.
+  // Makes an engine over `index`, deriving its per-face lifting data
+  // (O(faces)). Errors: InvalidArgument for a null index; FailedPrecondition
+  // if the index has no geodesic triangles or no samples.
   static absl::StatusOr<std::shared_ptr<const QueryEngine>> Create(
       std::shared_ptr<const index::Index> index, QueryOptions options = {});
+
+  ~QueryEngine();
 
   const index::Index& index() const { return *index_; }
   const QueryOptions& options() const { return options_; }
 
-  // Validates a point: OutOfRange for a face id past the end,
-  // InvalidArgument for NaN/Inf/negative weights or weights not summing to 1.
+  // Validates a point (mesh::ValidateSurfacePoint with the index's face
+  // count and QueryOptions::weight_tolerance): OutOfRange for a face id past
+  // the end, InvalidArgument for NaN/Inf/negative weights or weights not
+  // summing to 1.
   absl::Status Validate(const SurfacePoint& p) const;
 
   // Approximate geodesic distance; +inf between components. Validates both
@@ -161,8 +189,7 @@ class QueryEngine {
   // (the error names the pair index). Unrefined pairs allocate nothing.
   absl::Status DistanceBatch(std::span<const SurfacePoint> a, std::span<const SurfacePoint> b,
                              std::span<double> out, const DistanceOptions& options = {},
-                             QueryScratch* scratch = nullptr,
-                             std::span<double> bounds = {}) const;
+                             QueryScratch* scratch = nullptr, std::span<double> bounds = {}) const;
 
   // The length of the straightened gradient trace between the points, as
   // the refinement of Distance computes it (symmetric; a surface path, so
@@ -222,12 +249,14 @@ class QueryEngine {
   double LiftedDistance(const LiftedPoint& p, const LiftedPoint& q) const;
 
  private:
+  // The per-face lifting data derived at load (core/query/face_lift.h).
+  using FaceLift = internal::FaceLift;
+  using ApproxLift = internal::ApproxLift;
+  using FaceFrame = internal::FaceFrame;
+
   QueryEngine(std::shared_ptr<const index::Index> index, QueryOptions options);
   double Matrix(int32_t a, int32_t b) const {
     return static_cast<double>(matrix_[static_cast<size_t>(a) * num_samples_ + b]);
-  }
-  mesh::Vec3 Position(int32_t v) const {
-    return {positions_[3 * v], positions_[3 * v + 1], positions_[3 * v + 2]};
   }
   // Path restart chains for a valid point p: for each vertex one ring out
   // from p's face, that vertex, a vertex of p's face sharing a face with it,
@@ -254,41 +283,9 @@ class QueryEngine {
             {r.corner[0], r.corner[1], r.corner[2]},
             {r.distance[0], r.distance[1], r.distance[2]}};
   }
-  // Lifting of a face's interior points, derived at load, so that a lift
-  // costs one or two cache-line loads and no unfolding. The face lies in its
-  // plane (vertex 0 at the origin, vertex 1 at (l, 0), vertex 2 at (cx, cy)).
-  //  - Exact faces (all three vertices in the anchor triangle): per corner c,
-  //    the unfolded source of the corner's field, src[c], trilaterated from
-  //    the vertices' exact distances; a distance is |point - src[c]|.
-  //  - Approximate faces (a vertex outside the anchor triangle, or a sliver):
-  //    the paper's two-side unfolding (§5.2, case 4) about each face edge
-  //    puts corner c at a fixed image beyond the edge; the distance is the
-  //    smallest over the three images (ApproxLift). Faces whose vertices lie
-  //    in three different triangles take the anchor of the point's heaviest
-  //    vertex, so they keep three ApproxLifts.
-  //  - triangle -1: lifted by SlowLift (faces with a zero-length edge).
-  struct alignas(64) FaceLift {
-    int32_t triangle = -1;
-    int32_t corner[3] = {-1, -1, -1};
-    float l = 0, cx = 0, cy = 0;
-    int32_t approx = -1;  // first ApproxLift, or -1 for an exact face
-    int32_t anchors = 0;  // ApproxLifts of the face: 1, or 3 (by heaviest vertex)
-    float src[3][2] = {};
-  };
-  static_assert(sizeof(FaceLift) == 64);
-  struct ApproxLift {
-    int32_t triangle;
-    int32_t corner[3];
-    float image[3][3][2];  // [corner][face edge] = (x, y) in the face's plane
-  };
-  struct FaceFrame {
-    double l, cx, cy;
-  };
   // The ApproxLift a point of an approximate face uses; `heaviest` is its
   // face vertex of largest weight.
-  const ApproxLift& ApproxLiftOf(const FaceLift& fl, int heaviest) const {
-    return approx_lifts_[fl.approx + (fl.anchors == 3 ? heaviest : 0)];
-  }
+  const ApproxLift& ApproxLiftOf(const FaceLift& fl, int heaviest) const;
   // The ApproxLift of `face` anchored on the triangle of its vertex `k`.
   ApproxLift MakeApproxLift(const int32_t* face_vertices, const FaceFrame& frame, int k) const;
   FaceFrame FaceFrameOf(const int32_t* face_vertices) const;
@@ -357,9 +354,7 @@ class QueryEngine {
 
   std::shared_ptr<const index::Index> index_;
   QueryOptions options_;
-  std::span<const double> positions_;
-  std::span<const int32_t> faces_;
-  std::span<const int32_t> twins_;
+  MeshView view_;  // the index's positions, faces and twins
   std::span<const float> matrix_;
   std::span<const index::VertexRecord> records_;
   std::span<const index::GeodesicTriangle> triangles_;

@@ -12,6 +12,7 @@
 #include "absl/strings/str_format.h"
 #include "core/common/status_macros.h"
 #include "core/geodesic/exact_geodesic.h"
+#include "core/geometry/unfolding.h"
 #include "core/query/path_straightening.h"
 #include "core/query/query_engine.h"
 
@@ -20,16 +21,14 @@ namespace {
 
 using mesh::Vec3;
 
+// Steps a walk round a vertex takes at most (a guard against broken twins).
+constexpr int kMaxFanSteps = 1024;
+
 struct Tracer {
   const QueryEngine& engine;
-  std::span<const double> positions;
-  std::span<const int32_t> faces;
-  std::span<const int32_t> twins;
+  const MeshView& mesh;
   LiftedPoint source;
   absl::flat_hash_map<int32_t, double> cache;
-
-  Vec3 P(int32_t v) const { return {positions[3 * v], positions[3 * v + 1], positions[3 * v + 2]}; }
-  int32_t V(int32_t f, int i) const { return faces[3 * f + i]; }
 
   // Approximate distance from the source to vertex v (O(1), memoised).
   double D(int32_t v) {
@@ -54,8 +53,9 @@ struct Tracer {
   // field is planar. When the distances do not fit a point (|residual| large)
   // the gradient of their linear interpolant is used instead.
   std::array<double, 3> Descent(int32_t f, const std::array<double, 3>& b, double* magnitude) {
-    const Vec3 v[3] = {P(V(f, 0)), P(V(f, 1)), P(V(f, 2))};
-    const double d[3] = {D(V(f, 0)), D(V(f, 1)), D(V(f, 2))};
+    const Vec3 v[3] = {mesh.Position(mesh.Vertex(f, 0)), mesh.Position(mesh.Vertex(f, 1)),
+                       mesh.Position(mesh.Vertex(f, 2))};
+    const double d[3] = {D(mesh.Vertex(f, 0)), D(mesh.Vertex(f, 1)), D(mesh.Vertex(f, 2))};
     const Vec3 e1 = v[1] - v[0], e2 = v[2] - v[0];
     const Vec3 n = e1.cross(e2);
     const double area2 = n.squaredNorm();
@@ -68,8 +68,8 @@ struct Tracer {
     const double cx = e2.dot(ux), cy = e2.dot(uy);
     bool planar = false;
     if (cy > 1e-6 * l) {
-      const double sx = (l * l + d[0] * d[0] - d[1] * d[1]) / (2 * l);
-      const double sy = (cx * cx + cy * cy - 2 * sx * cx + d[0] * d[0] - d[2] * d[2]) / (2 * cy);
+      double sx, sy;
+      geometry::Trilaterate(l, cx, cy, d[0], d[1], d[2], &sx, &sy);
       const double r0 = std::sqrt(sx * sx + sy * sy);
       planar = std::abs(r0 - d[0]) < 1e-3 * (d[0] + l);
       if (planar) {
@@ -87,27 +87,16 @@ struct Tracer {
 
   // Faces around vertex v, starting from face f.
   std::vector<int32_t> FacesAround(int32_t v, int32_t f) const {
-    std::vector<int32_t> out = {f};
-    for (int dir = 0; dir < 2; ++dir) {
-      int32_t g = f;
-      for (size_t guard = 0; guard < 1024; ++guard) {
-        int k = 0;
-        while (V(g, k) != v) ++k;
-        const int32_t h = dir == 0 ? 3 * g + k : 3 * g + (k + 2) % 3;
-        const int32_t t = twins[h];
-        if (t < 0) break;
-        g = t / 3;
-        if (g == f) return out;
-        out.push_back(g);
-      }
-    }
+    std::vector<int32_t> out;
+    mesh.FacesAround(v, f, kMaxFanSteps, &out);
     return out;
   }
 };
 
 // Path restarts are tried when the straightened path is longer than the
-// approximate distance by more than this factor. Approximate distances err by
-// 0.6% RMS at m=1000 on bunny; paths in a wrong corridor exceed it by 2%.
+// approximate distance by more than this factor: above the approximate
+// distance's usual error, below the excess of a path in a wrong corridor
+// (figures: tests/bench/README.md).
 constexpr double kPathRestartRatio = 1.01;
 
 // True when a point strictly inside the path is a mesh vertex: there the
@@ -124,13 +113,6 @@ double PathLength(const std::vector<PathPoint>& path) {
   double sum = 0;
   for (size_t i = 1; i < path.size(); ++i) sum += (path[i].position - path[i - 1].position).norm();
   return sum;
-}
-
-int LocalIndex(std::span<const int32_t> faces, int32_t f, int32_t v) {
-  for (int i = 0; i < 3; ++i) {
-    if (faces[3 * f + i] == v) return i;
-  }
-  return -1;
 }
 
 }  // namespace
@@ -166,7 +148,7 @@ absl::StatusOr<std::vector<PathPoint>> QueryEngine::CorridorPath(const std::vect
     const size_t end = faces.size();
     for (size_t i = begin; i < end; ++i) {
       for (int k = 0; k < 3; ++k) {
-        const int32_t twin = twins_[3 * faces[i] + k];
+        const int32_t twin = view_.twins[3 * faces[i] + k];
         if (twin < 0) continue;
         const int32_t g = twin / 3;
         if (local_face.try_emplace(g, faces.size()).second) faces.push_back(g);
@@ -177,20 +159,20 @@ absl::StatusOr<std::vector<PathPoint>> QueryEngine::CorridorPath(const std::vect
   // A vertex whose corridor faces form more than one fan would make the
   // corridor non-manifold: such vertices get their whole star, until there
   // are none.
-  const Tracer tr{*this, positions_, faces_, twins_, {}, {}};
+  const Tracer tr{*this, view_, {}, {}};
   for (bool pinched = true; pinched;) {
     pinched = false;
     std::unordered_map<int32_t, int32_t> a_face_of;  // corridor vertex -> a corridor face
     for (int32_t f : faces) {
-      for (int k = 0; k < 3; ++k) a_face_of.try_emplace(faces_[3 * f + k], f);
+      for (int k = 0; k < 3; ++k) a_face_of.try_emplace(view_.faces[3 * f + k], f);
     }
     for (const auto& [v, f] : a_face_of) {
       const std::vector<int32_t> star = tr.FacesAround(v, f);
       int fan_ends = 0;
       for (int32_t g : star) {
         if (!local_face.contains(g)) continue;
-        const int32_t h = 3 * g + LocalIndex(faces_, g, v);  // the edge leaving v in g
-        fan_ends += twins_[h] < 0 || !local_face.contains(twins_[h] / 3);
+        const int32_t h = 3 * g + view_.Corner(g, v);  // the edge leaving v in g
+        fan_ends += view_.twins[h] < 0 || !local_face.contains(view_.twins[h] / 3);
       }
       if (fan_ends <= 1) continue;
       pinched = true;
@@ -206,9 +188,9 @@ absl::StatusOr<std::vector<PathPoint>> QueryEngine::CorridorPath(const std::vect
   for (int32_t f : faces) {
     mesh::Triangle t;
     for (int k = 0; k < 3; ++k) {
-      const int32_t v = faces_[3 * f + k];
+      const int32_t v = view_.faces[3 * f + k];
       auto [it, added] = local_vertex.try_emplace(v, positions.size());
-      if (added) positions.push_back(Position(v));
+      if (added) positions.push_back(view_.Position(v));
       t[k] = it->second;
     }
     triangles.push_back(t);
@@ -238,8 +220,7 @@ absl::StatusOr<std::vector<PathPoint>> QueryEngine::ShortestTrace(const SurfaceP
   GEODEX_RETURN_IF_ERROR(Validate(to));
   GEODEX_ASSIGN_OR_RETURN(std::vector<PathPoint> path, TracePath(from, to));
   if (!options_.straighten_paths) return path;
-  const MeshArrays mesh{positions_, faces_, twins_};
-  path = StraightenPath(mesh, std::move(path));
+  path = StraightenPath(view_, std::move(path));
   double best = PathLength(path);
   // Keeps `candidate` (running from `from` to `to`) if it is shorter, with
   // the exact endpoints as given.
@@ -253,23 +234,22 @@ absl::StatusOr<std::vector<PathPoint>> QueryEngine::ShortestTrace(const SurfaceP
   };
   // A near pair's straightened trace that wraps round no vertex is a
   // straight line through the unfolded faces it crosses, a local geodesic;
-  // between points this close, practically the shortest path. On 1,500 near
-  // pairs each of bunny_closed_30k and bunny_35k (m=1000), camelhead,
-  // rocker_arm, kitten and fandisk (m=250), such traces (79-97% of them)
-  // were within 0.07% of exact at p99 (max 0.8%), while traces that wrapped
-  // were 7-52% off at p99 and needed the other trace.
+  // between points this close, practically the shortest path. On scanned
+  // and CAD meshes most near-pair traces are such, and close to exact, while
+  // traces that wrapped were far off and needed the other trace (figures:
+  // tests/bench/README.md).
   if (search == TraceSearch::kNearPair && !WrapsRoundAVertex(path)) return path;
   // The trace of the other point's field may run in a better corridor (the
   // two approximate fields err differently).
   absl::StatusOr<std::vector<PathPoint>> back = TracePath(to, from);
   if (back.ok()) {
-    std::vector<PathPoint> other = StraightenPath(mesh, *std::move(back));
+    std::vector<PathPoint> other = StraightenPath(view_, *std::move(back));
     std::reverse(other.begin(), other.end());
     offer(std::move(other));
   }
   // Restarts. Beside a cut locus of the approximate field, the trace can
   // settle in a corridor round the wrong side of a feature: a local
-  // geodesic, but 1-2% longer than the shortest path, so the straightened
+  // geodesic, but longer than the shortest path, so the straightened
   // length exceeds the approximate distance by more than its usual error.
   // Then trace again from each vertex one ring out from either end's face,
   // join the end along one or two mesh edges, straighten, and keep the
@@ -287,7 +267,7 @@ absl::StatusOr<std::vector<PathPoint>> QueryEngine::ShortestTrace(const SurfaceP
       if (!trace.ok()) continue;
       std::vector<PathPoint> candidate = *std::move(trace);
       candidate.insert(candidate.end(), chain.begin() + 1, chain.end());
-      candidate = StraightenPath(mesh, std::move(candidate));
+      candidate = StraightenPath(view_, std::move(candidate));
       if (end == 1) std::reverse(candidate.begin(), candidate.end());
       offer(std::move(candidate));
     }
@@ -308,18 +288,19 @@ std::optional<QueryEngine::Trace> QueryEngine::PathNearDistance(const SurfacePoi
 std::vector<std::vector<PathPoint>> QueryEngine::RingChains(const SurfacePoint& p) const {
   auto vertex_point = [&](int32_t f, int32_t v) {
     SurfacePoint point{f, {0, 0, 0}};
-    point.w[LocalIndex(faces_, f, v)] = 1;
-    return PathPoint{point, Position(v)};
+    point.w[view_.Corner(f, v)] = 1;
+    return PathPoint{point, view_.Position(v)};
   };
   const PathPoint tip{p, PositionOf(p)};
-  Tracer tr{*this, positions_, faces_, twins_, {}, {}};
+  Tracer tr{*this, view_, {}, {}};
   std::vector<std::vector<PathPoint>> chains;
-  std::vector<int32_t> seen = {faces_[3 * p.face], faces_[3 * p.face + 1], faces_[3 * p.face + 2]};
+  std::vector<int32_t> seen = {view_.faces[3 * p.face], view_.faces[3 * p.face + 1],
+                               view_.faces[3 * p.face + 2]};
   for (int i = 0; i < 3; ++i) {
-    const int32_t u = faces_[3 * p.face + i];
+    const int32_t u = view_.faces[3 * p.face + i];
     for (int32_t g : tr.FacesAround(u, p.face)) {
       for (int k = 0; k < 3; ++k) {
-        const int32_t w = faces_[3 * g + k];
+        const int32_t w = view_.faces[3 * g + k];
         if (std::find(seen.begin(), seen.end(), w) != seen.end()) continue;
         seen.push_back(w);
         chains.push_back({vertex_point(g, w), vertex_point(g, u), tip});
@@ -332,19 +313,19 @@ std::vector<std::vector<PathPoint>> QueryEngine::RingChains(const SurfacePoint& 
 absl::StatusOr<std::vector<PathPoint>> QueryEngine::TracePath(const SurfacePoint& from_in,
                                                               const SurfacePoint& to_in) const {
   const SurfacePoint from = Canonical(from_in), to = Canonical(to_in);
-  Tracer tr{*this, positions_, faces_, twins_, Lift(from), {}};
+  Tracer tr{*this, view_, Lift(from), {}};
   if (!(LiftedDistance(tr.source, Lift(to)) < std::numeric_limits<double>::infinity())) {
     return absl::NotFoundError("the two points lie on different connected components");
   }
   // The source's support: the vertices with non-zero weight.
   absl::InlinedVector<int32_t, 3> support;
   for (int i = 0; i < 3; ++i) {
-    if (from.w[i] > 0) support.push_back(faces_[3 * from.face + i]);
+    if (from.w[i] > 0) support.push_back(view_.faces[3 * from.face + i]);
   }
   auto contains_source = [&](int32_t f) {
     if (f == from.face) return true;
     for (int32_t v : support) {
-      if (LocalIndex(faces_, f, v) < 0) return false;
+      if (view_.Corner(f, v) < 0) return false;
     }
     return true;  // the source is a vertex or edge point of f
   };
@@ -354,7 +335,7 @@ absl::StatusOr<std::vector<PathPoint>> QueryEngine::TracePath(const SurfacePoint
   };
   auto vertex_point = [&](int32_t f, int32_t v) {
     std::array<double, 3> b = {0, 0, 0};
-    b[LocalIndex(faces_, f, v)] = 1;
+    b[view_.Corner(f, v)] = 1;
     return point_at(f, b);
   };
 
@@ -364,7 +345,7 @@ absl::StatusOr<std::vector<PathPoint>> QueryEngine::TracePath(const SurfacePoint
   const Vec3 goal = point_at(from.face, from.w).position;
   auto finish_on_graph = [&](std::vector<PathPoint>& path, int32_t v,
                              int32_t f) -> absl::StatusOr<std::vector<PathPoint>> {
-    if (path.back().position != Position(v)) path.push_back(vertex_point(f, v));
+    if (path.back().position != view_.Position(v)) path.push_back(vertex_point(f, v));
     struct Node {
       double g;
       int32_t face;  // a face containing the vertex and its parent
@@ -374,26 +355,26 @@ absl::StatusOr<std::vector<PathPoint>> QueryEngine::TracePath(const SurfacePoint
     using Item = std::pair<double, int32_t>;
     std::priority_queue<Item, std::vector<Item>, std::greater<>> open;
     seen[v] = {0, f, -1};
-    open.push({(Position(v) - goal).norm(), v});
+    open.push({(view_.Position(v) - goal).norm(), v});
     int32_t reached = -1;
     while (!open.empty()) {
       const auto [key, u] = open.top();
       open.pop();
       const Node node = seen[u];
-      if (key > node.g + (Position(u) - goal).norm() + 1e-12) continue;  // stale
-      if (LocalIndex(faces_, from.face, u) >= 0) {
+      if (key > node.g + (view_.Position(u) - goal).norm() + 1e-12) continue;  // stale
+      if (view_.Corner(from.face, u) >= 0) {
         reached = u;
         break;
       }
       for (int32_t g : tr.FacesAround(u, node.face)) {
         for (int i = 0; i < 3; ++i) {
-          const int32_t w = faces_[3 * g + i];
+          const int32_t w = view_.faces[3 * g + i];
           if (w == u) continue;
-          const double cost = node.g + (Position(w) - Position(u)).norm();
+          const double cost = node.g + (view_.Position(w) - view_.Position(u)).norm();
           auto it = seen.find(w);
           if (it != seen.end() && it->second.g <= cost) continue;
           seen[w] = {cost, g, u};
-          open.push({cost + (Position(w) - goal).norm(), w});
+          open.push({cost + (view_.Position(w) - goal).norm(), w});
         }
       }
     }
@@ -414,7 +395,7 @@ absl::StatusOr<std::vector<PathPoint>> QueryEngine::TracePath(const SurfacePoint
   std::array<double, 3> b = to.w;
   int32_t at_vertex = -1;  // set while the path sits on a vertex
   for (int i = 0; i < 3; ++i) {
-    if (b[i] >= 1) at_vertex = faces_[3 * f + i];
+    if (b[i] >= 1) at_vertex = view_.faces[3 * f + i];
   }
   const int64_t max_steps = 8 * int64_t{index_->num_faces()} + 64;
   // A face entered again and again means the approximate field circles
@@ -422,7 +403,7 @@ absl::StatusOr<std::vector<PathPoint>> QueryEngine::TracePath(const SurfacePoint
   absl::flat_hash_map<int32_t, int> visits;
   for (int64_t step = 0; step < max_steps; ++step) {
     if (++visits[f] > 6)
-      return finish_on_graph(path, at_vertex >= 0 ? at_vertex : faces_[3 * f], f);
+      return finish_on_graph(path, at_vertex >= 0 ? at_vertex : view_.faces[3 * f], f);
     if (contains_source(f)) {
       path.push_back(point_at(from.face, from.w));
       std::reverse(path.begin(), path.end());
@@ -439,7 +420,7 @@ absl::StatusOr<std::vector<PathPoint>> QueryEngine::TracePath(const SurfacePoint
           break;
         }
         double magnitude;
-        const int k = LocalIndex(faces_, g, v);
+        const int k = view_.Corner(g, v);
         std::array<double, 3> at = {0, 0, 0};
         at[k] = 1;
         const auto beta = tr.Descent(g, at, &magnitude);
@@ -453,7 +434,7 @@ absl::StatusOr<std::vector<PathPoint>> QueryEngine::TracePath(const SurfacePoint
       if (best_face >= 0) {
         f = best_face;
         b = {0, 0, 0};
-        b[LocalIndex(faces_, f, v)] = 1;
+        b[view_.Corner(f, v)] = 1;
         if (contains_source(f)) continue;
         at_vertex = -1;
         // Fall through to the face step below from the vertex.
@@ -463,7 +444,7 @@ absl::StatusOr<std::vector<PathPoint>> QueryEngine::TracePath(const SurfacePoint
         double lowest = tr.D(v);
         for (int32_t g : tr.FacesAround(v, f)) {
           for (int i = 0; i < 3; ++i) {
-            const int32_t u = faces_[3 * g + i];
+            const int32_t u = view_.faces[3 * g + i];
             if (u != v && tr.D(u) < lowest) {
               lowest = tr.D(u);
               next = u;
@@ -501,9 +482,9 @@ absl::StatusOr<std::vector<PathPoint>> QueryEngine::TracePath(const SurfacePoint
       // No way forward inside this face: go to its lowest vertex.
       int k = 0;
       for (int i = 1; i < 3; ++i) {
-        if (tr.D(faces_[3 * f + i]) < tr.D(faces_[3 * f + k])) k = i;
+        if (tr.D(view_.faces[3 * f + i]) < tr.D(view_.faces[3 * f + k])) k = i;
       }
-      at_vertex = faces_[3 * f + k];
+      at_vertex = view_.faces[3 * f + k];
       path.push_back(vertex_point(f, at_vertex));
       continue;
     }
@@ -513,7 +494,7 @@ absl::StatusOr<std::vector<PathPoint>> QueryEngine::TracePath(const SurfacePoint
     for (double& x : b) x /= sum;
     path.push_back(point_at(f, b));
     for (int i = 0; i < 3; ++i) {
-      if (b[i] >= 1 - 1e-12) at_vertex = faces_[3 * f + i];
+      if (b[i] >= 1 - 1e-12) at_vertex = view_.faces[3 * f + i];
     }
     if (at_vertex >= 0) {
       path.back() = vertex_point(f, at_vertex);
@@ -521,10 +502,11 @@ absl::StatusOr<std::vector<PathPoint>> QueryEngine::TracePath(const SurfacePoint
     }
     // Cross the edge opposite `exit` into the neighbouring face.
     const int32_t h = 3 * f + (exit + 1) % 3;
-    const int32_t g = twins_[h];
+    const int32_t g = view_.twins[h];
     if (g < 0) {
       // A boundary edge: slide to its lower end.
-      const int32_t a = faces_[3 * f + (exit + 1) % 3], c = faces_[3 * f + (exit + 2) % 3];
+      const int32_t a = view_.faces[3 * f + (exit + 1) % 3],
+                    c = view_.faces[3 * f + (exit + 2) % 3];
       at_vertex = tr.D(a) <= tr.D(c) ? a : c;
       path.push_back(vertex_point(f, at_vertex));
       continue;
@@ -535,7 +517,7 @@ absl::StatusOr<std::vector<PathPoint>> QueryEngine::TracePath(const SurfacePoint
     f = g / 3;
     b = nb;
   }
-  return finish_on_graph(path, at_vertex >= 0 ? at_vertex : faces_[3 * f], f);
+  return finish_on_graph(path, at_vertex >= 0 ? at_vertex : view_.faces[3 * f], f);
 }
 
 }  // namespace geodex::query

@@ -20,6 +20,8 @@
 #include <cmath>
 #include <limits>
 
+#include "core/geometry/unfolding.h"
+
 #if defined(__AVX2__)
 #include <immintrin.h>
 #endif
@@ -66,6 +68,12 @@ void FarDistancesOneByOne(const FarPair* pairs, double* out);
 // Defined in unfold_kernel_avx2.cc; call only when HasAvx2Lanes().
 void FarDistancesAvx2(const FarPair* pairs, double* out);
 
+// For tests of the lanes against one point at a time: out[k] =
+// PlaceInTriangle(frames[k], d[k]) for k < kLanes, computed in AVX2 lanes.
+// Defined in unfold_kernel_avx2.cc; call only when HasAvx2Lanes().
+void PlaceInTriangleAvx2(const Frame<double>* const* frames, const double* const* d,
+                         Placed<double>* out);
+
 #if defined(__AVX2__)
 inline namespace avx2 {
 #else
@@ -107,10 +115,11 @@ inline T Max0(T v) {
 
 // Places a point at distances (da, db) from the edge's ends, y >= 0;
 // distances that break the triangle inequality are clamped onto the edge.
+// geometry::Place with the frame's stored 1 / (2 l).
 template <typename T>
 inline void PlaceOn(const Frame<T>& e, T da, T db, T* x, T* y) {
-  *x = (e.l * e.l + da * da - db * db) * e.inv_2l;
-  *y = Sqrt(Max0(da * da - *x * *x));
+  *x = geometry::AlongEdgeInv2l(e.l, e.inv_2l, da, db);
+  *y = Sqrt(Max0(geometry::HeightSquared(da, *x)));
 }
 
 // True when a placement at height y from distance d is almost on the edge's
@@ -147,8 +156,7 @@ inline Placed<T> PlaceInTriangle(const Frame<T>* frames, const T* d) {
     PlaceSigned(e, da, d[(i + 1) % 3], dc, &out.x[i], &out.y[i]);
     // Near the edge's line: take the height from the third corner instead
     // (linear, conditioned by the triangle's height; the point is near).
-    const T from_third =
-        (e.cx * e.cx + e.cy * e.cy - 2.0 * out.x[i] * e.cx + da * da - dc * dc) / (2.0 * e.cy);
+    const T from_third = geometry::HeightFromThirdCorner(e.cx, e.cy, out.x[i], da, dc);
     out.y[i] = Select(And(Weak(out.y[i], da, 1e-4), e.cy > 1e-3 * e.l), from_third, out.y[i]);
   }
   return out;

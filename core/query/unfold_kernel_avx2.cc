@@ -31,4 +31,24 @@ void FarDistancesAvx2(const FarPair* pairs, double* out) {
   for (int k = 0; k < kLanes; ++k) out[k] = d[k];
 }
 
+void PlaceInTriangleAvx2(const Frame<double>* const* frames, const double* const* d,
+                         Placed<double>* out) {
+  Frame<Lanes> lane_frames[3];
+  Lanes lane_d[3];
+  for (int i = 0; i < 3; ++i) {
+    lane_frames[i] = Frame<Lanes>{MakeLanes([&](int k) { return frames[k][i].l; }),
+                                  MakeLanes([&](int k) { return frames[k][i].cx; }),
+                                  MakeLanes([&](int k) { return frames[k][i].cy; }),
+                                  MakeLanes([&](int k) { return frames[k][i].inv_2l; })};
+    lane_d[i] = MakeLanes([&](int k) { return d[k][i]; });
+  }
+  const Placed<Lanes> placed = PlaceInTriangle(lane_frames, lane_d);
+  for (int k = 0; k < kLanes; ++k) {
+    for (int i = 0; i < 3; ++i) {
+      out[k].x[i] = placed.x[i][k];
+      out[k].y[i] = placed.y[i][k];
+    }
+  }
+}
+
 }  // namespace geodex::query::kernel

@@ -19,8 +19,7 @@ void Frames(double ab, double bc, double ca, Frame<double>* out) {
     Frame<double>& e = out[i];
     e.l = l;
     if (l > 0) {
-      e.cx = (l * l + to_a * to_a - to_b * to_b) / (2 * l);
-      e.cy = std::sqrt(std::max(to_a * to_a - e.cx * e.cx, 0.0));
+      geometry::Place(l, to_a, to_b, &e.cx, &e.cy);
       e.inv_2l = 1 / (2 * l);
     } else {
       e.cx = e.cy = e.inv_2l = 0;
@@ -78,6 +77,28 @@ TEST(UnfoldKernelTest, Avx2LanesEqualOnePairAtATimeToTheBit) {
     for (int i = 0; i < kLanes; ++i) {
       ASSERT_EQ(std::memcmp(&lanes[i], &one[i], sizeof(double)), 0)
           << "pair " << k + i << ": " << lanes[i] << " vs " << one[i];
+    }
+  }
+}
+
+// The unfolding of core/geometry/unfolding.h as the kernel instantiates it
+// (PlaceOn: AlongEdgeInv2l and HeightSquared; HeightFromThirdCorner), in
+// lanes and one point at a time.
+TEST(UnfoldKernelTest, Avx2PlacementEqualsOnePointAtATimeToTheBit) {
+  if (!HasAvx2Lanes()) GTEST_SKIP() << "this build or CPU has no AVX2: the lanes are not used";
+  const RandomPairs random(40000, 7);
+  for (size_t k = 0; k + kLanes <= random.pairs.size(); k += kLanes) {
+    const Frame<double>* frames[kLanes];
+    const double* d[kLanes];
+    for (int i = 0; i < kLanes; ++i) {
+      frames[i] = random.pairs[k + i].p_frames;
+      d[i] = random.pairs[k + i].p_distance;
+    }
+    Placed<double> lanes[kLanes];
+    PlaceInTriangleAvx2(frames, d, lanes);
+    for (int i = 0; i < kLanes; ++i) {
+      const Placed<double> one = PlaceInTriangle(frames[i], d[i]);
+      ASSERT_EQ(std::memcmp(&lanes[i], &one, sizeof(one)), 0) << "point " << k + i;
     }
   }
 }

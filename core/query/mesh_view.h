@@ -1,0 +1,65 @@
+#pragma once
+
+// A read-only view of a mesh as the index stores it, with the few walks the
+// query code needs: vertex positions, face corners, twins, and the fan of
+// faces round a vertex. Internal to core/query (QueryEngine, the path
+// tracer, the path straightener).
+//
+// Thread safety: a view of immutable arrays; every method is const and
+// thread-safe.
+
+#include <cstdint>
+#include <span>
+
+#include "core/mesh/mesh.h"
+
+namespace geodex::query {
+
+// xyz per vertex, 3 vertex ids per face, and the twin of each half-edge
+// (3 f + i: from corner i to corner i+1) or -1 on the boundary.
+struct MeshView {
+  std::span<const double> positions;
+  std::span<const int32_t> faces;
+  std::span<const int32_t> twins;
+
+  mesh::Vec3 Position(int32_t v) const {
+    return {positions[3 * v], positions[3 * v + 1], positions[3 * v + 2]};
+  }
+  // The vertex at corner i of face f.
+  int32_t Vertex(int32_t f, int i) const { return faces[3 * f + i]; }
+  // The corner of face f at vertex v, or -1 when f does not hold v.
+  int Corner(int32_t f, int32_t v) const {
+    for (int i = 0; i < 3; ++i) {
+      if (faces[3 * f + i] == v) return i;
+    }
+    return -1;
+  }
+  // One step round vertex v: the face across the edge of f that leaves v
+  // (dir 0) or enters it (dir 1); -1 at the boundary or when f does not
+  // hold v.
+  int32_t Turn(int32_t f, int32_t v, int dir) const {
+    const int k = Corner(f, v);
+    if (k < 0) return -1;
+    const int32_t t = twins[dir == 0 ? 3 * f + k : 3 * f + (k + 2) % 3];
+    return t < 0 ? -1 : t / 3;
+  }
+  // Appends the faces round vertex v to *out: f first, then the faces one
+  // step after another in direction 0 until the fan closes back on f, or,
+  // at a boundary, those of direction 1 too. At most max_steps steps a
+  // direction: a guard against broken twins, far above any valence.
+  template <typename Faces>
+  void FacesAround(int32_t v, int32_t f, int max_steps, Faces* out) const {
+    out->push_back(f);
+    for (int dir = 0; dir < 2; ++dir) {
+      int32_t g = f;
+      for (int step = 0; step < max_steps; ++step) {
+        g = Turn(g, v, dir);
+        if (g < 0) break;
+        if (g == f) return;
+        out->push_back(g);
+      }
+    }
+  }
+};
+
+}  // namespace geodex::query
