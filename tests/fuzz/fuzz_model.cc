@@ -40,17 +40,16 @@ const std::string& FuzzIndexBytes() {
 }
 
 const query::QueryEngine& FuzzEngine() {
-  static const query::QueryEngine* const engine =
-      [] {
-        auto index = index::Index::FromBytes(FuzzIndexBytes());
-        if (!index.ok()) Die(index.status());
-        auto created = query::QueryEngine::Create(*std::move(index));
-        if (!created.ok()) Die(created.status());
-        // Kept alive for the process, like the server's loaded model.
-        return new std::shared_ptr<const query::QueryEngine>(*std::move(created));
-      }()
-          ->get();
-  return *engine;
+  // Held for the process, like the server's loaded model (and reachable, so
+  // LeakSanitizer does not count it).
+  static const std::shared_ptr<const query::QueryEngine>* const engine = [] {
+    auto index = index::Index::FromBytes(FuzzIndexBytes());
+    if (!index.ok()) Die(index.status());
+    auto created = query::QueryEngine::Create(*std::move(index));
+    if (!created.ok()) Die(created.status());
+    return new std::shared_ptr<const query::QueryEngine>(*std::move(created));
+  }();
+  return **engine;
 }
 
 }  // namespace geodex::fuzz

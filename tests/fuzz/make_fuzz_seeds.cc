@@ -10,6 +10,7 @@
 #include "core/builder/builder.h"
 #include "core/index/index.h"
 #include "core/mesh/generators.h"
+#include "core/validation/calibration.h"
 #include "geodex/v1/geodex.pb.h"
 
 namespace {
@@ -20,9 +21,9 @@ void Write(const std::string& path, const std::string& bytes) {
   if (!out) std::fprintf(stderr, "cannot write %s\n", path.c_str());
 }
 
-std::string TinyIndex() {
-  // The smallest index the builder makes: a 2x2 grid with 4 samples, without
-  // calibration (the fuzzer finds the accuracy section in the other seed).
+// An index of a 2x2 grid with 4 samples, small enough to mutate; with
+// `calibrate`, with its accuracy section (format 1.1).
+std::string TinyIndex(bool calibrate) {
   geodex::builder::BuildOptions options;
   options.num_samples = 4;
   options.threads = 1;
@@ -30,6 +31,10 @@ std::string TinyIndex() {
   auto data =
       geodex::builder::BuildIndex(geodex::mesh::gen::Grid(2, 2, 1.0, 1.0), options, &summary);
   if (!data.ok()) return "";
+  if (calibrate &&
+      !geodex::validation::AddCalibration(geodex::mesh::gen::Grid(2, 2, 1.0, 1.0), *data).ok()) {
+    return "";
+  }
   auto bytes = geodex::index::SerializeIndex(*data);
   return bytes.ok() ? *bytes : "";
 }
@@ -49,7 +54,8 @@ int main(int argc, char** argv) {
     return 2;
   }
   const std::string dir = argv[1];
-  Write(dir + "/index/seed_grid", TinyIndex());
+  Write(dir + "/index/seed_grid", TinyIndex(false));
+  Write(dir + "/index/seed_grid_calibrated", TinyIndex(true));
 
   // One far pair, one near pair and a vertex-on-vertex pair.
   geodex::v1::DistanceRequest distance;
