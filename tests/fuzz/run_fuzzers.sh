@@ -37,7 +37,13 @@ if [[ ! -f "$build_dir/build.ninja" ]]; then
   CC=clang CXX=clang++ cmake -S "$repo" -B "$build_dir" -G Ninja \
     -DGEODEX_BUILD_FUZZERS=ON -DGEODEX_WITH_CGAL=OFF >/dev/null
 fi
-nice -n 10 cmake --build "$build_dir" -j2 --target $(printf 'fuzz_%s ' "${targets[@]}")
+build_log="$build_dir/run_fuzzers_build.log"
+if ! nice -n 10 cmake --build "$build_dir" -j2 --target $(printf 'fuzz_%s ' "${targets[@]}") \
+    >"$build_log" 2>&1; then
+  tail -n 40 "$build_log"
+  echo "FAILED: building the fuzz targets (log $build_log)"
+  exit 1
+fi
 
 if [[ -n "$keep" ]]; then
   work="$keep"
