@@ -1,0 +1,91 @@
+#!/usr/bin/env bash
+# Builds the libFuzzer targets (clang, ASan + UBSan) in BUILD_DIR (default
+# <repo>/build-fuzz, reused when it exists) and runs each for N seconds on a
+# copy of its seed corpus (tests/fuzz/corpus/<target>). Exits non-zero on any
+# crash, sanitizer report, leak or slow input (> 1 s); prints the executions
+# of every target.
+#
+#   tests/fuzz/run_fuzzers.sh [--seconds N] [--build-dir DIR] [--keep DIR] [TARGET...]
+#
+# TARGET: obj ply off index pairs request (default: all). With --keep, the
+# grown corpora and any crashing inputs are left in DIR (a temporary
+# directory, removed at exit, otherwise).
+set -euo pipefail
+
+repo="$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)"
+seconds=20
+build_dir="$repo/build-fuzz"
+keep=""
+targets=()
+while [[ $# -gt 0 ]]; do
+  case "$1" in
+    --seconds) seconds="$2"; shift 2 ;;
+    --build-dir) build_dir="$2"; shift 2 ;;
+    --keep) keep="$2"; shift 2 ;;
+    -h|--help) sed -n '2,13p' "$0"; exit 0 ;;
+    -*) echo "unknown option $1" >&2; exit 2 ;;
+    *) targets+=("$1"); shift ;;
+  esac
+done
+[[ ${#targets[@]} -gt 0 ]] || targets=(obj ply off index pairs request)
+
+# Longest input worth mutating, per target: meshes and requests of a few
+# hundred elements exercise every path; longer inputs only slow the search.
+declare -A max_len=([obj]=4096 [ply]=4096 [off]=4096 [index]=16384 [pairs]=2048 [request]=2048)
+
+if [[ ! -f "$build_dir/build.ninja" ]]; then
+  CC=clang CXX=clang++ cmake -S "$repo" -B "$build_dir" -G Ninja \
+    -DGEODEX_BUILD_FUZZERS=ON -DGEODEX_WITH_CGAL=OFF >/dev/null
+fi
+build_log="$build_dir/run_fuzzers_build.log"
+if ! nice -n 10 cmake --build "$build_dir" -j2 --target $(printf 'fuzz_%s ' "${targets[@]}") \
+    >"$build_log" 2>&1; then
+  tail -n 40 "$build_log"
+  echo "FAILED: building the fuzz targets (log $build_log)"
+  exit 1
+fi
+
+if [[ -n "$keep" ]]; then
+  work="$keep"
+  mkdir -p "$work"
+else
+  work="$(mktemp -d "${TMPDIR:-/tmp}/geodex_fuzz.XXXXXX")"
+  trap 'rm -rf "$work"' EXIT
+fi
+
+# A leak is a finding too; UBSan already aborts (-fno-sanitize-recover).
+export ASAN_OPTIONS="detect_leaks=1:abort_on_error=0:${ASAN_OPTIONS:-}"
+export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1:${UBSAN_OPTIONS:-}"
+
+failed=()
+for t in "${targets[@]}"; do
+  bin="$build_dir/tests/fuzz/fuzz_$t"
+  corpus="$work/corpus_$t"
+  artifacts="$work/artifacts_$t/"
+  mkdir -p "$corpus" "$artifacts"
+  cp -r "$repo/tests/fuzz/corpus/$t/." "$corpus/"
+  log="$work/fuzz_$t.log"
+  status=0
+  nice -n 10 "$bin" "$corpus" -max_total_time="$seconds" -max_len="${max_len[$t]}" \
+    -timeout=1 -rss_limit_mb=2048 -print_final_stats=1 -artifact_prefix="$artifacts" \
+    >"$log" 2>&1 || status=$?
+  execs="$(grep -o 'stat::number_of_executed_units: *[0-9]*' "$log" | grep -o '[0-9]*$' || true)"
+  if [[ $status -ne 0 ]] || grep -qE 'ERROR: (AddressSanitizer|LeakSanitizer|libFuzzer)|runtime error:' "$log"; then
+    echo "fuzz_$t: FAILED (exit $status), ${execs:-?} executions; log $log"
+    grep -E 'ERROR:|runtime error:|SUMMARY:|Test unit written' "$log" | head -20 || true
+    failed+=("$t")
+    if [[ -z "$keep" ]]; then
+      # Keep the evidence when the work directory is about to be removed.
+      saved="$(mktemp -d "${TMPDIR:-/tmp}/geodex_fuzz_failed.XXXXXX")"
+      cp -r "$log" "$artifacts" "$saved/"
+      echo "  log and crashing inputs copied to $saved"
+    fi
+  else
+    echo "fuzz_$t: ok, ${execs:-?} executions in ${seconds} s"
+  fi
+done
+
+if [[ ${#failed[@]} -gt 0 ]]; then
+  echo "FAILED: ${failed[*]}"
+  exit 1
+fi
