@@ -13,23 +13,13 @@
 #include "core/builder/builder.h"
 #include "core/index/index.h"
 #include "core/mesh/generators.h"
-#include "core/validation/calibration.h"
+#include "core/validation/test_index.h"
 
 namespace geodex::server::testing {
 namespace fs = std::filesystem;
 
 std::string BuildIndexBytes(const mesh::Mesh& mesh, int32_t samples, bool calibrate) {
-  builder::BuildOptions options;
-  options.num_samples = samples;
-  options.threads = 2;
-  builder::BuildSummary summary;
-  auto data = builder::BuildIndex(mesh, options, &summary);
-  if (!data.ok()) throw std::runtime_error(data.status().ToString());
-  if (calibrate) {
-    const absl::Status status = validation::AddCalibration(mesh, *data);
-    if (!status.ok()) throw std::runtime_error(status.ToString());
-  }
-  auto bytes = index::SerializeIndex(*data);
+  absl::StatusOr<std::string> bytes = geodex::testing::BuildTestIndex(mesh, samples, calibrate);
   if (!bytes.ok()) throw std::runtime_error(bytes.status().ToString());
   return *std::move(bytes);
 }

@@ -1,4 +1,5 @@
 #include "core/query/query_engine.h"
+#include "core/validation/test_index.h"
 
 #include <algorithm>
 #include <cmath>
@@ -18,19 +19,7 @@ using ::testing::HasSubstr;
 
 std::shared_ptr<const QueryEngine> MakeEngine(const Mesh& m, int32_t samples,
                                               QueryOptions options = {}) {
-  builder::BuildOptions build_options;
-  build_options.num_samples = samples;
-  build_options.threads = 2;
-  builder::BuildSummary summary;
-  auto data = builder::BuildIndex(m, build_options, &summary);
-  EXPECT_TRUE(data.ok()) << data.status();
-  auto bytes = index::SerializeIndex(*data);
-  EXPECT_TRUE(bytes.ok());
-  auto index = index::Index::FromBytes(*bytes);
-  EXPECT_TRUE(index.ok()) << index.status();
-  auto engine = QueryEngine::Create(*index, options);
-  EXPECT_TRUE(engine.ok()) << engine.status();
-  return *engine;
+  return geodex::testing::TestEngineOrThrow(m, samples, /*calibrate=*/false, options);
 }
 
 // Area-uniform random surface points.

@@ -7,9 +7,8 @@
 #include <cstdio>
 #include <utility>
 
-#include "core/builder/builder.h"
 #include "core/mesh/generators.h"
-#include "core/validation/calibration.h"
+#include "core/validation/test_index.h"
 #include "gtest/gtest.h"
 
 namespace geodex::accuracy {
@@ -23,24 +22,16 @@ struct Measured {
 };
 
 Measured Measure(const mesh::Mesh& m, int32_t samples) {
-  builder::BuildOptions build_options;
-  build_options.num_samples = samples;
-  build_options.threads = 2;
-  builder::BuildSummary summary;
-  auto data = builder::BuildIndex(m, build_options, &summary);
-  EXPECT_TRUE(data.ok()) << data.status();
-  EXPECT_TRUE(validation::AddCalibration(m, *data).ok());
-  auto index = index::Index::FromBytes(*index::SerializeIndex(*data));
-  EXPECT_TRUE(index.ok());
-  auto engine = query::QueryEngine::Create(*index);
-  EXPECT_TRUE(engine.ok()) << engine.status();
+  const std::shared_ptr<const query::QueryEngine> engine =
+      geodex::testing::TestEngineOrThrow(m, samples, /*calibrate=*/true);
+  const index::Index* index = &engine->index();
   const auto pairs = validation::DrawPairs(
-      m, (*index)->num_samples(),
+      m, index->num_samples(),
       {.num_sources = 8, .uniform_points = 100, .per_bin_points = 30, .seed = 7});
   auto mode = [&](query::DistanceOptions options) {
     return Evaluate(pairs, [&](const mesh::SurfacePoint& p, const mesh::SurfacePoint& q) {
       Answer a;
-      a.distance = *(*engine)->Distance(p, q, options, nullptr, &a.bound);
+      a.distance = *engine->Distance(p, q, options, nullptr, &a.bound);
       return a;
     });
   };
@@ -48,8 +39,8 @@ Measured Measure(const mesh::Mesh& m, int32_t samples) {
   r.unfold = mode({.near_pairs = query::NearPairs::kUnfold});
   r.by_default = mode({});
   r.tolerance = mode({.tolerance = 0.005});
-  r.paths = MeasurePaths(m, **engine, 4, 15, 3);
-  const std::string label = m.name() + " m=" + std::to_string((*index)->num_samples());
+  r.paths = MeasurePaths(m, *engine, 4, 15, 3);
+  const std::string label = m.name() + " m=" + std::to_string(index->num_samples());
   std::printf("%s%s%s%s", MarkdownHeader().c_str(), MarkdownRows(label + " unfold", r.unfold).c_str(),
               MarkdownRows(label + " default", r.by_default).c_str(),
               MarkdownRows(label + " tol0.005", r.tolerance).c_str());

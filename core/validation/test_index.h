@@ -1,0 +1,35 @@
+#pragma once
+
+// Test utilities: an index of a generated mesh, built the way every test
+// wants it (seed 1, two threads, its accuracy calibration on request), and a
+// query engine over it. Test-only (library geodex_test_index).
+
+#include <cstdint>
+#include <memory>
+#include <string>
+
+#include "absl/status/statusor.h"
+#include "core/mesh/mesh.h"
+#include "core/query/query_engine.h"
+
+namespace geodex::testing {
+
+// The index file bytes of `mesh` with `samples` samples, calibrated when
+// `calibrate`. Errors: the builder's and the calibration's.
+absl::StatusOr<std::string> BuildTestIndex(const mesh::Mesh& mesh, int32_t samples,
+                                           bool calibrate = false);
+
+// A query engine over BuildTestIndex's index.
+absl::StatusOr<std::shared_ptr<const query::QueryEngine>> BuildTestEngine(
+    const mesh::Mesh& mesh, int32_t samples, bool calibrate = false,
+    query::QueryOptions options = {});
+
+// The same, for test bodies: throws std::runtime_error with the status on
+// failure, which GoogleTest reports as the test's failure (no dereference of
+// an error).
+std::shared_ptr<const query::QueryEngine> TestEngineOrThrow(const mesh::Mesh& mesh,
+                                                            int32_t samples,
+                                                            bool calibrate = false,
+                                                            query::QueryOptions options = {});
+
+}  // namespace geodex::testing
