@@ -12,6 +12,7 @@ PACKAGES=(
   prometheus-cpp-dev
   libcgal-dev libgmp-dev libmpfr-dev libboost-dev
   clang-format
+  clang libclang-rt-14-dev  # the libFuzzer targets (tests/fuzz)
   openssl  # server tests generate TLS certificates with it
 )
 
