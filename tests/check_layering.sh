@@ -2,7 +2,8 @@
 # Fails if a layer depends on a layer it must not, by what it includes and by
 # what its CMake targets link (directly or through other targets):
 #   core/         nothing from gRPC, protobuf, generated, server or client code;
-#   core/builder  not the query engine (geodex_query);
+#   core/builder  nothing built from core/query sources (the query engine, the
+#                 point locator); the face BVH it stores is in core/index;
 #   client/       nothing from core/ or server/;
 #   server/       not the client library.
 # The link graph is read from the target_link_libraries calls of the
@@ -24,16 +25,17 @@ if [ -d "$root/client" ] && grep -rnE '#include\s*[<"](core|server)/' "$root/cli
 fi
 
 # --- links ---------------------------------------------------------------------
-# Prints "def TARGET LAYER" for add_library / add_executable and
-# "link TARGET DEPENDENCY" for every item of target_link_libraries (comments
-# dropped; a call may span lines).
+# Prints "def TARGET LAYER" for add_library / add_executable, "src TARGET
+# FILE" for every source of add_library / add_executable / target_sources that
+# lies in query/, and "link TARGET DEPENDENCY" for every item of
+# target_link_libraries (comments dropped; a call may span lines).
 read -r -d '' links_awk <<'AWK'
 FNR == 1 { call = ""; depth = 0 }
 {
   line = $0
   sub(/#.*/, "", line)
   if (depth == 0) {
-    if (!match(line, /(add_library|add_executable|target_link_libraries)[ \t]*\(/)) next
+    if (!match(line, /(add_library|add_executable|target_sources|target_link_libraries)[ \t]*\(/)) next
     call = substr(line, RSTART)
     depth = 1
   } else {
@@ -43,8 +45,11 @@ FNR == 1 { call = ""; depth = 0 }
   call = substr(call, 1, index(call, ")") - 1)
   gsub(/\(/, " ", call)
   n = split(call, w, /[ \t]+/)
-  if (w[1] == "add_library" || w[1] == "add_executable") {
-    print "def", w[2], layer
+  if (w[1] == "add_library" || w[1] == "add_executable" || w[1] == "target_sources") {
+    if (w[1] != "target_sources") print "def", w[2], layer
+    for (i = 3; i <= n; i++) {
+      if (layer == "core" && w[i] ~ /^query\//) print "src", w[2], w[i]
+    }
   } else {
     for (i = 3; i <= n; i++) {
       if (w[i] == "" || w[i] ~ /^(PUBLIC|PRIVATE|INTERFACE|LINK_PUBLIC|LINK_PRIVATE)$/) continue
@@ -61,9 +66,10 @@ AWK
 read -r -d '' check_awk <<'AWK'
 $1 == "def" { layer[$2] = $3; targets[++num_targets] = $2 }
 $1 == "link" { adj[$2] = adj[$2] " " $3 }
+$1 == "src" { query_source[$2] = $3 }
 function forbidden(from, to) {
-  if (from == "geodex_builder" && to == "geodex_query")
-    return "core/builder must not link the query engine"
+  if (from == "geodex_builder" && (to == "geodex_query" || to in query_source))
+    return "core/builder must not link code built from core/query (" query_source[to] ")"
   if (layer[from] == "core" && (layer[to] ~ /^(proto|server|client)$/ || to ~ /^(gRPC|protobuf)::/))
     return "core/ must not link gRPC, protobuf, generated, server or client code"
   if (layer[from] == "client" && layer[to] ~ /^(core|server)$/)
@@ -76,6 +82,11 @@ END {
   failed = 0
   for (i = 1; i <= num_targets; i++) {
     start = targets[i]
+    why = forbidden(start, start)
+    if (why != "") {
+      printf "layering: %s compiles %s: %s\n", start, query_source[start], why
+      failed = 1
+    }
     split("", seen)
     split("", parent)
     top = 0

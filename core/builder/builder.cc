@@ -13,7 +13,7 @@
 #include "core/builder/vertex_assignment.h"
 #include "core/common/status_macros.h"
 #include "core/geodesic/exact_geodesic.h"
-#include "core/query/point_locator.h"
+#include "core/index/face_bvh.h"
 #include "core/sampling/farthest_point_sampling.h"
 
 namespace geodex::builder {
@@ -173,7 +173,7 @@ void AddMeshAndTriangulation(const Mesh& mesh, const Plan& plan, index::IndexDat
     }
     data->triangles.push_back(tri);
   }
-  query::BuildFaceBvh(data->positions, data->faces, &data->bvh_nodes, &data->bvh_faces);
+  index::BuildFaceBvh(data->positions, data->faces, &data->bvh_nodes, &data->bvh_faces);
 }
 
 // The summary's figures but merge_seconds.

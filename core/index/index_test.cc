@@ -14,8 +14,8 @@
 #include <vector>
 
 #include "absl/strings/str_cat.h"
+#include "core/index/face_bvh.h"
 #include "core/mesh/generators.h"
-#include "core/query/point_locator.h"
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
 
@@ -96,7 +96,7 @@ IndexData MakeSphereIndex() {
     none.distance[k] = kInf;
   }
   d.vertices.push_back(none);
-  query::BuildFaceBvh(d.positions, d.faces, &d.bvh_nodes, &d.bvh_faces);
+  BuildFaceBvh(d.positions, d.faces, &d.bvh_nodes, &d.bvh_faces);
   d.mesh_hash = MeshHash(d.positions, d.faces);
   d.params = {.requested_samples = 10,
               .num_samples = static_cast<uint32_t>(m),

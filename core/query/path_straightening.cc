@@ -153,6 +153,12 @@ class Straightener {
     int32_t left_id, right_id;  // mesh vertices; -1 for the ends
     int32_t face;               // the face before the portal (holds both ends)
   };
+  // An apex of the funnel: an index into the portals and a side (0 start or
+  // end, +1 left, -1 right).
+  struct Apex {
+    size_t portal;
+    int side;
+  };
 
   // A face holding the point, and each face holding both it and `other`.
   Small<int32_t> FacesOf(const SurfacePoint& p, const Support& s) const {
@@ -204,8 +210,23 @@ class Straightener {
     const size_t k = run.size();
     Small<Support> support(k);
     for (size_t i = 0; i < k; ++i) support[i] = SupportOf(run[i].point);
-    // Segment faces: segment i (run[i] -> run[i+1]) lies in face seg[i].
     Small<int32_t> seg(k - 1, -1);
+    if (!SegmentFaces(run, support, &seg)) return false;
+    Small<int32_t> strip = {seg[0]};
+    Small<std::array<int32_t, 2>> edges;
+    if (!BuildStrip(support, seg, &strip, &edges)) return false;
+    Small<Portal> portals;
+    Vec2 start, end;
+    if (!UnfoldStrip(strip, edges, support, &portals, &start, &end)) return false;
+    return Rebuild(run, portals, Funnel(portals, start), start, end, out);
+  }
+
+  // Segment faces: segment i (run[i] -> run[i+1]) lies in face (*seg)[i].
+  // False if a segment lies in no face.
+  bool SegmentFaces(const std::vector<PathPoint>& run, const Small<Support>& support,
+                    Small<int32_t>* seg_out) const {
+    const size_t k = run.size();
+    Small<int32_t>& seg = *seg_out;
     for (size_t i = 0; i + 1 < k; ++i) {
       for (int32_t f : FacesOf(run[i].point, support[i])) {
         if (FaceHolds(f, support[i + 1])) {
@@ -215,9 +236,17 @@ class Straightener {
       }
       if (seg[i] < 0) return false;
     }
-    // The strip: faces in order and the edges (portals) between them.
-    Small<int32_t> strip = {seg[0]};
-    Small<std::array<int32_t, 2>> edges;
+    return true;
+  }
+
+  // The strip: faces in order (*strip starts with the first segment's face)
+  // and the edges (portals) between them. False if the path does not cross
+  // from face to face over shared edges or round a vertex.
+  bool BuildStrip(const Small<Support>& support, const Small<int32_t>& seg,
+                  Small<int32_t>* strip_out, Small<std::array<int32_t, 2>>* edges_out) const {
+    const size_t k = support.size();
+    Small<int32_t>& strip = *strip_out;
+    Small<std::array<int32_t, 2>>& edges = *edges_out;
     // Entering the face just left (back across the same edge) cancels out.
     auto push = [&](int32_t face, std::array<int32_t, 2> edge) {
       if (strip.size() >= 2 && strip[strip.size() - 2] == face) {
@@ -254,10 +283,21 @@ class Straightener {
       }
     }
     if (strip.size() > 1 && strip.back() != seg[k - 2]) return false;
-    // Unfold the strip and collect its portals.
+    return true;
+  }
+
+  // Unfolds the strip and collects its portals, the start and end points
+  // first and last as degenerate portals. False if the end is not in the
+  // strip's last face.
+  bool UnfoldStrip(const Small<int32_t>& strip, const Small<std::array<int32_t, 2>>& edges,
+                   const Small<Support>& support, Small<Portal>* portals_out, Vec2* start_out,
+                   Vec2* end_out) const {
+    const size_t k = support.size();
+    Small<Portal>& portals = *portals_out;
+    Vec2& start = *start_out;
+    Vec2& end = *end_out;
     Small<Flat> flats = {FirstFlat(strip[0])};
-    Small<Portal> portals;
-    const Vec2 start = Place(flats[0], support[0]);
+    start = Place(flats[0], support[0]);
     const int32_t start_id = support[0].count == 1 ? support[0].vertex[0] : -1;
     portals.push_back({start, start, start_id, start_id, strip[0]});
     for (size_t i = 0; i < edges.size(); ++i) {
@@ -276,17 +316,16 @@ class Straightener {
       portals.push_back(portal);
       flats.push_back(NextFlat(prev, strip[i + 1], a, b));
     }
-    const Vec2 end = Place(flats.back(), support[k - 1]);
+    end = Place(flats.back(), support[k - 1]);
     if (!FaceHolds(flats.back().face, support[k - 1])) return false;
     const int32_t end_id = support[k - 1].count == 1 ? support[k - 1].vertex[0] : -1;
     portals.push_back({end, end, end_id, end_id, flats.back().face});
+    return true;
+  }
 
-    // The funnel: apexes are indices into portals with a side (0 start/end,
-    // +1 left, -1 right).
-    struct Apex {
-      size_t portal;
-      int side;
-    };
+  // The funnel: the apexes of the shortest path through the portals, from
+  // the start (portal 0) to the end (the last portal).
+  Small<Apex> Funnel(const Small<Portal>& portals, const Vec2& start) const {
     Small<Apex> apexes = {{0, 0}};
     Vec2 apex = start, left = start, right = start;
     size_t apex_index = 0, left_index = 0, right_index = 0;
@@ -324,8 +363,15 @@ class Straightener {
     if (apexes.back().portal == n - 1) apexes.pop_back();
     apexes.push_back({n - 1, 0});
 
-    // Rebuild the path: the crossings of each straight section with the
-    // portals it passes, and the apexes as vertex points.
+    return apexes;
+  }
+
+  // Rebuild the path: the crossings of each straight section with the
+  // portals it passes, and the apexes as vertex points. False on a
+  // degenerate crossing or an apex that is not a mesh vertex.
+  bool Rebuild(const std::vector<PathPoint>& run, const Small<Portal>& portals,
+               const Small<Apex>& apexes, const Vec2& start, const Vec2& end,
+               std::vector<PathPoint>* out) const {
     auto apex_point = [&](const Apex& a) -> Vec2 {
       return a.side > 0 ? portals[a.portal].left : portals[a.portal].right;
     };

@@ -1,15 +1,15 @@
 #pragma once
 
 // Point location: the closest surface point to a 3D position, through an
-// axis-aligned bounding-box hierarchy over the faces (stored in the index so
-// the server uses it in place).
+// axis-aligned bounding-box hierarchy over the faces (built by
+// index::BuildFaceBvh, core/index/face_bvh.h, and stored in the index so the
+// server uses it in place).
 //
 // Thread safety: PointLocator is a read-only view; Locate is const and safe
 // from any number of threads.
 
 #include <cstdint>
 #include <span>
-#include <vector>
 
 #include "Eigen/Core"
 #include "absl/status/statusor.h"
@@ -17,12 +17,6 @@
 #include "core/mesh/mesh.h"
 
 namespace geodex::query {
-
-// Builds the BVH over faces (positions: 3 doubles per vertex, faces: 3 ids per
-// face). Boxes are rounded outwards to float so they always contain their
-// faces. Deterministic. `nodes[0]` is the root.
-void BuildFaceBvh(std::span<const double> positions, std::span<const int32_t> faces,
-                  std::vector<index::BvhNode>* nodes, std::vector<int32_t>* leaf_faces);
 
 struct LocatedPoint {
   mesh::SurfacePoint point;  // face + barycentric weights (>= 0, sum 1)

@@ -115,6 +115,136 @@ double PathLength(const std::vector<PathPoint>& path) {
   return sum;
 }
 
+// TracePath's fallback: from vertex v (a vertex of face f) along mesh edges to
+// a vertex of the face holding the source, by A* with the straight-line
+// distance to the source as heuristic, then straight to the source (`source`,
+// the point at `from`). Appends to `path` (traced from the target) and returns
+// it reversed, source first.
+template <typename VertexPoint>
+absl::StatusOr<std::vector<PathPoint>> FinishOnGraph(
+    Tracer& tr, const MeshView& view, const SurfacePoint& from, const PathPoint& source,
+    const VertexPoint& vertex_point, std::vector<PathPoint>& path, int32_t v, int32_t f) {
+  const Vec3 goal = source.position;
+  if (path.back().position != view.Position(v)) path.push_back(vertex_point(f, v));
+  struct Node {
+    double g;
+    int32_t face;  // a face containing the vertex and its parent
+    int32_t parent;
+  };
+  std::unordered_map<int32_t, Node> seen;
+  using Item = std::pair<double, int32_t>;
+  std::priority_queue<Item, std::vector<Item>, std::greater<>> open;
+  seen[v] = {0, f, -1};
+  open.push({(view.Position(v) - goal).norm(), v});
+  int32_t reached = -1;
+  while (!open.empty()) {
+    const auto [key, u] = open.top();
+    open.pop();
+    const Node node = seen[u];
+    if (key > node.g + (view.Position(u) - goal).norm() + 1e-12) continue;  // stale
+    if (view.Corner(from.face, u) >= 0) {
+      reached = u;
+      break;
+    }
+    for (int32_t g : tr.FacesAround(u, node.face)) {
+      for (int i = 0; i < 3; ++i) {
+        const int32_t w = view.faces[3 * g + i];
+        if (w == u) continue;
+        const double cost = node.g + (view.Position(w) - view.Position(u)).norm();
+        auto it = seen.find(w);
+        if (it != seen.end() && it->second.g <= cost) continue;
+        seen[w] = {cost, g, u};
+        open.push({cost + (view.Position(w) - goal).norm(), w});
+      }
+    }
+  }
+  if (reached < 0) return absl::InternalError("no mesh path to the source");
+  std::vector<PathPoint> tail;
+  for (int32_t u = reached; u != v; u = seen[u].parent)
+    tail.push_back(vertex_point(seen[u].face, u));
+  path.insert(path.end(), tail.rbegin(), tail.rend());
+  path.push_back(source);
+  std::reverse(path.begin(), path.end());
+  return path;
+}
+
+// The face round vertex v (starting from face f) to leave v by: the first
+// holding the source, else the one where the descent from v points inside the
+// face and is steepest; -1 if there is none.
+template <typename ContainsSource>
+int32_t FaceToLeaveVertex(Tracer& tr, const MeshView& view, int32_t v, int32_t f,
+                          const ContainsSource& contains_source) {
+  int32_t best_face = -1;
+  double best_slope = 0;
+  for (int32_t g : tr.FacesAround(v, f)) {
+    if (contains_source(g)) {
+      best_face = g;
+      break;
+    }
+    double magnitude;
+    const int k = view.Corner(g, v);
+    std::array<double, 3> at = {0, 0, 0};
+    at[k] = 1;
+    const auto beta = tr.Descent(g, at, &magnitude);
+    const double e = 1e-12 * (std::abs(beta[0]) + std::abs(beta[1]) + std::abs(beta[2]));
+    if (beta[(k + 1) % 3] >= -e && beta[(k + 2) % 3] >= -e && beta[k] < -e &&
+        magnitude > best_slope) {
+      best_slope = magnitude;
+      best_face = g;
+    }
+  }
+  return best_face;
+}
+
+// The neighbour of vertex v (round v from face f) with the lowest distance,
+// if lower than v's, and a face holding the edge to it; false if v is a local
+// minimum of the approximate field.
+bool LowerNeighbour(Tracer& tr, const MeshView& view, int32_t v, int32_t f, int32_t* next,
+                    int32_t* next_face) {
+  *next = -1;
+  *next_face = -1;
+  double lowest = tr.D(v);
+  for (int32_t g : tr.FacesAround(v, f)) {
+    for (int i = 0; i < 3; ++i) {
+      const int32_t u = view.faces[3 * g + i];
+      if (u != v && tr.D(u) < lowest) {
+        lowest = tr.D(u);
+        *next = u;
+        *next_face = g;
+      }
+    }
+  }
+  return *next >= 0;
+}
+
+// Where the descent beta from barycentric position b leaves the face: the
+// corner whose weight reaches 0 first (-1 if none decreases) and the step
+// `t` to it.
+int DescentExit(const std::array<double, 3>& beta, const std::array<double, 3>& b, double* t) {
+  *t = std::numeric_limits<double>::infinity();
+  int exit = -1;
+  const double eps = 1e-12 * (std::abs(beta[0]) + std::abs(beta[1]) + std::abs(beta[2]));
+  for (int i = 0; i < 3; ++i) {
+    if (beta[i] < -eps) {
+      const double ti = -b[i] / beta[i];
+      if (ti < *t) {
+        *t = ti;
+        exit = i;
+      }
+    }
+  }
+  return exit;
+}
+
+// The vertex of face f with the lowest approximate distance (first on ties).
+int32_t LowestVertex(Tracer& tr, const MeshView& view, int32_t f) {
+  int k = 0;
+  for (int i = 1; i < 3; ++i) {
+    if (tr.D(view.faces[3 * f + i]) < tr.D(view.faces[3 * f + k])) k = i;
+  }
+  return view.faces[3 * f + k];
+}
+
 }  // namespace
 
 absl::StatusOr<std::vector<PathPoint>> QueryEngine::Path(const SurfacePoint& from,
@@ -339,53 +469,11 @@ absl::StatusOr<std::vector<PathPoint>> QueryEngine::TracePath(const SurfacePoint
     return point_at(f, b);
   };
 
-  // Fallback: from vertex v (a vertex of face f) along mesh edges to a
-  // vertex of the face holding the source, by A* with the straight-line
-  // distance to the source as heuristic, then straight to the source.
-  const Vec3 goal = point_at(from.face, from.w).position;
-  auto finish_on_graph = [&](std::vector<PathPoint>& path, int32_t v,
-                             int32_t f) -> absl::StatusOr<std::vector<PathPoint>> {
-    if (path.back().position != view_.Position(v)) path.push_back(vertex_point(f, v));
-    struct Node {
-      double g;
-      int32_t face;  // a face containing the vertex and its parent
-      int32_t parent;
-    };
-    std::unordered_map<int32_t, Node> seen;
-    using Item = std::pair<double, int32_t>;
-    std::priority_queue<Item, std::vector<Item>, std::greater<>> open;
-    seen[v] = {0, f, -1};
-    open.push({(view_.Position(v) - goal).norm(), v});
-    int32_t reached = -1;
-    while (!open.empty()) {
-      const auto [key, u] = open.top();
-      open.pop();
-      const Node node = seen[u];
-      if (key > node.g + (view_.Position(u) - goal).norm() + 1e-12) continue;  // stale
-      if (view_.Corner(from.face, u) >= 0) {
-        reached = u;
-        break;
-      }
-      for (int32_t g : tr.FacesAround(u, node.face)) {
-        for (int i = 0; i < 3; ++i) {
-          const int32_t w = view_.faces[3 * g + i];
-          if (w == u) continue;
-          const double cost = node.g + (view_.Position(w) - view_.Position(u)).norm();
-          auto it = seen.find(w);
-          if (it != seen.end() && it->second.g <= cost) continue;
-          seen[w] = {cost, g, u};
-          open.push({cost + (view_.Position(w) - goal).norm(), w});
-        }
-      }
-    }
-    if (reached < 0) return absl::InternalError("no mesh path to the source");
-    std::vector<PathPoint> tail;
-    for (int32_t u = reached; u != v; u = seen[u].parent)
-      tail.push_back(vertex_point(seen[u].face, u));
-    path.insert(path.end(), tail.rbegin(), tail.rend());
-    path.push_back(point_at(from.face, from.w));
-    std::reverse(path.begin(), path.end());
-    return path;
+  // Fallback when the descent stalls or circles: along mesh edges to the
+  // source (FinishOnGraph).
+  const PathPoint source = point_at(from.face, from.w);
+  auto finish_on_graph = [&](std::vector<PathPoint>& path, int32_t v, int32_t f) {
+    return FinishOnGraph(tr, view_, from, source, vertex_point, path, v, f);
   };
 
   std::vector<PathPoint> path;
@@ -405,32 +493,14 @@ absl::StatusOr<std::vector<PathPoint>> QueryEngine::TracePath(const SurfacePoint
     if (++visits[f] > 6)
       return finish_on_graph(path, at_vertex >= 0 ? at_vertex : view_.faces[3 * f], f);
     if (contains_source(f)) {
-      path.push_back(point_at(from.face, from.w));
+      path.push_back(source);
       std::reverse(path.begin(), path.end());
       return path;
     }
     if (at_vertex >= 0) {
       // Leave the vertex into the face where the descent points inside.
       const int32_t v = at_vertex;
-      int32_t best_face = -1;
-      double best_slope = 0;
-      for (int32_t g : tr.FacesAround(v, f)) {
-        if (contains_source(g)) {
-          best_face = g;
-          break;
-        }
-        double magnitude;
-        const int k = view_.Corner(g, v);
-        std::array<double, 3> at = {0, 0, 0};
-        at[k] = 1;
-        const auto beta = tr.Descent(g, at, &magnitude);
-        const double e = 1e-12 * (std::abs(beta[0]) + std::abs(beta[1]) + std::abs(beta[2]));
-        if (beta[(k + 1) % 3] >= -e && beta[(k + 2) % 3] >= -e && beta[k] < -e &&
-            magnitude > best_slope) {
-          best_slope = magnitude;
-          best_face = g;
-        }
-      }
+      const int32_t best_face = FaceToLeaveVertex(tr, view_, v, f, contains_source);
       if (best_face >= 0) {
         f = best_face;
         b = {0, 0, 0};
@@ -440,19 +510,8 @@ absl::StatusOr<std::vector<PathPoint>> QueryEngine::TracePath(const SurfacePoint
         // Fall through to the face step below from the vertex.
       } else {
         // Walk along the edge to the lowest neighbour, if lower.
-        int32_t next = -1, next_face = -1;
-        double lowest = tr.D(v);
-        for (int32_t g : tr.FacesAround(v, f)) {
-          for (int i = 0; i < 3; ++i) {
-            const int32_t u = view_.faces[3 * g + i];
-            if (u != v && tr.D(u) < lowest) {
-              lowest = tr.D(u);
-              next = u;
-              next_face = g;
-            }
-          }
-        }
-        if (next < 0) {
+        int32_t next, next_face;
+        if (!LowerNeighbour(tr, view_, v, f, &next, &next_face)) {
           // A local minimum of the approximate field: finish along mesh
           // edges (A* towards the source), which always arrives.
           return finish_on_graph(path, v, f);
@@ -466,25 +525,11 @@ absl::StatusOr<std::vector<PathPoint>> QueryEngine::TracePath(const SurfacePoint
     // Face step: follow the descent to the face's boundary.
     double magnitude;
     const auto beta = tr.Descent(f, b, &magnitude);
-    double t = std::numeric_limits<double>::infinity();
-    int exit = -1;
-    const double eps = 1e-12 * (std::abs(beta[0]) + std::abs(beta[1]) + std::abs(beta[2]));
-    for (int i = 0; i < 3; ++i) {
-      if (beta[i] < -eps) {
-        const double ti = -b[i] / beta[i];
-        if (ti < t) {
-          t = ti;
-          exit = i;
-        }
-      }
-    }
+    double t;
+    const int exit = DescentExit(beta, b, &t);
     if (exit < 0 || !(t > 1e-14) || !(magnitude > 0)) {
       // No way forward inside this face: go to its lowest vertex.
-      int k = 0;
-      for (int i = 1; i < 3; ++i) {
-        if (tr.D(view_.faces[3 * f + i]) < tr.D(view_.faces[3 * f + k])) k = i;
-      }
-      at_vertex = view_.faces[3 * f + k];
+      at_vertex = LowestVertex(tr, view_, f);
       path.push_back(vertex_point(f, at_vertex));
       continue;
     }

@@ -37,9 +37,9 @@
 #include "CLI/CLI.hpp"
 #include "absl/strings/str_format.h"
 #include "core/builder/builder.h"
+#include "core/index/face_bvh.h"
 #include "core/index/index.h"
 #include "core/mesh/generators.h"
-#include "core/query/point_locator.h"
 #include "core/query/query_engine.h"
 #include "geodex/v1/geodex.grpc.pb.h"
 #include "grpcpp/create_channel.h"
@@ -148,7 +148,7 @@ index::IndexData FlatSheetIndex(int cells, int fine) {
       }
     }
   }
-  query::BuildFaceBvh(d.positions, d.faces, &d.bvh_nodes, &d.bvh_faces);
+  index::BuildFaceBvh(d.positions, d.faces, &d.bvh_nodes, &d.bvh_faces);
   d.builder_version = "server_bench flat sheet";
   d.mesh_hash = index::MeshHash(d.positions, d.faces);
   d.params.requested_samples = num_samples;
