@@ -441,6 +441,10 @@ TEST(ServerTest, SlowReaderStopsTheStream) {
   *batch.mutable_model() = Ref("sphere");
   *batch.mutable_a() = ToProto(testing::RandomPoints(1280, 2000, 1));
   *batch.mutable_b() = ToProto(testing::RandomPoints(1280, 2000, 2));
+  // Flow control is the subject: the pure O(1) mode keeps each batch quick
+  // (on this coarse sphere most pairs are closer than 3L and would be
+  // traced), so that a stall means a full window, not a busy worker.
+  batch.set_near_pairs(v1::NEAR_PAIRS_UNFOLD);
   constexpr int kBatches = 1500;  // ~170 MB of requests, ~24 MB of answers
   std::atomic<int> written{0};
   std::thread writer([&] {
