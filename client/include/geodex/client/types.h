@@ -139,6 +139,22 @@ struct Mesh {
   int64_t version = 0;                         // the model version whose mesh this is
 };
 
+// The discrete exponential map (geodesic polar coordinates) round a centre
+// point: for each mesh vertex within the radius, `r` its geodesic distance
+// from the centre and `theta` (radians, in (-pi, pi]) the angle at which the
+// geodesic to it leaves the centre, measured from the reference direction in
+// the centre's tangent plane, counter-clockwise about the face normal;
+// (u, v) = r (cos theta, sin theta). Entry i is about mesh vertex
+// vertices[i]; vertices ascend. Vertices beyond the radius are left out.
+struct ExpMap {
+  std::vector<int32_t> vertices;
+  std::vector<double> r;
+  std::vector<double> theta;
+  std::vector<double> u;
+  std::vector<double> v;
+  int64_t version = 0;  // the model version that answered
+};
+
 // The closest surface point to a 3D position and the Euclidean distance to it.
 struct LocatedPoint {
   SurfacePoint point;
