@@ -187,6 +187,32 @@ Mesh Cylinder(int n_around, int n_along, double radius, double length) {
   return MustCreate(std::move(positions), std::move(faces), "Cylinder");
 }
 
+Mesh Cone(int n_around, int n_along, double radius, double height) {
+  Check(n_around >= 3 && n_along >= 1, "Cone", "needs n_around >= 3 and n_along >= 1");
+  Check(radius > 0 && height > 0, "Cone", "radius and height must be > 0");
+  std::vector<Vec3> positions = {Vec3(0, 0, height)};
+  std::vector<Triangle> faces;
+  for (int j = 1; j <= n_along; ++j) {
+    const double t = static_cast<double>(j) / n_along;  // from the apex to the base
+    for (int k = 0; k < n_around; ++k) {
+      const double angle = 2 * std::numbers::pi * k / n_around;
+      positions.push_back(
+          Vec3(t * radius * std::cos(angle), t * radius * std::sin(angle), (1 - t) * height));
+    }
+  }
+  auto id = [n_around](int k, int j) {
+    return static_cast<int32_t>(1 + (j - 1) * n_around + k % n_around);
+  };
+  // (around, towards the apex) is counter-clockwise seen from outside.
+  for (int k = 0; k < n_around; ++k) faces.push_back({0, id(k, 1), id(k + 1, 1)});
+  for (int j = 1; j < n_along; ++j) {
+    for (int k = 0; k < n_around; ++k) {
+      AddQuad(faces, id(k, j + 1), id(k + 1, j + 1), id(k + 1, j), id(k, j), false);
+    }
+  }
+  return MustCreate(std::move(positions), std::move(faces), "Cone");
+}
+
 Mesh Cube(int n, double size) {
   Check(n >= 1, "Cube", "n must be >= 1");
   Check(size > 0, "Cube", "size must be > 0");

@@ -34,6 +34,11 @@ Mesh FoldedSheet(int nx, int ny, double width, double height, double fold_angle)
 // segments around and n_along along. Developable.
 Mesh Cylinder(int n_around, int n_along, double radius, double length);
 
+// Open cone (a pyramid over a regular n_around-gon, so each side is flat)
+// with its apex at (0, 0, height) and its base circle of `radius` in z = 0,
+// n_along rings of vertices below the apex. Developable away from the apex.
+Mesh Cone(int n_around, int n_along, double radius, double height);
+
 // Closed cube surface [0,size]^3, n cells per face side.
 Mesh Cube(int n, double size);
 

@@ -18,6 +18,10 @@ namespace geodex::query {
 // xyz per vertex, 3 vertex ids per face, and the twin of each half-edge
 // (3 f + i: from corner i to corner i+1) or -1 on the boundary.
 struct MeshView {
+  // The most steps a walk round one vertex takes: a guard against broken
+  // twins, far above any valence a mesh has.
+  static constexpr int kMaxFanSteps = 4096;
+
   std::span<const double> positions;
   std::span<const int32_t> faces;
   std::span<const int32_t> twins;
@@ -45,14 +49,14 @@ struct MeshView {
   }
   // Appends the faces round vertex v to *out: f first, then the faces one
   // step after another in direction 0 until the fan closes back on f, or,
-  // at a boundary, those of direction 1 too. At most max_steps steps a
-  // direction: a guard against broken twins, far above any valence.
+  // at a boundary, those of direction 1 too. At most kMaxFanSteps steps a
+  // direction.
   template <typename Faces>
-  void FacesAround(int32_t v, int32_t f, int max_steps, Faces* out) const {
+  void FacesAround(int32_t v, int32_t f, Faces* out) const {
     out->push_back(f);
     for (int dir = 0; dir < 2; ++dir) {
       int32_t g = f;
-      for (int step = 0; step < max_steps; ++step) {
+      for (int step = 0; step < kMaxFanSteps; ++step) {
         g = Turn(g, v, dir);
         if (g < 0) break;
         if (g == f) return;

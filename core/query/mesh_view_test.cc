@@ -37,13 +37,13 @@ TEST(MeshViewTest, FanAtABoundaryVertexWalksBothWays) {
   EXPECT_EQ(view.Turn(0, 0, 1), 1);   // across the diagonal
   EXPECT_EQ(view.Turn(0, 3, 0), -1);  // face 0 does not hold vertex 3
   std::vector<int32_t> fan;
-  view.FacesAround(0, 0, 16, &fan);
+  view.FacesAround(0, 0, &fan);
   EXPECT_THAT(fan, ElementsAre(0, 1));
   fan.clear();
-  view.FacesAround(0, 1, 16, &fan);
+  view.FacesAround(0, 1, &fan);
   EXPECT_THAT(fan, ElementsAre(1, 0));
   fan.clear();
-  view.FacesAround(1, 0, 16, &fan);
+  view.FacesAround(1, 0, &fan);
   EXPECT_THAT(fan, ElementsAre(0));
 }
 
@@ -57,13 +57,13 @@ TEST(MeshViewTest, FanAtAnInteriorVertexClosesOnce) {
     for (int32_t f = 0; f < 4; ++f) {
       if (view.Corner(f, v) < 0) continue;
       std::vector<int32_t> fan;
-      view.FacesAround(v, f, 16, &fan);
+      view.FacesAround(v, f, &fan);
       ASSERT_EQ(fan.size(), 3u) << "vertex " << v << " face " << f;
       EXPECT_EQ(fan[0], f);
     }
   }
   std::vector<int32_t> fan;
-  view.FacesAround(0, 0, 16, &fan);
+  view.FacesAround(0, 0, &fan);
   EXPECT_THAT(fan, UnorderedElementsAre(0, 1, 2));
 }
 

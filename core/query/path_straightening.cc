@@ -12,9 +12,6 @@ namespace geodex::query {
 namespace {
 
 constexpr double kZero = 1e-12;  // barycentric weights below this are on an edge
-// Steps a walk round a vertex takes at most (a guard against broken twins).
-constexpr int kMaxFanSteps = 4096;
-
 // Per-pass working arrays: most straightened paths are short (a near pair
 // crosses a handful of faces), so they live on the stack until they grow.
 template <typename T>
@@ -168,7 +165,7 @@ class Straightener {
       return g >= 0 ? Small<int32_t>{p.face, g} : Small<int32_t>{p.face};
     }
     Small<int32_t> out;
-    mesh_.FacesAround(s.vertex[0], p.face, kMaxFanSteps, &out);
+    mesh_.FacesAround(s.vertex[0], p.face, &out);
     return out;
   }
 
@@ -189,7 +186,7 @@ class Straightener {
       Small<int32_t> faces;
       double angle = 0;
       int32_t f = from;
-      for (int guard = 0; guard < kMaxFanSteps && f != to; ++guard) {
+      for (int guard = 0; guard < MeshView::kMaxFanSteps && f != to; ++guard) {
         f = mesh_.Turn(f, v, dir);
         if (f < 0 || f == from) break;
         faces.push_back(f);

@@ -7,6 +7,7 @@
 #include <queue>
 #include <tuple>
 
+#include "absl/container/inlined_vector.h"
 #include "absl/strings/str_format.h"
 #include "core/common/status_macros.h"
 #include "core/geometry/unfolding.h"
@@ -175,8 +176,9 @@ SurfacePoint QueryEngine::Canonical(const SurfacePoint& p) const {
     sum += w;
   }
   for (double& w : c.w) w /= sum;
-  // A point on an edge is expressed in the face of lower id, so that both
-  // descriptions of it give the same answers.
+  // A point on an edge, or a vertex, is expressed in its face of lowest id,
+  // so that every description of it gives the same answers (the refinement
+  // traces start from the point's face).
   int zeros = 0, zero = 0;
   for (int i = 0; i < 3; ++i) {
     if (c.w[i] == 0) {
@@ -191,6 +193,19 @@ SurfacePoint QueryEngine::Canonical(const SurfacePoint& p) const {
       SurfacePoint t{g / 3, {0, 0, 0}};
       t.w[g % 3] = c.w[(zero + 2) % 3];            // Origin(g) = Dest(h)
       t.w[(g % 3 + 1) % 3] = c.w[(zero + 1) % 3];  // Dest(g) = Origin(h)
+      return t;
+    }
+  }
+  if (zeros == 2) {
+    int corner = 0;
+    while (c.w[corner] == 0) ++corner;
+    const int32_t v = view_.Vertex(c.face, corner);
+    absl::InlinedVector<int32_t, 16> star;
+    view_.FacesAround(v, c.face, &star);
+    const int32_t lowest = *std::min_element(star.begin(), star.end());
+    if (lowest != c.face) {
+      SurfacePoint t{lowest, {0, 0, 0}};
+      t.w[view_.Corner(lowest, v)] = 1;
       return t;
     }
   }

@@ -21,9 +21,6 @@ namespace {
 
 using mesh::Vec3;
 
-// Steps a walk round a vertex takes at most (a guard against broken twins).
-constexpr int kMaxFanSteps = 1024;
-
 struct Tracer {
   const QueryEngine& engine;
   const MeshView& mesh;
@@ -88,7 +85,7 @@ struct Tracer {
   // Faces around vertex v, starting from face f.
   std::vector<int32_t> FacesAround(int32_t v, int32_t f) const {
     std::vector<int32_t> out;
-    mesh.FacesAround(v, f, kMaxFanSteps, &out);
+    mesh.FacesAround(v, f, &out);
     return out;
   }
 };
