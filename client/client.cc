@@ -555,6 +555,60 @@ absl::StatusOr<VertexDistances> Client::DistanceField(const ModelRef& model,
   return field;
 }
 
+absl::StatusOr<client::ExpMap> Client::ExpMap(const ModelRef& model, const SurfacePoint& center,
+                                               const ExpMapQuery& query) const {
+  if (absl::Status s = CheckModel(model); !s.ok()) return s;
+  if (!(std::isfinite(query.radius) && query.radius > 0)) {
+    return absl::InvalidArgumentError(
+        absl::StrFormat("the radius must be finite and > 0, got %g", query.radius));
+  }
+  v1::ExpMapRequest request;
+  *request.mutable_model() = ToProto(model);
+  *request.mutable_center() = ToProto(absl::Span<const SurfacePoint>(&center, 1));
+  request.set_radius(query.radius);
+  if (query.reference_direction) {
+    request.mutable_reference_direction()->mutable_xyz()->Assign(
+        query.reference_direction->begin(), query.reference_direction->end());
+  }
+  request.set_near_pairs(ToProto(query.near_pairs));
+  request.set_tolerance(query.tolerance);
+  absl::StatusOr<std::vector<v1::ExpMapChunk>> chunks = connection_->ExpMap(request);
+  if (!chunks.ok()) return chunks.status();
+
+  client::ExpMap map;
+  const int64_t n = chunks->empty() ? 0 : chunks->front().num_vertices();
+  for (const v1::ExpMapChunk& chunk : *chunks) {
+    const int size = chunk.vertices_size();
+    if (chunk.num_vertices() != n || chunk.r_size() != size || chunk.theta_size() != size ||
+        chunk.u_size() != size || chunk.v_size() != size ||
+        static_cast<int64_t>(map.vertices.size()) + size > n) {
+      return absl::DataLossError(absl::StrFormat(
+          "the server sent an exponential map chunk of %d vertices (%d r, %d theta, %d u, %d v) "
+          "of %d, after %d, for a map of %d",
+          size, chunk.r_size(), chunk.theta_size(), chunk.u_size(), chunk.v_size(),
+          chunk.num_vertices(), map.vertices.size(), n));
+    }
+    for (int i = 0; i < size; ++i) {
+      if (!map.vertices.empty() && chunk.vertices(i) <= map.vertices.back()) {
+        return absl::DataLossError(absl::StrFormat(
+            "the server sent exponential map vertices out of order (%d after %d)",
+            chunk.vertices(i), map.vertices.back()));
+      }
+      map.vertices.push_back(chunk.vertices(i));
+    }
+    map.r.insert(map.r.end(), chunk.r().begin(), chunk.r().end());
+    map.theta.insert(map.theta.end(), chunk.theta().begin(), chunk.theta().end());
+    map.u.insert(map.u.end(), chunk.u().begin(), chunk.u().end());
+    map.v.insert(map.v.end(), chunk.v().begin(), chunk.v().end());
+    map.version = chunk.version();
+  }
+  if (static_cast<int64_t>(map.vertices.size()) != n) {
+    return absl::DataLossError(absl::StrFormat(
+        "the server sent %d of the exponential map's %d vertices", map.vertices.size(), n));
+  }
+  return map;
+}
+
 absl::StatusOr<std::vector<LocatedPoint>> Client::Locate(
     const ModelRef& model, absl::Span<const Position> positions) const {
   if (absl::Status s = CheckModel(model); !s.ok()) return s;

@@ -52,5 +52,8 @@ absl::StatusOr<v1::LocateResponse> GeodexConnection::Locate(const v1::LocateRequ
 absl::StatusOr<std::vector<v1::MeshChunk>> GeodexConnection::GetMesh(const v1::GetMeshRequest&) {
   return NotImplemented("GetMesh");
 }
+absl::StatusOr<std::vector<v1::ExpMapChunk>> GeodexConnection::ExpMap(const v1::ExpMapRequest&) {
+  return NotImplemented("ExpMap");
+}
 
 }  // namespace geodex::client

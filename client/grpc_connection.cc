@@ -113,6 +113,9 @@ class GrpcConnection : public GeodexConnection {
   absl::StatusOr<std::vector<v1::MeshChunk>> GetMesh(const v1::GetMeshRequest& r) override {
     return ServerStream<v1::MeshChunk>(r, &v1::Geodex::Stub::GetMesh);
   }
+  absl::StatusOr<std::vector<v1::ExpMapChunk>> ExpMap(const v1::ExpMapRequest& r) override {
+    return ServerStream<v1::ExpMapChunk>(r, &v1::Geodex::Stub::ExpMap);
+  }
 
  private:
   std::unique_ptr<grpc::ClientContext> MakeContext(absl::Duration deadline) const {

@@ -70,6 +70,9 @@ class RetryingConnection : public GeodexConnection {
   absl::StatusOr<std::vector<v1::MeshChunk>> GetMesh(const v1::GetMeshRequest& r) override {
     return RetryLoop(policy_, sleep_, [&] { return inner_->GetMesh(r); });
   }
+  absl::StatusOr<std::vector<v1::ExpMapChunk>> ExpMap(const v1::ExpMapRequest& r) override {
+    return RetryLoop(policy_, sleep_, [&] { return inner_->ExpMap(r); });
+  }
 
  private:
   std::shared_ptr<GeodexConnection> inner_;

@@ -117,6 +117,20 @@ void FieldChunkToProto(const query::DistanceField& field, int64_t offset, int64_
   }
 }
 
+void ExpMapChunkToProto(std::span<const query::ExpMapVertex> map, int64_t offset, int64_t count,
+                        int64_t version, v1::ExpMapChunk* chunk) {
+  chunk->Clear();
+  chunk->set_num_vertices(static_cast<int64_t>(map.size()));
+  chunk->set_version(version);
+  for (const query::ExpMapVertex& e : map.subspan(offset, count)) {
+    chunk->add_vertices(e.vertex);
+    chunk->add_r(e.r);
+    chunk->add_theta(e.theta);
+    chunk->add_u(e.u);
+    chunk->add_v(e.v);
+  }
+}
+
 void MeshChunkToProto(const index::Index& index, int64_t vertex_offset, int64_t vertex_count,
                       int64_t face_offset, int64_t face_count, int64_t version,
                       v1::MeshChunk* chunk) {

@@ -17,6 +17,7 @@
 #include "absl/status/status.h"
 #include "core/index/index.h"
 #include "core/mesh/mesh.h"
+#include "core/query/exp_map.h"
 #include "core/query/query_engine.h"
 #include "geodex/v1/geodex.pb.h"
 #include "server/model_registry.h"
@@ -62,6 +63,10 @@ void MatrixBlockToProto(int64_t row_offset, int64_t rows, int64_t num_targets,
 // Vertices [offset, offset + count) of a distance field.
 void FieldChunkToProto(const query::DistanceField& field, int64_t offset, int64_t count,
                        bool with_nearest_source, int64_t version, v1::DistanceFieldChunk* chunk);
+
+// Entries [offset, offset + count) of an exponential map.
+void ExpMapChunkToProto(std::span<const query::ExpMapVertex> map, int64_t offset, int64_t count,
+                        int64_t version, v1::ExpMapChunk* chunk);
 
 // Vertices [vertex_offset, vertex_offset + vertex_count) and faces
 // [face_offset, face_offset + face_count) of `index`'s mesh, with the mesh's

@@ -90,6 +90,8 @@ class GeodexService final : public v1::Geodex::CallbackService {
                                  v1::PathResponse* response) override;
   grpc::ServerWriteReactor<v1::DistanceFieldChunk>* DistanceField(
       grpc::CallbackServerContext* context, const v1::DistanceFieldRequest* request) override;
+  grpc::ServerWriteReactor<v1::ExpMapChunk>* ExpMap(grpc::CallbackServerContext* context,
+                                                     const v1::ExpMapRequest* request) override;
   grpc::ServerUnaryReactor* Locate(grpc::CallbackServerContext* context,
                                    const v1::LocateRequest* request,
                                    v1::LocateResponse* response) override;
@@ -114,6 +116,7 @@ class GeodexService final : public v1::Geodex::CallbackService {
   class DistanceStream;
   class MatrixStream;
   class FieldStream;
+  class ExpMapStream;
   class MeshStream;
 
   // Names the call (the client's x-request-id if it sent a sane one) and

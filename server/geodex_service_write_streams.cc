@@ -1,5 +1,5 @@
-// The server streams written one message at a time: Matrix, DistanceField and
-// GetMesh (see "Streams" in server/geodex_service.h).
+// The server streams written one message at a time: Matrix, DistanceField,
+// ExpMap and GetMesh (see "Streams" in server/geodex_service.h).
 
 #include <algorithm>
 #include <span>
@@ -259,6 +259,69 @@ class GeodexService::FieldStream final : public ChunkedWriteStream<v1::DistanceF
 grpc::ServerWriteReactor<v1::DistanceFieldChunk>* GeodexService::DistanceField(
     grpc::CallbackServerContext* context, const v1::DistanceFieldRequest* request) {
   return (new FieldStream(this, context, request))->Start();
+}
+
+// ExpMap: one job computes the whole map, then its chunks are written one at
+// a time, as DistanceField's.
+class GeodexService::ExpMapStream final : public ChunkedWriteStream<v1::ExpMapChunk> {
+ public:
+  ExpMapStream(GeodexService* service, grpc::CallbackServerContext* context,
+               const v1::ExpMapRequest* request)
+      : ChunkedWriteStream(service, context, "ExpMap", nullptr), request_(request) {}
+
+ private:
+  absl::Status ComputeNext(WorkerContext& worker) override {
+    GEODEX_RETURN_IF_ERROR(CheckAlive(*context_));
+    GEODEX_ASSIGN_OR_RETURN(model_, service_->Resolve(request_->model(), call_));
+    if (PointCount(request_->center()) != 1) {
+      return absl::InvalidArgumentError(absl::StrFormat(
+          "center: give exactly one point, got %d", PointCount(request_->center())));
+    }
+    const query::QueryEngine& engine = model_.version->engine();
+    GEODEX_RETURN_IF_ERROR(PointsFromProto(request_->center(), "center", engine, &worker.a));
+    query::ExpMapOptions options;
+    options.radius = request_->radius();
+    const auto& direction = request_->reference_direction().xyz();
+    if (direction.size() == 3) {
+      options.reference_direction = mesh::Vec3(direction[0], direction[1], direction[2]);
+    } else if (!direction.empty()) {
+      return absl::InvalidArgumentError(absl::StrFormat(
+          "reference_direction: give one direction (3 numbers), got %d numbers",
+          direction.size()));
+    }
+    GEODEX_ASSIGN_OR_RETURN(options.distance,
+                            DistanceOptionsFor(*model_.model, request_->near_pairs(), false,
+                                               request_->tolerance()));
+    GEODEX_ASSIGN_OR_RETURN(map_, query::ExpMap(engine, worker.a[0], options, &worker.scratch));
+    call_.pairs = static_cast<int64_t>(map_.size());
+    return absl::OkStatus();
+  }
+
+  const v1::ExpMapChunk* TakeNextLocked() override {
+    // vertex, r, theta, u, v: 36 bytes an entry.
+    constexpr int64_t kEntries = kChunkBytes / 36;
+    const int64_t n = static_cast<int64_t>(map_.size());
+    const int64_t count = std::min(kEntries, n - next_);
+    ExpMapChunkToProto(map_, next_, count, model_.version->version(), &chunk_);
+    next_ += count;
+    return &chunk_;
+  }
+
+  bool HasMoreLocked() const override { return next_ < static_cast<int64_t>(map_.size()); }
+
+  void NextLocked() override { WriteLocked(TakeNextLocked()); }
+
+  const v1::ExpMapRequest* const request_;
+
+  ResolvedModel model_;
+  std::vector<query::ExpMapVertex> map_;
+  int64_t next_ = 0;
+  v1::ExpMapChunk chunk_;
+};
+
+grpc::ServerWriteReactor<v1::ExpMapChunk>* GeodexService::ExpMap(
+    grpc::CallbackServerContext* context, const v1::ExpMapRequest* request) {
+  return (new ExpMapStream(this, context, request))->Start();
 }
 
 // GetMesh: each job copies one chunk out of the mapped index. model_ holds

@@ -1,5 +1,5 @@
 // End-to-end tests of geodex-server's streaming RPCs (StreamDistances,
-// Matrix, DistanceField, GetMesh): order, chunking, cancellation and
+// Matrix, DistanceField, ExpMap, GetMesh): order, chunking, cancellation and
 // backpressure, against the core engine on the same index bytes.
 
 #include <algorithm>
@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "core/mesh/generators.h"
+#include "core/query/exp_map.h"
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
 #include "server/server_test_util.h"
@@ -358,6 +359,85 @@ TEST(ServerTest, GetMeshOfALargeMeshComesInSeveralChunks) {
   EXPECT_EQ(reply.chunks[1].faces_size(), 0);
   EXPECT_EQ(reply.chunks[1].face_offset(), 1280u);
   ExpectMeshOfIndex(reply.chunks, **index, 1);
+}
+
+// Reads an ExpMap stream to its end.
+struct ExpMapReply {
+  grpc::Status status;
+  std::vector<v1::ExpMapChunk> chunks;
+};
+ExpMapReply ReadExpMap(v1::Geodex::Stub& stub, const v1::ExpMapRequest& request) {
+  auto context = Context();
+  auto reader = stub.ExpMap(context.get(), request);
+  ExpMapReply reply;
+  v1::ExpMapChunk chunk;
+  while (reader->Read(&chunk)) reply.chunks.push_back(chunk);
+  reply.status = reader->Finish();
+  return reply;
+}
+
+TEST(ServerTest, ExpMapIsTheEnginesToTheBit) {
+  TestServer ts;
+  auto stub = v1::Geodex::NewStub(ts.TcpChannel());
+  v1::ExpMapRequest request;
+  *request.mutable_model() = Ref("sphere");
+  *request.mutable_center() = ToProto(std::vector<mesh::SurfacePoint>{{17, {0.2, 0.3, 0.5}}});
+  request.set_radius(1.5);
+  for (double x : {0.3, -1.0, 0.2}) request.mutable_reference_direction()->add_xyz(x);
+  const ExpMapReply reply = ReadExpMap(*stub, request);
+  ASSERT_TRUE(reply.status.ok()) << reply.status.error_message();
+  ASSERT_EQ(reply.chunks.size(), 1u);
+  const v1::ExpMapChunk& chunk = reply.chunks[0];
+  EXPECT_EQ(chunk.version(), 1);
+
+  auto engine = ReferenceEngine(testing::SphereIndexBytes());
+  query::ExpMapOptions options;
+  options.radius = 1.5;
+  options.reference_direction = mesh::Vec3(0.3, -1.0, 0.2);
+  auto map = query::ExpMap(*engine, {17, {0.2, 0.3, 0.5}}, options);
+  ASSERT_TRUE(map.ok()) << map.status();
+  ASSERT_GT(map->size(), 50u);
+  ASSERT_EQ(chunk.num_vertices(), static_cast<int64_t>(map->size()));
+  ASSERT_EQ(chunk.vertices_size(), static_cast<int>(map->size()));
+  for (size_t i = 0; i < map->size(); ++i) {
+    EXPECT_EQ(chunk.vertices(i), (*map)[i].vertex);
+    EXPECT_EQ(chunk.r(i), (*map)[i].r);
+    EXPECT_EQ(chunk.theta(i), (*map)[i].theta);
+    EXPECT_EQ(chunk.u(i), (*map)[i].u);
+    EXPECT_EQ(chunk.v(i), (*map)[i].v);
+  }
+}
+
+TEST(ServerTest, ExpMapRejectsBadRequests) {
+  TestServer ts;
+  auto stub = v1::Geodex::NewStub(ts.TcpChannel());
+  auto request = [](std::vector<mesh::SurfacePoint> centre, double radius) {
+    v1::ExpMapRequest r;
+    *r.mutable_model() = Ref("sphere");
+    *r.mutable_center() = ToProto(centre);
+    r.set_radius(radius);
+    return r;
+  };
+  const mesh::SurfacePoint good{3, {1, 0, 0}};
+  ExpMapReply reply = ReadExpMap(*stub, request({good, good}, 1));
+  EXPECT_EQ(reply.status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_THAT(reply.status.error_message(), HasSubstr("exactly one point"));
+  reply = ReadExpMap(*stub, request({good}, -1));
+  EXPECT_EQ(reply.status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_THAT(reply.status.error_message(), HasSubstr("radius"));
+  reply = ReadExpMap(*stub, request({{99999, {1, 0, 0}}}, 1));
+  EXPECT_EQ(reply.status.error_code(), grpc::StatusCode::OUT_OF_RANGE);
+  v1::ExpMapRequest two_numbers = request({good}, 1);
+  two_numbers.mutable_reference_direction()->add_xyz(1);
+  two_numbers.mutable_reference_direction()->add_xyz(0);
+  reply = ReadExpMap(*stub, two_numbers);
+  EXPECT_EQ(reply.status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_THAT(reply.status.error_message(), HasSubstr("reference_direction"));
+  v1::ExpMapRequest unknown = request({good}, 1);
+  *unknown.mutable_model() = Ref("no-such-model");
+  EXPECT_EQ(ReadExpMap(*stub, unknown).status.error_code(), grpc::StatusCode::NOT_FOUND);
+  // The server keeps serving.
+  EXPECT_TRUE(ReadExpMap(*stub, request({good}, 0.5)).status.ok());
 }
 
 TEST(ServerTest, GetMeshInSmallChunksTilesVerticesAndFaces) {

@@ -5,13 +5,17 @@
 //   geodex-query INDEX --paths FILE [--format xyz|json] [--exact-path-corridor K]
 //   geodex-query INDEX --field SOURCES [--nearest]
 //   geodex-query INDEX --locate POINTS
+//   geodex-query INDEX --expmap "F W0 W1 W2" --radius R [--direction X Y Z]
 //   geodex-query INDEX --info
 //
 // FILE holds lines "fa a0 a1 a2 fb b0 b1 b2" (core/mesh/pairs_io.h); SOURCES
-// lines "f w0 w1 w2"; POINTS lines "x y z". "-" reads standard input. Output
+// lines "f w0 w1 w2"; POINTS lines "x y z". "-" reads standard input.
+// --expmap prints "vertex u v" for every vertex within R of the centre (the
+// exponential map, core/query/exp_map.h), ascending by vertex id. Output
 // goes to standard output in input order; on a bad line nothing is printed and
 // the error names the line. Exit codes: 0 ok, 2 bad input, 1 other errors.
 
+#include <cmath>
 #include <cstdio>
 #include <string>
 
@@ -19,6 +23,7 @@
 #include "absl/strings/str_format.h"
 #include "core/common/status_macros.h"
 #include "core/mesh/pairs_io.h"
+#include "core/query/exp_map.h"
 #include "core/query/query_engine.h"
 
 namespace geodex {
@@ -79,7 +84,31 @@ absl::Status CheckPairs(const query::QueryEngine& engine,
   return absl::OkStatus();
 }
 
+// "F W0 W1 W2" as a surface point.
+absl::StatusOr<mesh::SurfacePoint> ParseCentre(const std::string& text) {
+  std::vector<double> values;
+  const char* p = text.c_str();
+  char* next = nullptr;
+  while (true) {
+    const double v = std::strtod(p, &next);
+    if (next == p) break;
+    values.push_back(v);
+    p = next;
+  }
+  while (*p == ' ' || *p == '\t') ++p;
+  if (*p != '\0' || values.size() != 4 || values[0] != std::floor(values[0]) ||
+      !(std::abs(values[0]) < 2147483648.0)) {
+    return absl::InvalidArgumentError(
+        absl::StrFormat("--expmap wants \"F W0 W1 W2\" (a face id and three weights), got \"%s\"",
+                        text));
+  }
+  return mesh::SurfacePoint{static_cast<int32_t>(values[0]), {values[1], values[2], values[3]}};
+}
+
 struct Args {
+  std::string expmap;
+  double radius = 0;
+  std::vector<double> direction;
   std::string index, pairs, paths, field, locate, format = "xyz", near_pairs = "path";
   bool exact_near = false, baseline = false, nearest = false, error_bounds = false, info = false;
   double tolerance = 0;
@@ -182,8 +211,23 @@ absl::Status Run(const Args& args) {
       out += absl::StrFormat("%d %.17g %.17g %.17g %.17g\n", located.point.face, located.point.w[0],
                              located.point.w[1], located.point.w[2], located.distance);
     }
+  } else if (!args.expmap.empty()) {
+    GEODEX_ASSIGN_OR_RETURN(const mesh::SurfacePoint centre, ParseCentre(args.expmap));
+    query::ExpMapOptions map_options;
+    map_options.radius = args.radius;
+    map_options.distance = distance_options;
+    if (!args.direction.empty()) {
+      map_options.reference_direction =
+          mesh::Vec3(args.direction[0], args.direction[1], args.direction[2]);
+    }
+    query::QueryScratch scratch;
+    GEODEX_ASSIGN_OR_RETURN(const auto map, query::ExpMap(*engine, centre, map_options, &scratch));
+    for (const query::ExpMapVertex& e : map) {
+      out += absl::StrFormat("%d %.17g %.17g\n", e.vertex, e.u, e.v);
+    }
   } else {
-    return absl::InvalidArgumentError("give one of --pairs, --paths, --field, --locate");
+    return absl::InvalidArgumentError(
+        "give one of --pairs, --paths, --field, --locate, --expmap");
   }
   std::fwrite(out.data(), 1, out.size(), stdout);
   return absl::OkStatus();
@@ -201,11 +245,22 @@ int main(int argc, char** argv) {
   auto* paths = app.add_option("--paths", args.paths, "Paths for lines 'fa a0 a1 a2 fb b0 b1 b2'");
   auto* field = app.add_option("--field", args.field, "Distance field from lines 'f w0 w1 w2'");
   auto* locate = app.add_option("--locate", args.locate, "Closest surface points to lines 'x y z'");
+  auto* expmap = app.add_option("--expmap", args.expmap,
+                                "Exponential map round the point \"F W0 W1 W2\": 'vertex u v' "
+                                "for every vertex within --radius");
+  app.add_option("--radius", args.radius, "With --expmap: the geodesic radius")
+      ->needs(expmap);
+  app.add_option("--direction", args.direction,
+                 "With --expmap: the reference direction X Y Z (theta = 0), projected into "
+                 "the centre's face; default its first edge")
+      ->expected(3)
+      ->needs(expmap);
   auto* info = app.add_flag("--info", args.info,
                             "The index's counts and build report, with its accuracy figures");
-  pairs->excludes(paths)->excludes(field)->excludes(locate)->excludes(info);
-  paths->excludes(field)->excludes(locate);
-  field->excludes(locate);
+  pairs->excludes(paths)->excludes(field)->excludes(locate)->excludes(info)->excludes(expmap);
+  paths->excludes(field)->excludes(locate)->excludes(expmap);
+  field->excludes(locate)->excludes(expmap);
+  locate->excludes(expmap);
   app.add_option("--near-pairs", args.near_pairs,
                  "Near pairs (the same or adjacent geodesic triangles, or closer than 3 scale "
                  "lengths): path (the traced path's length, default), unfold (pure O(1)) or "

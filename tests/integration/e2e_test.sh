@@ -311,6 +311,38 @@ if [ $FAKE -eq 0 ]; then
     fail "field.ply: not exactly one vertex at distance 0" ply_quality.txt
 fi
 
+# The exponential map: lines as geodex-query prints them offline, the decal
+# as a textured OBJ + MTL + PNG, and a rendered picture.
+if [ $FAKE -eq 0 ]; then
+  "$GEODEX" expmap "${S[@]}" --model "$MODEL" --center "1 0.2 0.3 0.5" --radius 0.4 \
+    --direction 0 1 0 --out map.txt 2> err.txt &&
+    "$QUERY_BIN" models/cube/1/index.gdx --expmap "1 0.2 0.3 0.5" --radius 0.4 \
+      --direction 0 1 0 > map_offline.txt 2>> err.txt &&
+    [ "$(wc -l < map.txt)" -gt 10 ] && same_numbers map.txt map_offline.txt &&
+    pass "expmap: $(wc -l < map.txt) vertices, as geodex-query --expmap" ||
+    fail "expmap differs from geodex-query --expmap" err.txt map.txt map_offline.txt
+  if "$GEODEX" expmap "${S[@]}" --model "$MODEL" --center "1 0.2 0.3 0.5" --radius 0.4 \
+       --out decal.obj --png decal_view.png 2> err.txt &&
+     grep -q '^mtllib decal.mtl$' decal.obj && grep -q '^usemtl ' decal.obj &&
+     [ "$(grep -c '^v ' decal.obj)" -eq "$(grep -c '^vt ' decal.obj)" ] &&
+     [ "$(grep -c '^f [0-9]*/[0-9]* [0-9]*/[0-9]* [0-9]*/[0-9]*$' decal.obj)" -gt 0 ] &&
+     grep -q '^map_Kd decal.png$' decal.mtl &&
+     [ "$(head -c 8 decal.png | od -An -tx1 | tr -d ' \n')" = "89504e470d0a1a0a" ] &&
+     [ "$(head -c 8 decal_view.png | od -An -tx1 | tr -d ' \n')" = "89504e470d0a1a0a" ]; then
+    pass "expmap --out decal.obj: OBJ with texture coordinates, MTL, checkerboard PNG; --png"
+  else
+    fail "expmap --out decal.obj" err.txt decal.obj decal.mtl
+  fi
+  mkdir -p decal_dir && printf 'not really a picture' > my_picture.jpg
+  if "$GEODEX" expmap "${S[@]}" --model "$MODEL" --center "1 0.2 0.3 0.5" --radius 0.4 \
+       --out decal_dir/d.obj --image my_picture.jpg 2> err.txt &&
+     grep -q '^map_Kd my_picture.jpg$' decal_dir/d.mtl && cmp -s my_picture.jpg decal_dir/my_picture.jpg; then
+    pass "expmap --image: the MTL applies the user's picture, copied beside the OBJ"
+  else
+    fail "expmap --image" err.txt
+  fi
+fi
+
 "$GEODEX" matrix "${S[@]}" --model "$MODEL" --sources sources.txt --targets sources.txt > m.txt 2> err.txt &&
   [ "$(wc -l < m.txt)" -eq 2 ] && awk '{ if ($1 + 0 != $1 || NF != 2) exit 1 }' m.txt &&
   pass "matrix 2x2" || fail "matrix" m.txt err.txt
@@ -364,6 +396,18 @@ expect "unknown model (models info): exit 1" 1 "NOT_FOUND" \
   "$GEODEX" info "${S[@]}" --model no-such-model
 expect "unknown model (field --out X.ply): exit 1" 1 "NOT_FOUND" \
   "$GEODEX" field "${S[@]}" --model no-such-model --sources sources.txt --out none.ply
+if [ $FAKE -eq 0 ]; then
+  expect "expmap with a zero radius: exit 2" 2 "radius" \
+    "$GEODEX" expmap "${S[@]}" --model "$MODEL" --center "1 0.2 0.3 0.5" --radius 0
+  expect "expmap with a malformed centre: exit 2" 2 "--center wants" \
+    "$GEODEX" expmap "${S[@]}" --model "$MODEL" --center "1 0.2 0.3" --radius 0.4
+  expect "expmap with a face past the end: exit 2" 2 "OUT_OF_RANGE|out of range|past" \
+    "$GEODEX" expmap "${S[@]}" --model "$MODEL" --center "99999 1 0 0" --radius 0.4
+  expect "expmap with a zero reference direction: exit 1 (the server's INVALID_ARGUMENT)" 1 \
+    "INVALID_ARGUMENT.*zero or perpendicular" \
+    "$GEODEX" expmap "${S[@]}" --model "$MODEL" --center "1 0.2 0.3 0.5" --radius 0.4 \
+      --direction 0 0 0
+fi
 expect "field --nearest with a .ply: exit 2" 2 "--nearest is for text output" \
   "$GEODEX" field "${S[@]}" --model "$MODEL" --sources sources.txt --nearest --out nearest.ply
 NO_SERVER="127.0.0.1:$(free_port)"

@@ -152,6 +152,14 @@ class Client {
                                                 absl::Span<const SurfacePoint> sources,
                                                 bool with_nearest_source = false) const;
 
+  // The exponential map round `center` (geodesic polar coordinates of every
+  // vertex within query.radius), assembled from the streamed chunks; entries
+  // ascend by vertex. Errors: INVALID_ARGUMENT for a bad centre, radius or
+  // reference direction (checked here where possible); DATA_LOSS if the
+  // chunks are not one consistent map.
+  absl::StatusOr<client::ExpMap> ExpMap(const ModelRef& model, const SurfacePoint& center,
+                                        const ExpMapQuery& query) const;
+
   // The closest surface point of each position, in input order.
   absl::StatusOr<std::vector<LocatedPoint>> Locate(const ModelRef& model,
                                                    absl::Span<const Position> positions) const;

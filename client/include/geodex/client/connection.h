@@ -71,6 +71,8 @@ class GeodexConnection {
   virtual absl::StatusOr<v1::LocateResponse> Locate(const v1::LocateRequest& request);
   // All chunks of the server stream, in the order received.
   virtual absl::StatusOr<std::vector<v1::MeshChunk>> GetMesh(const v1::GetMeshRequest& request);
+  // All chunks of the server stream, in the order received.
+  virtual absl::StatusOr<std::vector<v1::ExpMapChunk>> ExpMap(const v1::ExpMapRequest& request);
 };
 
 }  // namespace geodex::client

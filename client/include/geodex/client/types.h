@@ -6,6 +6,7 @@
 #include <array>
 #include <cstdint>
 #include <map>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -153,6 +154,18 @@ struct ExpMap {
   std::vector<double> u;
   std::vector<double> v;
   int64_t version = 0;  // the model version that answered
+};
+
+// What one ExpMap call asks for.
+struct ExpMapQuery {
+  // Vertices farther than this from the centre are left out; > 0.
+  double radius = 0;
+  // theta = 0 along this direction, projected into the plane of the centre's
+  // face; unset: along that face's first edge.
+  std::optional<Position> reference_direction;
+  // How r is computed, as in DistanceQuery.
+  NearPairs near_pairs = NearPairs::kModelDefault;
+  double tolerance = 0;
 };
 
 // The closest surface point to a 3D position and the Euclidean distance to it.

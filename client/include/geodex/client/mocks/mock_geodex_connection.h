@@ -38,6 +38,8 @@ class MockGeodexConnection : public GeodexConnection {
               (const v1::DistanceFieldRequest& request), (override));
   MOCK_METHOD(absl::StatusOr<v1::LocateResponse>, Locate, (const v1::LocateRequest& request),
               (override));
+  MOCK_METHOD(absl::StatusOr<std::vector<v1::ExpMapChunk>>, ExpMap,
+              (const v1::ExpMapRequest& request), (override));
   MOCK_METHOD(absl::StatusOr<std::vector<v1::MeshChunk>>, GetMesh,
               (const v1::GetMeshRequest& request), (override));
 };
