@@ -4,7 +4,9 @@
 #include <cmath>
 #include <functional>
 #include <numbers>
+#include <limits>
 #include <queue>
+#include <span>
 #include <utility>
 
 #include "absl/container/flat_hash_map.h"
@@ -19,10 +21,11 @@ namespace {
 
 using mesh::Vec3;
 
-// A placed vertex whose angle came from a path more than this share longer
-// than its distance is placed again when a shorter path appears. Relative
-// to the distance, well above rounding and well below the discretisation.
+// A vertex placed round a neighbour is placed again when a path more than
+// this share shorter appears. Well above rounding, well below the
+// discretisation.
 constexpr double kStale = 1e-9;
+constexpr double kInfinity = std::numeric_limits<double>::infinity();
 // Placing a vertex again moves its neighbours when its angle moves by more
 // than this (radians).
 constexpr double kMoved = 1e-12;
@@ -54,6 +57,7 @@ struct Node {
   // The length of the path theta was taken from: the unfolded ray, or the
   // way round a placed neighbour (longer than r when that was a stopgap).
   double path = 0;
+  bool round_vertex = false;  // theta is a neighbour's: no unfolding reached w
   bool done = false;
   bool seed = false;  // placed directly (SeedFromFaces, SeedFromVertex): final
   int placements = 0;
@@ -88,6 +92,7 @@ class ExpMapper {
   struct Angle {
     double theta = 0;
     double path = std::numeric_limits<double>::infinity();
+    bool round_vertex = false;
   };
   Angle AngleOf(int32_t w, const Node& node) const;
   // Places w at `angle`; then, as long as placing a vertex gives a placed
@@ -111,6 +116,10 @@ class ExpMapper {
   mesh::SurfacePoint centre_;
   const ExpMapOptions& options_;
   QueryScratch* scratch_;
+  // Exact distances of the vertices within exact_radius_ of the centre
+  // (QueryEngine::LocalExactDistances), when the distance options refine.
+  std::span<const double> exact_;
+  double exact_radius_ = -1;
   Vec3 origin_, normal_, e1_, e2_;
   absl::flat_hash_map<int32_t, Node> nodes_;
   using Entry = std::pair<double, int32_t>;  // (r, vertex)
@@ -233,8 +242,8 @@ void ExpMapper::SeedFromVertex(int32_t v) {
 
 ExpMapper::Angle ExpMapper::AngleOf(int32_t w, const Node& node) const {
   Angle best;
-  auto consider = [&](double length, double theta) {
-    if (length < best.path) best = {theta, length};
+  auto consider = [&](double length, double theta, bool round_vertex) {
+    if (length < best.path) best = {theta, length, round_vertex};
   };
   absl::InlinedVector<int32_t, 16> star;
   view_.FacesAround(w, node.face, &star);
@@ -245,8 +254,8 @@ ExpMapper::Angle ExpMapper::AngleOf(int32_t w, const Node& node) const {
     const bool a_done = ia != nodes_.end() && ia->second.done;
     const bool b_done = ib != nodes_.end() && ib->second.done;
     // Through a placed corner: the geodesic bends round it.
-    if (a_done) consider(ia->second.r + Edge(w, a), ia->second.theta);
-    if (b_done) consider(ib->second.r + Edge(w, b), ib->second.theta);
+    if (a_done) consider(ia->second.r + Edge(w, a), ia->second.theta, true);
+    if (b_done) consider(ib->second.r + Edge(w, b), ib->second.theta, true);
     if (!a_done || !b_done) continue;
     // Across the edge a-b, unfolded into a plane with a at the origin and b
     // on the x axis: w above it ((w, a, b) is counter-clockwise), and below
@@ -271,7 +280,7 @@ ExpMapper::Angle ExpMapper::AngleOf(int32_t w, const Node& node) const {
     const double share = part / span;
     if (!(share >= 0 && share <= 1)) continue;
     const double turn = std::remainder(ib->second.theta - ia->second.theta, 2 * std::numbers::pi);
-    consider(Norm(to_w), ia->second.theta + share * turn);
+    consider(Norm(to_w), ia->second.theta + share * turn, false);
   }
   return best;
 }
@@ -289,6 +298,7 @@ void ExpMapper::Place(int32_t w, Angle angle) {
     const bool again = node.done;
     node.theta = item.angle.theta;
     node.path = item.angle.path;
+    node.round_vertex = item.angle.round_vertex;
     node.at = {node.r * std::cos(node.theta), node.r * std::sin(node.theta)};
     node.done = true;
     ++node.placements;
@@ -309,7 +319,7 @@ void ExpMapper::Place(int32_t w, Angle angle) {
           continue;
         }
         const Node& other = it->second;
-        if (!again && !(other.path > other.r * (1 + kStale))) continue;
+        if (!again && !other.round_vertex) continue;
         const Angle better = AngleOf(y, other);
         const bool shorter = better.path < other.path * (1 - kStale);
         const bool moved = std::abs(std::remainder(better.theta - other.theta,
@@ -336,10 +346,12 @@ absl::Status ExpMapper::Expand(int32_t v) {
     for (int i = 0; i < 3; ++i) {
       const int32_t u = view_.Vertex(g, i);
       if (nodes_.contains(u)) continue;
-      mesh::SurfacePoint p{g, {0, 0, 0}};
-      p.w[i] = 1;
-      GEODEX_ASSIGN_OR_RETURN(const double r,
-                              engine_.Distance(centre_, p, options_.distance, scratch_));
+      double r = u < static_cast<int32_t>(exact_.size()) ? exact_[u] : kInfinity;
+      if (!(r <= exact_radius_)) {
+        mesh::SurfacePoint p{g, {0, 0, 0}};
+        p.w[i] = 1;
+        GEODEX_ASSIGN_OR_RETURN(r, engine_.Distance(centre_, p, options_.distance, scratch_));
+      }
       Node& met = nodes_[u];
       met.face = g;
       met.r = r;
@@ -363,6 +375,13 @@ absl::StatusOr<std::vector<ExpMapVertex>> ExpMapper::Run() {
   int32_t at_vertex = -1;
   for (int i = 0; i < 3; ++i) {
     if (centre_.w[i] >= 1 - 1e-12) at_vertex = view_.Vertex(centre_.face, i);
+  }
+  // Near the centre, where the O(1) distance errs most relative to r and the
+  // engine would refine vertex after vertex by traces, one local exact
+  // propagation gives every r at once, exactly.
+  if (options_.distance.near_pairs != NearPairs::kUnfold) {
+    exact_radius_ = std::min(options_.radius, kRefineScale * engine_.scale_length());
+    GEODEX_ASSIGN_OR_RETURN(exact_, engine_.LocalExactDistances(centre_, exact_radius_, *scratch_));
   }
   if (at_vertex >= 0) {
     SeedFromVertex(at_vertex);
@@ -399,7 +418,8 @@ absl::StatusOr<std::vector<ExpMapVertex>> ExpMap(const QueryEngine& engine,
                                                  const mesh::SurfacePoint& centre,
                                                  const ExpMapOptions& options,
                                                  QueryScratch* scratch) {
-  return ExpMapper(engine, centre, options, scratch).Run();
+  QueryScratch local;
+  return ExpMapper(engine, centre, options, scratch != nullptr ? scratch : &local).Run();
 }
 
 }  // namespace geodex::query

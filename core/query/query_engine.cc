@@ -484,21 +484,42 @@ double QueryEngine::AtLeastChord(const SurfacePoint& p, const SurfacePoint& q, d
   return std::max(d, (PositionOf(p) - PositionOf(q)).norm());
 }
 
+geodesic::ExactGeodesicSolver* QueryEngine::ExactSolver(QueryScratch& scratch) const {
+  const mesh::Mesh* m = ExactMesh();
+  if (m == nullptr) return nullptr;
+  if (scratch.solver_ == nullptr || scratch.mesh_ != m) {
+    scratch.solver_ = std::make_unique<geodesic::ExactGeodesicSolver>(*m);
+    scratch.mesh_ = m;
+  }
+  return scratch.solver_.get();
+}
+
 std::optional<double> QueryEngine::ExactNearDistance(const SurfacePoint& from,
                                                      const SurfacePoint& to,
                                                      QueryScratch* scratch) const {
-  const mesh::Mesh* m = ExactMesh();
-  if (m == nullptr) return std::nullopt;
   QueryScratch local;
-  if (scratch == nullptr) scratch = &local;
-  if (scratch->solver_ == nullptr || scratch->mesh_ != m) {
-    scratch->solver_ = std::make_unique<geodesic::ExactGeodesicSolver>(*m);
-    scratch->mesh_ = m;
-  }
+  geodesic::ExactGeodesicSolver* solver = ExactSolver(scratch != nullptr ? *scratch : local);
+  if (solver == nullptr) return std::nullopt;
   geodesic::GeodesicOptions options;
   options.stop_points = {to};
-  if (!scratch->solver_->Propagate({from}, options).ok()) return std::nullopt;
-  return scratch->solver_->DistanceAt(to);
+  if (!solver->Propagate({from}, options).ok()) return std::nullopt;
+  return solver->DistanceAt(to);
+}
+
+absl::StatusOr<std::span<const double>> QueryEngine::LocalExactDistances(
+    const SurfacePoint& p, double radius, QueryScratch& scratch) const {
+  GEODEX_RETURN_IF_ERROR(Validate(p));
+  if (!(radius >= 0)) {
+    return absl::InvalidArgumentError(absl::StrFormat("the radius must be >= 0, got %g", radius));
+  }
+  geodesic::ExactGeodesicSolver* solver = ExactSolver(scratch);
+  if (solver == nullptr) {
+    return absl::InternalError("the index's mesh cannot be rebuilt for exact propagation");
+  }
+  geodesic::GeodesicOptions options;
+  options.stop_radius = radius;
+  GEODEX_RETURN_IF_ERROR(solver->Propagate({Canonical(p)}, options));
+  return std::span<const double>(solver->VertexDistances());
 }
 
 double QueryEngine::BoundOf(AnswerKind kind, bool vertex_pair, double d) const {

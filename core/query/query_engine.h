@@ -200,6 +200,15 @@ class QueryEngine {
   absl::StatusOr<double> TracedDistance(const SurfacePoint& p, const SurfacePoint& q,
                                         bool* wraps = nullptr) const;
 
+  // Exact distances from p to every vertex within `radius` of it, by one
+  // local exact propagation (not O(1): its cost grows with the faces inside
+  // the radius). Entry v is vertex v's distance when it is at most `radius`,
+  // a larger value or +inf otherwise. The span lives in `scratch` until its
+  // next use. Errors: as Validate; InvalidArgument for a negative radius.
+  absl::StatusOr<std::span<const double>> LocalExactDistances(const SurfacePoint& p,
+                                                              double radius,
+                                                              QueryScratch& scratch) const;
+
   // L = sqrt(2 A / (sqrt(3) m)): the edge of an equilateral geodesic
   // triangle when the index's m samples tile the surface's area A.
   double scale_length() const { return scale_length_; }
@@ -320,6 +329,9 @@ class QueryEngine {
   bool NeedsRefine(const DistanceOptions& options, bool bounds, bool near, double unfolded) const;
   // The mesh for exact propagations, made on first use.
   const mesh::Mesh* ExactMesh() const;
+  // The scratch's exact solver over ExactMesh(), made on first use; null when
+  // the mesh cannot be made.
+  geodesic::ExactGeodesicSolver* ExactSolver(QueryScratch& scratch) const;
   // The near-pair modes from `from` to `to`; nullopt when they fail.
   std::optional<double> ExactNearDistance(const SurfacePoint& from, const SurfacePoint& to,
                                           QueryScratch* scratch) const;

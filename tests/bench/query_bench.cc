@@ -17,9 +17,14 @@
 // default mode, the pure O(1) mode, the default with error bounds and with
 // a tolerance of 0.005, on uniform pairs and on pairs at each scale.
 //
+// Then the exponential map (core/query/exp_map.h): the time of one map round
+// an interior point for radii of 3 L, 10 L and the whole mesh, in the default
+// mode and with r from the pure O(1) distance.
+//
 // Without --index it builds an index of a generated sphere (a note says so).
 
 #include <cstdio>
+#include <limits>
 #include <ctime>
 #include <random>
 #include <span>
@@ -28,6 +33,7 @@
 #include "absl/strings/str_format.h"
 #include "core/builder/builder.h"
 #include "core/mesh/generators.h"
+#include "core/query/exp_map.h"
 #include "core/query/query_engine.h"
 #include "core/query/unfold_kernel.h"
 
@@ -302,6 +308,35 @@ void Bench(const std::string& label, std::shared_ptr<const index::Index> ix, int
       m * (m - 1) / 2 * 4 / (1 << 20));
 }
 
+void BenchExpMap(const std::string& label, std::shared_ptr<const index::Index> ix) {
+  auto engine = *query::QueryEngine::Create(ix);
+  const auto centres = InteriorPoints(*ix, 5, 7);
+  const double l = engine->scale_length();
+  for (const double radius : {3 * l, 10 * l, std::numeric_limits<double>::max()}) {
+    double ms[2];
+    size_t mapped = 0;
+    for (int mode = 0; mode < 2; ++mode) {
+      query::ExpMapOptions options;
+      options.radius = radius;
+      if (mode == 1) options.distance.near_pairs = query::NearPairs::kUnfold;
+      query::QueryScratch scratch;
+      (void)query::ExpMap(*engine, centres[0], options, &scratch);  // the lazy exact mesh
+      mapped = 0;
+      const double t0 = ThreadSeconds();
+      for (const mesh::SurfacePoint& c : centres) {
+        mapped += query::ExpMap(*engine, c, options, &scratch)->size();
+      }
+      ms[mode] = 1e3 * (ThreadSeconds() - t0) / centres.size();
+    }
+    const double per_map = static_cast<double>(mapped) / centres.size();
+    const std::string scale = radius == std::numeric_limits<double>::max()
+                                  ? "whole mesh"
+                                  : absl::StrFormat("%.0f L", radius / l);
+    std::printf("| %s | %s | %.0f | %.2f ms | %.2f ms | %.2f us |\n", label.c_str(),
+                scale.c_str(), per_map, ms[0], ms[1], 1e3 * ms[0] / per_map);
+  }
+}
+
 }  // namespace
 }  // namespace geodex
 
@@ -311,6 +346,8 @@ int main(int argc, char** argv) {
   int pairs = 1'000'000;
   app.add_option("--index", indexes, "Index files to measure");
   app.add_option("--pairs", pairs, "Pairs per measurement");
+  bool expmap_only = false;
+  app.add_flag("--expmap-only", expmap_only, "Only the exponential map table");
   CLI11_PARSE(app, argc, argv);
   std::printf("(batch: far pairs %s)\n", geodex::query::kernel::HasAvx2Lanes()
                                              ? "four at a time with AVX2"
@@ -329,6 +366,9 @@ int main(int argc, char** argv) {
     auto data = geodex::builder::BuildIndex(geodex::mesh::gen::Sphere(5, 1.0), options, &summary);
     auto ix = geodex::index::Index::FromBytes(*geodex::index::SerializeIndex(*data));
     geodex::Bench("sphere(5)", *ix, pairs);
+    std::printf("\n| index | radius | vertices mapped | one map, default | one map, pure O(1) | "
+                "per vertex, default |\n|---|---|---|---|---|---|\n");
+    geodex::BenchExpMap("sphere(5)", *ix);
     return 0;
   }
   std::vector<std::shared_ptr<const geodex::index::Index>> loaded;
@@ -339,14 +379,18 @@ int main(int argc, char** argv) {
       return 1;
     }
     loaded.push_back(*ix);
-    geodex::Bench(path, *ix, pairs);
+    if (!expmap_only) geodex::Bench(path, *ix, pairs);
   }
   std::printf(
       "\nRefinement (DistanceOptions), batch pairs/s; tolerance: at most 300 pairs, once\n"
       "| index | pairs | count | default/s | pure O(1)/s | default / pure | default + bounds/s | "
       "tolerance 0.005/s |\n|---|---|---|---|---|---|---|---|\n");
-  for (size_t i = 0; i < loaded.size(); ++i) {
+  for (size_t i = 0; i < loaded.size() && !expmap_only; ++i) {
     geodex::BenchRefinement(indexes[i], loaded[i], std::min(pairs, 200'000));
   }
+  std::printf("\nExponential map (5 interior centres)\n| index | radius | vertices mapped | "
+              "one map, default | one map, pure O(1) | per vertex, default |\n"
+              "|---|---|---|---|---|---|\n");
+  for (size_t i = 0; i < loaded.size(); ++i) geodex::BenchExpMap(indexes[i], loaded[i]);
   return 0;
 }
