@@ -27,7 +27,7 @@
 // `expmap` asks for the exponential map round the centre, then for the mesh
 // of the version that answered it. --out X.obj writes the patch of faces
 // inside the radius with texture coordinates (X.mtl beside it, and a
-// checkerboard X.png unless --image names the picture to apply, which is
+// checkerboard X_checker.png unless --image names the picture to apply, which is
 // copied beside the OBJ); any other --out gets lines "vertex u v". --png
 // renders the decal on the whole mesh (client/cli/render.h).
 //
@@ -458,7 +458,7 @@ absl::Status ExpMapCommand(const ConnectionFlags& conn, const ExpMapFlags& flags
   if (obj) {
     const std::string stem = flags.out.substr(0, flags.out.size() - 4);
     const std::string texture =
-        flags.image.empty() ? BaseName(stem) + ".png" : BaseName(flags.image);
+        flags.image.empty() ? BaseName(stem) + "_checker.png" : BaseName(flags.image);
     absl::StatusOr<DecalFiles> files =
         DecalToObj(*mesh, *map, query.radius, BaseName(stem) + ".mtl", texture);
     if (!files.ok()) return files.status();
@@ -466,6 +466,10 @@ absl::Status ExpMapCommand(const ConnectionFlags& conn, const ExpMapFlags& flags
     if (absl::Status s = WriteOutput(flags.out, files->obj); !s.ok()) return s;
     if (absl::Status s = WriteOutput(stem + ".mtl", files->mtl); !s.ok()) return s;
     const std::string texture_path = dir + texture;
+    if (texture_path == flags.png) {
+      return InputError(absl::InvalidArgumentError(
+          absl::StrCat("--png ", flags.png, " would overwrite the decal's texture")));
+    }
     if (flags.image.empty()) {
       if (absl::Status s = WriteOutput(texture_path, EncodePng(Checkerboard(1024, 8))); !s.ok()) {
         return s;
@@ -646,7 +650,7 @@ int Main(int argc, char** argv) {
                      "Relative error tolerance of the distances r (as for distance)");
   expmap
       ->add_option("-o,--out", expmap_flags.out,
-                   "Output: X.obj writes the decal (X.obj, X.mtl and X.png, the texture); "
+                   "Output: X.obj writes the decal (X.obj, X.mtl and the texture X_checker.png); "
                    "anything else gets lines 'vertex u v' ('-': standard output)")
       ->capture_default_str();
   expmap->add_option("--image", expmap_flags.image,

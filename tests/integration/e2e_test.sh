@@ -326,8 +326,8 @@ if [ $FAKE -eq 0 ]; then
      grep -q '^mtllib decal.mtl$' decal.obj && grep -q '^usemtl ' decal.obj &&
      [ "$(grep -c '^v ' decal.obj)" -eq "$(grep -c '^vt ' decal.obj)" ] &&
      [ "$(grep -c '^f [0-9]*/[0-9]* [0-9]*/[0-9]* [0-9]*/[0-9]*$' decal.obj)" -gt 0 ] &&
-     grep -q '^map_Kd decal.png$' decal.mtl &&
-     [ "$(head -c 8 decal.png | od -An -tx1 | tr -d ' \n')" = "89504e470d0a1a0a" ] &&
+     grep -q '^map_Kd decal_checker.png$' decal.mtl &&
+     [ "$(head -c 8 decal_checker.png | od -An -tx1 | tr -d ' \n')" = "89504e470d0a1a0a" ] &&
      [ "$(head -c 8 decal_view.png | od -An -tx1 | tr -d ' \n')" = "89504e470d0a1a0a" ]; then
     pass "expmap --out decal.obj: OBJ with texture coordinates, MTL, checkerboard PNG; --png"
   else
