@@ -10,11 +10,15 @@
 #include <string>
 #include <vector>
 
+#include <fstream>
+#include <utility>
+
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_split.h"
 #include "client/cli/decal_testing.h"
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
+#include "tiny_obj_loader.h"
 
 namespace geodex::client::cli {
 namespace {
@@ -174,6 +178,39 @@ TEST(DecalToObj, PatchCountsRenumberingAndTextureCoordinates) {
   }
   // The mtllib line comes before the first usemtl, as readers expect.
   EXPECT_LT(files->obj.find("mtllib "), files->obj.find("usemtl "));
+}
+
+// An independent reader (tinyobjloader, as MeshLab-style importers read OBJ)
+// finds the material, its texture and a texture coordinate for every corner.
+TEST(DecalToObj, AnIndependentReaderFindsTheTexturedPatch) {
+  const Mesh mesh = FlatGrid(6);
+  const ExpMap map = PlanarExpMap(mesh, 0, 0, 1.2);
+  const absl::StatusOr<DecalFiles> files = DecalToObj(mesh, map, 1.2, "d.mtl", "d_checker.png");
+  ASSERT_TRUE(files.ok()) << files.status();
+  const std::string dir = ::testing::TempDir();
+  for (const auto& [name, text] : {std::pair{"d.obj", files->obj}, std::pair{"d.mtl", files->mtl}}) {
+    std::ofstream(dir + "/" + name) << text;
+  }
+  tinyobj::ObjReaderConfig config;
+  config.mtl_search_path = dir;
+  config.triangulate = false;
+  tinyobj::ObjReader reader;
+  ASSERT_TRUE(reader.ParseFromFile(dir + "/d.obj", config)) << reader.Error();
+  EXPECT_EQ(reader.Warning(), "");
+  ASSERT_EQ(reader.GetMaterials().size(), 1u);
+  EXPECT_EQ(reader.GetMaterials()[0].diffuse_texname, "d_checker.png");
+  const tinyobj::attrib_t& attrib = reader.GetAttrib();
+  EXPECT_EQ(attrib.texcoords.size() / 2, attrib.vertices.size() / 3);
+  size_t corners = 0;
+  for (const tinyobj::shape_t& shape : reader.GetShapes()) {
+    for (const tinyobj::index_t& index : shape.mesh.indices) {
+      ++corners;
+      EXPECT_GE(index.texcoord_index, 0);
+    }
+    for (const int material : shape.mesh.material_ids) EXPECT_EQ(material, 0);
+  }
+  EXPECT_GT(corners, 30u);
+  EXPECT_EQ(corners, 3 * ParseObj(files->obj).f.size());
 }
 
 TEST(DecalToObj, FacesWithAVertexOutsideTheMapAreLeftOut) {
