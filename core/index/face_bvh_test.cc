@@ -1,4 +1,5 @@
 #include "core/index/face_bvh.h"
+#include "core/index/face_bvh_testing.h"
 
 #include <algorithm>
 #include <cstring>
@@ -13,19 +14,7 @@ namespace {
 using mesh::Mesh;
 using mesh::Vec3;
 
-// A mesh flattened the way the index stores it, with its BVH.
-struct Flat {
-  std::vector<double> positions;
-  std::vector<int32_t> faces;
-  std::vector<BvhNode> nodes;
-  std::vector<int32_t> leaf_faces;
-
-  explicit Flat(const Mesh& mesh) {
-    for (const Vec3& p : mesh.positions()) positions.insert(positions.end(), {p.x(), p.y(), p.z()});
-    for (const mesh::Triangle& f : mesh.faces()) faces.insert(faces.end(), f.begin(), f.end());
-    BuildFaceBvh(positions, faces, &nodes, &leaf_faces);
-  }
-};
+using Flat = testing::FlatMesh;
 
 TEST(BuildFaceBvhTest, EmptyMesh) {
   std::vector<BvhNode> nodes;

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "core/index/face_bvh.h"
+#include "core/index/face_bvh_testing.h"
 #include "core/index/index.h"
 #include "core/mesh/generators.h"
 #include "gmock/gmock.h"
@@ -20,18 +21,9 @@ namespace {
 using mesh::Mesh;
 using mesh::Vec3;
 
-// A mesh flattened the way the index stores it, with its BVH.
-struct Flat {
-  std::vector<double> positions;
-  std::vector<int32_t> faces;
-  std::vector<index::BvhNode> nodes;
-  std::vector<int32_t> leaf_faces;
-
-  explicit Flat(const Mesh& mesh) {
-    for (const Vec3& p : mesh.positions()) positions.insert(positions.end(), {p.x(), p.y(), p.z()});
-    for (const mesh::Triangle& f : mesh.faces()) faces.insert(faces.end(), f.begin(), f.end());
-    index::BuildFaceBvh(positions, faces, &nodes, &leaf_faces);
-  }
+// The index's flattened mesh and BVH, and a locator over them.
+struct Flat : index::testing::FlatMesh {
+  using FlatMesh::FlatMesh;
   PointLocator Locator() const { return PointLocator(positions, faces, nodes, leaf_faces); }
 };
 

@@ -242,6 +242,53 @@ int32_t LowestVertex(Tracer& tr, const MeshView& view, int32_t f) {
   return view.faces[3 * f + k];
 }
 
+// TracePath's step inside face *f from barycentric position *b: along the
+// descent to the face's boundary, then across the edge it reaches into the
+// next face (*f and *b move there), or onto a vertex (*at_vertex: the face's
+// lowest vertex when the descent has no way forward, the edge's lower end at
+// the boundary). Appends the point reached to *path, unless it crossed.
+template <typename PointAt, typename VertexPoint>
+void FaceStep(Tracer& tr, const MeshView& view, int32_t* f, std::array<double, 3>* b,
+              int32_t* at_vertex, std::vector<PathPoint>* path, const PointAt& point_at,
+              const VertexPoint& vertex_point) {
+  double magnitude;
+  const auto beta = tr.Descent(*f, *b, &magnitude);
+  double t;
+  const int exit = DescentExit(beta, *b, &t);
+  if (exit < 0 || !(t > 1e-14) || !(magnitude > 0)) {
+    *at_vertex = LowestVertex(tr, view, *f);
+    path->push_back(vertex_point(*f, *at_vertex));
+    return;
+  }
+  std::array<double, 3>& w = *b;
+  for (int i = 0; i < 3; ++i) w[i] = std::max(w[i] + t * beta[i], 0.0);
+  w[exit] = 0;
+  const double sum = w[0] + w[1] + w[2];
+  for (double& x : w) x /= sum;
+  path->push_back(point_at(*f, w));
+  for (int i = 0; i < 3; ++i) {
+    if (w[i] >= 1 - 1e-12) *at_vertex = view.faces[3 * *f + i];
+  }
+  if (*at_vertex >= 0) {
+    path->back() = vertex_point(*f, *at_vertex);
+    return;
+  }
+  const int32_t h = 3 * *f + (exit + 1) % 3;  // the edge opposite `exit`
+  const int32_t g = view.twins[h];
+  if (g < 0) {
+    const int32_t a = view.faces[3 * *f + (exit + 1) % 3],
+                  c = view.faces[3 * *f + (exit + 2) % 3];
+    *at_vertex = tr.D(a) <= tr.D(c) ? a : c;
+    path->push_back(vertex_point(*f, *at_vertex));
+    return;
+  }
+  std::array<double, 3> next = {0, 0, 0};
+  next[g % 3] = w[(exit + 2) % 3];            // Origin(g) = Dest(h)
+  next[(g % 3 + 1) % 3] = w[(exit + 1) % 3];  // Dest(g) = Origin(h)
+  *f = g / 3;
+  w = next;
+}
+
 }  // namespace
 
 absl::StatusOr<std::vector<PathPoint>> QueryEngine::Path(const SurfacePoint& from,
@@ -519,45 +566,7 @@ absl::StatusOr<std::vector<PathPoint>> QueryEngine::TracePath(const SurfacePoint
         continue;
       }
     }
-    // Face step: follow the descent to the face's boundary.
-    double magnitude;
-    const auto beta = tr.Descent(f, b, &magnitude);
-    double t;
-    const int exit = DescentExit(beta, b, &t);
-    if (exit < 0 || !(t > 1e-14) || !(magnitude > 0)) {
-      // No way forward inside this face: go to its lowest vertex.
-      at_vertex = LowestVertex(tr, view_, f);
-      path.push_back(vertex_point(f, at_vertex));
-      continue;
-    }
-    for (int i = 0; i < 3; ++i) b[i] = std::max(b[i] + t * beta[i], 0.0);
-    b[exit] = 0;
-    const double sum = b[0] + b[1] + b[2];
-    for (double& x : b) x /= sum;
-    path.push_back(point_at(f, b));
-    for (int i = 0; i < 3; ++i) {
-      if (b[i] >= 1 - 1e-12) at_vertex = view_.faces[3 * f + i];
-    }
-    if (at_vertex >= 0) {
-      path.back() = vertex_point(f, at_vertex);
-      continue;
-    }
-    // Cross the edge opposite `exit` into the neighbouring face.
-    const int32_t h = 3 * f + (exit + 1) % 3;
-    const int32_t g = view_.twins[h];
-    if (g < 0) {
-      // A boundary edge: slide to its lower end.
-      const int32_t a = view_.faces[3 * f + (exit + 1) % 3],
-                    c = view_.faces[3 * f + (exit + 2) % 3];
-      at_vertex = tr.D(a) <= tr.D(c) ? a : c;
-      path.push_back(vertex_point(f, at_vertex));
-      continue;
-    }
-    std::array<double, 3> nb = {0, 0, 0};
-    nb[g % 3] = b[(exit + 2) % 3];            // Origin(g) = Dest(h)
-    nb[(g % 3 + 1) % 3] = b[(exit + 1) % 3];  // Dest(g) = Origin(h)
-    f = g / 3;
-    b = nb;
+    FaceStep(tr, view_, &f, &b, &at_vertex, &path, point_at, vertex_point);
   }
   return finish_on_graph(path, at_vertex >= 0 ? at_vertex : view_.faces[3 * f], f);
 }

@@ -17,6 +17,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <optional>
 #include <string>
 
 #include "CLI/CLI.hpp"
@@ -28,6 +29,23 @@
 
 namespace geodex {
 namespace {
+
+// The whitespace-separated numbers of `text`; nullopt when something else
+// follows them.
+std::optional<std::vector<double>> ParseNumbers(const std::string& text) {
+  std::vector<double> values;
+  const char* p = text.c_str();
+  char* next = nullptr;
+  while (true) {
+    const double v = std::strtod(p, &next);
+    if (next == p) break;
+    values.push_back(v);
+    p = next;
+  }
+  while (*p == ' ' || *p == '\t' || *p == '\r') ++p;
+  if (*p != '\0') return std::nullopt;
+  return values;
+}
 
 // Lines of `width` numbers; errors name the line.
 absl::StatusOr<std::vector<std::vector<double>>> ReadNumberLines(const std::string& path,
@@ -46,26 +64,17 @@ absl::StatusOr<std::vector<std::vector<double>>> ReadNumberLines(const std::stri
         line[line.find_first_not_of(" \t")] == '#') {
       continue;
     }
-    std::vector<double> values;
-    const char* p = line.c_str();
-    char* next = nullptr;
-    while (true) {
-      const double v = std::strtod(p, &next);
-      if (next == p) break;
-      values.push_back(v);
-      p = next;
-    }
-    while (*p == ' ' || *p == '\t' || *p == '\r') ++p;
-    if (*p != '\0' || values.size() != width) {
+    const std::optional<std::vector<double>> values = ParseNumbers(line);
+    if (!values || values->size() != width) {
       return absl::InvalidArgumentError(
           absl::StrFormat("line %d: expected %d numbers", number, width));
     }
-    for (double v : values) {
+    for (double v : *values) {
       if (!std::isfinite(v)) {
         return absl::InvalidArgumentError(absl::StrFormat("line %d: non-finite number", number));
       }
     }
-    lines.push_back(std::move(values));
+    lines.push_back(*values);
   }
   return lines;
 }
@@ -86,17 +95,8 @@ absl::Status CheckPairs(const query::QueryEngine& engine,
 
 // "F W0 W1 W2" as a surface point.
 absl::StatusOr<mesh::SurfacePoint> ParseCentre(const std::string& text) {
-  std::vector<double> values;
-  const char* p = text.c_str();
-  char* next = nullptr;
-  while (true) {
-    const double v = std::strtod(p, &next);
-    if (next == p) break;
-    values.push_back(v);
-    p = next;
-  }
-  while (*p == ' ' || *p == '\t') ++p;
-  if (*p != '\0' || values.size() != 4 || values[0] != std::floor(values[0]) ||
+  const std::vector<double> values = ParseNumbers(text).value_or(std::vector<double>{});
+  if (values.size() != 4 || values[0] != std::floor(values[0]) ||
       !(std::abs(values[0]) < 2147483648.0)) {
     return absl::InvalidArgumentError(
         absl::StrFormat("--expmap wants \"F W0 W1 W2\" (a face id and three weights), got \"%s\"",

@@ -1,0 +1,364 @@
+#include "core/index/index.h"
+
+// Files that are truncated, flipped, of another format, or corrupt behind
+// valid checksums: each is refused with the right code, none is read.
+
+#include <algorithm>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "core/index/index_test_util.h"
+#include "gmock/gmock.h"
+#include "gtest/gtest.h"
+
+namespace geodex::index {
+namespace {
+
+using namespace testing_util;  // NOLINT: the shared fixtures of the index tests
+using ::testing::AnyOf;
+using ::testing::HasSubstr;
+
+TEST(IndexTest, EveryTruncationIsRejected) {
+  const std::string bytes = Serialize(MakeSphereIndex());
+  // Every prefix of a valid file starts with (a prefix of) the magic, so each
+  // is reported as truncated, including the empty file.
+  for (size_t n = 0; n < bytes.size(); ++n) {
+    const absl::Status status = Index::FromBytes(bytes.substr(0, n)).status();
+    ASSERT_EQ(status.code(), absl::StatusCode::kDataLoss) << n << ": " << status;
+    ASSERT_THAT(status.message(), HasSubstr("truncated")) << n;
+  }
+  EXPECT_THAT(
+      Index::FromBytes(bytes.substr(0, bytes.size() - 1)).status().message(),
+      HasSubstr(absl::StrCat("expected ", bytes.size(), " bytes, found ", bytes.size() - 1)));
+}
+
+TEST(IndexTest, TrailingBytesAreRejected) {
+  const std::string bytes = Serialize(MakeSphereIndex());
+  EXPECT_EQ(CodeOf(bytes + std::string(1, '\0')), absl::StatusCode::kDataLoss);
+  EXPECT_EQ(CodeOf(bytes + std::string(64, 'x')), absl::StatusCode::kDataLoss);
+}
+
+// Every byte is covered by a checksum or must be zero padding.
+void ExpectFlipRejected(const std::string& bytes, size_t position, uint8_t mask) {
+  std::string corrupt = bytes;
+  corrupt[position] = static_cast<char>(corrupt[position] ^ mask);
+  const absl::Status status = Index::FromBytes(std::move(corrupt)).status();
+  EXPECT_THAT(status.code(),
+              AnyOf(absl::StatusCode::kDataLoss, absl::StatusCode::kFailedPrecondition))
+      << "byte " << position << " ^ " << int{mask} << ": " << status;
+}
+
+TEST(IndexTest, RandomByteFlipsAreRejected) {
+  const std::string bytes = Serialize(MakeSphereIndex());
+  std::mt19937_64 random(20240611);
+  std::uniform_int_distribution<size_t> position(0, bytes.size() - 1);
+  std::uniform_int_distribution<int> mask(1, 255);
+  for (int trial = 0; trial < 2000; ++trial) {
+    ExpectFlipRejected(bytes, position(random), static_cast<uint8_t>(mask(random)));
+  }
+}
+
+TEST(IndexTest, EveryBitOfEveryByteIsProtected) {
+  const std::string bytes = Serialize(MakeSphereIndex());
+  for (size_t i = 0; i < bytes.size(); ++i) ExpectFlipRejected(bytes, i, uint8_t{1} << (i % 8));
+}
+
+TEST(IndexTest, WrongMagicIsFailedPrecondition) {
+  std::string bytes = Serialize(MakeSphereIndex());
+  bytes[0] = 'X';
+  const absl::Status status = Index::FromBytes(bytes).status();
+  EXPECT_EQ(status.code(), absl::StatusCode::kFailedPrecondition);
+  EXPECT_THAT(status.message(), HasSubstr("not a geodex index"));
+  EXPECT_EQ(CodeOf("hello"), absl::StatusCode::kFailedPrecondition);
+  EXPECT_EQ(CodeOf(std::string(1000, '\0')), absl::StatusCode::kFailedPrecondition);
+}
+
+TEST(IndexTest, WrongMajorVersionIsFailedPrecondition) {
+  Image image = Image::Parse(Serialize(MakeSphereIndex()));
+  image.header.format_major = kFormatMajor + 1;
+  image.header.format_minor = 3;
+  const absl::Status status = Index::FromBytes(image.Layout()).status();
+  EXPECT_EQ(status.code(), absl::StatusCode::kFailedPrecondition);
+  EXPECT_THAT(status.message(), HasSubstr(absl::StrCat(kFormatMajor + 1, ".3")));
+  EXPECT_THAT(status.message(), HasSubstr(absl::StrCat(kFormatMajor, ".", kFormatMinor)));
+}
+
+TEST(IndexTest, SwappedByteOrderIsFailedPrecondition) {
+  Image image = Image::Parse(Serialize(MakeSphereIndex()));
+  image.header.byte_order_mark = 0x04030201;
+  const absl::Status status = Index::FromBytes(image.Layout()).status();
+  EXPECT_EQ(status.code(), absl::StatusCode::kFailedPrecondition);
+  EXPECT_THAT(status.message(), HasSubstr("byte order"));
+}
+
+TEST(IndexTest, FutureMinorVersionWithUnknownSectionIsAccepted) {
+  const IndexData d = MakeSphereIndex();
+  Image image = Image::Parse(Serialize(d));
+  image.header.format_minor = kFormatMinor + 1;
+  // A new section in the middle of the table and one at the end.
+  image.entries.insert(image.entries.begin() + 3, UnknownEntry(77, 8));
+  image.payloads.insert(image.payloads.begin() + 3, std::string(200, '\x5a'));
+  image.entries.push_back(UnknownEntry(1000, 1));
+  image.payloads.push_back("future data");
+  absl::StatusOr<std::shared_ptr<const Index>> index = Index::FromBytes(image.Layout());
+  ASSERT_TRUE(index.ok()) << index.status();
+  ExpectSameData(**index, d);
+  EXPECT_EQ((*index)->header().format_minor, kFormatMinor + 1);
+}
+
+TEST(IndexTest, SemanticCorruptionWithValidChecksumsIsDataLoss) {
+  const IndexData d = MakeSphereIndex();
+  const std::string bytes = Serialize(d);
+  const int32_t nv = static_cast<int32_t>(d.positions.size() / 3);
+  const int32_t nf = static_cast<int32_t>(d.faces.size() / 3);
+  const int32_t m = static_cast<int32_t>(d.samples.size());
+  const int32_t nt = static_cast<int32_t>(d.triangles.size());
+  const int32_t nb = static_cast<int32_t>(d.bvh_nodes.size());
+  struct Case {
+    std::string name;
+    std::function<void(Image&)> corrupt;
+    std::string message;
+  };
+  const float kNaN = std::numeric_limits<float>::quiet_NaN();
+  const std::vector<Case> cases = {
+      {"face vertex out of range", [&](Image& i) { i.Set<int32_t>(SectionId::kFaces, 7, nv); },
+       "face 2"},
+      {"negative face vertex", [&](Image& i) { i.Set<int32_t>(SectionId::kFaces, 0, -1); },
+       "face 0"},
+      {"twin out of range", [&](Image& i) { i.Set<int32_t>(SectionId::kTwins, 5, 3 * nf); },
+       "twin"},
+      {"twin below -1", [&](Image& i) { i.Set<int32_t>(SectionId::kTwins, 5, -2); }, "twin"},
+      {"sample out of range", [&](Image& i) { i.Set<int32_t>(SectionId::kSamples, 3, nv); },
+       "sample 3"},
+      {"NaN position", [&](Image& i) { i.Set<double>(SectionId::kPositions, 4, std::nan("")); },
+       "vertex 1"},
+      {"infinite position",
+       [&](Image& i) {
+         i.Set<double>(SectionId::kPositions, 4, std::numeric_limits<double>::infinity());
+       },
+       "vertex 1"},
+      {"NaN sample distance", [&](Image& i) { i.Set<float>(SectionId::kSampleDistances, 1, kNaN); },
+       "sample distance"},
+      {"negative sample distance",
+       [&](Image& i) { i.Set<float>(SectionId::kSampleDistances, m + 2, -0.5f); },
+       "sample distance (1, 2)"},
+      {"vertex triangle out of range",
+       [&](Image& i) {
+         VertexRecord r = i.Get<VertexRecord>(SectionId::kVertexRecords, 9);
+         r.triangle = nt;
+         i.Set(SectionId::kVertexRecords, 9, r);
+       },
+       "vertex record 9"},
+      {"vertex corner out of range",
+       [&](Image& i) {
+         VertexRecord r = i.Get<VertexRecord>(SectionId::kVertexRecords, 9);
+         r.corner[2] = m;
+         i.Set(SectionId::kVertexRecords, 9, r);
+       },
+       "vertex record 9"},
+      {"corner of a vertex without triangle",
+       [&](Image& i) {
+         VertexRecord r = i.Get<VertexRecord>(SectionId::kVertexRecords, nv - 1);
+         r.corner[0] = 0;
+         i.Set(SectionId::kVertexRecords, nv - 1, r);
+       },
+       "vertex record"},
+      {"infinite vertex distance",
+       [&](Image& i) {
+         VertexRecord r = i.Get<VertexRecord>(SectionId::kVertexRecords, 9);
+         r.distance[1] = kInf;
+         i.Set(SectionId::kVertexRecords, 9, r);
+       },
+       "vertex record 9"},
+      {"negative vertex distance",
+       [&](Image& i) {
+         VertexRecord r = i.Get<VertexRecord>(SectionId::kVertexRecords, 9);
+         r.distance[1] = -1e-3f;
+         i.Set(SectionId::kVertexRecords, 9, r);
+       },
+       "vertex record 9"},
+      {"triangle corner out of range",
+       [&](Image& i) {
+         GeodesicTriangle g = i.Get<GeodesicTriangle>(SectionId::kTriangles, 4);
+         g.corner[1] = -1;
+         i.Set(SectionId::kTriangles, 4, g);
+       },
+       "geodesic triangle 4"},
+      {"triangle neighbour out of range",
+       [&](Image& i) {
+         GeodesicTriangle g = i.Get<GeodesicTriangle>(SectionId::kTriangles, 4);
+         g.neighbor[0] = nt;
+         i.Set(SectionId::kTriangles, 4, g);
+       },
+       "geodesic triangle 4"},
+      {"BVH child out of range",
+       [&](Image& i) {
+         BvhNode n = i.Get<BvhNode>(SectionId::kFaceBvh, 0);
+         n.first = nb - 1;
+         i.Set(SectionId::kFaceBvh, 0, n);
+       },
+       "BVH node 0"},
+      {"BVH cycle",
+       [&](Image& i) {
+         BvhNode n = i.Get<BvhNode>(SectionId::kFaceBvh, 0);
+         n.first = 0;
+         i.Set(SectionId::kFaceBvh, 0, n);
+       },
+       "BVH node 0"},
+      {"BVH leaf beyond the faces",
+       [&](Image& i) {
+         BvhNode n = i.Get<BvhNode>(SectionId::kFaceBvh, nb - 1);
+         n.first = nf - 1;
+         n.count = 2;
+         i.Set(SectionId::kFaceBvh, nb - 1, n);
+       },
+       "BVH node"},
+      {"BVH negative count",
+       [&](Image& i) {
+         BvhNode n = i.Get<BvhNode>(SectionId::kFaceBvh, nb - 1);
+         n.count = -1;
+         i.Set(SectionId::kFaceBvh, nb - 1, n);
+       },
+       "BVH node"},
+      {"BVH NaN box",
+       [&](Image& i) {
+         BvhNode n = i.Get<BvhNode>(SectionId::kFaceBvh, 1);
+         n.lo[2] = kNaN;
+         i.Set(SectionId::kFaceBvh, 1, n);
+       },
+       "BVH node 1"},
+      {"BVH face out of range", [&](Image& i) { i.Set<int32_t>(SectionId::kBvhFaces, 0, nf); },
+       "BVH face 0"},
+      {"BVH face repeated",
+       [&](Image& i) {
+         i.Set<int32_t>(SectionId::kBvhFaces, 1, i.Get<int32_t>(SectionId::kBvhFaces, 0));
+       },
+       "BVH face 1"},
+  };
+  for (const Case& c : cases) {
+    Image image = Image::Parse(bytes);
+    c.corrupt(image);
+    const absl::Status status = Index::FromBytes(image.Layout()).status();
+    EXPECT_EQ(status.code(), absl::StatusCode::kDataLoss) << c.name << ": " << status;
+    EXPECT_THAT(status.message(), HasSubstr(c.message)) << c.name;
+  }
+}
+
+TEST(IndexTest, StructuralCorruptionWithValidChecksumsIsDataLoss) {
+  const std::string bytes = Serialize(MakeSphereIndex());
+  struct Case {
+    std::string name;
+    std::function<std::string(Image&)> corrupt;
+    std::string message;
+  };
+  const std::vector<Case> cases = {
+      {"missing required section",
+       [](Image& i) {
+         i.Remove(SectionId::kTriangles);
+         return i.Layout();
+       },
+       "missing section: geodesic triangles"},
+      {"missing BVH faces with a BVH",
+       [](Image& i) {
+         i.Remove(SectionId::kBvhFaces);
+         return i.Layout();
+       },
+       "missing section: BVH faces"},
+      {"duplicate section",
+       [](Image& i) {
+         i.entries.push_back(i.entries[1]);
+         i.payloads.push_back(i.payloads[1]);
+         return i.Layout();
+       },
+       "appears twice"},
+      {"section shorter than the counts say",
+       [](Image& i) {
+         i.Payload(SectionId::kSamples).resize(4);
+         return i.Layout();
+       },
+       "section samples"},
+      {"header count larger than the section",
+       [](Image& i) {
+         ++i.header.num_triangles;
+         return i.Layout();
+       },
+       "section geodesic triangles"},
+      {"wrong element size",
+       [](Image& i) {
+         i.entries[1].element_size = 8;
+         return i.Layout();
+       },
+       "element size"},
+      {"misaligned section",
+       [](Image& i) {
+         std::string out = i.Layout();
+         i.entries[2].offset += 4;
+         return i.Finish(out);
+       },
+       "aligned"},
+      {"section beyond the end",
+       [](Image& i) {
+         std::string out = i.Layout();
+         i.entries.back().offset = (out.size() / kAlignment + 10) * kAlignment;
+         return i.Finish(out);
+       },
+       "do not fit"},
+      {"section size overflowing",
+       [](Image& i) {
+         std::string out = i.Layout();
+         i.entries[3].size = ~uint64_t{0} - 8;
+         return i.Finish(out);
+       },
+       "do not fit"},
+      {"overlapping sections",
+       [](Image& i) {
+         // An unknown section (zeros) moved onto the positions, checksummed.
+         i.entries.push_back(UnknownEntry(500, 1));
+         i.payloads.push_back(std::string(64, '\0'));
+         std::string out = i.Layout();
+         SectionEntry& e = i.entries.back();
+         e.offset = i.entries[0].offset;
+         e.checksum = XXH64(out.data() + e.offset, e.size, 0);
+         return i.Finish(out);
+       },
+       "overlapping"},
+      {"section table beyond the end",
+       [](Image& i) {
+         std::string out = i.Layout();
+         i.header.num_sections = 1000;
+         return i.Finish(out);
+       },
+       "section table"},
+      {"section table overlapping the header",
+       [](Image& i) {
+         std::string out = i.Layout();
+         i.header.section_table_offset = 64;
+         return i.WriteHeader(out);
+       },
+       "section table offset"},
+      {"non-zero padding",
+       [](Image& i) {
+         std::string out = i.Layout();
+         out[i.entries[0].offset - 1] = 1;
+         return out;
+       },
+       "non-zero padding"},
+      {"params disagree with counts",
+       [](Image& i) {
+         ++i.header.params.num_samples;
+         return i.Layout();
+       },
+       "num_samples"},
+  };
+  for (const Case& c : cases) {
+    Image image = Image::Parse(bytes);
+    const std::string corrupt = c.corrupt(image);
+    const absl::Status status = Index::FromBytes(corrupt).status();
+    EXPECT_EQ(status.code(), absl::StatusCode::kDataLoss) << c.name << ": " << status;
+    EXPECT_THAT(status.message(), HasSubstr(c.message)) << c.name;
+  }
+}
+
+}  // namespace
+}  // namespace geodex::index
