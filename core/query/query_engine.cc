@@ -110,24 +110,6 @@ const QueryEngine::ApproxLift& QueryEngine::ApproxLiftOf(const FaceLift& fl, int
   return approx_lifts_[fl.approx + (fl.anchors == 3 ? heaviest : 0)];
 }
 
-const mesh::Mesh* QueryEngine::ExactMesh() const {
-  std::call_once(mesh_once_, [this] {
-    const index::Index& ix = *index_;
-    std::vector<mesh::Vec3> positions(ix.num_vertices());
-    for (int32_t v = 0; v < ix.num_vertices(); ++v) positions[v] = view_.Position(v);
-    std::vector<mesh::Triangle> faces(ix.num_faces());
-    for (int32_t f = 0; f < ix.num_faces(); ++f) {
-      faces[f] = {ix.faces()[3 * f], ix.faces()[3 * f + 1], ix.faces()[3 * f + 2]};
-    }
-    // The index was made from a valid mesh; a failure here leaves exact
-    // refinement off (the callers fall back to the other answers).
-    absl::StatusOr<mesh::Mesh> m =
-        mesh::Mesh::Create(std::move(positions), std::move(faces), "index");
-    if (m.ok()) mesh_ = std::make_unique<mesh::Mesh>(*std::move(m));
-  });
-  return mesh_.get();
-}
-
 QueryEngine::QueryEngine(std::shared_ptr<const index::Index> index, QueryOptions options)
     : index_(std::move(index)),
       options_(options),
@@ -482,44 +464,6 @@ mesh::Vec3 QueryEngine::PositionOf(const SurfacePoint& p) const {
 
 double QueryEngine::AtLeastChord(const SurfacePoint& p, const SurfacePoint& q, double d) const {
   return std::max(d, (PositionOf(p) - PositionOf(q)).norm());
-}
-
-geodesic::ExactGeodesicSolver* QueryEngine::ExactSolver(QueryScratch& scratch) const {
-  const mesh::Mesh* m = ExactMesh();
-  if (m == nullptr) return nullptr;
-  if (scratch.solver_ == nullptr || scratch.mesh_ != m) {
-    scratch.solver_ = std::make_unique<geodesic::ExactGeodesicSolver>(*m);
-    scratch.mesh_ = m;
-  }
-  return scratch.solver_.get();
-}
-
-std::optional<double> QueryEngine::ExactNearDistance(const SurfacePoint& from,
-                                                     const SurfacePoint& to,
-                                                     QueryScratch* scratch) const {
-  QueryScratch local;
-  geodesic::ExactGeodesicSolver* solver = ExactSolver(scratch != nullptr ? *scratch : local);
-  if (solver == nullptr) return std::nullopt;
-  geodesic::GeodesicOptions options;
-  options.stop_points = {to};
-  if (!solver->Propagate({from}, options).ok()) return std::nullopt;
-  return solver->DistanceAt(to);
-}
-
-absl::StatusOr<std::span<const double>> QueryEngine::LocalExactDistances(
-    const SurfacePoint& p, double radius, QueryScratch& scratch) const {
-  GEODEX_RETURN_IF_ERROR(Validate(p));
-  if (!(radius >= 0)) {
-    return absl::InvalidArgumentError(absl::StrFormat("the radius must be >= 0, got %g", radius));
-  }
-  geodesic::ExactGeodesicSolver* solver = ExactSolver(scratch);
-  if (solver == nullptr) {
-    return absl::InternalError("the index's mesh cannot be rebuilt for exact propagation");
-  }
-  geodesic::GeodesicOptions options;
-  options.stop_radius = radius;
-  GEODEX_RETURN_IF_ERROR(solver->Propagate({Canonical(p)}, options));
-  return std::span<const double>(solver->VertexDistances());
 }
 
 double QueryEngine::BoundOf(AnswerKind kind, bool vertex_pair, double d) const {
