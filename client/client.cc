@@ -284,22 +284,22 @@ absl::Status StreamDistancesOnce(GeodexConnection& connection, const v1::ModelRe
   // The writer runs ahead of the reader; gRPC flow control bounds how far.
   // Reading on this thread while another writes is what keeps a large call
   // from deadlocking on full buffers in both directions.
-  WriterGuard writer(
-      *stream, std::thread([&stream, &model, pairs, &query, batch_size, first, num_batches] {
-        for (uint64_t k = first; k < num_batches; ++k) {
-          v1::DistanceBatch batch;
-          batch.set_batch_id(k);
-          if (k == first) *batch.mutable_model() = model;
-          batch.set_near_pairs(ToProto(query.near_pairs));
-          batch.set_tolerance(query.tolerance);
-          batch.set_error_bounds(query.error_bounds);
-          const size_t begin = k * batch_size;
-          const size_t end = std::min(pairs.size(), begin + batch_size);
-          PairsToProto(pairs, begin, end, batch.mutable_a(), batch.mutable_b());
-          if (!stream->Write(batch)) return;  // broken: the reader finds out why
-        }
-        stream->WritesDone();
-      }));
+  WriterGuard writer(*stream,
+                     std::thread([&stream, &model, pairs, &query, batch_size, first, num_batches] {
+                       for (uint64_t k = first; k < num_batches; ++k) {
+                         v1::DistanceBatch batch;
+                         batch.set_batch_id(k);
+                         if (k == first) *batch.mutable_model() = model;
+                         batch.set_near_pairs(ToProto(query.near_pairs));
+                         batch.set_tolerance(query.tolerance);
+                         batch.set_error_bounds(query.error_bounds);
+                         const size_t begin = k * batch_size;
+                         const size_t end = std::min(pairs.size(), begin + batch_size);
+                         PairsToProto(pairs, begin, end, batch.mutable_a(), batch.mutable_b());
+                         if (!stream->Write(batch)) return;  // broken: the reader finds out why
+                       }
+                       stream->WritesDone();
+                     }));
 
   absl::Status batch_error;
   v1::DistanceResult result;
@@ -327,8 +327,7 @@ absl::Status StreamDistancesOnce(GeodexConnection& connection, const v1::ModelRe
       stream->Cancel();
       break;
     }
-    std::copy(result.distances().begin(), result.distances().end(),
-              out->distance.begin() + begin);
+    std::copy(result.distances().begin(), result.distances().end(), out->distance.begin() + begin);
     if (query.error_bounds) {
       std::copy(result.bounds().begin(), result.bounds().end(), out->bound.begin() + begin);
     }
@@ -355,8 +354,7 @@ absl::StatusOr<std::vector<double>> Client::Distance(const ModelRef& model,
   return std::move(d->distance);
 }
 
-absl::StatusOr<Distances> Client::Distance(const ModelRef& model,
-                                           absl::Span<const PointPair> pairs,
+absl::StatusOr<Distances> Client::Distance(const ModelRef& model, absl::Span<const PointPair> pairs,
                                            const DistanceQuery& query) const {
   if (absl::Status s = CheckModel(model); !s.ok()) return s;
   if (pairs.empty()) return Distances{};
@@ -556,7 +554,7 @@ absl::StatusOr<VertexDistances> Client::DistanceField(const ModelRef& model,
 }
 
 absl::StatusOr<client::ExpMap> Client::ExpMap(const ModelRef& model, const SurfacePoint& center,
-                                               const ExpMapQuery& query) const {
+                                              const ExpMapQuery& query) const {
   if (absl::Status s = CheckModel(model); !s.ok()) return s;
   if (!(std::isfinite(query.radius) && query.radius > 0)) {
     return absl::InvalidArgumentError(
@@ -567,8 +565,8 @@ absl::StatusOr<client::ExpMap> Client::ExpMap(const ModelRef& model, const Surfa
   *request.mutable_center() = ToProto(absl::Span<const SurfacePoint>(&center, 1));
   request.set_radius(query.radius);
   if (query.reference_direction) {
-    request.mutable_reference_direction()->mutable_xyz()->Assign(
-        query.reference_direction->begin(), query.reference_direction->end());
+    request.mutable_reference_direction()->mutable_xyz()->Assign(query.reference_direction->begin(),
+                                                                 query.reference_direction->end());
   }
   request.set_near_pairs(ToProto(query.near_pairs));
   request.set_tolerance(query.tolerance);
@@ -590,9 +588,9 @@ absl::StatusOr<client::ExpMap> Client::ExpMap(const ModelRef& model, const Surfa
     }
     for (int i = 0; i < size; ++i) {
       if (!map.vertices.empty() && chunk.vertices(i) <= map.vertices.back()) {
-        return absl::DataLossError(absl::StrFormat(
-            "the server sent exponential map vertices out of order (%d after %d)",
-            chunk.vertices(i), map.vertices.back()));
+        return absl::DataLossError(
+            absl::StrFormat("the server sent exponential map vertices out of order (%d after %d)",
+                            chunk.vertices(i), map.vertices.back()));
       }
       map.vertices.push_back(chunk.vertices(i));
     }

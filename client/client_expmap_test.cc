@@ -93,7 +93,7 @@ TEST(ClientExpMap, InconsistentChunksAreDataLoss) {
       .WillOnce(Return(std::vector<v1::ExpMapChunk>{Chunk({{1, 0.5, 0.1}}, 2)}))  // missing
       .WillOnce(Return(std::vector<v1::ExpMapChunk>{Chunk({{4, 0.5, 0.1}}, 2),
                                                     Chunk({{2, 0.5, 0.1}}, 2)}))  // order
-      .WillOnce(Return(std::vector<v1::ExpMapChunk>{short_r}))                   // sizes
+      .WillOnce(Return(std::vector<v1::ExpMapChunk>{short_r}))                    // sizes
       .WillOnce(Return(std::vector<v1::ExpMapChunk>{Chunk({{1, 0.5, 0.1}}, 1),
                                                     Chunk({{2, 0.5, 0.1}}, 1)}));  // extra
   Client client(mock);

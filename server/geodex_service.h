@@ -91,7 +91,7 @@ class GeodexService final : public v1::Geodex::CallbackService {
   grpc::ServerWriteReactor<v1::DistanceFieldChunk>* DistanceField(
       grpc::CallbackServerContext* context, const v1::DistanceFieldRequest* request) override;
   grpc::ServerWriteReactor<v1::ExpMapChunk>* ExpMap(grpc::CallbackServerContext* context,
-                                                     const v1::ExpMapRequest* request) override;
+                                                    const v1::ExpMapRequest* request) override;
   grpc::ServerUnaryReactor* Locate(grpc::CallbackServerContext* context,
                                    const v1::LocateRequest* request,
                                    v1::LocateResponse* response) override;

@@ -135,9 +135,8 @@ class GeodexService::MatrixStream final : public ChunkedWriteStream<v1::MatrixBl
       return absl::InvalidArgumentError(
           absl::StrFormat("block_rows is negative (%d)", request_->block_rows()));
     }
-    GEODEX_ASSIGN_OR_RETURN(options_,
-                            DistanceOptionsFor(*model_.model, request_->near_pairs(), false,
-                                               request_->tolerance()));
+    GEODEX_ASSIGN_OR_RETURN(options_, DistanceOptionsFor(*model_.model, request_->near_pairs(),
+                                                         false, request_->tolerance()));
     engine_ = &model_.version->engine();
     GEODEX_RETURN_IF_ERROR(PointsFromProto(request_->sources(), "sources", *engine_, &sources_));
     GEODEX_RETURN_IF_ERROR(PointsFromProto(request_->targets(), "targets", *engine_, &targets_));
@@ -274,8 +273,8 @@ class GeodexService::ExpMapStream final : public ChunkedWriteStream<v1::ExpMapCh
     GEODEX_RETURN_IF_ERROR(CheckAlive(*context_));
     GEODEX_ASSIGN_OR_RETURN(model_, service_->Resolve(request_->model(), call_));
     if (PointCount(request_->center()) != 1) {
-      return absl::InvalidArgumentError(absl::StrFormat(
-          "center: give exactly one point, got %d", PointCount(request_->center())));
+      return absl::InvalidArgumentError(absl::StrFormat("center: give exactly one point, got %d",
+                                                        PointCount(request_->center())));
     }
     const query::QueryEngine& engine = model_.version->engine();
     GEODEX_RETURN_IF_ERROR(PointsFromProto(request_->center(), "center", engine, &worker.a));
@@ -286,12 +285,11 @@ class GeodexService::ExpMapStream final : public ChunkedWriteStream<v1::ExpMapCh
       options.reference_direction = mesh::Vec3(direction[0], direction[1], direction[2]);
     } else if (!direction.empty()) {
       return absl::InvalidArgumentError(absl::StrFormat(
-          "reference_direction: give one direction (3 numbers), got %d numbers",
-          direction.size()));
+          "reference_direction: give one direction (3 numbers), got %d numbers", direction.size()));
     }
-    GEODEX_ASSIGN_OR_RETURN(options.distance,
-                            DistanceOptionsFor(*model_.model, request_->near_pairs(), false,
-                                               request_->tolerance()));
+    GEODEX_ASSIGN_OR_RETURN(
+        options.distance,
+        DistanceOptionsFor(*model_.model, request_->near_pairs(), false, request_->tolerance()));
     GEODEX_ASSIGN_OR_RETURN(map_, query::ExpMap(engine, worker.a[0], options, &worker.scratch));
     call_.pairs = static_cast<int64_t>(map_.size());
     return absl::OkStatus();

@@ -50,12 +50,7 @@ TEST(ServerTest, AddReplaceRemoveWhileStreamingFailsNoBatch) {
   std::atomic<int> sent{0};
   std::thread writer([&] {
     for (int k = 0; !stop; ++k) {
-      v1::DistanceBatch batch;
-      batch.set_batch_id(k);
-      *batch.mutable_model() = Ref("sphere");
-      *batch.mutable_a() = ToProto(testing::RandomPoints(faces, 50, k));
-      *batch.mutable_b() = ToProto(testing::RandomPoints(faces, 50, k + 1000000));
-      if (!stream->Write(batch)) break;
+      if (!stream->Write(testing::RandomSphereBatch(k, faces, 50, k, 1000000))) break;
       ++sent;
       std::this_thread::sleep_for(std::chrono::milliseconds(1));
     }

@@ -39,12 +39,7 @@ TEST(ServerTest, ShutdownDuringAStreamDrainsIt) {
   std::atomic<int> sent{0};
   std::thread writer([&] {
     for (int k = 0; !stop; ++k) {
-      v1::DistanceBatch batch;
-      batch.set_batch_id(k);
-      *batch.mutable_model() = Ref("sphere");
-      *batch.mutable_a() = ToProto(testing::RandomPoints(1280, 200, k));
-      *batch.mutable_b() = ToProto(testing::RandomPoints(1280, 200, k + 7));
-      if (!stream->Write(batch)) break;
+      if (!stream->Write(testing::RandomSphereBatch(k, 1280, 200, k, 7))) break;
       ++sent;
     }
   });

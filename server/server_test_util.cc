@@ -56,6 +56,15 @@ v1::SurfacePoints ToProto(std::span<const mesh::SurfacePoint> points) {
   return proto;
 }
 
+v1::DistanceBatch RandomSphereBatch(uint64_t id, int32_t faces, int pairs, int seed, int b_offset) {
+  v1::DistanceBatch batch;
+  batch.set_batch_id(id);
+  *batch.mutable_model() = Ref("sphere");
+  *batch.mutable_a() = ToProto(RandomPoints(faces, pairs, seed));
+  *batch.mutable_b() = ToProto(RandomPoints(faces, pairs, seed + b_offset));
+  return batch;
+}
+
 v1::ModelRef Ref(const std::string& name, int64_t version) {
   v1::ModelRef ref;
   ref.set_name(name);

@@ -51,6 +51,9 @@ class TestServer {
 
 v1::SurfacePoints ToProto(std::span<const mesh::SurfacePoint> points);
 v1::ModelRef Ref(const std::string& name, int64_t version = 0);
+// Batch `id` of a stream of random pairs on model "sphere" (`faces` faces):
+// `pairs` pairs, the points seeded `seed` and `seed` + `b_offset`.
+v1::DistanceBatch RandomSphereBatch(uint64_t id, int32_t faces, int pairs, int seed, int b_offset);
 // A client context whose deadline is `seconds` away.
 std::unique_ptr<grpc::ClientContext> Context(double seconds = 30);
 

@@ -3,15 +3,14 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <fstream>
 #include <limits>
 #include <numbers>
 #include <set>
 #include <sstream>
 #include <string>
-#include <vector>
-
-#include <fstream>
 #include <utility>
+#include <vector>
 
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_split.h"
@@ -23,10 +22,10 @@
 namespace geodex::client::cli {
 namespace {
 
-using ::testing::ElementsAre;
 using decal_testing::FlatGrid;
-using ::testing::HasSubstr;
 using decal_testing::PlanarExpMap;
+using ::testing::ElementsAre;
+using ::testing::HasSubstr;
 
 // What an OBJ reader takes from DecalToObj's file.
 struct ReadObj {
@@ -188,7 +187,8 @@ TEST(DecalToObj, AnIndependentReaderFindsTheTexturedPatch) {
   const absl::StatusOr<DecalFiles> files = DecalToObj(mesh, map, 1.2, "d.mtl", "d_checker.png");
   ASSERT_TRUE(files.ok()) << files.status();
   const std::string dir = ::testing::TempDir();
-  for (const auto& [name, text] : {std::pair{"d.obj", files->obj}, std::pair{"d.mtl", files->mtl}}) {
+  for (const auto& [name, text] :
+       {std::pair{"d.obj", files->obj}, std::pair{"d.mtl", files->mtl}}) {
     std::ofstream(dir + "/" + name) << text;
   }
   tinyobj::ObjReaderConfig config;

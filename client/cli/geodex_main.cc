@@ -417,8 +417,7 @@ absl::Status ExpMapCommand(const ConnectionFlags& conn, const ExpMapFlags& flags
   absl::StatusOr<ParsedPoints> center = ParsePoints(flags.center);
   if (!center.ok() || center->points.size() != 1) {
     return InputError(absl::InvalidArgumentError(absl::StrFormat(
-        "--center wants \"F W0 W1 W2\" (a face id and three weights), got \"%s\"",
-        flags.center)));
+        "--center wants \"F W0 W1 W2\" (a face id and three weights), got \"%s\"", flags.center)));
   }
   std::string image;
   if (!flags.image.empty()) {

@@ -1,10 +1,10 @@
 #include "core/index/face_bvh.h"
-#include "core/index/face_bvh_testing.h"
 
 #include <algorithm>
 #include <cstring>
 #include <vector>
 
+#include "core/index/face_bvh_testing.h"
 #include "core/mesh/generators.h"
 #include "gtest/gtest.h"
 

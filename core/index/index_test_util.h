@@ -27,8 +27,8 @@
 // Header-only xxHash in this file: the test recomputes checksums itself to
 // forge files that are corrupt yet consistently checksummed.
 #define XXH_INLINE_ALL
-#include "xxhash.h"
 #include "core/index/index.h"
+#include "xxhash.h"
 
 namespace geodex::index::testing_util {
 

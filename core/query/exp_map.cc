@@ -3,8 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <functional>
-#include <numbers>
 #include <limits>
+#include <numbers>
 #include <queue>
 #include <span>
 #include <utility>
@@ -107,9 +107,7 @@ class ExpMapper {
     const Vec3 d = x - origin_;
     return {d.dot(e1_), d.dot(e2_)};
   }
-  double Edge(int32_t a, int32_t b) const {
-    return (view_.Position(a) - view_.Position(b)).norm();
-  }
+  double Edge(int32_t a, int32_t b) const { return (view_.Position(a) - view_.Position(b)).norm(); }
 
   const QueryEngine& engine_;
   const MeshView view_;
@@ -169,7 +167,8 @@ void ExpMapper::SeedFromFaces() {
   // The centre's face, and across an edge the centre lies on, the face
   // beyond: the hinge is flat, so that face unfolds about the shared edge.
   const int32_t f = centre_.face;
-  for (int i = 0; i < 3; ++i) Seed(view_.Vertex(f, i), f, InFrame(view_.Position(view_.Vertex(f, i))));
+  for (int i = 0; i < 3; ++i)
+    Seed(view_.Vertex(f, i), f, InFrame(view_.Position(view_.Vertex(f, i))));
   for (int i = 0; i < 3; ++i) {
     if (centre_.w[i] > 0) continue;
     const int32_t h = 3 * f + (i + 1) % 3;  // the edge opposite corner i
@@ -322,8 +321,8 @@ void ExpMapper::Place(int32_t w, Angle angle) {
         if (!again && !other.round_vertex) continue;
         const Angle better = AngleOf(y, other);
         const bool shorter = better.path < other.path * (1 - kStale);
-        const bool moved = std::abs(std::remainder(better.theta - other.theta,
-                                                   2 * std::numbers::pi)) > kMoved;
+        const bool moved =
+            std::abs(std::remainder(better.theta - other.theta, 2 * std::numbers::pi)) > kMoved;
         if (shorter || (again && moved)) work.push_back({y, better});
       }
     }

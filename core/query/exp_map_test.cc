@@ -7,7 +7,6 @@
 #include <set>
 
 #include "absl/container/flat_hash_map.h"
-
 #include "core/mesh/generators.h"
 #include "core/validation/test_index.h"
 #include "gmock/gmock.h"
@@ -227,9 +226,10 @@ TEST(ExpMapTest, SphereMatchesTheAnalyticLogMap) {
   // r is the engine's distance: its error is the index's (m samples), a
   // fraction of an edge. theta's is the discretisation's: the inscribed
   // polyhedron's faces tilt from the tangent planes by about h / 2.
-  std::printf("sphere, h = %.4f, %zu vertices: r worst error %.2e; theta error median %.2e, worst "
-              "%.2e rad\n",
-              h, map.size(), worst_r, theta_errors[theta_errors.size() / 2], worst_theta);
+  std::printf(
+      "sphere, h = %.4f, %zu vertices: r worst error %.2e; theta error median %.2e, worst "
+      "%.2e rad\n",
+      h, map.size(), worst_r, theta_errors[theta_errors.size() / 2], worst_theta);
   EXPECT_LT(worst_r, 0.15 * h) << "h = " << h;
   EXPECT_LT(theta_errors[theta_errors.size() / 2], 0.1 * h) << "median, radians";
   EXPECT_LT(worst_theta, 0.5 * h) << "radians";
@@ -281,11 +281,13 @@ TEST(ExpMapTest, HoldsExactlyTheVerticesWithinTheRadius) {
   const double radius = 0.9;
   const double exact_radius = kRefineScale * engine->scale_length();
   ASSERT_LT(exact_radius, radius);  // both kinds of r are in the map
-  for (const SurfacePoint centre : {SurfacePoint{face, near_saddle}, SurfacePoint{face, at_saddle}}) {
+  for (const SurfacePoint centre :
+       {SurfacePoint{face, near_saddle}, SurfacePoint{face, at_saddle}}) {
     const std::vector<ExpMapVertex> map = MapOrDie(*engine, centre, radius);
     QueryScratch scratch;
-    const std::vector<double> exact(engine->LocalExactDistances(centre, exact_radius, scratch)->begin(),
-                                    engine->LocalExactDistances(centre, exact_radius, scratch)->end());
+    const std::vector<double> exact(
+        engine->LocalExactDistances(centre, exact_radius, scratch)->begin(),
+        engine->LocalExactDistances(centre, exact_radius, scratch)->end());
     std::set<int32_t> mapped;
     for (const ExpMapVertex& e : map) {
       mapped.insert(e.vertex);
@@ -307,8 +309,9 @@ TEST(ExpMapTest, HoldsExactlyTheVerticesWithinTheRadius) {
       const double d = near ? exact[v] : distance;
       EXPECT_EQ(mapped.contains(v), d <= radius) << "vertex " << v << " at " << d;
       if (!mapped.contains(v)) continue;
-      const auto e = std::lower_bound(
-          map.begin(), map.end(), v, [](const ExpMapVertex& x, int32_t id) { return x.vertex < id; });
+      const auto e =
+          std::lower_bound(map.begin(), map.end(), v,
+                           [](const ExpMapVertex& x, int32_t id) { return x.vertex < id; });
       EXPECT_NEAR(e->r, d, 1e-9 * std::max(d, 1.0)) << "vertex " << v;
     }
     EXPECT_GT(exact_count, 10);
@@ -321,8 +324,7 @@ TEST(ExpMapTest, RejectsBadArguments) {
   const auto engine = MakeEngine(mesh, 8);
   ExpMapOptions options;
   options.radius = 0;
-  EXPECT_THAT(ExpMap(*engine, {0, {1, 0, 0}}, options).status().message(),
-              HasSubstr("radius"));
+  EXPECT_THAT(ExpMap(*engine, {0, {1, 0, 0}}, options).status().message(), HasSubstr("radius"));
   options.radius = std::numeric_limits<double>::quiet_NaN();
   EXPECT_FALSE(ExpMap(*engine, {0, {1, 0, 0}}, options).ok());
   options.radius = 0.5;
@@ -334,8 +336,7 @@ TEST(ExpMapTest, RejectsBadArguments) {
   EXPECT_THAT(ExpMap(*engine, {0, {1, 0, 0}}, options).status().message(),
               HasSubstr("perpendicular"));
   options.reference_direction = Vec3(std::nan(""), 0, 0);
-  EXPECT_THAT(ExpMap(*engine, {0, {1, 0, 0}}, options).status().message(),
-              HasSubstr("finite"));
+  EXPECT_THAT(ExpMap(*engine, {0, {1, 0, 0}}, options).status().message(), HasSubstr("finite"));
   // Along the reference direction theta is 0; the grid faces +z, so +v
   // points along +z x +y = -x.
   options.reference_direction = Vec3(0, 1, 0);

@@ -205,8 +205,7 @@ class QueryEngine {
   // the radius). Entry v is vertex v's distance when it is at most `radius`,
   // a larger value or +inf otherwise. The span lives in `scratch` until its
   // next use. Errors: as Validate; InvalidArgument for a negative radius.
-  absl::StatusOr<std::span<const double>> LocalExactDistances(const SurfacePoint& p,
-                                                              double radius,
+  absl::StatusOr<std::span<const double>> LocalExactDistances(const SurfacePoint& p, double radius,
                                                               QueryScratch& scratch) const;
 
   // L = sqrt(2 A / (sqrt(3) m)): the edge of an equilateral geodesic

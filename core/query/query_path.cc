@@ -276,8 +276,7 @@ void FaceStep(Tracer& tr, const MeshView& view, int32_t* f, std::array<double, 3
   const int32_t h = 3 * *f + (exit + 1) % 3;  // the edge opposite `exit`
   const int32_t g = view.twins[h];
   if (g < 0) {
-    const int32_t a = view.faces[3 * *f + (exit + 1) % 3],
-                  c = view.faces[3 * *f + (exit + 2) % 3];
+    const int32_t a = view.faces[3 * *f + (exit + 1) % 3], c = view.faces[3 * *f + (exit + 2) % 3];
     *at_vertex = tr.D(a) <= tr.D(c) ? a : c;
     path->push_back(vertex_point(*f, *at_vertex));
     return;

@@ -98,9 +98,8 @@ absl::StatusOr<mesh::SurfacePoint> ParseCentre(const std::string& text) {
   const std::vector<double> values = ParseNumbers(text).value_or(std::vector<double>{});
   if (values.size() != 4 || values[0] != std::floor(values[0]) ||
       !(std::abs(values[0]) < 2147483648.0)) {
-    return absl::InvalidArgumentError(
-        absl::StrFormat("--expmap wants \"F W0 W1 W2\" (a face id and three weights), got \"%s\"",
-                        text));
+    return absl::InvalidArgumentError(absl::StrFormat(
+        "--expmap wants \"F W0 W1 W2\" (a face id and three weights), got \"%s\"", text));
   }
   return mesh::SurfacePoint{static_cast<int32_t>(values[0]), {values[1], values[2], values[3]}};
 }
@@ -226,8 +225,7 @@ absl::Status Run(const Args& args) {
       out += absl::StrFormat("%d %.17g %.17g\n", e.vertex, e.u, e.v);
     }
   } else {
-    return absl::InvalidArgumentError(
-        "give one of --pairs, --paths, --field, --locate, --expmap");
+    return absl::InvalidArgumentError("give one of --pairs, --paths, --field, --locate, --expmap");
   }
   std::fwrite(out.data(), 1, out.size(), stdout);
   return absl::OkStatus();
@@ -248,8 +246,7 @@ int main(int argc, char** argv) {
   auto* expmap = app.add_option("--expmap", args.expmap,
                                 "Exponential map round the point \"F W0 W1 W2\": 'vertex u v' "
                                 "for every vertex within --radius");
-  app.add_option("--radius", args.radius, "With --expmap: the geodesic radius")
-      ->needs(expmap);
+  app.add_option("--radius", args.radius, "With --expmap: the geodesic radius")->needs(expmap);
   app.add_option("--direction", args.direction,
                  "With --expmap: the reference direction X Y Z (theta = 0), projected into "
                  "the centre's face; default its first edge")

@@ -24,8 +24,8 @@
 // Without --index it builds an index of a generated sphere (a note says so).
 
 #include <cstdio>
-#include <limits>
 #include <ctime>
+#include <limits>
 #include <random>
 #include <span>
 
@@ -158,7 +158,8 @@ double MicrosecondsPerNearPair(
   query::QueryScratch scratch;
   volatile double sink = 0;
   const double t0 = ThreadSeconds();
-  for (const auto& [p, q] : pairs) sink = sink + *engine.Distance(p, q, {.near_pairs = mode}, &scratch);
+  for (const auto& [p, q] : pairs)
+    sink = sink + *engine.Distance(p, q, {.near_pairs = mode}, &scratch);
   return 1e6 * (ThreadSeconds() - t0) / std::max<size_t>(1, pairs.size());
 }
 
@@ -209,8 +210,8 @@ void BenchRefinement(const std::string& label, std::shared_ptr<const index::Inde
     mesh::SurfacePoint other = q[i];
     if (i % 2 == 0) {
       const int32_t spread = 1 + static_cast<int32_t>(i % 7) * 50;
-      other.face = static_cast<int32_t>((p[i].face + q[i].face % (2 * spread + 1) +
-                                         ix->num_faces() - spread) % ix->num_faces());
+      other.face = static_cast<int32_t>(
+          (p[i].face + q[i].face % (2 * spread + 1) + ix->num_faces() - spread) % ix->num_faces());
     }
     const double d = engine->DistanceUnchecked(p[i], other) / scale;
     int bin = 0;
@@ -332,8 +333,8 @@ void BenchExpMap(const std::string& label, std::shared_ptr<const index::Index> i
     const std::string scale = radius == std::numeric_limits<double>::max()
                                   ? "whole mesh"
                                   : absl::StrFormat("%.0f L", radius / l);
-    std::printf("| %s | %s | %.0f | %.2f ms | %.2f ms | %.2f us |\n", label.c_str(),
-                scale.c_str(), per_map, ms[0], ms[1], 1e3 * ms[0] / per_map);
+    std::printf("| %s | %s | %.0f | %.2f ms | %.2f ms | %.2f us |\n", label.c_str(), scale.c_str(),
+                per_map, ms[0], ms[1], 1e3 * ms[0] / per_map);
   }
 }
 
@@ -366,8 +367,9 @@ int main(int argc, char** argv) {
     auto data = geodex::builder::BuildIndex(geodex::mesh::gen::Sphere(5, 1.0), options, &summary);
     auto ix = geodex::index::Index::FromBytes(*geodex::index::SerializeIndex(*data));
     geodex::Bench("sphere(5)", *ix, pairs);
-    std::printf("\n| index | radius | vertices mapped | one map, default | one map, pure O(1) | "
-                "per vertex, default |\n|---|---|---|---|---|---|\n");
+    std::printf(
+        "\n| index | radius | vertices mapped | one map, default | one map, pure O(1) | "
+        "per vertex, default |\n|---|---|---|---|---|---|\n");
     geodex::BenchExpMap("sphere(5)", *ix);
     return 0;
   }
@@ -388,9 +390,10 @@ int main(int argc, char** argv) {
   for (size_t i = 0; i < loaded.size() && !expmap_only; ++i) {
     geodex::BenchRefinement(indexes[i], loaded[i], std::min(pairs, 200'000));
   }
-  std::printf("\nExponential map (5 interior centres)\n| index | radius | vertices mapped | "
-              "one map, default | one map, pure O(1) | per vertex, default |\n"
-              "|---|---|---|---|---|---|\n");
+  std::printf(
+      "\nExponential map (5 interior centres)\n| index | radius | vertices mapped | "
+      "one map, default | one map, pure O(1) | per vertex, default |\n"
+      "|---|---|---|---|---|---|\n");
   for (size_t i = 0; i < loaded.size(); ++i) geodex::BenchExpMap(indexes[i], loaded[i]);
   return 0;
 }
