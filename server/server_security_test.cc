@@ -140,5 +140,16 @@ TEST(ServerTest, StartRejectsBadOptions) {
   EXPECT_EQ(GeodexServer::Start(options).status().code(), absl::StatusCode::kUnavailable);
 }
 
+// Bytes that are not a protobuf message of the method's request type.
+TEST(ServerTest, RequestBytesThatDoNotParse) {
+  TestServer ts;
+  auto channel = ts.TcpChannel();
+  for (const char* method : {"/geodex.v1.Geodex/Distance", "/geodex.v1.Geodex/Path",
+                             "/geodex.v1.Geodex/Locate", "/geodex.v1.Geodex/GetModel"}) {
+    auto [status, response] = testing::RawUnary(channel, method, std::string("\xff\xff\xff\x0f", 4));
+    std::printf("%s: code %d '%s'\n", method, status.error_code(), status.error_message().c_str());
+  }
+}
+
 }  // namespace
 }  // namespace geodex::server
