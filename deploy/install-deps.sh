@@ -14,6 +14,7 @@ PACKAGES=(
   clang-format
   clang libclang-rt-14-dev  # the libFuzzer targets (tests/fuzz)
   openssl  # server tests generate TLS certificates with it
+  shellcheck  # deploy/k8s/check.sh lints every script in deploy/ and tests/
 )
 
 SUDO=""
@@ -32,3 +33,9 @@ if [ "${#missing[@]}" -gt 0 ]; then
 else
   echo "install-deps: all packages present"
 fi
+
+# The offline Kubernetes schema validator of deploy/k8s/check.sh (npm packages
+# pinned in deploy/k8s/validate/package-lock.json), installed now because the
+# check runs without network. Debian's nodejs/npm only if no node is present.
+command -v npm > /dev/null || { $SUDO apt-get update -qq && $SUDO apt-get install -y -qq --no-install-recommends nodejs npm; }
+npm ci --silent --no-audit --no-fund --prefix "$(dirname "$0")/k8s/validate"
