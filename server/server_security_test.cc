@@ -140,15 +140,29 @@ TEST(ServerTest, StartRejectsBadOptions) {
   EXPECT_EQ(GeodexServer::Start(options).status().code(), absl::StatusCode::kUnavailable);
 }
 
-// Bytes that are not a protobuf message of the method's request type.
-TEST(ServerTest, RequestBytesThatDoNotParse) {
+// Bytes that are not a protobuf message of the method's request type: gRPC's
+// callback handlers would answer UNIMPLEMENTED (the method does not exist);
+// the server says INVALID_ARGUMENT and keeps serving. An unknown method is
+// still UNIMPLEMENTED.
+TEST(ServerTest, RequestBytesThatDoNotParseAreInvalidArgument) {
   TestServer ts;
   auto channel = ts.TcpChannel();
-  for (const char* method : {"/geodex.v1.Geodex/Distance", "/geodex.v1.Geodex/Path",
-                             "/geodex.v1.Geodex/Locate", "/geodex.v1.Geodex/GetModel"}) {
-    auto [status, response] = testing::RawUnary(channel, method, std::string("\xff\xff\xff\x0f", 4));
-    std::printf("%s: code %d '%s'\n", method, status.error_code(), status.error_message().c_str());
+  const std::string garbage("\xff\xff\xff\x0f", 4);
+  for (const char* method :
+       {"/geodex.v1.Geodex/Distance", "/geodex.v1.Geodex/Path", "/geodex.v1.Geodex/Locate",
+        "/geodex.v1.Geodex/GetModel", "/geodex.v1.Geodex/ListModels",
+        "/geodex.v1.Geodex/DistanceField", "/geodex.v1.Geodex/ExpMap"}) {
+    auto [status, response] = testing::RawUnary(channel, method, garbage);
+    EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT) << method;
+    EXPECT_NE(status.error_message().find("not a valid protobuf message"), std::string::npos)
+        << method << ": " << status.error_message();
   }
+  auto [unknown, unused] = testing::RawUnary(channel, "/geodex.v1.Geodex/NoSuchMethod", garbage);
+  EXPECT_EQ(unknown.error_code(), grpc::StatusCode::UNIMPLEMENTED);
+  // A valid (empty) request still works.
+  auto [ok, models] = testing::RawUnary(channel, "/geodex.v1.Geodex/ListModels", "");
+  EXPECT_TRUE(ok.ok()) << ok.error_message();
+  EXPECT_FALSE(models.empty());
 }
 
 }  // namespace
