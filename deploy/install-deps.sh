@@ -1,21 +1,47 @@
 #!/usr/bin/env bash
 # Installs every Debian 12 package that geodex needs to build, test and benchmark.
 # Idempotent: packages already present are left alone. Needs root (or sudo).
+#
+#   deploy/install-deps.sh               everything: build, tests, benchmarks,
+#                                        fuzzers, linters, the k8s validator (npm)
+#   deploy/install-deps.sh --build-only  only what building the binaries needs
+#                                        (cmake -DGEODEX_BUILD_TESTS=OFF
+#                                        -DGEODEX_BUILD_BENCHMARKS=OFF
+#                                        -DGEODEX_WITH_CGAL=OFF): no CGAL, clang,
+#                                        test frameworks, shellcheck, node/npm
+#                                        (the image's build stage uses it)
 set -euo pipefail
 
-PACKAGES=(
-  build-essential cmake ninja-build pkg-config git
+BUILD_ONLY=0
+case "${1:-}" in
+  "") ;;
+  --build-only) BUILD_ONLY=1 ;;
+  -h|--help) sed -n '2,12p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+  *) echo "install-deps: unknown argument $1 (--build-only or nothing)" >&2; exit 2 ;;
+esac
+if [ "$#" -gt 1 ]; then echo "install-deps: one argument at most" >&2; exit 2; fi
+
+# Building the binaries (server, builder, query tool, CLI, client library).
+BUILD_PACKAGES=(
+  build-essential cmake ninja-build pkg-config
   libabsl-dev libeigen3-dev libspdlog-dev libfmt-dev
-  libtinyobjloader-dev libcli11-dev libtbb-dev libxxhash-dev
-  libgtest-dev libgmock-dev libbenchmark-dev
+  libtinyobjloader-dev libcli11-dev libxxhash-dev
   libprotobuf-dev protobuf-compiler libgrpc++-dev protobuf-compiler-grpc
   prometheus-cpp-dev
+)
+# Tests, benchmarks, reference cross-checks and tooling.
+DEV_PACKAGES=(
+  git libtbb-dev
+  libgtest-dev libgmock-dev libbenchmark-dev
   libcgal-dev libgmp-dev libmpfr-dev libboost-dev
   clang-format
   clang libclang-rt-14-dev  # the libFuzzer targets (tests/fuzz)
   openssl  # server tests generate TLS certificates with it
   shellcheck  # deploy/k8s/check.sh lints every script in deploy/ and tests/
 )
+
+PACKAGES=("${BUILD_PACKAGES[@]}")
+if [ "$BUILD_ONLY" -eq 0 ]; then PACKAGES+=("${DEV_PACKAGES[@]}"); fi
 
 SUDO=""
 if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
@@ -33,6 +59,8 @@ if [ "${#missing[@]}" -gt 0 ]; then
 else
   echo "install-deps: all packages present"
 fi
+
+if [ "$BUILD_ONLY" -eq 1 ]; then exit 0; fi
 
 # The offline Kubernetes schema validator of deploy/k8s/check.sh (npm packages
 # pinned in deploy/k8s/validate/package-lock.json), installed now because the
