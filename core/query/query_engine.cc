@@ -7,7 +7,6 @@
 #include <queue>
 #include <tuple>
 
-#include "absl/container/inlined_vector.h"
 #include "absl/strings/str_format.h"
 #include "core/common/status_macros.h"
 #include "core/geometry/unfolding.h"
@@ -182,9 +181,12 @@ SurfacePoint QueryEngine::Canonical(const SurfacePoint& p) const {
     int corner = 0;
     while (c.w[corner] == 0) ++corner;
     const int32_t v = view_.Vertex(c.face, corner);
-    absl::InlinedVector<int32_t, 16> star;
-    view_.FacesAround(v, c.face, &star);
-    const int32_t lowest = *std::min_element(star.begin(), star.end());
+    struct LowestFace {  // FacesAround's output, keeping only the lowest id
+      int32_t id;
+      void push_back(int32_t f) { id = std::min(id, f); }
+    } lowest_face{c.face};
+    view_.FacesAround(v, c.face, &lowest_face);
+    const int32_t lowest = lowest_face.id;
     if (lowest != c.face) {
       SurfacePoint t{lowest, {0, 0, 0}};
       t.w[view_.Corner(lowest, v)] = 1;
