@@ -7,8 +7,9 @@
 #           swap, shutdown, limits) (build-tsan/).
 # The system libraries (gRPC, protobuf, Abseil) are not instrumented: ASan
 # still checks every access our code makes; TSan cannot see the
-# synchronisation inside gRPC, so reports whose every frame is in those
-# libraries are suppressed (tests/sanitizers/tsan.supp), never ours.
+# synchronisation inside gRPC, so races reported from within those libraries
+# are suppressed (tests/sanitizers/tsan.supp), and LeakSanitizer ignores what
+# they never free (lsan.supp): never ours.
 #
 #   tests/sanitizers/run.sh [--asan] [--tsan] [--jobs N]   (default: both)
 set -euo pipefail
@@ -42,6 +43,7 @@ if [[ $asan -eq 1 ]]; then
   nice -n 10 cmake --build "$dir" -j"$jobs" --target "${unit[@]}" client_tests server_tests
   export ASAN_OPTIONS="detect_leaks=1:abort_on_error=0:halt_on_error=1"
   export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1"
+  export LSAN_OPTIONS="suppressions=$repo/tests/sanitizers/lsan.supp:print_suppressions=0"
   for t in "${unit[@]}"; do
     start=$(date +%s)
     if "$dir/core/$t" --gtest_brief=1 > "$dir/$t.log" 2>&1; then
