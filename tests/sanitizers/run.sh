@@ -7,9 +7,10 @@
 #           swap, shutdown, limits) (build-tsan/).
 # The system libraries (gRPC, protobuf, Abseil) are not instrumented: ASan
 # still checks every access our code makes; TSan cannot see the
-# synchronisation inside gRPC, so races reported from within those libraries
-# are suppressed (tests/sanitizers/tsan.supp), and LeakSanitizer ignores what
-# they never free (lsan.supp): never ours.
+# synchronisation inside gRPC: races reported from within those libraries are
+# suppressed by library (tests/sanitizers/tsan.supp), which does not yet
+# silence all of them (see the README, "Sanitizers"); LeakSanitizer ignores
+# what they never free (lsan.supp). Nothing of geodex's is suppressed.
 #
 #   tests/sanitizers/run.sh [--asan] [--tsan] [--jobs N]   (default: both)
 set -euo pipefail
