@@ -157,9 +157,8 @@ SurfacePoint QueryEngine::Canonical(const SurfacePoint& p) const {
     sum += w;
   }
   for (double& w : c.w) w /= sum;
-  // A point on an edge, or a vertex, is expressed in its face of lowest id,
-  // so that every description of it gives the same answers (the refinement
-  // traces start from the point's face).
+  // A point on an edge is expressed in the face of lower id, so that both
+  // descriptions of it give the same answers.
   int zeros = 0, zero = 0;
   for (int i = 0; i < 3; ++i) {
     if (c.w[i] == 0) {
@@ -177,23 +176,24 @@ SurfacePoint QueryEngine::Canonical(const SurfacePoint& p) const {
       return t;
     }
   }
-  if (zeros == 2) {
-    int corner = 0;
-    while (c.w[corner] == 0) ++corner;
-    const int32_t v = view_.Vertex(c.face, corner);
-    struct LowestFace {  // FacesAround's output, keeping only the lowest id
-      int32_t id;
-      void push_back(int32_t f) { id = std::min(id, f); }
-    } lowest_face{c.face};
-    view_.FacesAround(v, c.face, &lowest_face);
-    const int32_t lowest = lowest_face.id;
-    if (lowest != c.face) {
-      SurfacePoint t{lowest, {0, 0, 0}};
-      t.w[view_.Corner(lowest, v)] = 1;
-      return t;
-    }
-  }
   return c;
+}
+
+SurfacePoint QueryEngine::InLowestFaceIfVertex(const SurfacePoint& c) const {
+  int corner = -1;
+  for (int i = 0; i < 3; ++i) {
+    if (c.w[i] == 1) corner = i;
+  }
+  if (corner < 0) return c;
+  const int32_t v = view_.Vertex(c.face, corner);
+  struct LowestFace {  // FacesAround's output, keeping only the lowest id
+    int32_t id;
+    void push_back(int32_t f) { id = std::min(id, f); }
+  } lowest{c.face};
+  view_.FacesAround(v, c.face, &lowest);
+  SurfacePoint t{lowest.id, {0, 0, 0}};
+  t.w[view_.Corner(lowest.id, v)] = 1;
+  return t;
 }
 
 double QueryEngine::ToSample(const LiftedPoint& p, int32_t s) const {
@@ -488,9 +488,10 @@ double QueryEngine::BoundOf(AnswerKind kind, bool vertex_pair, double d) const {
   return 0;
 }
 
-double QueryEngine::Refine(const SurfacePoint& p, const SurfacePoint& q, double unfolded, bool near,
-                           const DistanceOptions& options, QueryScratch* scratch,
+double QueryEngine::Refine(const SurfacePoint& p_in, const SurfacePoint& q_in, double unfolded,
+                           bool near, const DistanceOptions& options, QueryScratch* scratch,
                            double* bound) const {
+  const SurfacePoint p = InLowestFaceIfVertex(p_in), q = InLowestFaceIfVertex(q_in);
   if (!(unfolded < kInf)) {  // different components: exactly unreachable
     if (bound != nullptr) *bound = BoundOf(AnswerKind::kExact, false, unfolded);
     return unfolded;
@@ -554,7 +555,7 @@ absl::StatusOr<double> QueryEngine::TracedDistance(const SurfacePoint& p, const 
                                                    bool* wraps) const {
   GEODEX_RETURN_IF_ERROR(Validate(p));
   GEODEX_RETURN_IF_ERROR(Validate(q));
-  const SurfacePoint a = Canonical(p), b = Canonical(q);
+  const SurfacePoint a = InLowestFaceIfVertex(Canonical(p)), b = InLowestFaceIfVertex(Canonical(q));
   const bool swap = std::tie(b.face, b.w) < std::tie(a.face, a.w);
   const std::optional<Trace> t = PathNearDistance(swap ? b : a, swap ? a : b);
   if (!t) return absl::NotFoundError("no trace between the points");

@@ -362,6 +362,11 @@ class QueryEngine {
                                                        const SurfacePoint& to,
                                                        TraceSearch search) const;
   SurfacePoint Canonical(const SurfacePoint& p) const;
+  // A canonical vertex point re-expressed in the vertex's face of lowest id,
+  // other points unchanged. Only the traces need it (they start from the
+  // point's face; the O(1) lift of a vertex is its record, whatever the
+  // face), so it stays off the batch path.
+  SurfacePoint InLowestFaceIfVertex(const SurfacePoint& c) const;
 
   std::shared_ptr<const index::Index> index_;
   QueryOptions options_;

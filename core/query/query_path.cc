@@ -485,7 +485,8 @@ std::vector<std::vector<PathPoint>> QueryEngine::RingChains(const SurfacePoint& 
 
 absl::StatusOr<std::vector<PathPoint>> QueryEngine::TracePath(const SurfacePoint& from_in,
                                                               const SurfacePoint& to_in) const {
-  const SurfacePoint from = Canonical(from_in), to = Canonical(to_in);
+  const SurfacePoint from = InLowestFaceIfVertex(Canonical(from_in)),
+                     to = InLowestFaceIfVertex(Canonical(to_in));
   Tracer tr{*this, view_, Lift(from), {}};
   if (!(LiftedDistance(tr.source, Lift(to)) < std::numeric_limits<double>::infinity())) {
     return absl::NotFoundError("the two points lie on different connected components");
