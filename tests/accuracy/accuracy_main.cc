@@ -104,8 +104,8 @@ absl::Status Run(const Flags& flags) {
         const accuracy::ModeReport report = accuracy::Evaluate(pairs, answer);
         const double seconds =
             std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-        std::fprintf(stderr, "%s %s: %.2f us per pair, %d failed\n", name.c_str(), mode.c_str(),
-                     1e6 * seconds / pairs.size(), failed);
+        std::fprintf(stderr, "%s %s: %.2f us per pair, %lld failed\n", name.c_str(), mode.c_str(),
+                     1e6 * seconds / pairs.size(), static_cast<long long>(failed));
         std::printf("%s", accuracy::MarkdownRows(
                               absl::StrFormat("%s m=%d %s", name, index->num_samples(), mode),
                               report)
