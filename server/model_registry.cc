@@ -8,6 +8,7 @@
 #include <cstring>
 #include <filesystem>
 #include <set>
+#include <utility>
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
@@ -370,7 +371,11 @@ void ModelRegistry::Publish(bool initial_scan_done) {
   next->initial_scan_done = initial_scan_done;
   for (const auto& [name, entry] : entries_) next->models.emplace(name, MakeModelSnapshot(entry));
   std::shared_ptr<const RegistrySnapshot> published = next;
-  std::shared_ptr<const RegistrySnapshot> before = snapshot_.exchange(published);
+  std::shared_ptr<const RegistrySnapshot> before;
+  {
+    std::lock_guard<std::mutex> lock(snapshot_mutex_);
+    before = std::exchange(snapshot_, published);
+  }
   if (listener_) listener_(*before, *published);
 }
 
@@ -379,7 +384,7 @@ absl::StatusOr<ResolvedModel> ModelRegistry::Resolve(std::string_view name, int6
   if (version < 0) {
     return absl::InvalidArgumentError(absl::StrFormat("model version %d is negative", version));
   }
-  std::shared_ptr<const RegistrySnapshot> snapshot = snapshot_.load();
+  std::shared_ptr<const RegistrySnapshot> snapshot = this->snapshot();
   auto it = snapshot->models.find(name);
   if (it == snapshot->models.end()) {
     if (!snapshot->initial_scan_done) {

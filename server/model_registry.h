@@ -21,7 +21,7 @@
 // (read-only MAP_SHARED mapping: every server process on the host shares the
 // page cache) and query::QueryEngine::Create, in the background; the new set
 // of served versions is then published as one immutable RegistrySnapshot
-// through an atomic shared_ptr. Requests resolve a model against the snapshot
+// through one shared_ptr. Requests resolve a model against the snapshot
 // of the moment and keep it alive until they finish, so a swap never blocks a
 // query and in-flight requests complete on the version they started with.
 //
@@ -33,11 +33,13 @@
 // dropped at once (new requests: NOT_FOUND).
 //
 // Thread safety: every public method is safe from any thread. Resolve and
-// snapshot() take no lock (one atomic shared_ptr load).
+// snapshot() copy the published shared_ptr under a mutex held for that copy
+// only. Not std::atomic<std::shared_ptr>: libstdc++ 12 implements it with a
+// lock bit ThreadSanitizer cannot follow (it reports a race on every swap),
+// and a pthread mutex is just as cheap here, once per call, not per pair.
 
 #include <sys/types.h>
 
-#include <atomic>
 #include <condition_variable>
 #include <cstdint>
 #include <functional>
@@ -167,7 +169,10 @@ class ModelRegistry {
   void Stop();
 
   // The current snapshot. Never null.
-  std::shared_ptr<const RegistrySnapshot> snapshot() const { return snapshot_.load(); }
+  std::shared_ptr<const RegistrySnapshot> snapshot() const {
+    std::lock_guard<std::mutex> lock(snapshot_mutex_);
+    return snapshot_;
+  }
 
   // The model and version a request asks for; `version` 0 is the newest
   // served. Errors: InvalidArgument for a malformed name or a negative
@@ -208,7 +213,8 @@ class ModelRegistry {
 
   const RegistryOptions options_;
   Listener listener_;
-  std::atomic<std::shared_ptr<const RegistrySnapshot>> snapshot_;
+  mutable std::mutex snapshot_mutex_;  // guards snapshot_ (the pointer, not the snapshot)
+  std::shared_ptr<const RegistrySnapshot> snapshot_;
 
   // Owned by the registry thread.
   std::map<std::string, ModelEntry, std::less<>> entries_;
