@@ -1,10 +1,13 @@
 #include "core/common/file_util.h"
 
+#include <dirent.h>
 #include <fcntl.h>
+#include <signal.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cerrno>
 #include <cstring>
 #include <random>
@@ -24,15 +27,58 @@ absl::Status ErrnoError(int err, const std::string& what, const std::string& pat
     case EPERM:
     case EROFS:
       return absl::PermissionDeniedError(message);
+    case ENOSPC:
+    case EDQUOT:
+    case EFBIG:
+      return absl::ResourceExhaustedError(message);
     default:
       return absl::InternalError(message);
   }
 }
 
+namespace {
+
+// "<name>.tmp.<pid>.<16 hex digits>": AtomicWriteFile's temporary for `name`;
+// the pid of its writer, or 0 when `entry` is not one.
+pid_t TemporaryWriter(const std::string& entry, const std::string& name) {
+  const std::string prefix = name + ".tmp.";
+  if (entry.size() <= prefix.size() || entry.compare(0, prefix.size(), prefix) != 0) return 0;
+  const std::string rest = entry.substr(prefix.size());
+  const size_t dot = rest.find('.');
+  if (dot == std::string::npos || dot == 0 || dot > 9 || rest.size() - dot - 1 != 16) return 0;
+  pid_t pid = 0;
+  for (size_t i = 0; i < dot; ++i) {
+    if (rest[i] < '0' || rest[i] > '9') return 0;
+    pid = pid * 10 + (rest[i] - '0');
+  }
+  for (size_t i = dot + 1; i < rest.size(); ++i) {
+    if (!std::isxdigit(static_cast<unsigned char>(rest[i]))) return 0;
+  }
+  return pid;
+}
+
+// Removes the temporaries of `name` in `dir` whose writer is no longer
+// running on this host: what a writer killed before its rename leaves. A
+// live writer's temporary is kept (kill(pid, 0) succeeds or says EPERM).
+void RemoveAbandonedTemporaries(const std::string& dir, const std::string& name) {
+  DIR* d = ::opendir(dir.c_str());
+  if (d == nullptr) return;  // the create below reports why
+  std::vector<std::string> abandoned;
+  while (const struct dirent* e = ::readdir(d)) {
+    const pid_t pid = TemporaryWriter(e->d_name, name);
+    if (pid != 0 && ::kill(pid, 0) != 0 && errno == ESRCH) abandoned.emplace_back(e->d_name);
+  }
+  ::closedir(d);
+  for (const std::string& entry : abandoned) ::unlink((dir + "/" + entry).c_str());
+}
+
+}  // namespace
+
 absl::Status AtomicWriteFile(const std::string& path, std::string_view bytes) {
   const size_t slash = path.rfind('/');
   const std::string dir =
       slash == std::string::npos ? "." : (slash == 0 ? "/" : path.substr(0, slash));
+  RemoveAbandonedTemporaries(dir, slash == std::string::npos ? path : path.substr(slash + 1));
   std::random_device random;
   const uint64_t nonce = (uint64_t{random()} << 32) ^ random();
   const std::string tmp = absl::StrFormat("%s.tmp.%d.%016x", path, ::getpid(), nonce);

@@ -20,16 +20,19 @@ namespace geodex {
 // Writes `bytes` to `path` atomically: a temporary file in the same directory,
 // fsync, rename over `path`, fsync of the directory. Readers see the old file
 // or the new one, never a partial one; on failure the temporary file is
-// removed and an existing `path` is left as it was. Errors (ErrnoError, naming
-// the path and the reason): NotFound when the directory does not exist,
-// PermissionDenied when it may not be written (read-only, no access),
-// Internal otherwise. Thread-safe: concurrent writers of one path each use
-// their own temporary file, and the last rename wins.
+// removed and an existing `path` is left as it was. A writer killed before its
+// rename leaves its temporary ("<path>.tmp.<pid>.<nonce>"); the next write of
+// `path` removes those whose process no longer runs on this host. Errors
+// (ErrnoError, naming the path and the reason): NotFound when the directory
+// does not exist, PermissionDenied when it may not be written (read-only, no
+// access), ResourceExhausted when the disk or quota is full, Internal
+// otherwise. Thread-safe: concurrent writers of one path each use their own
+// temporary file, and the last rename wins.
 absl::Status AtomicWriteFile(const std::string& path, std::string_view bytes);
 
 // An error for a failed system call: "<what> <path>: <strerror(err)>", as
-// NotFound (ENOENT, ENOTDIR), PermissionDenied (EACCES, EPERM, EROFS) or
-// Internal.
+// NotFound (ENOENT, ENOTDIR), PermissionDenied (EACCES, EPERM, EROFS),
+// ResourceExhausted (ENOSPC, EDQUOT, EFBIG) or Internal.
 absl::Status ErrnoError(int err, const std::string& what, const std::string& path);
 
 // Opens `path` read-only (close-on-exec) and fills `info` (fstat); returns the

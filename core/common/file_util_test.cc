@@ -5,6 +5,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <atomic>
 #include <cstdlib>
 #include <filesystem>
@@ -134,6 +135,42 @@ TEST_F(FileUtilTest, ReadOnlyDirectoryIsPermissionDeniedAndKeepsTheOldFile) {
   EXPECT_THAT(status->message(), HasSubstr("Permission denied"));
   EXPECT_EQ(*ReadWholeFile(path), "old");
   EXPECT_EQ(std::distance(fs::directory_iterator(locked), fs::directory_iterator()), 1);
+}
+
+// What a writer killed before its rename leaves is removed by the next write
+// of the same path; a live writer's temporary and other files are kept.
+TEST_F(FileUtilTest, NextWriteRemovesTheTemporariesOfDeadWriters) {
+  const pid_t dead = fork();
+  if (dead == 0) _exit(0);
+  ASSERT_GT(dead, 0);
+  ASSERT_EQ(waitpid(dead, nullptr, 0), dead);
+  auto touch = [&](const std::string& name) {
+    ASSERT_TRUE(AtomicWriteFile((dir_ / name).string(), "x").ok());
+  };
+  const std::string abandoned = "data.bin.tmp." + std::to_string(dead) + ".0123456789abcdef";
+  const std::string live = "data.bin.tmp." + std::to_string(getpid()) + ".fedcba9876543210";
+  touch(abandoned);
+  touch(live);
+  touch("other.bin.tmp." + std::to_string(dead) + ".0123456789abcdef");  // another path's
+  touch("data.bin.tmp.notapid.0123456789abcdef");                       // not a temporary
+  touch("data.bin");
+
+  ASSERT_TRUE(AtomicWriteFile((dir_ / "data.bin").string(), "new").ok());
+  const std::vector<std::string> files = Files();
+  EXPECT_THAT(files, ::testing::Not(::testing::Contains(abandoned)));
+  EXPECT_THAT(files, ::testing::Contains(live));
+  EXPECT_EQ(files.size(), 4u) << ::testing::PrintToString(files);
+  EXPECT_EQ(*ReadWholeFile((dir_ / "data.bin").string()), "new");
+}
+
+TEST(ErrnoErrorTest, AFullDiskIsResourceExhaustedAndSaysSo) {
+  for (int err : {ENOSPC, EDQUOT, EFBIG}) {
+    const absl::Status status = ErrnoError(err, "cannot write", "/x/y.gdx");
+    EXPECT_EQ(status.code(), absl::StatusCode::kResourceExhausted) << status;
+    EXPECT_THAT(status.message(), HasSubstr("/x/y.gdx"));
+  }
+  EXPECT_THAT(ErrnoError(ENOSPC, "cannot write", "f").message(),
+              HasSubstr("No space left on device"));
 }
 
 TEST_F(FileUtilTest, MissingDirectoryIsNotFound) {
