@@ -15,6 +15,7 @@
 #include <map>
 #include <thread>
 
+#include "absl/cleanup/cleanup.h"
 #include "absl/strings/str_format.h"
 #include "core/mesh/generators.h"
 #include "gmock/gmock.h"
@@ -531,9 +532,9 @@ TEST(ServerTest, EachRequestMayChooseItsNearPairMode) {
 }
 
 TEST(ServerTest, DeadlineExpiredWhileQueuedIsNotComputed) {
+  std::latch blocked(1), release(1);  // outlive the server's pool
   TestServer ts([](ServerOptions& o) { o.workers = 1; });
   auto stub = v1::Geodex::NewStub(ts.TcpChannel());
-  std::latch blocked(1), release(1);
   ASSERT_TRUE(ts.server().pool().Submit([&](WorkerContext&) {
     blocked.count_down();
     release.wait();
@@ -564,12 +565,16 @@ TEST(ServerTest, DeadlineExpiredWhileQueuedIsNotComputed) {
 }
 
 TEST(ServerTest, FullWorkerQueueIsResourceExhausted) {
+  // The latches outlive the server, whose pool joins the blocked worker; the
+  // worker is released however the test ends (clang's ASan caught the
+  // worker reading `release` after it went out of scope).
+  std::latch blocked(1), release(1);
   TestServer ts([](ServerOptions& o) {
     o.workers = 1;
     o.queue_capacity = 1;
   });
+  absl::Cleanup unblock = [&release] { release.count_down(); };
   auto stub = v1::Geodex::NewStub(ts.TcpChannel());
-  std::latch blocked(1), release(1);
   ASSERT_TRUE(ts.server().pool().Submit([&](WorkerContext&) {
     blocked.count_down();
     release.wait();
@@ -583,7 +588,6 @@ TEST(ServerTest, FullWorkerQueueIsResourceExhausted) {
   grpc::Status s = stub->Distance(context.get(), request, &response);
   EXPECT_EQ(s.error_code(), grpc::StatusCode::RESOURCE_EXHAUSTED);
   EXPECT_THAT(s.error_message(), HasSubstr("server busy"));
-  release.count_down();
 }
 
 TEST(ServerTest, PairsOnDifferentComponentsAreUnreachable) {
