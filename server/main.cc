@@ -14,6 +14,7 @@
 #include <string>
 
 #include "CLI/CLI.hpp"
+#include "server/mapped_files.h"
 #include "server/server.h"
 #include "spdlog/sinks/stdout_color_sinks.h"
 #include "spdlog/spdlog.h"
@@ -98,6 +99,7 @@ int main(int argc, char** argv) {
   spdlog::set_default_logger(spdlog::stderr_color_mt("geodex-server"));
   spdlog::set_level(spdlog::level::from_str(log_level));
   signal(SIGPIPE, SIG_IGN);
+  geodex::server::InstallSigbusReport();
 
   // Signals are taken synchronously by this thread (sigwait); block them
   // before any thread starts so that none receives them asynchronously.

@@ -66,6 +66,7 @@ absl::StatusOr<std::shared_ptr<const ServedVersion>> ServedVersion::Load(int64_t
   served->file_id_ = file_id;
   served->index_ = *std::move(index);
   served->engine_ = *std::move(engine);
+  served->mapped_notice_ = std::make_unique<MappedFileNotice>(served->index_->image(), path);
   return std::shared_ptr<const ServedVersion>(std::move(served));
 }
 

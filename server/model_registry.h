@@ -56,6 +56,7 @@
 #include "absl/time/time.h"
 #include "core/index/index.h"
 #include "core/query/query_engine.h"
+#include "server/mapped_files.h"
 #include "server/model_config.pb.h"
 
 namespace geodex::server {
@@ -98,6 +99,8 @@ class ServedVersion {
   FileId file_id_;
   std::shared_ptr<const index::Index> index_;
   std::shared_ptr<const query::QueryEngine> engine_;
+  // Names this file in a SIGBUS report; released before index_ unmaps it.
+  std::unique_ptr<MappedFileNotice> mapped_notice_;
 };
 
 enum class LoadState { kLoading, kServing, kFailed };

@@ -109,6 +109,8 @@ class Index {
   }
   // Bytes of the file image (mapped or owned).
   size_t size_bytes() const { return size_; }
+  // The file image itself (for naming the file a fault address falls in).
+  std::span<const uint8_t> image() const { return {base_, size_}; }
   bool is_mapped() const { return mapped_; }
 
  private:
