@@ -37,8 +37,12 @@
 // error from the server or the network (NOT_FOUND for an unknown model,
 // UNAVAILABLE, ...) and local I/O errors on output.
 
+#include <unistd.h>
+
+#include <cerrno>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <fstream>
 #include <map>
 #include <string>
@@ -138,10 +142,27 @@ absl::Status WriteOutput(const std::string& path, const std::string& contents) {
     }
     return absl::OkStatus();
   }
-  std::ofstream out(path, std::ios::binary);
-  out << contents;
-  out.close();
-  if (!out) return absl::PermissionDeniedError(absl::StrCat("cannot write ", path));
+  // Written beside `path` and renamed over it, so that a reader (or a killed
+  // run) never leaves half a file under the name asked for.
+  const std::string tmp = absl::StrCat(path, ".tmp.", ::getpid());
+  auto failed = [&](const char* what) {
+    const std::string reason = std::strerror(errno);
+    ::unlink(tmp.c_str());
+    return absl::Status(errno == ENOSPC || errno == EDQUOT ? absl::StatusCode::kResourceExhausted
+                                                           : absl::StatusCode::kPermissionDenied,
+                        absl::StrCat("cannot ", what, " ", path, ": ", reason));
+  };
+  std::FILE* out = std::fopen(tmp.c_str(), "wb");
+  if (out == nullptr) return failed("write");
+  const bool written = std::fwrite(contents.data(), 1, contents.size(), out) == contents.size();
+  if (!written || std::fflush(out) != 0) {
+    const int err = errno;
+    std::fclose(out);
+    errno = err;
+    return failed("write");
+  }
+  if (std::fclose(out) != 0) return failed("write");
+  if (std::rename(tmp.c_str(), path.c_str()) != 0) return failed("replace");
   return absl::OkStatus();
 }
 
