@@ -1,11 +1,19 @@
-// geodex-geodesic: exact geodesic distances between surface point pairs.
+// geodex-geodesic: exact geodesic distances, with the engine the builder uses.
 //
 //   geodex-geodesic MESH --pairs FILE [--threads N]
+//   geodex-geodesic MESH --source-vertex V [--out FILE]
 //
-// Reads lines "fa a0 a1 a2 fb b0 b1 b2" (see core/mesh/pairs_io.h) and prints
-// one exact distance per pair in input order ("inf" when unreachable). Pairs
-// are grouped by their first point so that each distinct source is propagated
-// once, stopping as soon as all of its targets are settled.
+// --pairs reads lines "fa a0 a1 a2 fb b0 b1 b2" (see core/mesh/pairs_io.h)
+// and prints one exact distance per pair in input order ("inf" when
+// unreachable). Pairs are grouped by their first point so that each distinct
+// source is propagated once, stopping as soon as all of its targets are
+// settled.
+//
+// --source-vertex writes every vertex's exact distance from vertex V
+// (0-based, in the mesh file's order), one per line: the job an exact
+// solver's command line does (VTP's, for one), so that the two compare as
+// whole processes. The file is written beside its name and renamed into
+// place; '-' (the default) is standard output.
 
 #include <algorithm>
 #include <atomic>
@@ -16,6 +24,7 @@
 #include "CLI/CLI.hpp"
 #include "absl/status/status.h"
 #include "absl/strings/str_cat.h"
+#include "core/common/file_util.h"
 #include "core/common/status_macros.h"
 #include "core/geodesic/exact_geodesic.h"
 #include "core/mesh/mesh_io.h"
@@ -77,20 +86,57 @@ absl::Status Run(const std::string& mesh_path, const std::string& pairs_path, in
   return absl::OkStatus();
 }
 
+absl::Status RunFromVertex(const std::string& mesh_path, int64_t source, const std::string& out) {
+  GEODEX_ASSIGN_OR_RETURN(const mesh::Mesh mesh, mesh::LoadMesh(mesh_path));
+  if (source < 0 || source >= mesh.num_vertices()) {
+    return absl::OutOfRangeError(absl::StrCat("--source-vertex ", source, " is not a vertex of ",
+                                              mesh_path, " (it has ", mesh.num_vertices(),
+                                              " vertices, numbered from 0)"));
+  }
+  GEODEX_ASSIGN_OR_RETURN(const mesh::SurfacePoint point,
+                          mesh::VertexPoint(mesh, static_cast<int32_t>(source)));
+  geodesic::ExactGeodesicSolver solver(mesh);
+  GEODEX_RETURN_IF_ERROR(solver.Propagate({point}));
+  std::string text;
+  text.reserve(static_cast<size_t>(mesh.num_vertices()) * 20);
+  for (double d : solver.VertexDistances()) {
+    text += mesh::FormatDistance(d);
+    text += '\n';
+  }
+  if (out == "-") {
+    if (std::fwrite(text.data(), 1, text.size(), stdout) != text.size() || std::fflush(stdout) != 0) {
+      return absl::DataLossError("cannot write to standard output");
+    }
+    return absl::OkStatus();
+  }
+  return AtomicWriteFile(out, text);
+}
+
 }  // namespace
 }  // namespace geodex
 
 int main(int argc, char** argv) {
-  CLI::App app{"Exact geodesic distances between surface point pairs (ICH window propagation)."};
-  std::string mesh_path, pairs_path;
+  CLI::App app{"Exact geodesic distances (ICH window propagation, the builder's engine)."};
+  std::string mesh_path, pairs_path, out = "-";
+  int64_t source_vertex = -1;
   int threads = std::max(1u, std::thread::hardware_concurrency());
   app.add_option("mesh", mesh_path, "Mesh file (.obj, .ply, .off)")->required();
-  app.add_option("--pairs", pairs_path,
-                 "File of lines 'fa a0 a1 a2 fb b0 b1 b2' ('-' for standard input)")
-      ->required();
-  app.add_option("--threads", threads, "Worker threads")->check(CLI::Range(1, 256));
+  auto* pairs = app.add_option("--pairs", pairs_path,
+                               "File of lines 'fa a0 a1 a2 fb b0 b1 b2' ('-' for standard input)");
+  auto* source = app.add_option("--source-vertex", source_vertex,
+                                "Every vertex's distance from this vertex (0-based, file order)");
+  pairs->excludes(source);
+  app.add_option("--out", out, "With --source-vertex: output file ('-': standard output)")
+      ->needs(source);
+  app.add_option("--threads", threads, "Worker threads (--pairs)")->check(CLI::Range(1, 256));
   CLI11_PARSE(app, argc, argv);
-  const absl::Status status = geodex::Run(mesh_path, pairs_path, threads);
+  if (pairs->count() == 0 && source->count() == 0) {
+    std::fprintf(stderr, "geodex-geodesic: give --pairs FILE or --source-vertex V\n");
+    return 2;
+  }
+  const absl::Status status = pairs->count() > 0
+                                  ? geodex::Run(mesh_path, pairs_path, threads)
+                                  : geodex::RunFromVertex(mesh_path, source_vertex, out);
   if (!status.ok()) {
     std::fprintf(stderr, "geodex-geodesic: %s\n", status.ToString().c_str());
     return status.code() == absl::StatusCode::kInvalidArgument ||

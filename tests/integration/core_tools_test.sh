@@ -58,6 +58,28 @@ check "bounds without calibration exit 1, naming the remedy" grep -q "geodex-bui
 "$tools/geodex-build" calibrate builtin:sphere "$work/plain.gdx" -o "$work/calibrated.gdx" >/dev/null 2>&1
 check "geodex-build calibrate gives the index a one-process build gives" cmp -s "$work/one.gdx" "$work/calibrated.gdx"
 
+# --source-vertex: every vertex's distance from one vertex. On a flat 9x9
+# grid (an OBJ written here, with an unreferenced vertex last) the exact
+# distance is the Euclidean one.
+awk 'BEGIN { n = 9
+  for (j = 0; j < n; j++) for (i = 0; i < n; i++) printf "v %d %d 0\n", i, j
+  printf "v 50 50 50\n"
+  for (j = 0; j < n - 1; j++) for (i = 0; i < n - 1; i++) {
+    a = j * n + i + 1; b = a + 1; c = a + n; d = c + 1
+    printf "f %d %d %d\nf %d %d %d\n", a, b, d, a, d, c } }' >"$work/grid.obj"
+"$tools/geodex-geodesic" "$work/grid.obj" --source-vertex 40 --out "$work/from40.txt" 2>"$work/err"
+check "geodex-geodesic --source-vertex exits 0" test $? -eq 0
+check "one line per vertex, in file order" test "$(wc -l <"$work/from40.txt")" -eq 82
+check "flat grid: Euclidean to 1e-12, unreferenced vertex inf" awk '
+  NR <= 81 { i = (NR - 1) % 9; j = int((NR - 1) / 9); e = sqrt((i - 4)^2 + (j - 4)^2)
+             d = $1 - e; if (d < 0) d = -d; if (d > 1e-12) exit 1 }
+  NR == 82 && $1 != "inf" { exit 1 }' "$work/from40.txt"
+"$tools/geodex-geodesic" "$mesh" --source-vertex 7 >"$work/from7.txt" 2>"$work/err"
+check "--source-vertex to standard output" test "$(sed -n 8p "$work/from7.txt")" = "0"
+"$tools/geodex-geodesic" "$mesh" --source-vertex 100000 >/dev/null 2>"$work/err"
+check "a vertex past the end exits 2" test $? -eq 2
+check "a vertex past the end is named" grep -q "not a vertex" "$work/err"
+
 printf '0 1 0 0 5 0 1 0\n0 1 0 0 5 0 1\n' >"$work/bad.txt"
 "$tools/geodex-geodesic" "$mesh" --pairs "$work/bad.txt" >"$work/out" 2>"$work/err"
 check "bad line exits 2" test $? -eq 2
