@@ -166,7 +166,9 @@ void TriangulationToProto(const index::Index& index, int64_t version,
   std::vector<int32_t> face_of_sample(samples.size(), -1);
   std::unordered_multimap<int32_t, int32_t> samples_at;
   samples_at.reserve(samples.size());
-  for (size_t i = 0; i < samples.size(); ++i) samples_at.emplace(samples[i], static_cast<int32_t>(i));
+  for (size_t i = 0; i < samples.size(); ++i) {
+    samples_at.emplace(samples[i], static_cast<int32_t>(i));
+  }
   const std::span<const int32_t> faces = index.faces();
   v1::SurfacePoints* points = out->mutable_sample_points();
   std::vector<std::array<double, 3>> weights(samples.size(), {0, 0, 0});
@@ -198,7 +200,9 @@ void TriangulationToProto(const index::Index& index, int64_t version,
   }
   google::protobuf::RepeatedField<int32_t>* vertex_triangles = out->mutable_vertex_triangles();
   vertex_triangles->Reserve(index.num_vertices());
-  for (const index::VertexRecord& r : index.vertices()) vertex_triangles->AddAlreadyReserved(r.triangle);
+  for (const index::VertexRecord& r : index.vertices()) {
+    vertex_triangles->AddAlreadyReserved(r.triangle);
+  }
 }
 
 namespace {
