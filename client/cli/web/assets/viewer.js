@@ -347,7 +347,7 @@
   }
 
   function marker(position, color) {
-    const m = new THREE.Mesh(new THREE.SphereBufferGeometry(radius * 0.012, 16, 12),
+    const m = new THREE.Mesh(new THREE.SphereBufferGeometry(radius * 0.018, 16, 12),
                              new THREE.MeshBasicMaterial({ color }));
     m.position.copy(position);
     return m;
@@ -467,9 +467,17 @@
     $('path-length').textContent = formatDistance(length);
     $('path-length').dataset.length = String(length);
     if (xyz.length >= 6) {
-      const geometry = new THREE.BufferGeometry();
-      geometry.setAttribute('position', new THREE.BufferAttribute(Float32Array.from(xyz), 3));
-      pathLine = replace(pathLine, new THREE.Line(geometry, new THREE.LineBasicMaterial({ color: 0xff2d55, linewidth: 2 })));
+      // A thin tube: WebGL draws lines one pixel wide whatever linewidth says.
+      const n = xyz.length / 3;
+      const curve = new THREE.Curve();
+      curve.getPoint = (t, target = new THREE.Vector3()) => {
+        const x = Math.min(t, 1) * (n - 1), i = Math.min(Math.floor(x), n - 2), f = x - i;
+        return target.set(xyz[3 * i] + f * (xyz[3 * i + 3] - xyz[3 * i]),
+                          xyz[3 * i + 1] + f * (xyz[3 * i + 4] - xyz[3 * i + 1]),
+                          xyz[3 * i + 2] + f * (xyz[3 * i + 5] - xyz[3 * i + 2]));
+      };
+      const tube = new THREE.TubeBufferGeometry(curve, Math.min(4 * n, 4000), radius * 0.005, 6, false);
+      pathLine = replace(pathLine, new THREE.Mesh(tube, new THREE.MeshBasicMaterial({ color: 0xff2d55 })));
     } else {
       pathLine = replace(pathLine, null);
     }
@@ -561,6 +569,8 @@
       ctx.fillRect(x, 0, 1, bar.height);
     }
     const note = $('legend-note');
+    bar.style.visibility = state.triangulationShown ? 'hidden' : 'visible';
+    $('legend-min').textContent = state.triangulationShown ? '' : '0';
     if (state.triangulationShown) {
       $('legend-max').textContent = '';
       note.textContent = `Patches: the ${state.numTriangles} geodesic triangles over ${state.numSamples} samples (dots); lines: their borders.`;
