@@ -32,12 +32,15 @@
     numSamples: 0,
     frames: 0,
     errors: [],
+    timings: {},          // milliseconds of the last call of each kind, for diagnosis
   };
   window.geodexViewer = { state };
 
   // --- the HTTP API -------------------------------------------------------------
 
   async function api(method, path, body) {
+    const start = performance.now();
+    const kind = path.replace(/^\/v1\/models\/[^/:?]*/, '').replace(/\?.*/, '') || 'models';
     const response = await fetch(path, {
       method,
       headers: body ? { 'Content-Type': 'application/json' } : {},
@@ -50,6 +53,7 @@
     } catch (e) {
       throw new Error(`HTTP ${response.status}: ${text.slice(0, 200)}`);
     }
+    state.timings[kind] = Math.round(performance.now() - start);
     if (!response.ok) {
       const error = new Error(json.message || `HTTP ${response.status}`);
       error.code = json.code;
@@ -191,7 +195,9 @@
     renderPending = true;
     requestAnimationFrame(() => {
       renderPending = false;
+      const start = performance.now();
       renderer.render(scene, camera);
+      state.timings.render = Math.round(performance.now() - start);
       state.frames++;
     });
   }
@@ -252,9 +258,11 @@
     state.version = num(chunk.version);
     state.numVertices = num(chunk.numVertices);
     state.numFaces = num(chunk.numFaces);
+    const start = performance.now();
     positions = Float32Array.from(chunk.positions || []);
     faces = Uint32Array.from(chunk.faces || []);
     buildMesh();
+    state.timings.build = Math.round(performance.now() - start);
     setStatus(`${name} v${state.version}: ${state.numVertices} vertices, ${state.numFaces} faces`, 'ready');
     state.meshDrawn = true;
   }
@@ -333,7 +341,9 @@
     const ndc = new THREE.Vector2(((clientX - rect.left) / rect.width) * 2 - 1,
                                   -((clientY - rect.top) / rect.height) * 2 + 1);
     raycaster.setFromCamera(ndc, camera);
+    const start = performance.now();
     const hits = raycaster.intersectObject(mesh);
+    state.timings.pick = Math.round(performance.now() - start);
     if (hits.length === 0) return null;
     const hit = hits[0];
     const f = hit.faceIndex;
