@@ -89,8 +89,14 @@ def num(x):
 class Stack:
     """The model repository, geodex-server and `geodex web`, stopped on exit."""
 
-    def __init__(self, args, work):
+    def __init__(self, args, work, token=False):
         self.args, self.work, self.procs = args, work, []
+        auth = []
+        if token:  # the server wants a bearer token; the gateway's gRPC side sends it
+            self.token_file = os.path.join(work, "token.txt")
+            with open(self.token_file, "w") as f:
+                f.write("web-test-secret\n")
+            auth = ["--token-file", self.token_file]
         self.name = args.model_name
         self.index = os.path.join(work, "models", self.name, "1", "index.gdx")
         os.makedirs(os.path.dirname(self.index))
@@ -100,18 +106,13 @@ class Stack:
         check(r.returncode == 0, f"geodex-build failed (see {work}/build.log)")
         for attempt in range(3):
             self.grpc = f"127.0.0.1:{free_port()}"
-            server = self.start([args.server_bin, "--models", os.path.join(work, "models"), "--listen", self.grpc],
-                                "server.log")
+            server = self.start([args.server_bin, "--models", os.path.join(work, "models"), "--listen", self.grpc,
+                                 *auth], "server.log")
             time.sleep(0.3)
             if server.poll() is None:
                 break
             self.procs.remove(server)
-        web_log = os.path.join(work, "web.log")
-        web = self.start([args.geodex, "web", "--server", self.grpc, "--listen", "127.0.0.1:0",
-                          "--max-body", "65536", "--timeout", "30"], None, stdout=subprocess.PIPE)
-        line = web.stdout.readline().decode()
-        check(line.startswith("geodex web: serving http://"), f"geodex web printed {line!r}")
-        self.url = line.split()[3]
+        self.url = self.start_web(auth)
         self.http = Http(self.url)
         deadline = time.time() + 60
         while True:
@@ -121,8 +122,16 @@ class Stack:
                 if models.get(self.name, {}).get("state") == "SERVING":
                     self.info = models[self.name]
                     break
-            check(time.time() < deadline, f"model {self.name} not SERVING within 60 s (web log {web_log})")
+            check(time.time() < deadline, f"model {self.name} not SERVING within 60 s ({self.work}/server.log)")
             time.sleep(0.2)
+
+    def start_web(self, auth):
+        """Starts `geodex web` on a free port and returns its URL."""
+        web = self.start([self.args.geodex, "web", "--server", self.grpc, "--listen", "127.0.0.1:0",
+                          "--max-body", "65536", "--timeout", "30", *auth], None, stdout=subprocess.PIPE)
+        line = web.stdout.readline().decode()
+        check(line.startswith("geodex web: serving http://"), f"geodex web printed {line!r}")
+        return line.split()[3]
 
     def start(self, cmd, log_name, stdout=None):
         out = stdout if stdout is not None else open(os.path.join(self.work, log_name), "w")
@@ -230,23 +239,28 @@ def test_http(stack):
     http.error("GET", f"v1/models/{stack.name}:distance", 405, 12)
     http.error("GET", "v1/models/x/y/z", 404, 5)
     http.error("POST", f"v1/models/{stack.name}:distance", 413, 8, raw=b" " * 70000)
+    # The server wants a token: a gateway started without one gets 401, UNAUTHENTICATED.
+    Http(stack.start_web([])).error("GET", "v1/models", 401, 16)
     print(f"web_test: HTTP API ok ({vertices} vertices, 40 pairs, field, path, mesh, triangulation, errors)")
 
 
 # --- the page in headless Chromium -----------------------------------------------------
 
 
-def browser_or_skip():
+def browser_or_skip(launch=True):
+    """A headless Chromium under selenium; exits 77 (skipped) when one is missing."""
     chromium = shutil.which("chromium") or shutil.which("chromium-browser")
     driver = shutil.which("chromedriver")
     try:
-        from selenium import webdriver  # noqa: F401
+        from selenium import webdriver
     except ImportError:
         print("web_test: SKIP: python3-selenium is not installed (deploy/install-deps.sh installs it)")
         sys.exit(SKIP)
     if not chromium or not driver:
         print("web_test: SKIP: chromium or chromedriver is not installed (deploy/install-deps.sh installs them)")
         sys.exit(SKIP)
+    if not launch:
+        return None
     from selenium.webdriver.chrome.options import Options
     from selenium.webdriver.chrome.service import Service
     options = Options()
@@ -258,12 +272,13 @@ def browser_or_skip():
     return webdriver.Chrome(service=Service(executable_path=driver), options=options)
 
 
-def wait_for(driver, script, what, timeout=30):
+def wait_for(driver, script, what, timeout=60):
+    """Waits until `script` returns a true value and the page has drawn what it shows."""
     deadline = time.time() + timeout
     while time.time() < deadline:
         value = driver.execute_script(script)
-        if value:
-            return value
+        if value and not driver.execute_script("return window.geodexViewer.state.renderPending"):
+            return driver.execute_script(script)
         errors = driver.execute_script("return window.geodexViewer ? window.geodexViewer.state.errors : []")
         check(not errors, f"the page reports errors while waiting for {what}: {errors}")
         time.sleep(0.1)
@@ -321,7 +336,6 @@ def test_browser(stack, out_dir, screenshot):
 
         at(a).click().perform()
         wait_for(driver, "return window.geodexViewer.state.fieldReady", "the distance field")
-        time.sleep(0.3)
         _, field_colours = driver.execute_script(PIXELS)
         check(field_colours > colours, f"the field did not colour the mesh ({field_colours} <= {colours} colours)")
         at(h).perform()
@@ -357,7 +371,6 @@ def test_browser(stack, out_dir, screenshot):
         wait_for(driver, "return window.geodexViewer.state.triangulationShown", "the triangulation")
         s = driver.execute_script("return window.geodexViewer.state")
         check(s["numSamples"] == int(stack.info["numSamples"]), f"{s['numSamples']} samples drawn")
-        time.sleep(0.3)
         driver.save_screenshot(os.path.join(out_dir, "web_viewer_triangulation.png"))
         print(f"web_test: browser ok in {time.time() - start:.1f} s; screenshots in {out_dir}")
     finally:
@@ -376,10 +389,10 @@ def main():
     parser.add_argument("--screenshot", help="also save the field screenshot here")
     args = parser.parse_args()
     if args.browser:
-        browser_or_skip().quit()  # skip before building anything
+        browser_or_skip(launch=False)  # skip before building anything
     os.makedirs(args.out, exist_ok=True)
     work = tempfile.mkdtemp(prefix="web_test_", dir=args.out)
-    stack = Stack(args, work)
+    stack = Stack(args, work, token=not args.browser)
     try:
         if args.browser:
             test_browser(stack, args.out, args.screenshot)

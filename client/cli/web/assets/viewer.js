@@ -31,6 +31,10 @@
     triangulationShown: false,
     numSamples: 0,
     frames: 0,
+    // A frame is requested and not drawn yet: what the state says is on the
+    // canvas only once this is false (state changes and their render
+    // requests happen in the same task).
+    renderPending: false,
     errors: [],
     timings: {},          // milliseconds of the last call of each kind, for diagnosis
   };
@@ -188,13 +192,11 @@
   let faces = null;         // Uint32Array, 3 per face
   let radius = 1;
   let triangulationGroup = null;
-  let renderPending = false;
-
   function requestRender() {
-    if (renderPending) return;
-    renderPending = true;
+    if (state.renderPending) return;
+    state.renderPending = true;
     requestAnimationFrame(() => {
-      renderPending = false;
+      state.renderPending = false;
       const start = performance.now();
       renderer.render(scene, camera);
       state.timings.render = Math.round(performance.now() - start);
