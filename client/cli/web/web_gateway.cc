@@ -371,17 +371,19 @@ HttpResponse WebGateway::HandleApi(const HttpRequest& request) const {
   }
   std::string rest = path.substr(kModels.size() + 1);
   std::string verb, collection;
+  bool custom_method = false;  // "NAME:VERB"
   if (const size_t slash = rest.find('/'); slash != std::string::npos) {
     collection = rest.substr(slash + 1);
     rest.resize(slash);
   } else if (const size_t colon = rest.rfind(':'); colon != std::string::npos) {
+    custom_method = true;
     verb = rest.substr(colon + 1);
     rest.resize(colon);
   }
   const std::string& name = rest;
   if (name.empty()) return ErrorResponse(absl::NotFoundError("the path names no model"));
 
-  if (verb.empty()) {
+  if (!custom_method) {
     if (request.method != "GET") return wrong_method("GET");
     absl::StatusOr<v1::ModelRef> ref = GetModelRef(name, request);
     if (!ref.ok()) return ErrorResponse(ref.status());

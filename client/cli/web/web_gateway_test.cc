@@ -197,6 +197,7 @@ TEST_F(WebGatewayTest, RoutesAndMethods) {
   ExpectError(Post("/v1/models/torus:teleport", "{}"), 404, absl::StatusCode::kNotFound,
               "teleport");
   ExpectError(Get("/v1/models/torus/faces"), 404, absl::StatusCode::kNotFound, "no such API path");
+  ExpectError(Get("/v1/models/torus:"), 404, absl::StatusCode::kNotFound, "no such method");
   ExpectError(Get("/v1/elsewhere"), 404, absl::StatusCode::kNotFound, "no such API path");
   ExpectError(Get("/v1/models/"), 404, absl::StatusCode::kNotFound, "names no model");
   ExpectError(Get("/secret.txt"), 404, absl::StatusCode::kNotFound, "no such page");

@@ -385,7 +385,8 @@
   }
 
   async function setSource(point) {
-    state.source = { face: point.face, weights: point.weights };
+    const source = { face: point.face, weights: point.weights };
+    state.source = source;
     state.fieldReady = false;
     state.target = null;
     state.pair = null;
@@ -399,7 +400,7 @@
     $('source').textContent = `face ${point.face}`;
     setStatus('Computing the distance field…', 'loading');
     const field = await api('POST', modelPath(':field'), { model: pinned(), sources: pointsOf(point) });
-    if (state.source.face !== point.face || state.source.weights !== point.weights) return;  // superseded
+    if (state.source !== source) return;  // superseded by another click or model
     const d = (field.distances || []).map(num);
     const attr = mesh.geometry.getAttribute('distance');
     let max = 0;
@@ -460,7 +461,8 @@
   }
 
   async function setTarget(point) {
-    state.target = { face: point.face, weights: point.weights };
+    const target = { face: point.face, weights: point.weights };
+    state.target = target;
     state.pair = null;
     state.path = null;
     targetMarker = replace(targetMarker, marker(point.position, 0x2f7fe0));
@@ -469,7 +471,7 @@
       distance(state.source, point),
       api('POST', modelPath(':path'), { model: pinned(), a: pointsOf(state.source), b: pointsOf(point) }),
     ]);
-    if (state.target.face !== point.face || state.target.weights !== point.weights) return;
+    if (state.target !== target) return;  // superseded
     state.pair = d;
     setDistance($('pair'), d, formatDistance(d.distance, d.bound));
     const polyline = paths.paths[0];
