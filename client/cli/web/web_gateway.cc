@@ -1,6 +1,9 @@
 #include "client/cli/web/web_gateway.h"
 
+#include <cmath>
 #include <cstdint>
+#include <cstdio>
+#include <cstdlib>
 #include <exception>
 #include <fstream>
 #include <sstream>
@@ -91,6 +94,47 @@ HttpResponse Answer(const absl::StatusOr<Message>& answer) {
 absl::Status DataLoss(absl::string_view what, absl::string_view detail) {
   return absl::DataLossError(absl::StrCat("the server's ", what, " chunks ", detail));
 }
+
+// A double as protobuf's JSON printer writes it (3.21: SimpleDtoa, the
+// shortest of %.15g and %.17g that reads back exactly; non-finite values as
+// strings).
+void AppendJsonDouble(double x, std::string* out) {
+  if (std::isnan(x)) {
+    out->append("\"NaN\"");
+    return;
+  }
+  if (std::isinf(x)) {
+    out->append(x > 0 ? "\"Infinity\"" : "\"-Infinity\"");
+    return;
+  }
+  char buffer[32];
+  int n = std::snprintf(buffer, sizeof buffer, "%.15g", x);
+  if (std::strtod(buffer, nullptr) != x) n = std::snprintf(buffer, sizeof buffer, "%.17g", x);
+  out->append(buffer, n);
+}
+
+}  // namespace
+
+std::string MeshToJson(const v1::MeshChunk& mesh) {
+  std::string out;
+  out.reserve(24 * mesh.positions_size() + 8 * mesh.faces_size() + 160);
+  absl::StrAppend(&out, "{\"numVertices\":", mesh.num_vertices(),
+                  ",\"numFaces\":", mesh.num_faces(), ",\"version\":\"", mesh.version(),
+                  "\",\"vertexOffset\":", mesh.vertex_offset(), ",\"positions\":[");
+  for (int i = 0; i < mesh.positions_size(); ++i) {
+    if (i > 0) out.push_back(',');
+    AppendJsonDouble(mesh.positions(i), &out);
+  }
+  absl::StrAppend(&out, "],\"faceOffset\":", mesh.face_offset(), ",\"faces\":[");
+  for (int i = 0; i < mesh.faces_size(); ++i) {
+    if (i > 0) out.push_back(',');
+    absl::StrAppend(&out, mesh.faces(i));
+  }
+  out.append("]}");
+  return out;
+}
+
+namespace {
 
 // --- merging the chunks of a server stream into one message --------------------
 
@@ -397,7 +441,9 @@ HttpResponse WebGateway::HandleApi(const HttpRequest& request) const {
       *get.mutable_model() = *ref;
       absl::StatusOr<std::vector<v1::MeshChunk>> chunks = connection_->GetMesh(get);
       if (!chunks.ok()) return ErrorResponse(chunks.status());
-      return Answer(MergeMesh(*chunks));
+      absl::StatusOr<v1::MeshChunk> mesh = MergeMesh(*chunks);
+      if (!mesh.ok()) return ErrorResponse(mesh.status());
+      return {200, kJson, MeshToJson(*mesh)};
     }
     if (collection == "triangulation") {
       v1::GetTriangulationRequest get;

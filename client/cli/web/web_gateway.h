@@ -78,6 +78,11 @@ int HttpStatusFromCode(absl::StatusCode code);
 // (default: HttpStatusFromCode of its code).
 HttpResponse ErrorResponse(const absl::Status& status, int http_status = 0);
 
+// `mesh` in protobuf's JSON mapping, byte for byte what MessageToJsonString
+// prints with always_print_primitive_fields, several times faster (the mesh
+// is the largest answer the viewer asks for: 6.5 MB for 100K vertices).
+std::string MeshToJson(const v1::MeshChunk& mesh);
+
 // A file of the viewer: its bytes and MIME type.
 struct WebAsset {
   std::string content_type;

@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <random>
 #include <stdexcept>
 
 #include "geodex/client/mocks/mock_geodex_connection.h"
@@ -333,6 +334,34 @@ TEST_F(WebGatewayTest, ExceptionsBecomeInternalErrors) {
         throw std::runtime_error("boom");
       });
   ExpectError(Get("/v1/models"), 500, absl::StatusCode::kInternal, "boom");
+}
+
+TEST(MeshToJson, IsProtobufsJsonByteForByte) {
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> uniform(-3, 3);
+  v1::MeshChunk mesh;
+  mesh.set_num_vertices(4000000000u);
+  mesh.set_num_faces(7);
+  mesh.set_version(-12345678901234);
+  mesh.set_vertex_offset(3);
+  mesh.set_face_offset(9);
+  for (int i = 0; i < 20000; ++i) mesh.add_positions(uniform(rng));
+  for (int e = -320; e <= 308; e += 7) mesh.add_positions(std::ldexp(1.0, e / 3) * 1.1);
+  for (double x : {0.0, -0.0, 1.0, -2.0, 0.1, 1e21, 1e-7, 123456789012345680.0, 5e-324,
+                   std::numeric_limits<double>::max(), std::numeric_limits<double>::infinity(),
+                   -std::numeric_limits<double>::infinity()}) {
+    mesh.add_positions(x);
+  }
+  for (uint32_t v : {0u, 1u, 4294967295u, 65536u}) mesh.add_faces(v);
+  std::string expected;
+  google::protobuf::util::JsonPrintOptions options;
+  options.always_print_primitive_fields = true;
+  ASSERT_TRUE(google::protobuf::util::MessageToJsonString(mesh, &expected, options).ok());
+  EXPECT_EQ(MeshToJson(mesh), expected);
+  v1::MeshChunk empty;
+  expected.clear();  // MessageToJsonString appends
+  ASSERT_TRUE(google::protobuf::util::MessageToJsonString(empty, &expected, options).ok());
+  EXPECT_EQ(MeshToJson(empty), expected);
 }
 
 TEST(LoadWebAssets, NeedsEveryFile) {
