@@ -720,6 +720,8 @@ TEST(GeodexConnection, UnimplementedByDefault) {
   EXPECT_EQ(client.Distance("torus", NumberedPairs(5000)).status().code(),
             absl::StatusCode::kUnimplemented);
   EXPECT_EQ(client.GetMesh("torus").status().code(), absl::StatusCode::kUnimplemented);
+  EXPECT_EQ(client.connection()->GetTriangulation({}).status().code(),
+            absl::StatusCode::kUnimplemented);
 }
 
 }  // namespace

@@ -55,5 +55,9 @@ absl::StatusOr<std::vector<v1::MeshChunk>> GeodexConnection::GetMesh(const v1::G
 absl::StatusOr<std::vector<v1::ExpMapChunk>> GeodexConnection::ExpMap(const v1::ExpMapRequest&) {
   return NotImplemented("ExpMap");
 }
+absl::StatusOr<v1::TriangulationResponse> GeodexConnection::GetTriangulation(
+    const v1::GetTriangulationRequest&) {
+  return NotImplemented("GetTriangulation");
+}
 
 }  // namespace geodex::client

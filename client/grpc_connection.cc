@@ -97,6 +97,10 @@ class GrpcConnection : public GeodexConnection {
   absl::StatusOr<v1::LocateResponse> Locate(const v1::LocateRequest& r) override {
     return Unary(r, &v1::Geodex::Stub::Locate);
   }
+  absl::StatusOr<v1::TriangulationResponse> GetTriangulation(
+      const v1::GetTriangulationRequest& r) override {
+    return Unary(r, &v1::Geodex::Stub::GetTriangulation);
+  }
 
   std::unique_ptr<DistanceStream> StreamDistances(const StreamOptions& options) override {
     return std::make_unique<GrpcDistanceStream>(MakeContext(options.deadline.value_or(deadline_)),

@@ -73,6 +73,10 @@ class RetryingConnection : public GeodexConnection {
   absl::StatusOr<std::vector<v1::ExpMapChunk>> ExpMap(const v1::ExpMapRequest& r) override {
     return RetryLoop(policy_, sleep_, [&] { return inner_->ExpMap(r); });
   }
+  absl::StatusOr<v1::TriangulationResponse> GetTriangulation(
+      const v1::GetTriangulationRequest& r) override {
+    return RetryLoop(policy_, sleep_, [&] { return inner_->GetTriangulation(r); });
+  }
 
  private:
   std::shared_ptr<GeodexConnection> inner_;

@@ -83,6 +83,21 @@ TEST(RetryingConnection, DeadlineExceededRetriedOnlyWhenAskedFor) {
   EXPECT_EQ(sleep.waits.size(), 1u);
 }
 
+TEST(RetryingConnection, GetTriangulationIsRetriedWhenUnavailable) {
+  auto mock = std::make_shared<MockGeodexConnection>();
+  v1::TriangulationResponse answer;
+  answer.set_version(3);
+  EXPECT_CALL(*mock, GetTriangulation)
+      .WillOnce(Return(absl::UnavailableError("loading")))
+      .WillOnce(Return(answer));
+  RecordingSleeper sleep;
+  auto connection = MakeRetryingConnection(mock, RetryPolicy{}, sleep.sleeper());
+  absl::StatusOr<v1::TriangulationResponse> got = connection->GetTriangulation({});
+  ASSERT_TRUE(got.ok()) << got.status();
+  EXPECT_EQ(got->version(), 3);
+  EXPECT_EQ(sleep.waits.size(), 1u);
+}
+
 TEST(RetryingConnection, ServerStreamsAreRetriedWhole) {
   auto mock = std::make_shared<MockGeodexConnection>();
   EXPECT_CALL(*mock, Matrix)

@@ -28,6 +28,8 @@ BUILD_PACKAGES=(
   libtinyobjloader-dev libcli11-dev libxxhash-dev
   libprotobuf-dev protobuf-compiler libgrpc++-dev protobuf-compiler-grpc
   prometheus-cpp-dev
+  libcpp-httplib-dev  # the HTTP server of `geodex web`
+  libjs-three         # three.js for the web viewer, copied into the build and install trees
 )
 # Tests, benchmarks, reference cross-checks and tooling.
 DEV_PACKAGES=(
@@ -38,6 +40,7 @@ DEV_PACKAGES=(
   clang libclang-rt-14-dev  # the libFuzzer targets (tests/fuzz)
   openssl  # server tests generate TLS certificates with it
   shellcheck  # deploy/k8s/check.sh lints every script in deploy/ and tests/
+  chromium chromium-driver python3-selenium  # the web viewer's browser test
 )
 
 PACKAGES=("${BUILD_PACKAGES[@]}")

@@ -1,8 +1,11 @@
 #include "server/convert.h"
 
+#include <array>
 #include <cassert>
 #include <cmath>
 #include <limits>
+#include <unordered_map>
+#include <vector>
 
 #include "absl/strings/ascii.h"
 #include "absl/strings/str_format.h"
@@ -151,6 +154,55 @@ void MeshChunkToProto(const index::Index& index, int64_t vertex_offset, int64_t 
   out->Clear();
   out->Reserve(static_cast<int>(faces.size()));
   for (const int32_t v : faces) out->AddAlreadyReserved(static_cast<uint32_t>(v));
+}
+
+void TriangulationToProto(const index::Index& index, int64_t version,
+                          v1::TriangulationResponse* out) {
+  out->set_version(version);
+  out->set_num_vertices(index.num_vertices());
+  const std::span<const int32_t> samples = index.samples();
+  // Sample vertex -> sample ids, to find a face for each in one pass over
+  // the faces (a vertex may in principle be two samples).
+  std::vector<int32_t> face_of_sample(samples.size(), -1);
+  std::unordered_multimap<int32_t, int32_t> samples_at;
+  samples_at.reserve(samples.size());
+  for (size_t i = 0; i < samples.size(); ++i) {
+    samples_at.emplace(samples[i], static_cast<int32_t>(i));
+  }
+  const std::span<const int32_t> faces = index.faces();
+  v1::SurfacePoints* points = out->mutable_sample_points();
+  std::vector<std::array<double, 3>> weights(samples.size(), {0, 0, 0});
+  for (int32_t f = 0; f < index.num_faces(); ++f) {
+    for (int k = 0; k < 3; ++k) {
+      auto [begin, end] = samples_at.equal_range(faces[3 * f + k]);
+      for (auto it = begin; it != end; ++it) {
+        if (face_of_sample[it->second] >= 0) continue;
+        face_of_sample[it->second] = f;
+        weights[it->second][k] = 1;
+      }
+    }
+  }
+  out->mutable_sample_vertices()->Assign(samples.begin(), samples.end());
+  const std::span<const double> positions = index.positions();
+  for (size_t i = 0; i < samples.size(); ++i) {
+    const size_t v = static_cast<size_t>(samples[i]);
+    for (int k = 0; k < 3; ++k) out->mutable_sample_positions()->add_xyz(positions[3 * v + k]);
+    // A sample on no face (the builder never makes one) keeps face -1 and
+    // zero weights, which every query rejects rather than misreads.
+    points->add_faces(face_of_sample[i]);
+    for (int k = 0; k < 3; ++k) points->add_weights(weights[i][k]);
+  }
+  for (const index::GeodesicTriangle& t : index.triangles()) {
+    for (int k = 0; k < 3; ++k) {
+      out->add_triangle_corners(t.corner[k]);
+      out->add_triangle_neighbors(t.neighbor[k]);
+    }
+  }
+  google::protobuf::RepeatedField<int32_t>* vertex_triangles = out->mutable_vertex_triangles();
+  vertex_triangles->Reserve(index.num_vertices());
+  for (const index::VertexRecord& r : index.vertices()) {
+    vertex_triangles->AddAlreadyReserved(r.triangle);
+  }
 }
 
 namespace {

@@ -76,6 +76,13 @@ void MeshChunkToProto(const index::Index& index, int64_t vertex_offset, int64_t 
                       int64_t face_offset, int64_t face_count, int64_t version,
                       v1::MeshChunk* chunk);
 
+// The geodesic triangulation held by `index` (GetTriangulation), with
+// `version`. Each sample's surface point is the lowest-numbered face using
+// its vertex, with weight 1 on that vertex (face -1 and zero weights for a
+// sample on no face, which the builder never makes).
+void TriangulationToProto(const index::Index& index, int64_t version,
+                          v1::TriangulationResponse* out);
+
 // A model as GetModel and ListModels describe it: `version` (a served
 // version of `model`) if given, otherwise what is known without an index
 // (state, reason, versions on disk).

@@ -385,6 +385,19 @@ grpc::ServerUnaryReactor* GeodexService::Locate(grpc::CallbackServerContext* con
       });
 }
 
+grpc::ServerUnaryReactor* GeodexService::GetTriangulation(
+    grpc::CallbackServerContext* context, const v1::GetTriangulationRequest* request,
+    v1::TriangulationResponse* response) {
+  return RunUnary(context, "GetTriangulation",
+                  [this, request, response](Call& call, WorkerContext&) -> absl::Status {
+                    GEODEX_ASSIGN_OR_RETURN(ResolvedModel model, Resolve(request->model(), call));
+                    TriangulationToProto(model.version->index(), model.version->version(),
+                                         response);
+                    call.pairs = model.version->index().num_vertices();
+                    return absl::OkStatus();
+                  });
+}
+
 // --- streaming calls: registration and shutdown ---------------------------------
 
 absl::Status GeodexService::RegisterStream(StreamBase* stream) {

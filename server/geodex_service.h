@@ -97,6 +97,9 @@ class GeodexService final : public v1::Geodex::CallbackService {
                                    v1::LocateResponse* response) override;
   grpc::ServerWriteReactor<v1::MeshChunk>* GetMesh(grpc::CallbackServerContext* context,
                                                    const v1::GetMeshRequest* request) override;
+  grpc::ServerUnaryReactor* GetTriangulation(grpc::CallbackServerContext* context,
+                                             const v1::GetTriangulationRequest* request,
+                                             v1::TriangulationResponse* response) override;
 
  private:
   // One call: what its log lines and metrics need.

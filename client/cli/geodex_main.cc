@@ -11,6 +11,7 @@
 //                 [--out decal.obj|map.txt] [--image IMG] [--png view.png]
 //   geodex matrix --model M --sources FILE --targets FILE [--near-pairs MODE]
 //   geodex bench --model M --concurrency C --duration S --batch B
+//   geodex web --listen HOST:PORT [--assets DIR]   the viewer and an HTTP/JSON gateway
 //
 // Every subcommand takes --server ADDR (default $GEODEX_SERVER, else
 // localhost:50051), --tls-ca/--tls-cert/--tls-key, --token/--token-file and
@@ -61,6 +62,8 @@
 #include "client/cli/outputs.h"
 #include "client/cli/render.h"
 #include "client/cli/text_io.h"
+#include "client/cli/web/web_gateway.h"
+#include "client/cli/web/web_server.h"
 #include "geodex/client/client.h"
 
 namespace geodex::client::cli {
@@ -564,6 +567,36 @@ absl::Status Bench(const ConnectionFlags& conn, BenchFlags flags) {
   return WriteOutput("-", FormatBenchReport(flags.options, *report));
 }
 
+struct WebFlags {
+  WebServerOptions server;
+  std::string assets;
+  size_t max_body = 8 << 20;
+};
+
+// The viewer and the HTTP/JSON gateway (client/cli/web/web_gateway.h): a
+// client of the gRPC server like any other subcommand, serving until SIGINT
+// or SIGTERM. The URL goes to standard output once listening.
+absl::Status Web(const ConnectionFlags& conn, WebFlags flags) {
+  const std::string dir = flags.assets.empty() ? DefaultWebAssetsDir() : flags.assets;
+  if (dir.empty()) {
+    return InputError(absl::NotFoundError(
+        "the viewer's files are not beside this binary (web/ or ../share/geodex/web/); "
+        "name their directory with --assets"));
+  }
+  absl::StatusOr<WebAssets> assets = LoadWebAssets(dir);
+  if (!assets.ok()) return InputError(assets.status());
+  absl::StatusOr<Client> client = MakeClient(conn);
+  if (!client.ok()) return client.status();
+  const WebGateway gateway(client->connection(), *std::move(assets), flags.max_body);
+  flags.server.on_listening = [&conn](const std::string& url) {
+    std::printf("geodex web: serving %s (geodex server %s)\n", url.c_str(), conn.server.c_str());
+    std::fflush(stdout);
+  };
+  absl::Status status = ServeWeb(gateway, flags.server);
+  if (absl::IsInvalidArgument(status)) return InputError(status);
+  return status;
+}
+
 int Main(int argc, char** argv) {
   CLI::App app{
       "geodex: geodesic distances, paths and distance fields from a geodex server.\n"
@@ -736,6 +769,24 @@ int Main(int argc, char** argv) {
   AddNearPairsFlags(bench, &bench_flags.options.near_pairs);
   bench->add_option("--seed", bench_flags.options.seed, "Random pairs seed")->capture_default_str();
   bench->callback([&] { status = Bench(conn, bench_flags); });
+
+  CLI::App* web = app.add_subcommand(
+      "web",
+      "Serve the web viewer and an HTTP/JSON gateway to this server's API (GET /v1/models, "
+      "POST /v1/models/NAME:distance, ...) until interrupted");
+  AddConnectionFlags(web, &conn);
+  WebFlags web_flags;
+  web->add_option("--listen", web_flags.server.listen,
+                  "HTTP address HOST:PORT (port 0: any free port; the URL is printed). Anyone "
+                  "who reaches it uses this client's token: keep it on loopback or behind a proxy")
+      ->capture_default_str();
+  web->add_option("--assets", web_flags.assets,
+                  "Directory of the viewer's files (default: beside the binary, or the installed "
+                  "share/geodex/web)");
+  web->add_option("--max-body", web_flags.max_body, "Largest request body, bytes (larger: 413)")
+      ->check(CLI::Range(size_t{1}, size_t{1} << 30))
+      ->capture_default_str();
+  web->callback([&] { status = Web(conn, web_flags); });
 
   try {
     app.parse(argc, argv);

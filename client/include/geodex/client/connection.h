@@ -73,6 +73,8 @@ class GeodexConnection {
   virtual absl::StatusOr<std::vector<v1::MeshChunk>> GetMesh(const v1::GetMeshRequest& request);
   // All chunks of the server stream, in the order received.
   virtual absl::StatusOr<std::vector<v1::ExpMapChunk>> ExpMap(const v1::ExpMapRequest& request);
+  virtual absl::StatusOr<v1::TriangulationResponse> GetTriangulation(
+      const v1::GetTriangulationRequest& request);
 };
 
 }  // namespace geodex::client

@@ -42,6 +42,8 @@ class MockGeodexConnection : public GeodexConnection {
               (const v1::ExpMapRequest& request), (override));
   MOCK_METHOD(absl::StatusOr<std::vector<v1::MeshChunk>>, GetMesh,
               (const v1::GetMeshRequest& request), (override));
+  MOCK_METHOD(absl::StatusOr<v1::TriangulationResponse>, GetTriangulation,
+              (const v1::GetTriangulationRequest& request), (override));
 };
 
 // Note: Client::Distance writes and reads a stream from two threads at once;
