@@ -250,7 +250,22 @@ void ModelRegistry::ScanModel(ModelEntry& entry, const std::string& dir) {
     }
     ++v;
   }
-  for (const auto& [version, id] : disk) entry.versions[version].disk = id;
+  for (const auto& [version, id] : disk) {
+    VersionEntry& ve = entry.versions[version];
+    ve.disk = id;
+    // The served file itself changed (same inode, new size or mtime): it was
+    // rewritten or truncated in place under its mapping, so what is served
+    // is no longer what was validated. Stop serving it now; the file is then
+    // loaded afresh below like any changed file (served if it validates).
+    if (ve.served && ve.served->file_id() != id && ve.served->file_id().device == id.device &&
+        ve.served->file_id().inode == id.inode) {
+      spdlog::error(
+          "model {} version {}: {} was modified in place while mapped; no longer served "
+          "(publish indexes by writing them elsewhere and renaming them into place)",
+          entry.name, version, ve.served->path());
+      ve.served.reset();
+    }
+  }
 
   // Which versions should be served: the newest keep_versions ones on disk
   // that are not known to be broken (a broken file whose previous contents

@@ -30,7 +30,12 @@
 // retried until its file changes; the model's state becomes FAILED with the
 // reason, and the versions served before keep serving (or, at start, the
 // newest older version that loads). A model whose directory disappears is
-// dropped at once (new requests: NOT_FOUND).
+// dropped at once (new requests: NOT_FOUND). A served file that changes in
+// place (same inode: truncated, or rewritten by a tool that does not rename)
+// stops being served at the next scan, since its mapping no longer holds what
+// was validated; it is then loaded afresh like any changed file. Between the
+// change and that scan a query can still read it (and die of SIGBUS if it
+// shrank: server/mapped_files.h).
 //
 // Thread safety: every public method is safe from any thread. Resolve and
 // snapshot() copy the published shared_ptr under a mutex held for that copy

@@ -136,6 +136,42 @@ TEST_F(ModelRegistryTest, ReloadsAVersionWhoseFileChanged) {
   EXPECT_EQ(registry_->Resolve("a", 0)->version->index().num_samples(), 30);
 }
 
+// A served file changed in place (same inode) no longer holds what was
+// validated: it stops being served, and is served again once it validates.
+TEST_F(ModelRegistryTest, AFileModifiedInPlaceStopsBeingServed) {
+  Write("a", 1, testing::SphereIndexBytes());
+  Write("b", 1, testing::SphereIndexBytes());
+  Start();
+  ASSERT_TRUE(registry_->Resolve("a", 0).ok());
+  const std::string path = dir_.path() + "/a/1/index.gdx";
+  {
+    // Overwrite bytes in the middle without truncating or renaming, and move
+    // the mtime on so the change is seen even within one clock tick.
+    std::fstream f(path, std::ios::in | std::ios::out | std::ios::binary);
+    f.seekp(static_cast<std::streamoff>(testing::SphereIndexBytes().size() / 2));
+    f << std::string(64, '\x5a');
+  }
+  std::filesystem::last_write_time(
+      path, std::filesystem::last_write_time(path) + std::chrono::seconds(2));
+  registry_->RescanNow();
+  auto resolved = registry_->Resolve("a", 0);
+  EXPECT_EQ(resolved.status().code(), absl::StatusCode::kUnavailable) << resolved.status();
+  EXPECT_EQ(Model("a")->state, LoadState::kFailed);
+  EXPECT_THAT(Model("a")->reason, HasSubstr("checksum"));
+  EXPECT_TRUE(registry_->Resolve("b", 0).ok());  // the others serve on
+
+  // Rewritten in place with valid contents: validated again, served again.
+  {
+    std::ofstream f(path, std::ios::in | std::ios::out | std::ios::binary);
+    f << testing::SphereIndexBytes();
+  }
+  std::filesystem::last_write_time(
+      path, std::filesystem::last_write_time(path) + std::chrono::seconds(2));
+  registry_->RescanNow();
+  EXPECT_TRUE(registry_->Resolve("a", 0).ok());
+  EXPECT_EQ(Model("a")->state, LoadState::kServing);
+}
+
 TEST_F(ModelRegistryTest, BrokenNewVersionKeepsThePreviousServing) {
   Write("a", 1, testing::SphereIndexBytes());
   Start();
