@@ -14,11 +14,14 @@
 #      (at the end, once a server runs);
 #   3. the server killed with SIGKILL restarts and serves the same answers;
 #   4. the mmap hazard: an index replaced by rename while served changes
-#      nothing until the server reloads it; one truncated in place while
-#      mapped is measured (and printed): the server dies of SIGBUS on its next
-#      read of a lost page and its log names the file. A restart refuses the
-#      damaged file with its reason, keeps serving the other models, and
-#      serves the model again once a whole index is renamed into place.
+#      nothing until the server reloads it; one rewritten in place (same
+#      size) stops being served at the next poll (UNAVAILABLE, the checksum
+#      failure as the reason), never answered from; one truncated in place
+#      while mapped is measured (and printed): a server that does not poll
+#      dies of SIGBUS on its next read of a lost page, and its log names the
+#      file. A restart refuses the damaged file with its reason, keeps serving
+#      the other models, and serves the model again once a whole index is
+#      renamed into place.
 # Prints what it saw; exits 1 on any violation, 77 when a binary is missing.
 # Part 2 needs a private mount namespace (unshare, as root or through a user
 # namespace); without one they are reported as skipped.
@@ -197,8 +200,8 @@ publish() {  # FILE MODEL VERSION: staged beside the repository, then renamed
 publish old.gdx torus 1
 publish old.gdx other 1
 ADDR="127.0.0.1:$(free_port)"
-start_server() {
-  "$SERVER_BIN" --models "$REPO" --listen "$ADDR" --poll-seconds 0.2 --log-level info \
+start_server() {  # MODELS_SERVING [POLL_SECONDS (default 0.2; 0: only on SIGHUP)]
+  "$SERVER_BIN" --models "$REPO" --listen "$ADDR" --poll-seconds "${2:-0.2}" --log-level info \
     >> server.log 2>&1 &
   SERVER_PID=$!
   for _ in $(seq 150); do
@@ -217,19 +220,51 @@ served torus > now.ans && cmp -s now.ans old.ans || fail "the restarted server's
 ok "server: killed with SIGKILL, restarted on the same address, the same answers"
 
 # --- 4. the mmap hazard -------------------------------------------------------------------
+# Renames ref.gdx over torus version 1 and waits until the server answers
+# with it (its poll reloads the model); fails after 10 s.
+rename_ref_in_and_wait() {
+  cp ref.gdx "$REPO/torus/1/staged" && mv "$REPO/torus/1/staged" "$REPO/torus/1/index.gdx"
+  for _ in $(seq 100); do
+    served torus > now.ans 2> /dev/null && cmp -s now.ans ref.ans && return 0
+    sleep 0.1
+  done
+  return 1
+}
 # Replaced by rename while served: the mapping keeps the old inode; the next
 # poll serves the new file.
-cp ref.gdx "$REPO/torus/1/staged" && mv "$REPO/torus/1/staged" "$REPO/torus/1/index.gdx"
-for _ in $(seq 100); do
-  served torus > now.ans 2> /dev/null && cmp -s now.ans ref.ans && break
-  sleep 0.1
-done
-cmp -s now.ans ref.ans || fail "an index replaced by rename was not picked up"
+rename_ref_in_and_wait || fail "an index replaced by rename was not picked up"
 kill -0 "$SERVER_PID" || fail "the server died when an index was replaced by rename"
 ok "index replaced by rename while served: no interruption, the new answers after the reload"
 
-# Truncated in place while mapped (what `cp new index.gdx` or a rebuild into
-# the served path would do): measured, not wished away.
+# Rewritten in place, same size (bytes overwritten in the middle, as a tool
+# that writes into the served file would): the next poll sees the served
+# file change under its mapping and stops serving it; the model is refused
+# (its checksums fail), never answered from the changed bytes.
+SIZE=$(stat -c %s "$REPO/torus/1/index.gdx")
+dd if=/dev/zero of="$REPO/torus/1/index.gdx" bs=1 seek=$((SIZE / 2)) count=4096 conv=notrunc \
+  status=none
+touch -d "+2 seconds" "$REPO/torus/1/index.gdx"  # a new mtime even within one clock tick
+for _ in $(seq 100); do
+  "$CLIENT_BIN" models --server "$ADDR" 2> /dev/null | grep -E "^torus" | grep -q FAILED && break
+  sleep 0.1
+done
+"$CLIENT_BIN" models --server "$ADDR" > models.txt 2>&1
+grep -E "^torus" models.txt | grep -q "checksum" ||
+  fail "an index rewritten in place was not refused: $(cat models.txt)"
+! served torus > /dev/null || fail "the model was answered from an index rewritten in place"
+grep -q "UNAVAILABLE" served.err || fail "not UNAVAILABLE after a rewrite in place: $(cat served.err)"
+served other > now.ans && cmp -s now.ans old.ans || fail "the other model stopped serving"
+grep -q "modified in place while mapped" server.log || fail "the server's log does not say what happened"
+ok "index rewritten in place while served: no longer served at the next poll (UNAVAILABLE," \
+  "'$(grep -oE 'DATA_LOSS: [^;]*checksum mismatch' models.txt | head -n 1 | sed 's|.*index.gdx: ||')'), the others serve on"
+
+# Truncated in place while mapped (what `cp new.gdx index.gdx` does first):
+# measured, not wished away. A server that does not poll (--poll-seconds 0)
+# reads the lost pages on the next query.
+rename_ref_in_and_wait || fail "the model was not served again after a whole index was renamed into place"
+kill "$SERVER_PID"
+wait "$SERVER_PID" 2> /dev/null || true
+start_server 2 0
 truncate -s 4096 "$REPO/torus/1/index.gdx"
 TRUNC_OUTCOME="still serving"
 for _ in 1 2 3; do
@@ -255,12 +290,7 @@ start_server 1
 "$CLIENT_BIN" models --server "$ADDR" > models.txt 2>&1
 grep -E "^torus" models.txt | grep -q FAILED || fail "the truncated index was not refused: $(cat models.txt)"
 served other > now.ans && cmp -s now.ans old.ans || fail "the other model is not served after the restart"
-cp ref.gdx "$REPO/torus/1/staged" && mv "$REPO/torus/1/staged" "$REPO/torus/1/index.gdx"
-for _ in $(seq 100); do
-  served torus > now.ans 2> /dev/null && cmp -s now.ans ref.ans && break
-  sleep 0.1
-done
-cmp -s now.ans ref.ans || fail "the model was not served again after a whole index was renamed into place"
+rename_ref_in_and_wait || fail "the model was not served again after a whole index was renamed into place"
 ok "after the SIGBUS: the restart refused the truncated index ($(grep -E '^torus' models.txt | tr -s ' ' | cut -c1-60)...)," \
   "served the other model, and the model again once a whole index was renamed in"
 # The CLI's outputs on a full disk: said, and no partial file left.
