@@ -14,44 +14,13 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "absl/strings/string_view.h"
+#include "client/cli/outputs.h"
 #include "google/protobuf/util/json_util.h"
 
 namespace geodex::client::cli {
 namespace {
 
 constexpr char kJson[] = "application/json";
-
-// Escapes `s` as the contents of a JSON string.
-std::string JsonEscape(absl::string_view s) {
-  std::string out;
-  out.reserve(s.size() + 8);
-  for (const char c : s) {
-    switch (c) {
-      case '"':
-        out += "\\\"";
-        break;
-      case '\\':
-        out += "\\\\";
-        break;
-      case '\n':
-        out += "\\n";
-        break;
-      case '\r':
-        out += "\\r";
-        break;
-      case '\t':
-        out += "\\t";
-        break;
-      default:
-        if (static_cast<unsigned char>(c) < 0x20) {
-          absl::StrAppendFormat(&out, "\\u%04x", static_cast<unsigned char>(c));
-        } else {
-          out += c;
-        }
-    }
-  }
-  return out;
-}
 
 absl::StatusOr<std::string> ToJson(const google::protobuf::Message& message) {
   google::protobuf::util::JsonPrintOptions options;
@@ -330,8 +299,9 @@ HttpResponse ErrorResponse(const absl::Status& status, int http_status) {
   HttpResponse out;
   out.status = http_status != 0 ? http_status : HttpStatusFromCode(status.code());
   out.content_type = kJson;
-  out.body = absl::StrFormat(R"({"code":%d,"message":"%s","details":[]})",
-                             static_cast<int>(status.code()), JsonEscape(status.message()));
+  out.body = absl::StrFormat(R"({"code":%d,"message":%s,"details":[]})",
+                             static_cast<int>(status.code()),
+                             JsonString(std::string(status.message())));
   return out;
 }
 
