@@ -38,12 +38,8 @@
 // error from the server or the network (NOT_FOUND for an unknown model,
 // UNAVAILABLE, ...) and local I/O errors on output.
 
-#include <unistd.h>
-
-#include <cerrno>
 #include <cstdio>
 #include <cstdlib>
-#include <cstring>
 #include <fstream>
 #include <map>
 #include <string>
@@ -135,38 +131,6 @@ absl::StatusOr<Client> MakeClient(const ConnectionFlags& flags, int batch_size =
   // Everything Connect rejects comes from the command line.
   if (!client.ok()) return InputError(client.status());
   return client;
-}
-
-absl::Status WriteOutput(const std::string& path, const std::string& contents) {
-  if (path == "-") {
-    if (std::fwrite(contents.data(), 1, contents.size(), stdout) != contents.size() ||
-        std::fflush(stdout) != 0) {
-      return absl::DataLossError("cannot write to standard output");
-    }
-    return absl::OkStatus();
-  }
-  // Written beside `path` and renamed over it, so that a reader (or a killed
-  // run) never leaves half a file under the name asked for.
-  const std::string tmp = absl::StrCat(path, ".tmp.", ::getpid());
-  auto failed = [&](const char* what) {
-    const std::string reason = std::strerror(errno);
-    ::unlink(tmp.c_str());
-    return absl::Status(errno == ENOSPC || errno == EDQUOT ? absl::StatusCode::kResourceExhausted
-                                                           : absl::StatusCode::kPermissionDenied,
-                        absl::StrCat("cannot ", what, " ", path, ": ", reason));
-  };
-  std::FILE* out = std::fopen(tmp.c_str(), "wb");
-  if (out == nullptr) return failed("write");
-  const bool written = std::fwrite(contents.data(), 1, contents.size(), out) == contents.size();
-  if (!written || std::fflush(out) != 0) {
-    const int err = errno;
-    std::fclose(out);
-    errno = err;
-    return failed("write");
-  }
-  if (std::fclose(out) != 0) return failed("write");
-  if (std::rename(tmp.c_str(), path.c_str()) != 0) return failed("replace");
-  return absl::OkStatus();
 }
 
 // Reads and parses an input file; every failure is an input error.
@@ -285,12 +249,12 @@ absl::Status Models(const ConnectionFlags& conn, bool json) {
   if (!client.ok()) return client.status();
   absl::StatusOr<std::vector<ModelInfo>> models = client->ListModels();
   if (!models.ok()) return models.status();
-  if (!json) return WriteOutput("-", ModelsTable(*models));
+  if (!json) return WriteFileOrStdout("-", ModelsTable(*models));
   std::string out = "[\n";
   for (size_t i = 0; i < models->size(); ++i) {
     absl::StrAppend(&out, ModelToJson((*models)[i]), i + 1 < models->size() ? ",\n" : "");
   }
-  return WriteOutput("-", out + "]\n");
+  return WriteFileOrStdout("-", out + "]\n");
 }
 
 absl::Status Info(const ConnectionFlags& conn, const ModelFlags& model) {
@@ -298,7 +262,7 @@ absl::Status Info(const ConnectionFlags& conn, const ModelFlags& model) {
   if (!client.ok()) return client.status();
   absl::StatusOr<ModelInfo> info = client->GetModel(model.ref());
   if (!info.ok()) return info.status();
-  return WriteOutput("-", ModelToJson(*info));
+  return WriteFileOrStdout("-", ModelToJson(*info));
 }
 
 struct DistanceFlags {
@@ -324,7 +288,7 @@ absl::Status Distance(const ConnectionFlags& conn, const DistanceFlags& flags) {
     if (flags.query.error_bounds) absl::StrAppend(&out, " ", FormatDistance(d->bound[i]));
     absl::StrAppend(&out, "\n");
   }
-  return WriteOutput(flags.out, out);
+  return WriteFileOrStdout(flags.out, out);
 }
 
 struct PathFlags {
@@ -353,7 +317,7 @@ absl::Status Path(const ConnectionFlags& conn, const PathFlags& flags) {
   const std::string out = format == "obj"   ? PathsToObj(*paths)
                           : format == "ply" ? PathsToPly(*paths)
                                             : PathsToJson(*paths);
-  return WriteOutput(flags.out, out);
+  return WriteFileOrStdout(flags.out, out);
 }
 
 struct FieldFlags {
@@ -406,10 +370,10 @@ absl::Status Field(const ConnectionFlags& conn, const FieldFlags& flags) {
   absl::StatusOr<VertexDistances> field =
       client->DistanceField(flags.model.ref(), *sources, flags.nearest);
   if (!field.ok()) return field.status();
-  if (!ply) return WriteOutput(flags.out, FieldToText(*field));
+  if (!ply) return WriteFileOrStdout(flags.out, FieldToText(*field));
   absl::StatusOr<Mesh> mesh = MeshOfField(*client, flags.model, *field);
   if (!mesh.ok()) return mesh.status();
-  return WriteOutput(flags.out, FieldToPly(*mesh, field->distances));
+  return WriteFileOrStdout(flags.out, FieldToPly(*mesh, field->distances));
 }
 
 struct ExpMapFlags {
@@ -467,7 +431,7 @@ absl::Status ExpMapCommand(const ConnectionFlags& conn, const ExpMapFlags& flags
     for (size_t i = 0; i < map->vertices.size(); ++i) {
       out += absl::StrFormat("%d %.17g %.17g\n", map->vertices[i], map->u[i], map->v[i]);
     }
-    return WriteOutput(flags.out, out);
+    return WriteFileOrStdout(flags.out, out);
   }
   // The mesh of the version that answered the map.
   const int64_t version = map->version != 0 ? map->version : flags.model.version;
@@ -486,25 +450,25 @@ absl::Status ExpMapCommand(const ConnectionFlags& conn, const ExpMapFlags& flags
         DecalToObj(*mesh, *map, query.radius, BaseName(stem) + ".mtl", texture);
     if (!files.ok()) return files.status();
     const std::string dir = flags.out.substr(0, flags.out.size() - BaseName(flags.out).size());
-    if (absl::Status s = WriteOutput(flags.out, files->obj); !s.ok()) return s;
-    if (absl::Status s = WriteOutput(stem + ".mtl", files->mtl); !s.ok()) return s;
+    if (absl::Status s = WriteFileOrStdout(flags.out, files->obj); !s.ok()) return s;
+    if (absl::Status s = WriteFileOrStdout(stem + ".mtl", files->mtl); !s.ok()) return s;
     const std::string texture_path = dir + texture;
     if (texture_path == flags.png) {
       return InputError(absl::InvalidArgumentError(
           absl::StrCat("--png ", flags.png, " would overwrite the decal's texture")));
     }
     if (flags.image.empty()) {
-      if (absl::Status s = WriteOutput(texture_path, EncodePng(Checkerboard(1024, 8))); !s.ok()) {
+      if (absl::Status s = WriteFileOrStdout(texture_path, EncodePng(Checkerboard(1024, 8))); !s.ok()) {
         return s;
       }
     } else if (texture_path != flags.image) {
-      if (absl::Status s = WriteOutput(texture_path, image); !s.ok()) return s;
+      if (absl::Status s = WriteFileOrStdout(texture_path, image); !s.ok()) return s;
     }
   }
   if (!flags.png.empty()) {
     absl::StatusOr<Image> picture = RenderDecal(*mesh, *map, query.radius, RenderOptions{});
     if (!picture.ok()) return picture.status();
-    if (absl::Status s = WriteOutput(flags.png, EncodePng(*picture)); !s.ok()) return s;
+    if (absl::Status s = WriteFileOrStdout(flags.png, EncodePng(*picture)); !s.ok()) return s;
   }
   return absl::OkStatus();
 }
@@ -523,7 +487,7 @@ absl::Status Locate(const ConnectionFlags& conn, const ModelFlags& model, const 
     absl::StrAppendFormat(&out, "%d %.17g %.17g %.17g %.17g\n", l.point.face, l.point.w[0],
                           l.point.w[1], l.point.w[2], l.distance);
   }
-  return WriteOutput(out_path, out);
+  return WriteFileOrStdout(out_path, out);
 }
 
 absl::Status Matrix(const ConnectionFlags& conn, const ModelFlags& model,
@@ -547,7 +511,7 @@ absl::Status Matrix(const ConnectionFlags& conn, const ModelFlags& model,
     }
     out += "\n";
   }
-  return WriteOutput(out_path, out);
+  return WriteFileOrStdout(out_path, out);
 }
 
 struct BenchFlags {
@@ -564,7 +528,7 @@ absl::Status Bench(const ConnectionFlags& conn, BenchFlags flags) {
   flags.options.warmup = absl::Seconds(flags.warmup_s);
   absl::StatusOr<BenchReport> report = RunBench(*client, flags.options);
   if (!report.ok()) return report.status();
-  return WriteOutput("-", FormatBenchReport(flags.options, *report));
+  return WriteFileOrStdout("-", FormatBenchReport(flags.options, *report));
 }
 
 struct WebFlags {

@@ -1,6 +1,11 @@
 #include "client/cli/text_io.h"
 
+#include <unistd.h>
+
+#include <cerrno>
 #include <charconv>
+#include <cstring>
+#include <cstdio>
 #include <cmath>
 #include <cstdint>
 #include <fstream>
@@ -8,6 +13,7 @@
 #include <iterator>
 #include <sstream>
 
+#include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 
 namespace geodex::client::cli {
@@ -192,6 +198,38 @@ std::string FormatDistance(double d) {
   char buffer[64];
   const auto [ptr, ec] = std::to_chars(buffer, buffer + sizeof(buffer), d);
   return std::string(buffer, ptr);
+}
+
+absl::Status WriteFileOrStdout(const std::string& path, const std::string& contents) {
+  if (path == "-") {
+    if (std::fwrite(contents.data(), 1, contents.size(), stdout) != contents.size() ||
+        std::fflush(stdout) != 0) {
+      return absl::DataLossError("cannot write to standard output");
+    }
+    return absl::OkStatus();
+  }
+  // Written beside `path` and renamed over it, so that a reader (or a killed
+  // run) never leaves half a file under the name asked for.
+  const std::string tmp = absl::StrCat(path, ".tmp.", ::getpid());
+  auto failed = [&](const char* what) {
+    const std::string reason = std::strerror(errno);
+    ::unlink(tmp.c_str());
+    return absl::Status(errno == ENOSPC || errno == EDQUOT ? absl::StatusCode::kResourceExhausted
+                                                           : absl::StatusCode::kPermissionDenied,
+                        absl::StrCat("cannot ", what, " ", path, ": ", reason));
+  };
+  std::FILE* out = std::fopen(tmp.c_str(), "wb");
+  if (out == nullptr) return failed("write");
+  const bool written = std::fwrite(contents.data(), 1, contents.size(), out) == contents.size();
+  if (!written || std::fflush(out) != 0) {
+    const int err = errno;
+    std::fclose(out);
+    errno = err;
+    return failed("write");
+  }
+  if (std::fclose(out) != 0) return failed("write");
+  if (std::rename(tmp.c_str(), path.c_str()) != 0) return failed("replace");
+  return absl::OkStatus();
 }
 
 }  // namespace geodex::client::cli

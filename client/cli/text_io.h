@@ -17,6 +17,7 @@
 #include <string_view>
 #include <vector>
 
+#include "absl/status/status.h"
 #include "absl/status/statusor.h"
 #include "geodex/client/types.h"
 
@@ -24,6 +25,13 @@ namespace geodex::client::cli {
 
 // Whole file, or standard input for "-". Errors: NOT_FOUND.
 absl::StatusOr<std::string> ReadFileOrStdin(const std::string& path);
+
+// Writes `contents` to `path` ('-': standard output). A file is written
+// beside its name and renamed into place, so that a reader (or a killed run)
+// never sees half of it. Errors: ResourceExhausted on a full disk or quota,
+// PermissionDenied otherwise (with the system's reason); DataLoss when
+// standard output fails.
+absl::Status WriteFileOrStdout(const std::string& path, const std::string& contents);
 
 // Surface-point pairs, and the line each came from. Errors: INVALID_ARGUMENT
 // naming the first bad line (field count, not a number, not finite, face id
