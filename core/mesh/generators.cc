@@ -380,4 +380,31 @@ Mesh TwoComponents(int n) {
   return MustCreate(std::move(positions), std::move(faces), "TwoComponents");
 }
 
+Mesh SplitFacesInFour(const Mesh& mesh, int times) {
+  Check(times >= 0, "SplitFacesInFour", "times must be >= 0");
+  if (times == 0) return mesh;
+  std::vector<Vec3> positions = mesh.positions();
+  std::vector<Triangle> faces;
+  faces.reserve(4 * static_cast<size_t>(mesh.num_faces()));
+  // One midpoint per edge, shared by the edge's two half-edges.
+  std::vector<int32_t> midpoint(mesh.num_halfedges(), kNone);
+  for (int32_t h = 0; h < mesh.num_halfedges(); ++h) {
+    if (midpoint[h] != kNone) continue;
+    midpoint[h] = static_cast<int32_t>(positions.size());
+    positions.push_back(0.5 * (mesh.position(mesh.Origin(h)) + mesh.position(mesh.Dest(h))));
+    if (mesh.Twin(h) != kNone) midpoint[mesh.Twin(h)] = midpoint[h];
+  }
+  for (int32_t f = 0; f < mesh.num_faces(); ++f) {
+    const Triangle& t = mesh.face(f);
+    // Half-edge 3f+i runs from t[i] to t[i+1].
+    const int32_t m0 = midpoint[3 * f], m1 = midpoint[3 * f + 1], m2 = midpoint[3 * f + 2];
+    faces.push_back({t[0], m0, m2});
+    faces.push_back({m0, t[1], m1});
+    faces.push_back({m2, m1, t[2]});
+    faces.push_back({m0, m1, m2});
+  }
+  Mesh split = MustCreate(std::move(positions), std::move(faces), mesh.name().c_str());
+  return SplitFacesInFour(split, times - 1);
+}
+
 }  // namespace geodex::mesh::gen

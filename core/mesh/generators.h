@@ -52,6 +52,12 @@ Mesh Torus(int n_major, int n_minor, double major_radius, double minor_radius);
 // Closed genus-2 surface (two tori joined), roughly `size` across.
 Mesh DoubleTorus(int resolution, double size);
 
+// `mesh` with every face split in four at its edge midpoints (flat: the new
+// vertices lie on the old edges), repeated `times` times. The surface, and so
+// every exact geodesic distance between its points, is unchanged; the vertex
+// count grows about fourfold per split. The input's vertices keep their ids.
+Mesh SplitFacesInFour(const Mesh& mesh, int times = 1);
+
 // Two disjoint unit grids (n by n cells), the second shifted by 2 along x.
 Mesh TwoComponents(int n);
 

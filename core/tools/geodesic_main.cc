@@ -13,10 +13,14 @@
 // (0-based, in the mesh file's order), one per line: the job an exact
 // solver's command line does (VTP's, for one), so that the two compare as
 // whole processes. The file is written beside its name and renamed into
-// place; '-' (the default) is standard output.
+// place; '-' (the default) is standard output. It runs the builder's rows
+// engine (VertexGeodesicSolver); --engine windows runs ExactGeodesicSolver
+// instead, the engine of --pairs. --stats prints the propagation's seconds
+// and window counts to standard error.
 
 #include <algorithm>
 #include <atomic>
+#include <chrono>
 #include <cstdio>
 #include <map>
 #include <thread>
@@ -27,6 +31,7 @@
 #include "core/common/file_util.h"
 #include "core/common/status_macros.h"
 #include "core/geodesic/exact_geodesic.h"
+#include "core/geodesic/vertex_geodesic.h"
 #include "core/mesh/mesh_io.h"
 #include "core/mesh/pairs_io.h"
 
@@ -86,20 +91,40 @@ absl::Status Run(const std::string& mesh_path, const std::string& pairs_path, in
   return absl::OkStatus();
 }
 
-absl::Status RunFromVertex(const std::string& mesh_path, int64_t source, const std::string& out) {
+absl::Status RunFromVertex(const std::string& mesh_path, int64_t source, const std::string& out,
+                           const std::string& engine, bool stats) {
   GEODEX_ASSIGN_OR_RETURN(const mesh::Mesh mesh, mesh::LoadMesh(mesh_path));
   if (source < 0 || source >= mesh.num_vertices()) {
     return absl::OutOfRangeError(absl::StrCat("--source-vertex ", source, " is not a vertex of ",
                                               mesh_path, " (it has ", mesh.num_vertices(),
                                               " vertices, numbered from 0)"));
   }
-  GEODEX_ASSIGN_OR_RETURN(const mesh::SurfacePoint point,
-                          mesh::VertexPoint(mesh, static_cast<int32_t>(source)));
-  geodesic::ExactGeodesicSolver solver(mesh);
-  GEODEX_RETURN_IF_ERROR(solver.Propagate({point}));
+  const int32_t v = static_cast<int32_t>(source);
+  std::vector<double> distances;
+  const auto start = std::chrono::steady_clock::now();
+  int64_t windows = 0, peak = 0;
+  if (engine == "windows") {
+    GEODEX_ASSIGN_OR_RETURN(const mesh::SurfacePoint point, mesh::VertexPoint(mesh, v));
+    geodesic::ExactGeodesicSolver solver(mesh);
+    GEODEX_RETURN_IF_ERROR(solver.Propagate({point}));
+    distances = solver.VertexDistances();
+    windows = peak = solver.stats().windows_created;
+  } else {
+    geodesic::VertexGeodesicSolver solver(mesh);
+    GEODEX_RETURN_IF_ERROR(solver.Propagate({v}));
+    distances = solver.VertexDistances();
+    windows = solver.stats().windows_created;
+    peak = solver.stats().peak_windows;
+  }
+  if (stats) {
+    std::fprintf(stderr, "engine %s: %.3f s, %lld windows created, %lld at most alive\n",
+                 engine.c_str(),
+                 std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(),
+                 static_cast<long long>(windows), static_cast<long long>(peak));
+  }
   std::string text;
   text.reserve(static_cast<size_t>(mesh.num_vertices()) * 20);
-  for (double d : solver.VertexDistances()) {
+  for (double d : distances) {
     text += mesh::FormatDistance(d);
     text += '\n';
   }
@@ -128,6 +153,14 @@ int main(int argc, char** argv) {
   pairs->excludes(source);
   app.add_option("--out", out, "With --source-vertex: output file ('-': standard output)")
       ->needs(source);
+  std::string engine = "wavefront";
+  bool stats = false;
+  app.add_option("--engine", engine,
+                 "With --source-vertex: 'wavefront' (the builder's rows engine) or 'windows'")
+      ->check(CLI::IsMember({"wavefront", "windows"}))
+      ->needs(source);
+  app.add_flag("--stats", stats, "With --source-vertex: print time and window counts to stderr")
+      ->needs(source);
   app.add_option("--threads", threads, "Worker threads (--pairs)")->check(CLI::Range(1, 256));
   CLI11_PARSE(app, argc, argv);
   if (pairs->count() == 0 && source->count() == 0) {
@@ -136,7 +169,7 @@ int main(int argc, char** argv) {
   }
   const absl::Status status = pairs->count() > 0
                                   ? geodex::Run(mesh_path, pairs_path, threads)
-                                  : geodex::RunFromVertex(mesh_path, source_vertex, out);
+                                  : geodex::RunFromVertex(mesh_path, source_vertex, out, engine, stats);
   if (!status.ok()) {
     std::fprintf(stderr, "geodex-geodesic: %s\n", status.ToString().c_str());
     return status.code() == absl::StatusCode::kInvalidArgument ||

@@ -1,0 +1,340 @@
+#include "core/geodesic/vertex_geodesic.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+#include "absl/strings/str_format.h"
+
+namespace geodex::geodesic {
+namespace {
+
+using mesh::kNone;
+using mesh::Vec3;
+
+// A window is discarded only when a vertex offers a path shorter by more than
+// this fraction of the window's own distances, so rounding never discards a
+// window that carries a shortest path.
+constexpr double kFilterSlack = 1e-12;
+// Vertices whose angle sum reaches 2*pi minus this are treated as saddles
+// (pseudo-sources): it keeps flat vertices exact despite rounding.
+constexpr double kSaddleSlack = 1e-9;
+// Two crossings of an edge closer than this fraction of its length are the
+// same point for the "two sides" rule, which then keeps both sides.
+constexpr double kSideSlack = 1e-8;
+
+inline double Hypot(double x, double y) { return std::sqrt(x * x + y * y); }
+
+// Whether the segments from the pseudo-sources p and q to the points (a,0) and
+// (b,0) of the edge cross below it: then the path through (a,0) separates the
+// rays of q beyond (b,0) from q's own side of the face.
+bool CrossBelowEdge(double px, double py, double a, double qx, double qy, double b) {
+  // Line 1: (px,py) -> (a,0); line 2: (qx,qy) -> (b,0). Solve for y.
+  const double d1x = a - px, d1y = -py;
+  const double d2x = b - qx, d2y = -qy;
+  const double den = d1x * d2y - d1y * d2x;
+  if (!(std::abs(den) > 0)) return false;
+  const double t = ((qx - px) * d2y - (qy - py) * d2x) / den;
+  const double y = py + t * d1y;
+  return y <= 0 && y >= py && y >= qy;
+}
+
+}  // namespace
+
+VertexGeodesicSolver::VertexGeodesicSolver(const Mesh& mesh) : mesh_(mesh) {
+  const int32_t nh = mesh.num_halfedges();
+  frame_.resize(nh);
+  for (int32_t h = 0; h < nh; ++h) {
+    // From positions, not edge lengths: see ExactGeodesicSolver.
+    const Vec3& a = mesh.position(mesh.Origin(h));
+    const Vec3 ab = mesh.position(mesh.Dest(h)) - a;
+    const Vec3 ac = mesh.position(mesh.Opposite(h)) - a;
+    const double l = mesh.Length(h);
+    frame_[h] = {l, ab.dot(ac) / l, std::max(ab.cross(ac).norm() / l, 1e-300)};
+  }
+  emits_.resize(mesh.num_vertices());
+  for (int32_t v = 0; v < mesh.num_vertices(); ++v) {
+    emits_[v] = mesh.IsReferenced(v) && (mesh.IsBoundaryVertex(v) ||
+                                         mesh.AngleSum(v) >= 2 * std::numbers::pi - kSaddleSlack);
+  }
+  head_.assign(nh, kNone);
+  queued_.assign(nh, 0);
+}
+
+void VertexGeodesicSolver::Reset() {
+  dist_.assign(mesh_.num_vertices(), kInfinity);
+  nearest_.assign(mesh_.num_vertices(), kNone);
+  state_.assign(mesh_.num_vertices(), kOutside);
+  vertex_queue_.Clear();
+  // Lists are empty after every propagation that ran to its end; after one
+  // that stopped on an error, start afresh.
+  if (live_ != 0) {
+    std::fill(head_.begin(), head_.end(), kNone);
+    std::fill(queued_.begin(), queued_.end(), 0);
+  }
+  pool_.clear();
+  free_ = kNone;
+  live_ = 0;
+  fifo_.clear();
+  stats_ = {};
+}
+
+absl::Status VertexGeodesicSolver::Propagate(std::span<const int32_t> sources,
+                                             int64_t max_windows) {
+  Reset();
+  if (sources.empty()) return absl::InvalidArgumentError("no sources given");
+  for (const int32_t v : sources) {
+    if (v < 0 || v >= mesh_.num_vertices()) {
+      return absl::OutOfRangeError(absl::StrFormat("source vertex %d out of range [0, %d)", v,
+                                                   mesh_.num_vertices()));
+    }
+    if (!mesh_.IsReferenced(v)) {
+      return absl::InvalidArgumentError(
+          absl::StrFormat("source vertex %d belongs to no face", v));
+    }
+  }
+  max_windows_ =
+      max_windows > 0 ? max_windows : 400 * int64_t{mesh_.num_halfedges()} + 1'000'000;
+  for (int32_t s = 0; s < static_cast<int32_t>(sources.size()); ++s) {
+    UpdateVertex(sources[s], 0.0, s);
+  }
+  while (!vertex_queue_.empty()) {
+    const auto [d, v] = vertex_queue_.Pop();
+    if (d != dist_[v]) continue;  // superseded by a shorter path
+    Settle(v);
+    // Lists enqueued while these propagate are appended and taken in turn.
+    for (size_t i = 0; i < fifo_.size(); ++i) PropagateList(fifo_[i]);
+    fifo_.clear();
+    if (stats_.windows_created > max_windows_) {
+      return absl::ResourceExhaustedError(absl::StrFormat(
+          "geodesic propagation on %s exceeded %d windows", mesh_.name(), max_windows_));
+    }
+  }
+  return absl::OkStatus();
+}
+
+void VertexGeodesicSolver::UpdateVertex(int32_t v, double d, int32_t source) {
+  if (!(d < dist_[v])) return;
+  dist_[v] = d;
+  nearest_[v] = source;
+  // A settled vertex that got closer is settled again only if it emits
+  // windows of its own; elsewhere the windows that found the shorter path go
+  // on carrying it.
+  if (state_[v] != kInside) {
+    state_[v] = kFront;
+    vertex_queue_.Push(d, v);
+  } else if (emits_[v]) {
+    vertex_queue_.Push(d, v);
+  }
+}
+
+void VertexGeodesicSolver::Settle(int32_t v) {
+  ++stats_.vertices_settled;
+  state_[v] = kInside;
+  const auto fan = mesh_.Outgoing(v);
+  for (const int32_t o : fan) {
+    for (const int32_t u : {mesh_.Dest(o), mesh_.Opposite(o)}) {
+      if (state_[u] == kOutside) state_[u] = kFront;
+    }
+  }
+  if (emits_[v] || dist_[v] == 0) EmitFrom(v);
+  // The lists on the edges at v may now cross their faces; so may the lists
+  // on the edges opposite v, from either side, once the vertex beyond them
+  // has been reached.
+  for (const int32_t o : fan) {
+    Enqueue(o);
+    Enqueue(Mesh::Prev(o));
+    const int32_t g = Mesh::Next(o);
+    const int32_t t = mesh_.Twin(g);
+    if (t == kNone || state_[mesh_.Opposite(t)] != kOutside) {
+      Enqueue(g);
+      if (t != kNone) Enqueue(t);
+    }
+  }
+}
+
+void VertexGeodesicSolver::EmitFrom(int32_t v) {
+  const double d = dist_[v];
+  const int32_t source = nearest_[v];
+  for (const int32_t o : mesh_.Outgoing(v)) {
+    UpdateVertex(mesh_.Dest(o), d + mesh_.Length(o), source);
+    UpdateVertex(mesh_.Opposite(o), d + mesh_.Length(Mesh::Prev(o)), source);
+  }
+  // Unlike ExactGeodesicSolver, no shadow cone: the incoming direction is not
+  // kept, and the filters drop what a vertex already reaches sooner.
+  for (const int32_t o : mesh_.Outgoing(v)) {
+    const int32_t g = Mesh::Next(o);  // the edge opposite v in this face
+    const int32_t t = mesh_.Twin(g);
+    if (t == kNone) continue;
+    const Frame& fg = frame_[g];
+    Window w;
+    w.b0 = 0;
+    w.b1 = fg.length;
+    w.sx = fg.length - fg.cx;  // v, mirrored into the twin's frame
+    w.sy = -fg.cy;
+    w.sigma = d;
+    w.source = source;
+    AddWindow(t, w);
+  }
+}
+
+bool VertexGeodesicSolver::IsUseless(int32_t h, const Window& w) const {
+  const Frame& f = frame_[h];
+  const double d0 = w.sigma + Hypot(w.b0 - w.sx, w.sy);
+  const double d1 = w.sigma + Hypot(w.b1 - w.sx, w.sy);
+  const double slack = kFilterSlack * std::max(d0, d1);
+  // See ExactGeodesicSolver::IsUseless: A and B are checked at the far end of
+  // the interval, C at both ends when it is past the pseudo-source.
+  if (dist_[mesh_.Origin(h)] + w.b1 + slack < d1) return true;
+  if (dist_[mesh_.Dest(h)] + (f.length - w.b0) + slack < d0) return true;
+  const double dc = dist_[mesh_.Opposite(h)];
+  return dc >= w.sigma && dc + Hypot(w.b0 - f.cx, f.cy) + slack < d0 &&
+         dc + Hypot(w.b1 - f.cx, f.cy) + slack < d1;
+}
+
+int32_t VertexGeodesicSolver::Allocate() {
+  ++live_;
+  stats_.peak_windows = std::max(stats_.peak_windows, live_);
+  if (free_ != kNone) {
+    const int32_t k = free_;
+    free_ = pool_[k].next;
+    return k;
+  }
+  pool_.emplace_back();
+  return static_cast<int32_t>(pool_.size() - 1);
+}
+
+void VertexGeodesicSolver::Free(int32_t k) {
+  --live_;
+  pool_[k].next = free_;
+  free_ = k;
+}
+
+void VertexGeodesicSolver::AddWindow(int32_t h, const Window& w) {
+  if (!(w.b1 - w.b0 > 1e-14 * frame_[h].length)) return;
+  if (IsUseless(h, w)) return;
+  ++stats_.windows_created;
+  const int32_t k = Allocate();
+  pool_[k] = w;
+  pool_[k].next = head_[h];
+  head_[h] = k;
+  if (state_[mesh_.Origin(h)] == kInside || state_[mesh_.Dest(h)] == kInside) Enqueue(h);
+}
+
+void VertexGeodesicSolver::Enqueue(int32_t h) {
+  if (queued_[h] || head_[h] == kNone) return;
+  queued_[h] = 1;
+  fifo_.push_back(h);
+}
+
+void VertexGeodesicSolver::PropagateList(int32_t h) {
+  queued_[h] = 0;
+  int32_t k = head_[h];
+  if (k == kNone) return;
+  head_[h] = kNone;
+  ++stats_.lists_propagated;
+  const Frame& f = frame_[h];
+  const int32_t c = mesh_.Opposite(h);
+
+  // Pass 1: filter, and find the window that reaches C soonest.
+  pending_.clear();
+  double best = kInfinity;
+  int32_t best_source = kNone;
+  double best_crossing = 0, best_sx = 0, best_sy = 0;
+  while (k != kNone) {
+    const Window& w = pool_[k];
+    const int32_t next = w.next;
+    if (IsUseless(h, w)) {
+      Free(k);
+    } else {
+      const double xc = w.sx + (f.cx - w.sx) * (-w.sy) / (f.cy - w.sy);
+      const double crossing = std::clamp(xc, w.b0, w.b1);
+      // Straight to C when the ray through C crosses the interval, else
+      // round its nearer end: either way the length of a path to C.
+      const double dc = w.sigma + Hypot(crossing - w.sx, w.sy) + Hypot(f.cx - crossing, f.cy);
+      if (dc < best) {
+        best = dc;
+        best_source = w.source;
+        best_crossing = crossing;
+        best_sx = w.sx;
+        best_sy = w.sy;
+      }
+      pending_.push_back({k, crossing, xc});
+    }
+    k = next;
+  }
+  if (best < dist_[c]) UpdateVertex(c, best, best_source);
+
+  // Pass 2: "one angle, two sides" (VTP, Rule 1). Let P be the list's
+  // soonest path to C, crossing the edge at p. A window whose own route to C
+  // crosses left of p sends its rays right of C across P: inside the face
+  // when they enter left of p (and there P reaches the crossing no later,
+  // since it reaches C no later), below the edge when its ray through b1
+  // meets P there. Either way those rays are no shorter than P and are not
+  // propagated; mirrored for the right.
+  const double side_slack = kSideSlack * f.length;
+  for (const Pending& p : pending_) {
+    const Window w = pool_[p.window];
+    Free(p.window);
+    bool left = true, right = true;
+    if (p.crossing < best_crossing - side_slack) {
+      right = !(w.b1 < best_crossing ||
+                CrossBelowEdge(best_sx, best_sy, best_crossing, w.sx, w.sy, w.b1));
+    } else if (p.crossing > best_crossing + side_slack) {
+      left = !(w.b0 > best_crossing ||
+               CrossBelowEdge(best_sx, best_sy, best_crossing, w.sx, w.sy, w.b0));
+    }
+    // Rays through [b0, xc] leave through A->C, those through [xc, b1]
+    // through C->B.
+    if (left && w.b0 < std::min(w.b1, p.xc)) PropagateLeft(h, w, w.b0, std::min(w.b1, p.xc));
+    if (right && std::max(w.b0, p.xc) < w.b1) PropagateRight(h, w, std::max(w.b0, p.xc), w.b1);
+  }
+}
+
+void VertexGeodesicSolver::PropagateLeft(int32_t h, const Window& w, double b0, double b1) {
+  const int32_t t = mesh_.Twin(Mesh::Prev(h));
+  if (t == kNone) return;
+  const Frame& f = frame_[h];
+  auto hit = [&](double b) {  // fraction along A->C hit by the ray through (b,0)
+    const double den = f.cy * (b - w.sx) + f.cx * w.sy;
+    if (!(std::abs(den) > 0)) return 0.0;
+    return std::clamp(w.sy * b / den, 0.0, 1.0);
+  };
+  const double l = frame_[t].length;
+  const double ux = f.cx / l, uy = f.cy / l;
+  Window child;
+  child.b0 = hit(b0) * l;
+  child.b1 = hit(b1) * l;
+  child.sx = ux * w.sx + uy * w.sy;
+  child.sy = std::min(ux * w.sy - uy * w.sx, 0.0);
+  child.sigma = w.sigma;
+  child.source = w.source;
+  AddWindow(t, child);
+}
+
+void VertexGeodesicSolver::PropagateRight(int32_t h, const Window& w, double b0, double b1) {
+  const int32_t t = mesh_.Twin(Mesh::Next(h));
+  if (t == kNone) return;
+  const Frame& f = frame_[h];
+  const double bx = f.length - f.cx, by = -f.cy;  // B - C
+  auto hit = [&](double b) {                      // fraction along C->B
+    const double dx = b - w.sx, dy = -w.sy;
+    const double num = (w.sx - f.cx) * dy - (w.sy - f.cy) * dx;
+    const double den = bx * dy - by * dx;
+    if (!(std::abs(den) > 0)) return 1.0;
+    return std::clamp(num / den, 0.0, 1.0);
+  };
+  const double l = frame_[t].length;
+  const double ux = bx / l, uy = by / l;
+  const double rx = w.sx - f.cx, ry = w.sy - f.cy;
+  Window child;
+  child.b0 = hit(b0) * l;
+  child.b1 = hit(b1) * l;
+  child.sx = ux * rx + uy * ry;
+  child.sy = std::min(ux * ry - uy * rx, 0.0);
+  child.sigma = w.sigma;
+  child.source = w.source;
+  AddWindow(t, child);
+}
+
+}  // namespace geodex::geodesic
