@@ -12,7 +12,7 @@
 #include "core/builder/mesh_arrays.h"
 #include "core/builder/vertex_assignment.h"
 #include "core/common/status_macros.h"
-#include "core/geodesic/exact_geodesic.h"
+#include "core/geodesic/vertex_geodesic.h"
 #include "core/index/face_bvh.h"
 #include "core/sampling/farthest_point_sampling.h"
 
@@ -281,12 +281,12 @@ absl::StatusOr<std::vector<SampleRow>> ComputeRows(const Mesh& mesh, const Plan&
   const int threads = std::min<int>(ThreadCount(options), std::max<size_t>(1, sample_ids.size()));
   std::vector<absl::Status> errors(threads);
   auto worker = [&](int id) {
-    geodesic::ExactGeodesicSolver solver(mesh);
+    // Rows need vertex distances only: the wavefront engine, whose memory
+    // follows the front rather than the whole propagation.
+    geodesic::VertexGeodesicSolver solver(mesh);
     for (size_t k; (k = next.fetch_add(1)) < sample_ids.size();) {
       const int32_t a = sample_ids[k];
-      absl::StatusOr<mesh::SurfacePoint> source = mesh::VertexPoint(mesh, plan.samples[a]);
-      absl::Status status = source.status();
-      if (status.ok()) status = solver.Propagate({*source});
+      const absl::Status status = solver.Propagate({plan.samples[a]});
       if (!status.ok()) {
         errors[id] = status;
         return;

@@ -26,17 +26,18 @@ constexpr double kSideSlack = 1e-8;
 inline double Hypot(double x, double y) { return std::sqrt(x * x + y * y); }
 
 // Whether the segments from the pseudo-sources p and q to the points (a,0) and
-// (b,0) of the edge cross below it: then the path through (a,0) separates the
-// rays of q beyond (b,0) from q's own side of the face.
+// (b,0) of the edge cross (touching counts) below it. By orientation tests:
+// no division, and exact in sign up to rounding.
+inline double Orient(double ox, double oy, double ax, double ay, double bx, double by) {
+  return (ax - ox) * (by - oy) - (ay - oy) * (bx - ox);
+}
 bool CrossBelowEdge(double px, double py, double a, double qx, double qy, double b) {
-  // Line 1: (px,py) -> (a,0); line 2: (qx,qy) -> (b,0). Solve for y.
-  const double d1x = a - px, d1y = -py;
-  const double d2x = b - qx, d2y = -qy;
-  const double den = d1x * d2y - d1y * d2x;
-  if (!(std::abs(den) > 0)) return false;
-  const double t = ((qx - px) * d2y - (qy - py) * d2x) / den;
-  const double y = py + t * d1y;
-  return y <= 0 && y >= py && y >= qy;
+  const double o1 = Orient(px, py, a, 0, qx, qy);
+  const double o2 = Orient(px, py, a, 0, b, 0);
+  if ((o1 > 0 && o2 > 0) || (o1 < 0 && o2 < 0)) return false;
+  const double o3 = Orient(qx, qy, b, 0, px, py);
+  const double o4 = Orient(qx, qy, b, 0, a, 0);
+  return !((o3 > 0 && o4 > 0) || (o3 < 0 && o4 < 0));
 }
 
 }  // namespace
@@ -80,7 +81,7 @@ void VertexGeodesicSolver::Reset() {
 }
 
 absl::Status VertexGeodesicSolver::Propagate(std::span<const int32_t> sources,
-                                             int64_t max_windows) {
+                                             const VertexGeodesicOptions& options) {
   Reset();
   if (sources.empty()) return absl::InvalidArgumentError("no sources given");
   for (const int32_t v : sources) {
@@ -93,8 +94,23 @@ absl::Status VertexGeodesicSolver::Propagate(std::span<const int32_t> sources,
           absl::StrFormat("source vertex %d belongs to no face", v));
     }
   }
-  max_windows_ =
-      max_windows > 0 ? max_windows : 400 * int64_t{mesh_.num_halfedges()} + 1'000'000;
+  if (!options.initial_distance.empty()) {
+    if (options.initial_distance.size() != static_cast<size_t>(mesh_.num_vertices())) {
+      return absl::InvalidArgumentError(
+          absl::StrFormat("initial_distance has %d entries, the mesh %d vertices",
+                          options.initial_distance.size(), mesh_.num_vertices()));
+    }
+    for (int32_t v = 0; v < mesh_.num_vertices(); ++v) {
+      const double d = options.initial_distance[v];
+      if (std::isnan(d) || d < 0) {
+        return absl::InvalidArgumentError(
+            absl::StrFormat("initial_distance[%d] = %g is not a distance", v, d));
+      }
+      dist_[v] = d;
+    }
+  }
+  max_windows_ = options.max_windows > 0 ? options.max_windows
+                                         : 400 * int64_t{mesh_.num_halfedges()} + 1'000'000;
   for (int32_t s = 0; s < static_cast<int32_t>(sources.size()); ++s) {
     UpdateVertex(sources[s], 0.0, s);
   }
@@ -103,7 +119,13 @@ absl::Status VertexGeodesicSolver::Propagate(std::span<const int32_t> sources,
     if (d != dist_[v]) continue;  // superseded by a shorter path
     Settle(v);
     // Lists enqueued while these propagate are appended and taken in turn.
-    for (size_t i = 0; i < fifo_.size(); ++i) PropagateList(fifo_[i]);
+    for (size_t i = 0; i < fifo_.size(); ++i) {
+      // The first window of the next list is otherwise a cache miss.
+      if (i + 1 < fifo_.size() && head_[fifo_[i + 1]] != kNone) {
+        __builtin_prefetch(&pool_[head_[fifo_[i + 1]]]);
+      }
+      PropagateList(fifo_[i]);
+    }
     fifo_.clear();
     if (stats_.windows_created > max_windows_) {
       return absl::ResourceExhaustedError(absl::StrFormat(
@@ -137,7 +159,9 @@ void VertexGeodesicSolver::Settle(int32_t v) {
       if (state_[u] == kOutside) state_[u] = kFront;
     }
   }
-  if (emits_[v] || dist_[v] == 0) EmitFrom(v);
+  // A vertex that kept its initial distance is settled only to let the
+  // windows past it (see WakeEnd); it emits nothing of its own.
+  if (nearest_[v] != kNone && (emits_[v] || dist_[v] == 0)) EmitFrom(v);
   // The lists on the edges at v may now cross their faces; so may the lists
   // on the edges opposite v, from either side, once the vertex beyond them
   // has been reached.
@@ -212,13 +236,31 @@ void VertexGeodesicSolver::Free(int32_t k) {
 
 void VertexGeodesicSolver::AddWindow(int32_t h, const Window& w) {
   if (!(w.b1 - w.b0 > 1e-14 * frame_[h].length)) return;
-  if (IsUseless(h, w)) return;
   ++stats_.windows_created;
   const int32_t k = Allocate();
   pool_[k] = w;
   pool_[k].next = head_[h];
   head_[h] = k;
-  if (state_[mesh_.Origin(h)] == kInside || state_[mesh_.Dest(h)] == kInside) Enqueue(h);
+  const int32_t a = mesh_.Origin(h), b = mesh_.Dest(h);
+  if (state_[a] == kInside || state_[b] == kInside) {
+    Enqueue(h);
+  } else {
+    WakeEnd(a);
+    WakeEnd(b);
+  }
+}
+
+void VertexGeodesicSolver::WakeEnd(int32_t v) {
+  // A window waits on its edge until an end of the edge is settled. An end
+  // that this propagation does not improve on its initial distance would
+  // never be queued, yet the window may still improve vertices beyond it
+  // (the region a new source improves is star-shaped along geodesics, but
+  // its vertices need not be): queue such an end at its initial distance.
+  if (state_[v] != kInside && state_[v] != kWoken && nearest_[v] == kNone &&
+      dist_[v] < kInfinity) {
+    state_[v] = kWoken;
+    vertex_queue_.Push(dist_[v], v);
+  }
 }
 
 void VertexGeodesicSolver::Enqueue(int32_t h) {
@@ -236,36 +278,43 @@ void VertexGeodesicSolver::PropagateList(int32_t h) {
   const Frame& f = frame_[h];
   const int32_t c = mesh_.Opposite(h);
 
-  // Pass 1: filter, and find the window that reaches C soonest.
+  // Pass 1: drop what the face's vertices reach sooner.
   pending_.clear();
+  while (k != kNone) {
+    // The list's windows are copied out and their slots freed at once: the
+    // passes below then read contiguous memory, and the children reuse the
+    // slots while they are still in cache.
+    const int32_t next = pool_[k].next;
+    if (next != kNone) __builtin_prefetch(&pool_[next]);
+    if (!IsUseless(h, pool_[k])) pending_.push_back({pool_[k], 0, 0});
+    Free(k);
+    k = next;
+  }
+  // Pass 2: drop or trim what a neighbour in the list reaches sooner.
+  PruneNeighbours();
+  // Pass 3: find the window that reaches C soonest.
   double best = kInfinity;
   int32_t best_source = kNone;
   double best_crossing = 0, best_sx = 0, best_sy = 0;
-  while (k != kNone) {
-    const Window& w = pool_[k];
-    const int32_t next = w.next;
-    if (IsUseless(h, w)) {
-      Free(k);
-    } else {
-      const double xc = w.sx + (f.cx - w.sx) * (-w.sy) / (f.cy - w.sy);
-      const double crossing = std::clamp(xc, w.b0, w.b1);
-      // Straight to C when the ray through C crosses the interval, else
-      // round its nearer end: either way the length of a path to C.
-      const double dc = w.sigma + Hypot(crossing - w.sx, w.sy) + Hypot(f.cx - crossing, f.cy);
-      if (dc < best) {
-        best = dc;
-        best_source = w.source;
-        best_crossing = crossing;
-        best_sx = w.sx;
-        best_sy = w.sy;
-      }
-      pending_.push_back({k, crossing, xc});
+  for (Pending& p : pending_) {
+    const Window& w = p.window;
+    p.xc = w.sx + (f.cx - w.sx) * (-w.sy) / (f.cy - w.sy);
+    p.crossing = std::clamp(p.xc, w.b0, w.b1);
+    // Straight to C when the ray through C crosses the interval, else
+    // round its nearer end: either way the length of a path to C.
+    const double dc =
+        w.sigma + Hypot(p.crossing - w.sx, w.sy) + Hypot(f.cx - p.crossing, f.cy);
+    if (dc < best) {
+      best = dc;
+      best_source = w.source;
+      best_crossing = p.crossing;
+      best_sx = w.sx;
+      best_sy = w.sy;
     }
-    k = next;
   }
   if (best < dist_[c]) UpdateVertex(c, best, best_source);
 
-  // Pass 2: "one angle, two sides" (VTP, Rule 1). Let P be the list's
+  // Pass 4: "one angle, two sides" (VTP, Rule 1). Let P be the list's
   // soonest path to C, crossing the edge at p. A window whose own route to C
   // crosses left of p sends its rays right of C across P: inside the face
   // when they enter left of p (and there P reaches the crossing no later,
@@ -274,8 +323,7 @@ void VertexGeodesicSolver::PropagateList(int32_t h) {
   // propagated; mirrored for the right.
   const double side_slack = kSideSlack * f.length;
   for (const Pending& p : pending_) {
-    const Window w = pool_[p.window];
-    Free(p.window);
+    const Window& w = p.window;
     bool left = true, right = true;
     if (p.crossing < best_crossing - side_slack) {
       right = !(w.b1 < best_crossing ||
@@ -289,6 +337,67 @@ void VertexGeodesicSolver::PropagateList(int32_t h) {
     if (left && w.b0 < std::min(w.b1, p.xc)) PropagateLeft(h, w, w.b0, std::min(w.b1, p.xc));
     if (right && std::max(w.b0, p.xc) < w.b1) PropagateRight(h, w, std::max(w.b0, p.xc), w.b1);
   }
+}
+
+// VTP's Rule 2 on two windows of one edge, in the plane below it where both
+// pseudo-sources lie. Take an end e of window a inside window b's interval,
+// and suppose b's path to e crosses a's ray through its other end. Then every
+// ray of a crosses b's path to e, and every ray of b through the far side of
+// e crosses a's path to e. Where a reaches e later than b, a's rays meet b's
+// path too late everywhere (a is dropped); where b reaches e later, b's rays
+// beyond e do (b is trimmed at e). The crossing points see the same argument
+// as ExactGeodesicSolver's "one split" rule.
+VertexGeodesicSolver::PairVerdict VertexGeodesicSolver::ComparePair(Window& w1, Window& w2) const {
+  auto distance = [](const Window& w, double x) { return w.sigma + Hypot(x - w.sx, w.sy); };
+  constexpr double kTie = 1 - 1e-12;
+  // An end of `a` inside `b`: `at` is that end, `far` a's other end.
+  // Returns which of the two is dominated at `at`, if the geometry allows.
+  enum Outcome { kNeither, kADominated, kBDominated };
+  auto judge = [&](const Window& a, double at, double far, const Window& b) {
+    if (!CrossBelowEdge(b.sx, b.sy, at, a.sx, a.sy, far)) return kNeither;
+    const double da = distance(a, at), db = distance(b, at);
+    if (db < da * kTie) return kADominated;
+    if (da < db * kTie) return kBDominated;
+    return kNeither;
+  };
+  if (w1.b0 >= w2.b0 && w1.b0 <= w2.b1) {
+    const Outcome o = judge(w1, w1.b0, w1.b1, w2);
+    if (o == kADominated) return PairVerdict::kFirstDominated;
+    if (o == kBDominated) w2.b0 = w1.b0;
+  }
+  if (w1.b1 >= w2.b0 && w1.b1 <= w2.b1) {
+    const Outcome o = judge(w1, w1.b1, w1.b0, w2);
+    if (o == kADominated) return PairVerdict::kFirstDominated;
+    if (o == kBDominated) w2.b1 = w1.b1;
+  }
+  if (w2.b0 >= w1.b0 && w2.b0 <= w1.b1) {
+    const Outcome o = judge(w2, w2.b0, w2.b1, w1);
+    if (o == kADominated) return PairVerdict::kSecondDominated;
+    if (o == kBDominated) w1.b0 = w2.b0;
+  }
+  if (w2.b1 >= w1.b0 && w2.b1 <= w1.b1) {
+    const Outcome o = judge(w2, w2.b1, w2.b0, w1);
+    if (o == kADominated) return PairVerdict::kSecondDominated;
+    if (o == kBDominated) w1.b1 = w2.b1;
+  }
+  return PairVerdict::kBoth;
+}
+
+void VertexGeodesicSolver::PruneNeighbours() {
+  // Each window against the one before it among the survivors, as VTP walks
+  // its list; after a drop the new neighbours are compared in turn.
+  size_t kept = 0;
+  for (size_t i = 0; i < pending_.size(); ++i) {
+    pending_[kept++] = pending_[i];
+    while (kept >= 2) {
+      const PairVerdict verdict =
+          ComparePair(pending_[kept - 2].window, pending_[kept - 1].window);
+      if (verdict == PairVerdict::kBoth) break;
+      if (verdict == PairVerdict::kFirstDominated) pending_[kept - 2] = pending_[kept - 1];
+      --kept;
+    }
+  }
+  pending_.resize(kept);
 }
 
 void VertexGeodesicSolver::PropagateLeft(int32_t h, const Window& w, double b0, double b1) {

@@ -46,6 +46,19 @@
 
 namespace geodex::geodesic {
 
+struct VertexGeodesicOptions {
+  // Optional per-vertex distances from earlier propagations (size
+  // num_vertices): the propagation only explores where it gets closer than
+  // these, and afterwards VertexDistance(v) = min(initial, new). Vertices that
+  // keep their initial distance report NearestSource kNone. This is how
+  // farthest-point sampling adds one sample at a time in time proportional
+  // to the new sample's cell, not to the mesh.
+  std::span<const double> initial_distance;
+  // A guard against pathological input: ResourceExhausted past this many
+  // windows created. 0 means 400 per half-edge plus 10^6.
+  int64_t max_windows = 0;
+};
+
 struct VertexGeodesicStats {
   int64_t windows_created = 0;
   int64_t lists_propagated = 0;
@@ -62,13 +75,15 @@ class VertexGeodesicSolver {
 
   // Distances from the nearest of `sources` (vertex ids, at least one;
   // repeats allowed) to every vertex. Errors: InvalidArgument for no sources,
-  // OutOfRange for an id past the end, InvalidArgument for an unreferenced
-  // vertex; ResourceExhausted past `max_windows` windows created (0: 400 per
-  // half-edge plus 10^6), a guard against pathological input. Results of an
+  // for an unreferenced source vertex, or for an initial_distance of the
+  // wrong size or with a negative or NaN entry; OutOfRange for an id past
+  // the end; ResourceExhausted past options.max_windows. Results of an
   // earlier propagation are discarded.
-  absl::Status Propagate(std::span<const int32_t> sources, int64_t max_windows = 0);
-  absl::Status Propagate(std::initializer_list<int32_t> sources) {
-    return Propagate(std::span<const int32_t>(sources.begin(), sources.size()));
+  absl::Status Propagate(std::span<const int32_t> sources,
+                         const VertexGeodesicOptions& options = {});
+  absl::Status Propagate(std::initializer_list<int32_t> sources,
+                         const VertexGeodesicOptions& options = {}) {
+    return Propagate(std::span<const int32_t>(sources.begin(), sources.size()), options);
   }
 
   // Distance from the nearest source to vertex `v`; +inf when unreachable.
@@ -100,22 +115,29 @@ class VertexGeodesicSolver {
     int32_t next;  // next window of the same list, or the free list
   };
   static_assert(sizeof(Window) == 48);
-  enum State : uint8_t { kOutside, kFront, kInside };
+  // kFront: next to a settled vertex or reached by a path; kWoken: queued at
+  // its initial distance by WakeEnd (otherwise like kFront).
+  enum State : uint8_t { kOutside, kFront, kWoken, kInside };
   // A window of the list being propagated, and where its shortest route to
   // the face's third vertex crosses the edge.
   struct Pending {
-    int32_t window;
+    Window window;
     double crossing;  // the "separating point" of VTP, clamped to [b0,b1]
     double xc;        // where the ray from the pseudo-source through C crosses
   };
 
+  enum class PairVerdict { kBoth, kFirstDominated, kSecondDominated };
+
   void Reset();
+  PairVerdict ComparePair(Window& w1, Window& w2) const;
+  void PruneNeighbours();
   void Settle(int32_t v);
   void EmitFrom(int32_t v);
   void UpdateVertex(int32_t v, double d, int32_t source);
   void AddWindow(int32_t h, const Window& w);
   bool IsUseless(int32_t h, const Window& w) const;
   void Enqueue(int32_t h);
+  void WakeEnd(int32_t v);
   void PropagateList(int32_t h);
   void PropagateLeft(int32_t h, const Window& w, double b0, double b1);
   void PropagateRight(int32_t h, const Window& w, double b0, double b1);

@@ -264,6 +264,25 @@ TEST(GeneratorsTest, DoubleTorus) {
   }
 }
 
+TEST(GeneratorsTest, SplitFacesInFourKeepsTheSurface) {
+  for (const Mesh& mesh : {Torus(12, 8, 2.0, 0.5), SquareWithHole(6, 3.0)}) {
+    SCOPED_TRACE(mesh.name());
+    const Topology before = TopologyOf(mesh);
+    const Mesh split = SplitFacesInFour(mesh, 2);
+    const Topology after = TopologyOf(split);
+    EXPECT_EQ(split.num_faces(), 16 * mesh.num_faces());
+    EXPECT_EQ(after.euler, before.euler);
+    EXPECT_EQ(after.components, before.components);
+    EXPECT_EQ(after.boundary_loops, before.boundary_loops);
+    EXPECT_EQ(after.boundary_edges, 4 * before.boundary_edges);
+    EXPECT_NEAR(split.TotalArea(), mesh.TotalArea(), 1e-12 * mesh.TotalArea());
+    for (int32_t v = 0; v < mesh.num_vertices(); ++v) {
+      EXPECT_EQ(split.position(v), mesh.position(v));
+    }
+  }
+  EXPECT_EQ(SplitFacesInFour(Cube(2, 1.0), 0).num_faces(), Cube(2, 1.0).num_faces());
+}
+
 TEST(GeneratorsTest, TwoComponents) {
   const Mesh mesh = TwoComponents(4);
   const Topology topology = TopologyOf(mesh);

@@ -31,7 +31,7 @@ int32_t FarthestVertex(const mesh::Mesh& mesh, const SampleSet& set,
   return best_distance > 0 ? best : mesh::kNone;
 }
 
-absl::Status AddSample(geodesic::ExactGeodesicSolver& solver, int32_t v, SampleSet* set) {
+absl::Status AddSample(geodesic::VertexGeodesicSolver& solver, int32_t v, SampleSet* set) {
   const mesh::Mesh& mesh = solver.mesh();
   if (v < 0 || v >= mesh.num_vertices() || !mesh.IsReferenced(v)) {
     return absl::InvalidArgumentError(absl::StrFormat("vertex %d cannot be a sample", v));
@@ -39,10 +39,9 @@ absl::Status AddSample(geodesic::ExactGeodesicSolver& solver, int32_t v, SampleS
   if (set->distance[v] == 0) {
     return absl::InvalidArgumentError(absl::StrFormat("vertex %d is already a sample", v));
   }
-  GEODEX_ASSIGN_OR_RETURN(const mesh::SurfacePoint point, mesh::VertexPoint(mesh, v));
-  geodesic::GeodesicOptions options;
+  geodesic::VertexGeodesicOptions options;
   options.initial_distance = set->distance;
-  GEODEX_RETURN_IF_ERROR(solver.Propagate({point}, options));
+  GEODEX_RETURN_IF_ERROR(solver.Propagate({v}, options));
   const int32_t index = static_cast<int32_t>(set->samples.size());
   set->samples.push_back(v);
   for (int32_t u = 0; u < mesh.num_vertices(); ++u) {
@@ -65,7 +64,7 @@ absl::StatusOr<SampleSet> FarthestPointSampling(const mesh::Mesh& mesh, int32_t 
     return absl::InvalidArgumentError(absl::StrFormat(
         "cannot take %d samples from a mesh with %d referenced vertices", num_samples, referenced));
   }
-  geodesic::ExactGeodesicSolver solver(mesh);
+  geodesic::VertexGeodesicSolver solver(mesh);
   int32_t start = static_cast<int32_t>(SplitMix64(seed) % mesh.num_vertices());
   while (!mesh.IsReferenced(start)) start = (start + 1) % mesh.num_vertices();
 
@@ -73,8 +72,7 @@ absl::StatusOr<SampleSet> FarthestPointSampling(const mesh::Mesh& mesh, int32_t 
   set.distance.assign(mesh.num_vertices(), geodesic::kInfinity);
   set.nearest.assign(mesh.num_vertices(), mesh::kNone);
   {
-    GEODEX_ASSIGN_OR_RETURN(const mesh::SurfacePoint point, mesh::VertexPoint(mesh, start));
-    GEODEX_RETURN_IF_ERROR(solver.Propagate({point}));
+    GEODEX_RETURN_IF_ERROR(solver.Propagate({start}));
     SampleSet probe;
     probe.distance = solver.VertexDistances();
     const int32_t first = FarthestVertex(mesh, probe);

@@ -19,7 +19,7 @@
 #include <vector>
 
 #include "absl/status/statusor.h"
-#include "core/geodesic/exact_geodesic.h"
+#include "core/geodesic/vertex_geodesic.h"
 #include "core/mesh/mesh.h"
 
 namespace geodex::sampling {
@@ -37,7 +37,7 @@ absl::StatusOr<SampleSet> FarthestPointSampling(const mesh::Mesh& mesh, int32_t 
 
 // Adds vertex `v` as a new sample and updates distances and Voronoi labels
 // where it is closer. Errors: InvalidArgument if `v` is already a sample.
-absl::Status AddSample(geodesic::ExactGeodesicSolver& solver, int32_t v, SampleSet* set);
+absl::Status AddSample(geodesic::VertexGeodesicSolver& solver, int32_t v, SampleSet* set);
 
 // The referenced vertex farthest from the samples (+inf first, ties to the
 // lowest id), restricted to vertices with `mask[v]` when `mask` is non-empty.

@@ -315,7 +315,7 @@ DualComplex CheckDual(const Mesh& mesh, const std::vector<int32_t>& nearest, int
 absl::StatusOr<DualComplex> RepairTriangulation(const Mesh& mesh, sampling::SampleSet* set,
                                                 const RepairOptions& options,
                                                 RepairReport* report) {
-  geodesic::ExactGeodesicSolver solver(mesh);
+  geodesic::VertexGeodesicSolver solver(mesh);
   for (int32_t round = 0;; ++round) {
     const int32_t m = static_cast<int32_t>(set->samples.size());
     DualComplex dual = CheckDual(mesh, set->nearest, m);
