@@ -5,6 +5,7 @@
 #include <numbers>
 
 #include "absl/strings/str_format.h"
+#include "core/common/status_macros.h"
 
 namespace geodex::geodesic {
 namespace {
@@ -16,6 +17,8 @@ using mesh::Vec3;
 // this fraction of the window's own distances, so rounding never discards a
 // window that carries a shortest path.
 constexpr double kFilterSlack = 1e-12;
+// Barycentric weights below this count as zero when classifying sources.
+constexpr double kSnap = 1e-12;
 // Vertices whose angle sum reaches 2*pi minus this are treated as saddles
 // (pseudo-sources): it keeps flat vertices exact despite rounding.
 constexpr double kSaddleSlack = 1e-9;
@@ -60,6 +63,7 @@ VertexGeodesicSolver::VertexGeodesicSolver(const Mesh& mesh) : mesh_(mesh) {
   }
   head_.assign(nh, kNone);
   queued_.assign(nh, 0);
+  target_begin_.assign(mesh.num_faces(), -1);
 }
 
 void VertexGeodesicSolver::Reset() {
@@ -77,6 +81,11 @@ void VertexGeodesicSolver::Reset() {
   free_ = kNone;
   live_ = 0;
   fifo_.clear();
+  face_sources_.clear();
+  for (const int32_t f : target_faces_) target_begin_[f] = -1;
+  target_faces_.clear();
+  targets_.clear();
+  target_dist_.clear();
   stats_ = {};
 }
 
@@ -94,6 +103,63 @@ absl::Status VertexGeodesicSolver::Propagate(std::span<const int32_t> sources,
           absl::StrFormat("source vertex %d belongs to no face", v));
     }
   }
+  GEODEX_RETURN_IF_ERROR(Start(options));
+  for (int32_t s = 0; s < static_cast<int32_t>(sources.size()); ++s) {
+    UpdateVertex(sources[s], 0.0, s);
+  }
+  return Run();
+}
+
+absl::Status VertexGeodesicSolver::Propagate(std::span<const SurfacePoint> sources,
+                                             const VertexGeodesicOptions& options) {
+  Reset();
+  if (sources.empty()) return absl::InvalidArgumentError("no sources given");
+  for (const SurfacePoint& p : sources) {
+    GEODEX_RETURN_IF_ERROR(mesh::ValidateSurfacePoint(mesh_, p));
+  }
+  GEODEX_RETURN_IF_ERROR(Start(options));
+  for (int32_t s = 0; s < static_cast<int32_t>(sources.size()); ++s) {
+    const SurfacePoint& p = sources[s];
+    int zeros = 0, nonzero = 0;
+    for (int i = 0; i < 3; ++i) {
+      if (p.w[i] <= kSnap) {
+        ++zeros;
+      } else {
+        nonzero = i;
+      }
+    }
+    if (zeros >= 2) {  // at a vertex
+      UpdateVertex(mesh_.face(p.face)[nonzero], 0.0, s);
+      continue;
+    }
+    std::array<double, 3> w = p.w;
+    const double sum = w[0] + w[1] + w[2];
+    for (double& x : w) x /= sum;
+    if (zeros == 0) {
+      AddFaceSource(p.face, w, s, kNone);
+      continue;
+    }
+    // On an edge: both faces hold the source, and neither sends windows
+    // across the edge itself.
+    int zero = 0;
+    for (int i = 0; i < 3; ++i) {
+      if (w[i] <= kSnap) zero = i;
+    }
+    w[zero] = 0;
+    const int32_t h = 3 * p.face + (zero + 1) % 3;  // the edge opposite the zero weight
+    AddFaceSource(p.face, w, s, h);
+    const int32_t g = mesh_.Twin(h);
+    if (g != kNone) {
+      std::array<double, 3> wg = {0, 0, 0};
+      wg[g % 3] = w[(h + 1) % 3];  // Origin(g) = Dest(h)
+      wg[(g + 1) % 3] = w[h % 3];
+      AddFaceSource(Mesh::FaceOf(g), wg, s, g);
+    }
+  }
+  return Run();
+}
+
+absl::Status VertexGeodesicSolver::Start(const VertexGeodesicOptions& options) {
   if (!options.initial_distance.empty()) {
     if (options.initial_distance.size() != static_cast<size_t>(mesh_.num_vertices())) {
       return absl::InvalidArgumentError(
@@ -109,11 +175,28 @@ absl::Status VertexGeodesicSolver::Propagate(std::span<const int32_t> sources,
       dist_[v] = d;
     }
   }
+  for (const SurfacePoint& q : options.targets) {
+    GEODEX_RETURN_IF_ERROR(mesh::ValidateSurfacePoint(mesh_, q));
+  }
+  targets_.assign(options.targets.begin(), options.targets.end());
+  target_dist_.assign(targets_.size(), kInfinity);
+  target_order_.resize(targets_.size());
+  for (size_t i = 0; i < targets_.size(); ++i) target_order_[i] = static_cast<int32_t>(i);
+  std::stable_sort(target_order_.begin(), target_order_.end(),
+                   [&](int32_t a, int32_t b) { return targets_[a].face < targets_[b].face; });
+  for (size_t k = 0; k < target_order_.size(); ++k) {
+    const int32_t f = targets_[target_order_[k]].face;
+    if (target_begin_[f] < 0) {
+      target_begin_[f] = static_cast<int32_t>(k);
+      target_faces_.push_back(f);
+    }
+  }
   max_windows_ = options.max_windows > 0 ? options.max_windows
                                          : 400 * int64_t{mesh_.num_halfedges()} + 1'000'000;
-  for (int32_t s = 0; s < static_cast<int32_t>(sources.size()); ++s) {
-    UpdateVertex(sources[s], 0.0, s);
-  }
+  return absl::OkStatus();
+}
+
+absl::Status VertexGeodesicSolver::Run() {
   while (!vertex_queue_.empty()) {
     const auto [d, v] = vertex_queue_.Pop();
     if (d != dist_[v]) continue;  // superseded by a shorter path
@@ -132,7 +215,77 @@ absl::Status VertexGeodesicSolver::Propagate(std::span<const int32_t> sources,
           "geodesic propagation on %s exceeded %d windows", mesh_.name(), max_windows_));
     }
   }
+  FinishTargets();
   return absl::OkStatus();
+}
+
+void VertexGeodesicSolver::AddFaceSource(int32_t face, const std::array<double, 3>& w,
+                                         int32_t source, int32_t skip_halfedge) {
+  const SurfacePoint p{face, w};
+  const Vec3 x = mesh::PositionOf(mesh_, p);
+  face_sources_.push_back({face, source, x});
+  for (int i = 0; i < 3; ++i) {
+    const int32_t v = mesh_.face(face)[i];
+    UpdateVertex(v, (mesh_.position(v) - x).norm(), source);
+  }
+  for (int i = 0; i < 3; ++i) {
+    const int32_t h = 3 * face + i;
+    const int32_t t = mesh_.Twin(h);
+    if (h == skip_halfedge || t == kNone) continue;
+    const auto [px, py] = InFrame(h, p);
+    const double l = frame_[h].length;
+    Window win;
+    win.b0 = 0;
+    win.b1 = l;
+    win.sx = l - px;  // mirrored into the twin's frame
+    win.sy = -py;
+    win.sigma = 0;
+    win.source = source;
+    AddWindow(t, win);
+  }
+}
+
+std::array<double, 2> VertexGeodesicSolver::InFrame(int32_t h, const SurfacePoint& p) const {
+  const Frame& f = frame_[h];
+  const int i = h % 3;
+  const double wb = p.w[(i + 1) % 3], wc = p.w[(i + 2) % 3];
+  return {wb * f.length + wc * f.cx, wc * f.cy};
+}
+
+void VertexGeodesicSolver::EvaluateTargets(int32_t h) {
+  const int32_t f = Mesh::FaceOf(h);
+  const double eps = 1e-12 * frame_[h].length;
+  for (size_t k = target_begin_[f];
+       k < target_order_.size() && targets_[target_order_[k]].face == f; ++k) {
+    const int32_t i = target_order_[k];
+    const auto [px, py] = InFrame(h, targets_[i]);
+    for (const Pending& p : pending_) {
+      const Window& w = p.window;
+      const double den = py - w.sy;
+      if (!(den > 0)) continue;
+      const double cross = w.sx + (px - w.sx) * (-w.sy) / den;
+      if (cross < w.b0 - eps || cross > w.b1 + eps) continue;
+      target_dist_[i] = std::min(target_dist_[i], w.sigma + Hypot(px - w.sx, py - w.sy));
+    }
+  }
+}
+
+void VertexGeodesicSolver::FinishTargets() {
+  // Paths through a corner of the target's face, or straight from a source
+  // inside that face; the windows that enter it were seen as they passed.
+  for (size_t i = 0; i < targets_.size(); ++i) {
+    const SurfacePoint& q = targets_[i];
+    const Vec3 x = mesh::PositionOf(mesh_, q);
+    for (const int32_t v : mesh_.face(q.face)) {
+      if (nearest_[v] == kNone) continue;
+      target_dist_[i] = std::min(target_dist_[i], dist_[v] + (mesh_.position(v) - x).norm());
+    }
+    for (const SourceInFace& s : face_sources_) {
+      if (s.face == q.face) target_dist_[i] = std::min(target_dist_[i], (s.position - x).norm());
+    }
+  }
+  for (const int32_t f : target_faces_) target_begin_[f] = -1;
+  target_faces_.clear();
 }
 
 void VertexGeodesicSolver::UpdateVertex(int32_t v, double d, int32_t source) {
@@ -290,6 +443,7 @@ void VertexGeodesicSolver::PropagateList(int32_t h) {
     Free(k);
     k = next;
   }
+  if (target_begin_[Mesh::FaceOf(h)] >= 0) EvaluateTargets(h);
   // Pass 2: drop or trim what a neighbour in the list reaches sooner.
   PruneNeighbours();
   // Pass 3: find the window that reaches C soonest.

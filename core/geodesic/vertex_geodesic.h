@@ -34,6 +34,7 @@
 // Thread safety: a solver holds per-propagation state and is not thread-safe;
 // use one per thread. Any number of solvers may share one const Mesh.
 
+#include <array>
 #include <cstdint>
 #include <initializer_list>
 #include <span>
@@ -46,6 +47,8 @@
 
 namespace geodex::geodesic {
 
+using mesh::Vec3;
+
 struct VertexGeodesicOptions {
   // Optional per-vertex distances from earlier propagations (size
   // num_vertices): the propagation only explores where it gets closer than
@@ -54,6 +57,11 @@ struct VertexGeodesicOptions {
   // farthest-point sampling adds one sample at a time in time proportional
   // to the new sample's cell, not to the mesh.
   std::span<const double> initial_distance;
+  // Surface points whose exact distances are wanted as well (TargetDistance):
+  // each is evaluated against every window that enters its face, and against
+  // the face's corners, so they cost nothing like ExactGeodesicSolver's
+  // stored windows.
+  std::span<const SurfacePoint> targets;
   // A guard against pathological input: ResourceExhausted past this many
   // windows created. 0 means 400 per half-edge plus 10^6.
   int64_t max_windows = 0;
@@ -85,6 +93,15 @@ class VertexGeodesicSolver {
                          const VertexGeodesicOptions& options = {}) {
     return Propagate(std::span<const int32_t>(sources.begin(), sources.size()), options);
   }
+  // The same from surface points (a vertex, a point on an edge or inside a
+  // face). Errors as above, and those of mesh::ValidateSurfacePoint for the
+  // sources and targets.
+  absl::Status Propagate(std::span<const SurfacePoint> sources,
+                         const VertexGeodesicOptions& options = {});
+  absl::Status Propagate(std::initializer_list<SurfacePoint> sources,
+                         const VertexGeodesicOptions& options = {}) {
+    return Propagate(std::span<const SurfacePoint>(sources.begin(), sources.size()), options);
+  }
 
   // Distance from the nearest source to vertex `v`; +inf when unreachable.
   double VertexDistance(int32_t v) const { return dist_[v]; }
@@ -92,6 +109,9 @@ class VertexGeodesicSolver {
   // Index (into the sources given) of the source nearest to `v`, or
   // mesh::kNone when unreachable.
   int32_t NearestSource(int32_t v) const { return nearest_[v]; }
+  // Distance from the nearest source to options.targets[i] (+inf when
+  // unreachable or, with initial distances, not improved on them).
+  double TargetDistance(size_t i) const { return target_dist_[i]; }
 
   const VertexGeodesicStats& stats() const { return stats_; }
   const Mesh& mesh() const { return mesh_; }
@@ -128,7 +148,21 @@ class VertexGeodesicSolver {
 
   enum class PairVerdict { kBoth, kFirstDominated, kSecondDominated };
 
+  struct SourceInFace {
+    int32_t face;
+    int32_t source;
+    Vec3 position;
+  };
+
   void Reset();
+  absl::Status Start(const VertexGeodesicOptions& options);
+  absl::Status Run();
+  void AddFaceSource(int32_t face, const std::array<double, 3>& w, int32_t source,
+                     int32_t skip_halfedge);
+  void EvaluateTargets(int32_t h);
+  // 2D coordinates of a point of FaceOf(h) in the frame of half-edge h.
+  std::array<double, 2> InFrame(int32_t h, const SurfacePoint& p) const;
+  void FinishTargets();
   PairVerdict ComparePair(Window& w1, Window& w2) const;
   void PruneNeighbours();
   void Settle(int32_t v);
@@ -161,6 +195,14 @@ class VertexGeodesicSolver {
   std::vector<int32_t> fifo_;
   std::vector<uint8_t> queued_;
   std::vector<Pending> pending_;
+  // Targets: for each face holding some, [target_begin_[f], next face's) in
+  // target_order_ (indices into targets_); -1 elsewhere.
+  std::vector<SurfacePoint> targets_;
+  std::vector<double> target_dist_;
+  std::vector<int32_t> target_order_;
+  std::vector<int32_t> target_begin_;  // per face, or -1
+  std::vector<int32_t> target_faces_;  // faces with targets, to reset target_begin_
+  std::vector<SourceInFace> face_sources_;
   int64_t max_windows_ = 0;
   VertexGeodesicStats stats_;
 };

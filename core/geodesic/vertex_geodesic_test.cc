@@ -15,6 +15,7 @@ namespace geodex::geodesic {
 namespace {
 
 using mesh::Mesh;
+using mesh::SurfacePoint;
 using mesh::Vec3;
 namespace gen = mesh::gen;
 using ::testing::HasSubstr;
@@ -100,6 +101,58 @@ INSTANTIATE_TEST_SUITE_P(Generated, VertexGeodesicAgreementTest, ::testing::Valu
                          [](const ::testing::TestParamInfo<Case>& info) {
                            return info.param.name;
                          });
+
+// Sources anywhere on the surface and target points anywhere: the same as the
+// window engine's VertexDistance and DistanceAt.
+TEST_P(VertexGeodesicAgreementTest, SurfacePointSourcesAndTargetsEqualTheWindowEngine) {
+  const Mesh m = GetParam().make();
+  std::vector<SurfacePoint> targets;
+  uint64_t state = 99;
+  auto uniform = [&] {
+    state = state * 6364136223846793005ULL + 1442695040888963407ULL;
+    return static_cast<double>(state >> 11) * 0x1.0p-53;
+  };
+  for (int k = 0; k < 60; ++k) {
+    const int32_t f = static_cast<int32_t>(uniform() * m.num_faces());
+    const double a = uniform(), b = uniform() * (1 - a);
+    targets.push_back({f, {a, b, 1 - a - b}});
+  }
+  targets.push_back({3, {0.5, 0.5, 0}});  // on an edge
+  targets.push_back({7, {0, 1, 0}});      // at a vertex
+  const int32_t f = m.num_faces() / 2;
+  const std::vector<SurfacePoint> sources = {
+      {f, {0.2, 0.3, 0.5}},                  // inside a face
+      {m.num_faces() / 3, {0.25, 0.75, 0}},  // on an edge
+      *mesh::VertexPoint(m, m.num_vertices() / 4),
+  };
+  VertexGeodesicSolver fast(m);
+  ExactGeodesicSolver reference(m);
+  VertexGeodesicOptions options;
+  options.targets = targets;
+  for (const SurfacePoint& source : sources) {
+    SCOPED_TRACE(source.face);
+    ASSERT_TRUE(fast.Propagate({&source, 1}, options).ok());
+    ASSERT_TRUE(reference.Propagate({source}).ok());
+    for (int32_t v = 0; v < m.num_vertices(); ++v) {
+      const double want = reference.VertexDistance(v);
+      if (std::isinf(want)) {
+        ASSERT_EQ(fast.VertexDistance(v), want) << "vertex " << v;
+      } else {
+        ASSERT_NEAR(fast.VertexDistance(v), want, 1e-9 * std::max(want, 1e-3)) << "vertex " << v;
+      }
+    }
+    for (size_t i = 0; i < targets.size(); ++i) {
+      const double want = reference.DistanceAt(targets[i]);
+      if (std::isinf(want)) {
+        ASSERT_EQ(fast.TargetDistance(i), want) << "target " << i;
+      } else {
+        ASSERT_NEAR(fast.TargetDistance(i), want, 1e-9 * std::max(want, 1e-3)) << "target " << i;
+      }
+    }
+  }
+  EXPECT_THAT(fast.Propagate({SurfacePoint{m.num_faces(), {1, 0, 0}}}).message(),
+              HasSubstr("out of range"));
+}
 
 TEST(VertexGeodesicTest, FlatConvexDomainGivesEuclideanDistances) {
   const Mesh grid = gen::Grid(30, 20, 3.0, 2.0, 0.25, 9);

@@ -7,7 +7,7 @@
 #include <random>
 #include <span>
 
-#include "core/geodesic/exact_geodesic.h"
+#include "core/geodesic/vertex_geodesic.h"
 
 namespace geodex::validation {
 namespace {
@@ -78,7 +78,10 @@ std::vector<ExactPair> DrawPairs(const mesh::Mesh& mesh, int32_t num_samples,
     if (mesh.IsReferenced(v)) referenced.push_back(v);
   }
   std::uniform_int_distribution<size_t> any_vertex(0, referenced.size() - 1);
-  geodesic::ExactGeodesicSolver solver(mesh);
+  // The wavefront engine: its memory follows the front (the window engine
+  // keeps every window, gigabytes on a large mesh), and target points are
+  // evaluated as the windows pass their faces.
+  geodesic::VertexGeodesicSolver solver(mesh);
   std::vector<ExactPair> pairs;
   auto add = [&](const mesh::SurfacePoint& p, const mesh::SurfacePoint& q, double exact,
                  bool vertices, bool uniform) {
@@ -88,55 +91,73 @@ std::vector<ExactPair> DrawPairs(const mesh::Mesh& mesh, int32_t num_samples,
   };
   for (int32_t s = 0; s < options.num_sources; ++s) {
     const bool vertices = s % 2 == 0;
-    const mesh::SurfacePoint source = vertices
-                                          ? AtVertex(mesh, referenced[any_vertex(rng)])
-                                          : PointOnFaces(all_faces, all_cumulative, rng);
-    if (!solver.Propagate({source}).ok()) continue;
-    const std::vector<double>& dist = solver.VertexDistances();
-    for (int32_t k = 0; k < options.uniform_points; ++k) {
-      if (vertices) {
-        const int32_t v = referenced[any_vertex(rng)];
-        add(source, AtVertex(mesh, v), dist[v], true, true);
-      } else {
-        const mesh::SurfacePoint q = PointOnFaces(all_faces, all_cumulative, rng);
-        add(source, q, solver.DistanceAt(q), false, true);
+    if (vertices) {
+      const int32_t v = referenced[any_vertex(rng)];
+      const mesh::SurfacePoint source = AtVertex(mesh, v);
+      if (!solver.Propagate({v}).ok()) continue;
+      const std::vector<double>& dist = solver.VertexDistances();
+      for (int32_t k = 0; k < options.uniform_points; ++k) {
+        const int32_t u = referenced[any_vertex(rng)];
+        add(source, AtVertex(mesh, u), dist[u], true, true);
       }
-    }
-    for (int b = 0; b < kNumScaleBins; ++b) {
-      const double lo = kBinEdges[b] * scale, hi = kBinEdges[b + 1] * scale;
-      if (vertices) {
+      for (int b = 0; b < kNumScaleBins; ++b) {
+        const double lo = kBinEdges[b] * scale, hi = kBinEdges[b + 1] * scale;
         std::vector<int32_t> in_bin;
-        for (int32_t v : referenced) {
-          if (dist[v] >= lo && dist[v] < hi) in_bin.push_back(v);
+        for (int32_t u : referenced) {
+          if (dist[u] >= lo && dist[u] < hi) in_bin.push_back(u);
         }
         if (in_bin.empty()) continue;
         std::uniform_int_distribution<size_t> pick(0, in_bin.size() - 1);
         for (int32_t k = 0; k < options.per_bin_points; ++k) {
-          const int32_t v = in_bin[pick(rng)];
-          add(source, AtVertex(mesh, v), dist[v], true, false);
+          const int32_t u = in_bin[pick(rng)];
+          add(source, AtVertex(mesh, u), dist[u], true, false);
         }
-        continue;
       }
-      // Faces that reach into the bin; points drawn on them until enough
-      // land inside it.
+      continue;
+    }
+    // A source inside a face: one propagation for the vertex distances and
+    // the uniform points, a second for the candidates of every bin, drawn on
+    // the faces that reach into it (the first says which those are).
+    const mesh::SurfacePoint source = PointOnFaces(all_faces, all_cumulative, rng);
+    std::vector<mesh::SurfacePoint> uniform(options.uniform_points);
+    for (mesh::SurfacePoint& q : uniform) q = PointOnFaces(all_faces, all_cumulative, rng);
+    geodesic::VertexGeodesicOptions first;
+    first.targets = uniform;
+    if (!solver.Propagate({source}, first).ok()) continue;
+    for (size_t k = 0; k < uniform.size(); ++k) {
+      add(source, uniform[k], solver.TargetDistance(k), false, true);
+    }
+    const std::vector<double> dist = solver.VertexDistances();
+    std::vector<mesh::SurfacePoint> candidates;
+    std::vector<int> candidate_bin;
+    for (int b = 0; b < kNumScaleBins; ++b) {
+      const double lo = kBinEdges[b] * scale, hi = kBinEdges[b + 1] * scale;
       std::vector<int32_t> faces;
       for (int32_t f = 0; f < mesh.num_faces(); ++f) {
         const mesh::Triangle& t = mesh.face(f);
         const double d0 = dist[t[0]], d1 = dist[t[1]], d2 = dist[t[2]];
-        if (f == source.face ||
-            (std::min({d0, d1, d2}) < hi && std::max({d0, d1, d2}) >= lo)) {
+        if (f == source.face || (std::min({d0, d1, d2}) < hi && std::max({d0, d1, d2}) >= lo)) {
           faces.push_back(f);
         }
       }
       if (faces.empty()) continue;
       const std::vector<double> cumulative = Cumulative(mesh, faces);
       if (!(cumulative.back() > 0)) continue;
-      int32_t found = 0;
-      for (int32_t tries = 0; tries < 8 * options.per_bin_points && found < options.per_bin_points;
-           ++tries) {
-        const mesh::SurfacePoint q = PointOnFaces(faces, cumulative, rng);
-        const double exact = solver.DistanceAt(q);
-        if (exact >= lo && exact < hi && add(source, q, exact, false, false)) ++found;
+      for (int32_t k = 0; k < 8 * options.per_bin_points; ++k) {
+        candidates.push_back(PointOnFaces(faces, cumulative, rng));
+        candidate_bin.push_back(b);
+      }
+    }
+    geodesic::VertexGeodesicOptions second;
+    second.targets = candidates;
+    if (candidates.empty() || !solver.Propagate({source}, second).ok()) continue;
+    std::vector<int32_t> found(kNumScaleBins, 0);
+    for (size_t k = 0; k < candidates.size(); ++k) {
+      const int b = candidate_bin[k];
+      const double exact = solver.TargetDistance(k);
+      if (found[b] < options.per_bin_points && exact >= kBinEdges[b] * scale &&
+          exact < kBinEdges[b + 1] * scale && add(source, candidates[k], exact, false, false)) {
+        ++found[b];
       }
     }
   }

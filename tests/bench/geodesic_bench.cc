@@ -1,33 +1,38 @@
-// geodesic_bench: single-source exact geodesic propagation, ours
-// (ExactGeodesicSolver) against CGAL's Surface_mesh_shortest_path and VTP
-// (Qin et al. 2016, the fastest published exact solver), in the same run, on
-// the same mesh and the same sources. Prints a Markdown table.
+// geodesic_bench: single-source exact geodesic propagation, ours against
+// VTP (Qin et al. 2016, the fastest published exact solver) and CGAL's
+// Surface_mesh_shortest_path, in the same run, on the same mesh and the same
+// sources. Ours is two engines: the wavefront engine (VertexGeodesicSolver,
+// vertex distances only: the builder's rows and sampling) and the window
+// engine (ExactGeodesicSolver, which DistanceAt and PathTo need). Prints a
+// Markdown table, one line per engine and mesh.
 //
 //   geodesic_bench [--mesh PATH]... [--sources K] [--cgal-large-sources K]
 //                  [--large-vertices N] [--vtp-dir DIR] [--no-cgal]
+//                  [--no-windows]
 //
 // Without --mesh: bunny_closed_30k.obj and igea_134k.obj from the shared mesh
 // directory ($GEODEX_SHARED_MESHES, else GEODEX_SHARED_MESHES_DEFAULT), or,
 // when neither is there, a generated icosphere (6 subdivisions, 40962
-// vertices).
+// vertices). A mesh of 500K vertices and more: `split_mesh` (igea_134k split
+// once has 537K), with --no-cgal --no-windows.
 //
 // What is measured, per mesh: each algorithm runs in its own forked child
-// process, so neither sees the other's heap.
+// process, so none sees another's heap.
 //  - time: seconds per source, mean over the sources, as wall clock and as
 //    CPU time of the child (steadier when the machine is shared). One source
 //    is the propagation plus reading every vertex distance into a vector.
-//    Setup (our solver's per-mesh tables; CGAL's Surface_mesh copy) is not
-//    included and is printed separately.
+//    Setup (our solvers' per-mesh tables; CGAL's Surface_mesh copy) is not
+//    included and is printed separately. The ratio to VTP is of CPU times:
+//    VTP prints clock(), its CPU time.
 //  - memory: the increase of the child's peak RSS (getrusage RUSAGE_SELF
-//    ru_maxrss) from just before the algorithm to the end of the last
+//    ru_maxrss) from just before the solver is made to the end of the last
 //    propagation. The mesh is loaded in the parent before the fork, so it is
-//    in the baseline of both; CGAL's own copy of it (its Surface_mesh) is built
+//    in the baseline; CGAL's own copy of it (its Surface_mesh) is built
 //    in the child before the baseline, as the counterpart of our Mesh. The
 //    peak is reset to the current RSS at the baseline (/proc/self/clear_refs,
 //    "5") so that transient allocations made earlier do not hide the increase.
-//    Our increase includes the solver's per-mesh tables.
-//  - the ratio ours/CGAL of both, over the sources both ran; and the largest
-//    relative difference between the two distance fields, as a sanity check.
+//  - the largest relative difference between each engine's distance field
+//    and VTP's, as a check that all are exact.
 // CGAL's sequence tree needs ~9 GB on the 134k-vertex Igea, so on meshes with
 // at least --large-vertices vertices CGAL runs only --cgal-large-sources
 // sources (default 1); ours still runs --sources.
@@ -57,6 +62,7 @@
 #include <fstream>
 #include <functional>
 #include <limits>
+#include <memory>
 #include <string>
 #include <tuple>
 #include <vector>
@@ -67,6 +73,7 @@
 #include "absl/strings/match.h"
 #include "absl/strings/str_format.h"
 #include "core/geodesic/exact_geodesic.h"
+#include "core/geodesic/vertex_geodesic.h"
 #include "core/mesh/generators.h"
 #include "core/mesh/mesh.h"
 #include "core/mesh/mesh_io.h"
@@ -242,26 +249,42 @@ absl::StatusOr<ChildResult> InChild(const std::function<ChildResult()>& work) {
   return Deserialize(std::move(bytes));
 }
 
-ChildResult RunOurs(const Mesh& m, const std::vector<SurfacePoint>& sources, int keep) {
+// Ours: the window engine (ExactGeodesicSolver, which DistanceAt and PathTo
+// need) or the wavefront engine (VertexGeodesicSolver, the builder's rows).
+ChildResult RunOurs(const Mesh& m, const std::vector<int32_t>& sources, bool wavefront,
+                    int keep) {
   ChildResult r;
   ResetPeakRss();
   r.baseline_kb = MaxRssKb();
   auto start = std::chrono::steady_clock::now();
-  geodesic::ExactGeodesicSolver solver(m);
+  std::unique_ptr<geodesic::ExactGeodesicSolver> windows;
+  std::unique_ptr<geodesic::VertexGeodesicSolver> front;
+  if (wavefront) {
+    front = std::make_unique<geodesic::VertexGeodesicSolver>(m);
+  } else {
+    windows = std::make_unique<geodesic::ExactGeodesicSolver>(m);
+  }
   r.setup_seconds = Seconds(start);
   std::vector<std::vector<double>> kept;
   for (size_t i = 0; i < sources.size(); ++i) {
     start = std::chrono::steady_clock::now();
     const double cpu_start = CpuSeconds();
-    const absl::Status status = solver.Propagate({sources[i]});
-    std::vector<double> distances = solver.VertexDistances();
+    absl::Status status;
+    std::vector<double> distances;
+    if (wavefront) {
+      status = front->Propagate({sources[i]});
+      distances = front->VertexDistances();
+    } else {
+      status = windows->Propagate({*mesh::VertexPoint(m, sources[i])});
+      distances = windows->VertexDistances();
+    }
     r.cpu_seconds.push_back(CpuSeconds() - cpu_start);
     r.seconds.push_back(Seconds(start));
     if (!status.ok()) {
       r.error = std::string(status.message());
       return r;
     }
-    r.windows += solver.stats().windows_created;
+    r.windows += wavefront ? front->stats().windows_created : windows->stats().windows_created;
     if (static_cast<int>(i) < keep) kept.push_back(std::move(distances));
   }
   r.peak_kb = MaxRssKb();
@@ -390,6 +413,7 @@ struct Options {
   int large_vertices = 50000;
   std::string vtp_dir;  // empty: the shared directory's anchors/vtp
   bool cgal = true;
+  bool windows = true;  // also the window engine
 };
 
 std::string SharedMeshDir() {
@@ -421,7 +445,7 @@ double Mean(const std::vector<double>& x, size_t n) {
 std::string Megabytes(int64_t kb) { return absl::StrFormat("%.1f MB", kb / 1024.0); }
 
 struct Row {
-  std::string cells;
+  std::vector<std::string> lines;  // table rows
   std::vector<std::string> notes;
 };
 
@@ -429,6 +453,16 @@ std::string VtpDir(const Options& options) {
   if (!options.vtp_dir.empty()) return options.vtp_dir;
   return (std::filesystem::path(SharedMeshDir()) / ".." / "anchors" / "vtp").lexically_normal();
 }
+
+// One engine's figures, before the comparison columns.
+struct Measured {
+  std::string engine;
+  int sources = 0;
+  double wall = 0;  // mean seconds per source
+  double cpu = 0;
+  std::string memory;
+  const std::vector<std::vector<double>>* distances = nullptr;
+};
 
 // `path`: the mesh file, or empty for a generated mesh (VTP then gets an OBJ
 // written here).
@@ -443,48 +477,42 @@ absl::StatusOr<Row> BenchMesh(const std::string& label, const std::string& path,
   for (int32_t v : source_vertices) sources.push_back(*mesh::VertexPoint(m, v));
   const std::vector<SurfacePoint> cgal_sources(sources.begin(), sources.begin() + k_cgal);
   Row row;
+  std::vector<Measured> measured;
 
-  std::fprintf(stderr, "%s: ours, %d source(s)...\n", label.c_str(), options.sources);
-  absl::StatusOr<ChildResult> ours =
-      InChild([&] { return RunOurs(m, sources, options.sources); });
-  if (!ours.ok()) return ours.status();
-  if (!ours->error.empty()) return absl::InternalError("ours: " + ours->error);
-  const double ours_mean = Mean(ours->seconds, ours->seconds.size());
-  const double ours_cpu = Mean(ours->cpu_seconds, ours->cpu_seconds.size());
-  const int64_t ours_kb = ours->peak_kb - ours->baseline_kb;
-
-  std::string cgal_cells = "| - | - | - | - |";
-  if (k_cgal > 0) {
-    std::fprintf(stderr, "%s: CGAL, %d source(s)...\n", label.c_str(), k_cgal);
-    absl::StatusOr<ChildResult> cgal = InChild([&] { return RunCgal(m, cgal_sources); });
-    if (!cgal.ok()) return absl::InternalError("CGAL: " + std::string(cgal.status().message()));
-    if (!cgal->error.empty()) return absl::InternalError("CGAL: " + cgal->error);
-    double max_relative = 0;
-    for (int s = 0; s < k_cgal; ++s) {
-      max_relative = std::max(max_relative,
-                              MaxRelativeDifference(ours->distances[s], cgal->distances[s]));
-    }
-    const double cgal_mean = Mean(cgal->seconds, k_cgal);
-    const double cgal_cpu = Mean(cgal->cpu_seconds, k_cgal);
-    const int64_t cgal_kb = cgal->peak_kb - cgal->baseline_kb;
-    cgal_cells = absl::StrFormat("| %.3f (%.3f) | %.3f (%.3f) | %s | %.1e |", cgal_mean, cgal_cpu,
-                                 Mean(ours->seconds, k_cgal) / cgal_mean,
-                                 Mean(ours->cpu_seconds, k_cgal) / cgal_cpu, Megabytes(cgal_kb),
-                                 max_relative);
+  std::vector<ChildResult> ours(2);
+  for (const bool wavefront : {true, false}) {
+    const char* engine = wavefront ? "ours, wavefront (rows)" : "ours, windows";
+    if (!wavefront && !options.windows) continue;
+    std::fprintf(stderr, "%s: %s, %d source(s)...\n", label.c_str(), engine, options.sources);
+    absl::StatusOr<ChildResult> r =
+        InChild([&] { return RunOurs(m, source_vertices, wavefront, options.sources); });
+    if (!r.ok()) return r.status();
+    if (!r->error.empty()) return absl::InternalError(std::string(engine) + ": " + r->error);
+    ours[wavefront ? 0 : 1] = *std::move(r);
+    const ChildResult& o = ours[wavefront ? 0 : 1];
+    measured.push_back({engine, options.sources, Mean(o.seconds, o.seconds.size()),
+                        Mean(o.cpu_seconds, o.cpu_seconds.size()),
+                        Megabytes(o.peak_kb - o.baseline_kb), &o.distances});
     row.notes.push_back(absl::StrFormat(
-        "%s: setup ours %.3f s (solver tables), CGAL %.3f s (Surface_mesh copy); peak RSS of "
-        "the children: ours %s, CGAL %s (baselines %s, %s); CGAL/ours memory %.2f",
-        label, ours->setup_seconds, cgal->setup_seconds, Megabytes(ours->peak_kb),
-        Megabytes(cgal->peak_kb), Megabytes(ours->baseline_kb), Megabytes(cgal->baseline_kb),
-        static_cast<double>(cgal_kb) / ours_kb));
-    if (k_cgal < options.sources) {
-      row.notes.push_back(absl::StrFormat(
-          "%s: CGAL ran %d of the %d sources (>= %d vertices); its ratios use those %d only",
-          label, k_cgal, options.sources, options.large_vertices, k_cgal));
-    }
+        "%s, %s: setup %.3f s (solver tables), %.3g windows created per source", label, engine,
+        o.setup_seconds, static_cast<double>(o.windows) / options.sources));
   }
 
-  std::string vtp_cells = "| - | - | - | - |";
+  ChildResult cgal;
+  if (k_cgal > 0) {
+    std::fprintf(stderr, "%s: CGAL, %d source(s)...\n", label.c_str(), k_cgal);
+    absl::StatusOr<ChildResult> r = InChild([&] { return RunCgal(m, cgal_sources); });
+    if (!r.ok()) return absl::InternalError("CGAL: " + std::string(r.status().message()));
+    if (!r->error.empty()) return absl::InternalError("CGAL: " + r->error);
+    cgal = *std::move(r);
+    measured.push_back({"CGAL", k_cgal, Mean(cgal.seconds, k_cgal), Mean(cgal.cpu_seconds, k_cgal),
+                        Megabytes(cgal.peak_kb - cgal.baseline_kb), &cgal.distances});
+    row.notes.push_back(absl::StrFormat("%s, CGAL: setup %.3f s (Surface_mesh copy)", label,
+                                        cgal.setup_seconds));
+  }
+
+  VtpResult vtp;
+  bool have_vtp = false;
   const std::string vtp_dir = VtpDir(options);
   if (!std::filesystem::exists(std::filesystem::path(vtp_dir) / "build.sh")) {
     row.notes.push_back(absl::StrFormat("%s: VTP skipped: no %s/build.sh", label, vtp_dir));
@@ -500,22 +528,48 @@ absl::StatusOr<Row> BenchMesh(const std::string& label, const std::string& path,
       if (absl::Status written = mesh::WriteObj(m, obj); !written.ok()) return written;
     }
     std::fprintf(stderr, "%s: VTP, %d source(s)...\n", label.c_str(), options.sources);
-    absl::StatusOr<VtpResult> vtp = RunVtp(binary, obj, source_vertices, m.num_vertices());
+    absl::StatusOr<VtpResult> r = RunVtp(binary, obj, source_vertices, m.num_vertices());
     if (temporary_obj) std::filesystem::remove(obj);
-    if (!vtp.ok()) return vtp.status();
-    double max_relative = 0;
-    for (int s = 0; s < options.sources; ++s) {
-      max_relative = std::max(max_relative,
-                              MaxRelativeDifference(ours->distances[s], vtp->distances[s]));
-    }
-    const double vtp_mean = Mean(vtp->propagation_seconds, options.sources);
-    vtp_cells = absl::StrFormat("| %.3f (%.3f) | %.2f | %s | %.1e |", vtp_mean,
-                                Mean(vtp->process_seconds, options.sources), ours_mean / vtp_mean,
-                                Megabytes(vtp->peak_kb), max_relative);
+    if (!r.ok()) return r.status();
+    vtp = *std::move(r);
+    have_vtp = true;
+    const double propagation = Mean(vtp.propagation_seconds, options.sources);
+    // VTP prints clock(), the process's CPU time: its figure sits in the CPU
+    // column.
+    measured.push_back({"VTP", options.sources, Mean(vtp.process_seconds, options.sources),
+                        propagation, Megabytes(vtp.peak_kb) + " (process)", &vtp.distances});
+    row.notes.push_back(absl::StrFormat(
+        "%s, VTP: wall = its whole process (reading the OBJ, writing every distance); CPU = its "
+        "printed propagation time; memory = the process's peak RSS, mesh included",
+        label));
   }
-  row.cells = absl::StrFormat("| %s | %d | %d / %d | %.3f (%.3f) | %s ", label, m.num_vertices(),
-                              options.sources, k_cgal, ours_mean, ours_cpu, Megabytes(ours_kb)) +
-              cgal_cells.substr(0, cgal_cells.size() - 1) + vtp_cells;
+
+  for (const Measured& e : measured) {
+    auto ratio = [&](const std::string& engine) -> std::string {
+      for (const Measured& other : measured) {
+        if (other.engine == engine && &other != &e) return absl::StrFormat("%.2f", e.cpu / other.cpu);
+      }
+      return "-";
+    };
+    auto diff = [&](const Measured* other) -> std::string {
+      if (other == nullptr || other == &e) return "-";
+      double worst = 0;
+      const size_t n = std::min(e.distances->size(), other->distances->size());
+      for (size_t s = 0; s < n; ++s) {
+        worst = std::max(worst, MaxRelativeDifference((*e.distances)[s], (*other->distances)[s]));
+      }
+      return n == 0 ? "-" : absl::StrFormat("%.1e", worst);
+    };
+    const Measured* vtp_row = nullptr;
+    for (const Measured& other : measured) {
+      if (other.engine == "VTP") vtp_row = &other;
+    }
+    row.lines.push_back(absl::StrFormat("| %s | %d | %s | %d | %.3f | %.3f | %s | %s | %s |", label,
+                                        m.num_vertices(), e.engine, e.sources, e.wall, e.cpu,
+                                        e.memory, ratio("VTP"),
+                                        diff(e.engine == "VTP" ? &measured.front() : vtp_row)));
+  }
+  (void)have_vtp;
   return row;
 }
 
@@ -552,27 +606,22 @@ int Run(Options options) {
                    std::string(row.status().message()).c_str());
       return 1;
     }
-    rows.push_back(row->cells);
+    rows.insert(rows.end(), row->lines.begin(), row->lines.end());
     notes.insert(notes.end(), row->notes.begin(), row->notes.end());
   }
 
   std::printf(
-      "| mesh | vertices | sources ours / CGAL | ours s/source wall (CPU) | ours peak RSS "
-      "increase | CGAL s/source wall (CPU) | time ours/CGAL wall (CPU) | CGAL peak RSS increase | "
-      "max rel. diff CGAL | VTP s/source propagation (whole process) | time ours/VTP | VTP "
-      "process peak RSS | max rel. diff VTP |\n");
-  std::printf("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
+      "| mesh | vertices | engine | sources | s/source wall | s/source CPU | peak RSS increase "
+      "| CPU time / VTP's | max rel. diff vs VTP (VTP: vs ours, wavefront) |\n");
+  std::printf("|---|---:|---|---:|---:|---:|---:|---:|---:|\n");
   for (const std::string& row : rows) std::printf("%s\n", row.c_str());
   std::printf("\n");
   for (const std::string& note : notes) std::printf("- %s\n", note.c_str());
   std::printf(
-      "- vertex sources (fixed seed), the same for all three; ours and CGAL: propagation + "
-      "reading all vertex distances, mean over sources, wall clock and (in parentheses) CPU time "
-      "of the child, memory = increase of ru_maxrss from just before the algorithm to the end, "
-      "each in its own forked child (the mesh is in the baseline); VTP: its own printed "
-      "propagation time and (in parentheses) the wall time of its whole process (reading the OBJ, "
-      "writing every distance), memory = peak RSS of that process, mesh included; time ours/VTP "
-      "= ours wall / VTP propagation\n");
+      "- vertex sources (fixed seed), the same for every engine; ours and CGAL: propagation + "
+      "reading all vertex distances, mean over sources, each engine in its own forked child, "
+      "memory = increase of ru_maxrss from just before the solver is made to the end (the mesh "
+      "is in the baseline)\n");
   return 0;
 }
 
@@ -598,7 +647,11 @@ int main(int argc, char** argv) {
                  "VTP's sources (default: anchors/vtp beside the shared meshes)");
   bool no_cgal = false;
   app.add_flag("--no-cgal", no_cgal, "Skip CGAL (it needs ~9 GB on igea_134k)");
+  bool no_windows = false;
+  app.add_flag("--no-windows", no_windows,
+               "Skip our window engine (it needs ~8 GB per source on 500K vertices)");
   CLI11_PARSE(app, argc, argv);
   options.cgal = !no_cgal;
+  options.windows = !no_windows;
   return geodex::Run(std::move(options));
 }

@@ -1,5 +1,6 @@
-// Cross-check of ExactGeodesicSolver against an independent exact algorithm,
-// CGAL's Surface_mesh_shortest_path (CGAL 5.5.1, Exact_predicates_inexact_
+// Cross-check of ExactGeodesicSolver (and, from vertex sources, of
+// VertexGeodesicSolver, the builder's wavefront engine) against an
+// independent exact algorithm, CGAL's Surface_mesh_shortest_path (CGAL 5.5.1, Exact_predicates_inexact_
 // constructions_kernel, Surface_mesh): distances at EVERY vertex must agree to
 // a relative difference of kMaxRelativeDifference.
 //
@@ -37,6 +38,7 @@
 
 #include "absl/strings/str_format.h"
 #include "core/geodesic/exact_geodesic.h"
+#include "core/geodesic/vertex_geodesic.h"
 #include "core/mesh/generators.h"
 #include "core/mesh/mesh.h"
 #include "core/mesh/mesh_io.h"
@@ -61,6 +63,7 @@ constexpr int32_t kMaxVertices = 50000;  // pitfall (4)
 struct NamedSource {
   std::string name;
   SurfacePoint point;
+  int32_t vertex = mesh::kNone;  // set for a vertex source: the wavefront engine runs too
 };
 
 // |a - b| relative to the larger of the two; 0 when both are 0 or both +inf.
@@ -102,6 +105,7 @@ SurfacePoint InteriorEdgeMidpoint(const Mesh& m, int32_t f) {
 
 struct Agreement {
   double max_relative = 0;
+  double wavefront_max_relative = 0;  // vertex sources only
   int compared = 0;  // vertices times sources
   double ours_seconds = 0;
   double cgal_seconds = 0;
@@ -120,6 +124,7 @@ Agreement CheckAgreement(const Mesh& m, const std::vector<NamedSource>& sources)
     return result;
   }
   ExactGeodesicSolver solver(m);
+  geodesic::VertexGeodesicSolver wavefront(m);
   for (const NamedSource& source : sources) {
     SCOPED_TRACE(source.name);
     auto start = std::chrono::steady_clock::now();
@@ -160,6 +165,19 @@ Agreement CheckAgreement(const Mesh& m, const std::vector<NamedSource>& sources)
         << "worst at vertex " << worst_vertex << ": ours " << solver.VertexDistance(worst_vertex)
         << ", CGAL " << (*reference)[worst_vertex];
     result.max_relative = std::max(result.max_relative, worst);
+    if (source.vertex == mesh::kNone) continue;
+    if (const absl::Status status = wavefront.Propagate({source.vertex}); !status.ok()) {
+      ADD_FAILURE() << "wavefront: " << status;
+      continue;
+    }
+    for (int32_t v = 0; v < m.num_vertices(); ++v) {
+      if (!m.IsReferenced(v)) continue;
+      const double rel = RelativeDifference(wavefront.VertexDistance(v), (*reference)[v]);
+      result.wavefront_max_relative = std::max(result.wavefront_max_relative, rel);
+      ASSERT_LE(rel, kMaxRelativeDifference)
+          << "wavefront engine at vertex " << v << ": " << wavefront.VertexDistance(v)
+          << ", CGAL " << (*reference)[v];
+    }
   }
   return result;
 }
@@ -170,9 +188,9 @@ void Report(const std::string& label, const Mesh& m, size_t num_sources, const A
   ::testing::Test::RecordProperty("vertices", m.num_vertices());
   std::printf(
       "[ cgal     ] %s: max relative difference %.3g over %d vertex distances (%d vertices, %zu "
-      "sources); ours %.3f s, CGAL %.3f s\n",
-      label.c_str(), a.max_relative, a.compared, m.num_vertices(), num_sources, a.ours_seconds,
-      a.cgal_seconds);
+      "sources), wavefront engine %.3g; ours %.3f s, CGAL %.3f s\n",
+      label.c_str(), a.max_relative, a.compared, m.num_vertices(), num_sources,
+      a.wavefront_max_relative, a.ours_seconds, a.cgal_seconds);
   std::fflush(stdout);
 }
 
@@ -259,7 +277,7 @@ TEST_P(CgalCrossCheckGeneratedTest, AgreesAtEveryVertex) {
   const Mesh m = GetParam().make();
   const int32_t v = ReferencedVertexFrom(m, m.num_vertices() / 3);
   const std::vector<NamedSource> sources = {
-      {absl::StrFormat("vertex %d", v), AtVertex(m, v)},
+      {absl::StrFormat("vertex %d", v), AtVertex(m, v), v},
       {absl::StrFormat("inside face %d", m.num_faces() / 2), InsideFace(m.num_faces() / 2)},
       {"edge midpoint", InteriorEdgeMidpoint(m, m.num_faces() / 5)},
   };
@@ -345,7 +363,7 @@ TEST_P(CgalCrossCheckSharedMeshTest, AgreesAtEveryVertex) {
   const int32_t v = ReferencedVertexFrom(*m, m->num_vertices() / 3);
   const int32_t f = m->num_faces() / 2;
   const std::vector<NamedSource> sources = {
-      {absl::StrFormat("vertex %d", v), AtVertex(*m, v)},
+      {absl::StrFormat("vertex %d", v), AtVertex(*m, v), v},
       {absl::StrFormat("inside face %d", f), InsideFace(f)},
   };
   const Agreement a = CheckAgreement(*m, sources);
