@@ -127,6 +127,27 @@ absl::Status CheckUnrepairable(const RawMesh& raw, RepairReport* report) {
     }
   }
   const int64_t n = static_cast<int64_t>(raw.positions.size());
+  // A file polygon with a repeated corner can fan into triangles that do
+  // not repeat one (0 1 2 1 gives 0 1 2 and 0 2 1, duplicates the repair
+  // would drop): such a polygon is refused whole. Its corners are its first
+  // triangle's, then the last corner of each next one.
+  if (raw.polygons && raw.input_face.size() == raw.triangles.size()) {
+    std::vector<int32_t> corners;
+    for (size_t first = 0, end; first < raw.triangles.size(); first = end) {
+      end = first + 1;
+      while (end < raw.triangles.size() && raw.input_face[end] == raw.input_face[first]) ++end;
+      if (end - first == 1) continue;
+      corners.assign(raw.triangles[first].begin(), raw.triangles[first].end());
+      for (size_t t = first + 1; t < end; ++t) corners.push_back(raw.triangles[t][2]);
+      std::sort(corners.begin(), corners.end());
+      const auto repeated = std::adjacent_find(corners.begin(), corners.end());
+      if (repeated != corners.end()) {
+        return absl::InvalidArgumentError(absl::StrFormat(
+            "%s: polygon %d of the file (%d corners) repeats vertex %d", name,
+            raw.input_face[first], corners.size(), *repeated));
+      }
+    }
+  }
   for (size_t f = 0; f < raw.triangles.size(); ++f) {
     const Triangle& t = raw.triangles[f];
     for (int i = 0; i < 3; ++i) {
