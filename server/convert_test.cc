@@ -101,7 +101,10 @@ TEST(ConvertPathTest, LengthIsTheSumOfSegments) {
   path[1].position = {3, 4, 0};
   path[2].position = {3, 4, 1};
   v1::Polyline line;
-  PathToProto(engine_->input_ids(), path, &line);
+  auto index = index::Index::FromBytes(testing::SphereIndexBytes());
+  ASSERT_TRUE(index.ok()) << index.status();
+  const query::InputIds ids(**index);  // identity: the sphere needed no repair
+  PathToProto(ids, path, &line);
   EXPECT_DOUBLE_EQ(line.length(), 6);
   EXPECT_EQ(line.points().faces_size(), 3);
   EXPECT_EQ(line.positions().xyz_size(), 9);
