@@ -139,15 +139,14 @@ void ExpMapChunkToProto(std::span<const query::ExpMapVertex> map, int64_t offset
   }
 }
 
-void MeshChunkToProto(const query::QueryEngine& engine, int64_t vertex_offset,
-                      int64_t vertex_count, int64_t face_offset, int64_t face_count,
-                      int64_t version, v1::MeshChunk* chunk) {
+void MeshChunkToProto(const query::QueryEngine& engine, int64_t vertex_offset, int64_t vertex_count,
+                      int64_t face_offset, int64_t face_count, int64_t version,
+                      v1::MeshChunk* chunk) {
   const index::Index& index = engine.index();
   const query::InputIds& ids = engine.input_ids();
   assert(vertex_offset >= 0 && vertex_count >= 0 &&
          vertex_offset + vertex_count <= ids.num_input_vertices());
-  assert(face_offset >= 0 && face_count >= 0 &&
-         face_offset + face_count <= ids.num_input_faces());
+  assert(face_offset >= 0 && face_count >= 0 && face_offset + face_count <= ids.num_input_faces());
   chunk->set_num_vertices(static_cast<uint32_t>(ids.num_input_vertices()));
   chunk->set_num_faces(static_cast<uint32_t>(ids.num_input_faces()));
   chunk->set_version(version);

@@ -87,9 +87,9 @@ void ExpMapChunkToProto(std::span<const query::ExpMapVertex> map, int64_t offset
 // [face_offset, face_offset + face_count) of the input mesh of `engine`'s
 // index (the mesh file's vertices and faces, also when it was repaired), with
 // the mesh's totals and `version`. The ranges must lie within the input mesh.
-void MeshChunkToProto(const query::QueryEngine& engine, int64_t vertex_offset,
-                      int64_t vertex_count, int64_t face_offset, int64_t face_count,
-                      int64_t version, v1::MeshChunk* chunk);
+void MeshChunkToProto(const query::QueryEngine& engine, int64_t vertex_offset, int64_t vertex_count,
+                      int64_t face_offset, int64_t face_count, int64_t version,
+                      v1::MeshChunk* chunk);
 
 // The geodesic triangulation held by `engine`'s index (GetTriangulation), with
 // `version`, in input ids. Each sample's surface point is in the input face

@@ -293,12 +293,10 @@ class GeodexService::ExpMapStream final : public ChunkedWriteStream<v1::ExpMapCh
         DistanceOptionsFor(*model_.model, request_->near_pairs(), false, request_->tolerance()));
     // The centre as the request gives it (validated above): the map's θ runs
     // round that input face's normal (query::ExpMapOfInput).
-    const mesh::SurfacePoint centre{
-        request_->center().faces(0),
-        {request_->center().weights(0), request_->center().weights(1),
-         request_->center().weights(2)}};
-    GEODEX_ASSIGN_OR_RETURN(map_,
-                            query::ExpMapOfInput(engine, centre, options, &worker.scratch));
+    const mesh::SurfacePoint centre{request_->center().faces(0),
+                                    {request_->center().weights(0), request_->center().weights(1),
+                                     request_->center().weights(2)}};
+    GEODEX_ASSIGN_OR_RETURN(map_, query::ExpMapOfInput(engine, centre, options, &worker.scratch));
     call_.pairs = static_cast<int64_t>(map_.size());
     return absl::OkStatus();
   }

@@ -103,9 +103,9 @@ absl::StatusOr<std::pair<mesh::Mesh, Plan>> LoadPlan(const std::string& workdir)
   GEODEX_ASSIGN_OR_RETURN(mesh::RawMesh raw, mesh::LoadRawMeshFile(PlanMeshPath(workdir)));
   mesh::MeshOptions mesh_options;
   mesh_options.allow_zero_area_faces = true;
-  GEODEX_ASSIGN_OR_RETURN(mesh::Mesh mesh, mesh::Mesh::Create(std::move(raw.positions),
-                                                              std::move(raw.triangles),
-                                                              raw.name, mesh_options));
+  GEODEX_ASSIGN_OR_RETURN(mesh::Mesh mesh,
+                          mesh::Mesh::Create(std::move(raw.positions), std::move(raw.triangles),
+                                             raw.name, mesh_options));
   const std::string path = PlanPath(workdir);
   GEODEX_ASSIGN_OR_RETURN(const std::string bytes, ReadWholeFile(path));
   GEODEX_ASSIGN_OR_RETURN(const std::string_view payload, Unseal(bytes, kPlanMagic, path));

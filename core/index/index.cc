@@ -555,14 +555,14 @@ absl::StatusOr<std::string> SerializeIndex(const IndexData& d) {
     return bad(absl::StrFormat("builder_version must be under %d bytes without NULs: \"%s\"",
                                sizeof(FileHeader::builder_version), d.builder_version));
   }
-  GEODEX_RETURN_IF_ERROR(
-      CheckContents(Contents{counts, d.positions, d.faces, d.twins, d.samples, d.sample_distances,
-                             d.vertices, d.triangles, d.bvh_nodes, d.bvh_faces, d.input_faces,
-                             d.vertex_copies},
-                    absl::StatusCode::kInvalidArgument));
+  GEODEX_RETURN_IF_ERROR(CheckContents(
+      Contents{counts, d.positions, d.faces, d.twins, d.samples, d.sample_distances, d.vertices,
+               d.triangles, d.bvh_nodes, d.bvh_faces, d.input_faces, d.vertex_copies},
+      absl::StatusCode::kInvalidArgument));
   GEODEX_RETURN_IF_ERROR(CheckAccuracy(d.accuracy, absl::StatusCode::kInvalidArgument));
 
-  // Every section is written, empty ones with size 0, in kSpecs order.
+  // Every section is written, empty ones with size 0, in kSpecs order (but the
+  // input-id sections, below).
   struct Piece {
     const void* data;
     uint64_t size;
@@ -729,10 +729,10 @@ absl::Status Index::Validate() {
   vertex_copies_ = SectionView<int32_t>(p, entry(SectionId::kVertexCopies));
   GEODEX_RETURN_IF_ERROR(CheckAccuracy(accuracy_, absl::StatusCode::kDataLoss));
 
-  return CheckContents(Contents{counts, positions_, faces_, twins_, samples_, sample_distances_,
-                                vertices_, triangles_, bvh_nodes_, bvh_faces_, input_faces_,
-                                vertex_copies_},
-                       absl::StatusCode::kDataLoss);
+  return CheckContents(
+      Contents{counts, positions_, faces_, twins_, samples_, sample_distances_, vertices_,
+               triangles_, bvh_nodes_, bvh_faces_, input_faces_, vertex_copies_},
+      absl::StatusCode::kDataLoss);
 }
 
 IndexData ToIndexData(const Index& index) {

@@ -116,9 +116,9 @@ static_assert(sizeof(GeodesicTriangle) == 24);
 // Where one face of the input mesh went when the builder repaired the mesh
 // (1.2). Faces of the index are "internal"; requests name input faces.
 struct InputFaceRecord {
-  int32_t face;        // internal face; for a dropped duplicate, its twin's
-  uint8_t corner[3];   // input corner i is corner corner[i] of the internal face
-  uint8_t flags;       // kInputFaceDropped | kInputFaceReoriented
+  int32_t face;       // internal face; for a dropped duplicate, its twin's
+  uint8_t corner[3];  // input corner i is corner corner[i] of the internal face
+  uint8_t flags;      // kInputFaceDropped | kInputFaceReoriented
 };
 static_assert(sizeof(InputFaceRecord) == 8);
 inline constexpr uint8_t kInputFaceDropped = 1;     // a duplicate, answered by its twin

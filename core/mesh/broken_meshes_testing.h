@@ -112,8 +112,12 @@ inline RawMesh TwoPyramidsApexToApex() {
       base[k] = AddVertex(&raw, Vec3(std::cos(angle), std::sin(angle), side));
     }
     AddOutward(&raw,
-               {{0, base[0], base[1]}, {0, base[1], base[2]}, {0, base[2], base[3]},
-                {0, base[3], base[0]}, {base[0], base[1], base[2]}, {base[0], base[2], base[3]}},
+               {{0, base[0], base[1]},
+                {0, base[1], base[2]},
+                {0, base[2], base[3]},
+                {0, base[3], base[0]},
+                {base[0], base[1], base[2]},
+                {base[0], base[2], base[3]}},
                Vec3(0, 0, side / 2));
   }
   return raw;
@@ -140,8 +144,8 @@ inline RawMesh MobiusStrip(int n = 24) {
   for (int i = 0; i < n; ++i) {
     const double t = 2 * std::numbers::pi * i / n;
     const Vec3 centre(2 * std::cos(t), 2 * std::sin(t), 0);
-    const Vec3 across = std::cos(t / 2) * Vec3(std::cos(t), std::sin(t), 0) +
-                        std::sin(t / 2) * Vec3(0, 0, 1);
+    const Vec3 across =
+        std::cos(t / 2) * Vec3(std::cos(t), std::sin(t), 0) + std::sin(t / 2) * Vec3(0, 0, 1);
     AddVertex(&raw, centre + 0.5 * across);
     AddVertex(&raw, centre - 0.5 * across);
   }

@@ -142,9 +142,9 @@ absl::Status CheckUnrepairable(const RawMesh& raw, RepairReport* report) {
       std::sort(corners.begin(), corners.end());
       const auto repeated = std::adjacent_find(corners.begin(), corners.end());
       if (repeated != corners.end()) {
-        return absl::InvalidArgumentError(absl::StrFormat(
-            "%s: polygon %d of the file (%d corners) repeats vertex %d", name,
-            raw.input_face[first], corners.size(), *repeated));
+        return absl::InvalidArgumentError(
+            absl::StrFormat("%s: polygon %d of the file (%d corners) repeats vertex %d", name,
+                            raw.input_face[first], corners.size(), *repeated));
       }
     }
   }
@@ -187,7 +187,8 @@ void DropDuplicates(const RawMesh& raw, Soup* soup, std::vector<int32_t>* group_
   group_keeper->assign(nf, kNone);
   for (int32_t i = 0; i < nf; ++i) {
     const bool first = i == 0 || sorted[i].first != sorted[i - 1].first;
-    (*group_keeper)[sorted[i].second] = first ? sorted[i].second : (*group_keeper)[sorted[i - 1].second];
+    (*group_keeper)[sorted[i].second] =
+        first ? sorted[i].second : (*group_keeper)[sorted[i - 1].second];
   }
   for (int32_t f = 0; f < nf; ++f) {
     if ((*group_keeper)[f] == f) {
@@ -276,16 +277,15 @@ absl::StatusOr<std::vector<uint8_t>> Orient(const Soup& soup, const std::vector<
 }  // namespace
 
 std::string RepairReport::Summary() const {
-  return absl::StrCat(
-      Count(nonmanifold_vertices, "non-manifold vertex", "non-manifold vertices"), " split (",
-      Count(vertex_copies, "copy", "copies"), "), ",
-      Count(nonmanifold_edges, "non-manifold edge", "non-manifold edges"), " cut (",
-      Count(edge_copies, "copy", "copies"), "), ",
-      Count(duplicate_faces, "duplicate face", "duplicate faces"), " dropped, ",
-      Count(reoriented_faces, "face", "faces"), " re-oriented, ",
-      Count(unreferenced_vertices, "unreferenced vertex", "unreferenced vertices"), " ignored, ",
-      Count(zero_area_faces, "zero-area face", "zero-area faces"), " and ",
-      Count(sliver_faces, "sliver", "slivers"), " kept");
+  return absl::StrCat(Count(nonmanifold_vertices, "non-manifold vertex", "non-manifold vertices"),
+                      " split (", Count(vertex_copies, "copy", "copies"), "), ",
+                      Count(nonmanifold_edges, "non-manifold edge", "non-manifold edges"), " cut (",
+                      Count(edge_copies, "copy", "copies"), "), ",
+                      Count(duplicate_faces, "duplicate face", "duplicate faces"), " dropped, ",
+                      Count(reoriented_faces, "face", "faces"), " re-oriented, ",
+                      Count(unreferenced_vertices, "unreferenced vertex", "unreferenced vertices"),
+                      " ignored, ", Count(zero_area_faces, "zero-area face", "zero-area faces"),
+                      " and ", Count(sliver_faces, "sliver", "slivers"), " kept");
 }
 
 std::string RepairReport::ToText() const {
@@ -332,7 +332,9 @@ absl::StatusOr<RepairedMesh> RepairMesh(RawMesh raw, const RepairOptions& option
     const Triangle& t = soup.tri(k);
     faces[k] = flip[k] ? Triangle{t[0], t[2], t[1]} : t;
   }
-  auto internal_halfedge = [&](int32_t h) { return h - h % 3 + (flip[h / 3] ? kFlipEdge[h % 3] : h % 3); };
+  auto internal_halfedge = [&](int32_t h) {
+    return h - h % 3 + (flip[h / 3] ? kFlipEdge[h % 3] : h % 3);
+  };
 
   // One vertex per fan: corners 3k+c (corner c of face k) joined across
   // every paired edge; the fan of a vertex's first corner keeps its id.

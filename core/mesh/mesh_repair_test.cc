@@ -13,10 +13,10 @@
 namespace geodex::mesh {
 namespace {
 
-using ::testing::ElementsAre;
-using ::testing::HasSubstr;
 using testing::AddTriangle;
 using testing::AddVertex;
+using ::testing::ElementsAre;
+using ::testing::HasSubstr;
 using testing::RawOf;
 
 RepairOptions Strict() {
@@ -33,7 +33,8 @@ int32_t InputVertex(const RepairedMesh& r, int32_t v) {
 // Every input triangle's corners, through the maps, are its own vertices.
 void ExpectMapsRecoverInput(const RawMesh& raw, const RepairedMesh& r) {
   for (size_t f = 0; f < raw.triangles.size(); ++f) {
-    const InputFace in = r.maps.faces.empty() ? InputFace{static_cast<int32_t>(f)} : r.maps.faces[f];
+    const InputFace in =
+        r.maps.faces.empty() ? InputFace{static_cast<int32_t>(f)} : r.maps.faces[f];
     for (int i = 0; i < 3; ++i) {
       EXPECT_EQ(InputVertex(r, r.mesh.face(in.face)[in.corner[i]]), raw.triangles[f][i])
           << "input face " << f << " corner " << i;
@@ -150,7 +151,8 @@ TEST(MeshRepairTest, CubesSharingAnEdgeEachKeepTheirOwnEdge) {
   ExpectMapsRecoverInput(raw, *r);
   const absl::StatusOr<RepairedMesh> strict = RepairMesh(raw, Strict());
   ASSERT_FALSE(strict.ok());
-  EXPECT_THAT(strict.status().message(), HasSubstr("non-manifold edge (3, 7) is shared by 4 faces"));
+  EXPECT_THAT(strict.status().message(),
+              HasSubstr("non-manifold edge (3, 7) is shared by 4 faces"));
 }
 
 TEST(MeshRepairTest, BookPagesBecomeSheetsOfTheirOwn) {
@@ -240,8 +242,8 @@ TEST(MeshRepairTest, WhatCannotBeRepairedIsRefusedWithTheReason) {
 TEST(MeshRepairTest, PolygonWithARepeatedVertexIsRefusedFromAFile) {
   // A quad 0 1 2 1 fans into (0 1 2) and (0 2 1): a duplicate of a face, but
   // a repeated polygon corner is not repairable.
-  const absl::StatusOr<RawMesh> raw = ParseObjTriangles(
-      "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\nf 1 2 3 2\n", "quad.obj");
+  const absl::StatusOr<RawMesh> raw =
+      ParseObjTriangles("v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\nf 1 2 3 2\n", "quad.obj");
   ASSERT_TRUE(raw.ok()) << raw.status();
   ASSERT_TRUE(raw->polygons);
   const absl::StatusOr<RepairedMesh> r = RepairMesh(*raw);

@@ -92,9 +92,8 @@ absl::StatusOr<std::vector<ExpMapVertex>> ExpMapOfInput(const QueryEngine& engin
   if (mirrored && !options.reference_direction.has_value()) {
     const mesh::Triangle t = ids.InputFace(centre.face);
     const std::span<const double> p = engine.index().positions();
-    options.reference_direction =
-        mesh::Vec3(p[3 * t[1]], p[3 * t[1] + 1], p[3 * t[1] + 2]) -
-        mesh::Vec3(p[3 * t[0]], p[3 * t[0] + 1], p[3 * t[0] + 2]);
+    options.reference_direction = mesh::Vec3(p[3 * t[1]], p[3 * t[1] + 1], p[3 * t[1] + 2]) -
+                                  mesh::Vec3(p[3 * t[0]], p[3 * t[0] + 1], p[3 * t[0] + 2]);
   }
   GEODEX_ASSIGN_OR_RETURN(std::vector<ExpMapVertex> map,
                           ExpMap(engine, internal, options, scratch));
@@ -110,10 +109,9 @@ absl::StatusOr<std::vector<ExpMapVertex>> ExpMapOfInput(const QueryEngine& engin
   std::stable_sort(map.begin(), map.end(), [](const ExpMapVertex& a, const ExpMapVertex& b) {
     return a.vertex != b.vertex ? a.vertex < b.vertex : a.r < b.r;
   });
-  map.erase(std::unique(map.begin(), map.end(),
-                        [](const ExpMapVertex& a, const ExpMapVertex& b) {
-                          return a.vertex == b.vertex;
-                        }),
+  map.erase(std::unique(
+                map.begin(), map.end(),
+                [](const ExpMapVertex& a, const ExpMapVertex& b) { return a.vertex == b.vertex; }),
             map.end());
   return map;
 }

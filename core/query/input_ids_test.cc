@@ -175,8 +175,8 @@ TEST(InputIdsTest, CubesSharingAnEdgeBuildAndAnswer) {
   Built b = Build(mesh::testing::TwoCubesSharingAnEdge(), 16);
   const QueryEngine& e = *b.engine;
   // Across one face of the first cube: a straight line.
-  const double d = InputDistance(e, {0, {1.0 / 3, 1.0 / 3, 1.0 / 3}}, {1, {1.0 / 3, 1.0 / 3, 1.0 / 3}},
-                                 NearPairs::kExact);
+  const double d = InputDistance(e, {0, {1.0 / 3, 1.0 / 3, 1.0 / 3}},
+                                 {1, {1.0 / 3, 1.0 / 3, 1.0 / 3}}, NearPairs::kExact);
   EXPECT_TRUE(std::isfinite(d));
   // The two cubes are separate surfaces once the edge is cut.
   EXPECT_EQ(InputDistance(e, {0, {1, 0, 0}}, {12, {0.2, 0.3, 0.5}}),
@@ -191,12 +191,9 @@ TEST(InputIdsTest, ZeroAreaFaceBuildsAndAnswersFiniteDistances) {
   ASSERT_EQ(b.repaired.report.zero_area_faces, 1);
   // Points on the zero-area face, and across it: the grid is flat and
   // convex, so distances are Euclidean.
-  const std::vector<SurfacePoint> points = {{degenerate, {0.2, 0.3, 0.5}},
-                                            {degenerate, {1, 0, 0}},
-                                            {60, {0.3, 0.3, 0.4}},
-                                            {0, {0.2, 0.2, 0.6}},
-                                            {127, {0.5, 0.25, 0.25}},
-                                            {degenerate - 1, {0.6, 0.2, 0.2}}};
+  const std::vector<SurfacePoint> points = {
+      {degenerate, {0.2, 0.3, 0.5}}, {degenerate, {1, 0, 0}},  {60, {0.3, 0.3, 0.4}},
+      {0, {0.2, 0.2, 0.6}},          {127, {0.5, 0.25, 0.25}}, {degenerate - 1, {0.6, 0.2, 0.2}}};
   const mesh::Mesh& m = b.repaired.mesh;
   for (const SurfacePoint& p : points) {
     for (const SurfacePoint& q : points) {

@@ -126,8 +126,7 @@ void PrintSummary(const builder::BuildSummary& s, const std::string& out,
       "  longest edge     %.6g (%.4f of the bounding-box diagonal)\n"
       "  time             sampling %s, triangulation %s, rows %s, merge %s\n",
       out.c_str(), s.index_bytes / 1048576.0, repairs.c_str(), s.requested_samples, s.num_samples,
-      s.repair.c_str(),
-      s.num_triangles,
+      s.repair.c_str(), s.num_triangles,
       EdgeLine(s.geodesic_edges, s.edge_crossings_found, s.edge_length_total, s.edge_length_max)
           .c_str(),
       static_cast<long long>(s.referenced_vertices), static_cast<long long>(s.unassigned_vertices),

@@ -89,8 +89,8 @@ absl::Status CheckPairs(const query::QueryEngine& engine, std::vector<mesh::Poin
       absl::StatusOr<mesh::SurfacePoint> internal =
           engine.input_ids().ToInternal(*p, engine.options().weight_tolerance);
       if (!internal.ok()) {
-        return absl::Status(internal.status().code(), absl::StrFormat("line %d: %s", pair.line,
-                                                                      internal.status().message()));
+        return absl::Status(internal.status().code(),
+                            absl::StrFormat("line %d: %s", pair.line, internal.status().message()));
       }
       *p = *internal;
     }
@@ -136,8 +136,8 @@ absl::Status Run(const Args& args) {
         index->num_triangles(), index->size_bytes(),
         index->accuracy() != nullptr ? "yes" : "no (geodex-build calibrate adds them)");
     if (!ids.identity()) {
-      out += absl::StrFormat("repaired_vertices = %d\nrepaired_faces = %d\n",
-                             index->num_vertices(), index->num_faces());
+      out += absl::StrFormat("repaired_vertices = %d\nrepaired_faces = %d\n", index->num_vertices(),
+                             index->num_faces());
     }
     out += index->report();
     std::fwrite(out.data(), 1, out.size(), stdout);

@@ -3,8 +3,8 @@
 // triangulation) must be valid everywhere; meshes up to 7000 vertices also get
 // a full index whose vertices must all be assigned. Meshes are repaired as
 // geodex-build repairs them (core/mesh/mesh_repair.h): cow_nonmanifold_3k has
-// its non-manifold vertex split, and is refused clearly when strict. Meshes over 50000 vertices (igea_134k) run only with
-// GEODEX_LARGE_TESTS=1.
+// its non-manifold vertex split, and is refused clearly when strict. Meshes over 50000 vertices
+// (igea_134k) run only with GEODEX_LARGE_TESTS=1.
 
 #include <cstdlib>
 #include <filesystem>
