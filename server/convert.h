@@ -7,6 +7,13 @@
 // of range [0, 5000)"), and with the codes of STYLE.md: InvalidArgument for
 // malformed input, OutOfRange for a face id past the end.
 //
+// Ids. Requests and answers use the ids of the mesh file a model was built
+// from; when the builder repaired that mesh they differ from the index's
+// (core/query/input_ids.h). Points are read into the index's ids here
+// (PointsFromProto), and every answer that names faces or vertices is written
+// back in input ids here too (paths, located points, fields, exponential maps,
+// the mesh, the triangulation, the model's counts).
+//
 // Thread safety: pure functions (outputs are the caller's).
 
 #include <cstdint>
@@ -18,14 +25,16 @@
 #include "core/index/index.h"
 #include "core/mesh/mesh.h"
 #include "core/query/exp_map.h"
+#include "core/query/input_ids.h"
 #include "core/query/query_engine.h"
 #include "geodex/v1/geodex.pb.h"
 #include "server/model_registry.h"
 
 namespace geodex::server {
 
-// Reads `points` (named `name` in messages) into `out` and validates each
-// point against `engine`'s index. Errors: InvalidArgument if weights are not 3
+// Reads `points` (named `name` in messages, in input ids) into `out`, in the
+// index's ids, validating each point against the input mesh's face count and
+// the engine's weight tolerance. Errors: InvalidArgument if weights are not 3
 // per face ("a: 4 faces but 11 weights (want 12)"); OutOfRange for a face id
 // past the end and InvalidArgument for NaN, infinite or negative weights or
 // weights not summing to 1, both naming the point ("a[17]: ...").
@@ -41,51 +50,60 @@ inline int64_t PointCount(const v1::SurfacePoints& points) { return points.faces
 absl::Status PositionsFromProto(const v1::Positions& positions, std::string_view name,
                                 std::vector<mesh::Vec3>* out);
 
-// Appends one point to `points`.
+// Appends one point to `points` as it is (callers give input ids).
 void AppendPoint(const mesh::SurfacePoint& point, v1::SurfacePoints* points);
 
 // Resizes `values` to `n` and returns its storage, for the engine to fill.
 std::span<double> ResizeForOutput(google::protobuf::RepeatedField<double>* values, int64_t n);
 
-// A path from QueryEngine::Path; `length` is the sum of its 3D segments.
-void PathToProto(std::span<const query::PathPoint> path, v1::Polyline* polyline);
+// A path from QueryEngine::Path (in the index's ids), with its points in
+// input faces; `length` is the sum of its 3D segments.
+void PathToProto(const query::InputIds& ids, std::span<const query::PathPoint> path,
+                 v1::Polyline* polyline);
 // The answer for a pair on different connected components: no points,
 // length +Infinity.
 void UnreachablePathToProto(v1::Polyline* polyline);
 
-// A located point (QueryEngine::Locate) appended to a LocateResponse.
-void AppendLocated(const query::LocatedPoint& located, v1::LocateResponse* response);
+// A located point (QueryEngine::Locate, in the index's ids) appended to a
+// LocateResponse in input ids.
+void AppendLocated(const query::InputIds& ids, const query::LocatedPoint& located,
+                   v1::LocateResponse* response);
 
 // Rows [row_offset, row_offset + rows) of a matrix, `values` row-major.
 void MatrixBlockToProto(int64_t row_offset, int64_t rows, int64_t num_targets,
                         std::span<const double> values, int64_t version, v1::MatrixBlock* block);
 
-// Vertices [offset, offset + count) of a distance field.
+// Vertices [offset, offset + count) of a distance field (per input vertex:
+// InputIds::FieldToInput).
 void FieldChunkToProto(const query::DistanceField& field, int64_t offset, int64_t count,
                        bool with_nearest_source, int64_t version, v1::DistanceFieldChunk* chunk);
 
-// Entries [offset, offset + count) of an exponential map.
+// Entries [offset, offset + count) of an exponential map (in input ids:
+// query::ExpMapOfInput).
 void ExpMapChunkToProto(std::span<const query::ExpMapVertex> map, int64_t offset, int64_t count,
                         int64_t version, v1::ExpMapChunk* chunk);
 
 // Vertices [vertex_offset, vertex_offset + vertex_count) and faces
-// [face_offset, face_offset + face_count) of `index`'s mesh, with the mesh's
-// totals and `version`. The ranges must lie within the mesh (the index has
-// checked that every face's vertex ids are in range).
-void MeshChunkToProto(const index::Index& index, int64_t vertex_offset, int64_t vertex_count,
+// [face_offset, face_offset + face_count) of the input mesh of `engine`'s
+// index (the mesh file's vertices and faces, also when it was repaired), with
+// the mesh's totals and `version`. The ranges must lie within the input mesh.
+void MeshChunkToProto(const query::QueryEngine& engine, int64_t vertex_offset, int64_t vertex_count,
                       int64_t face_offset, int64_t face_count, int64_t version,
                       v1::MeshChunk* chunk);
 
-// The geodesic triangulation held by `index` (GetTriangulation), with
-// `version`. Each sample's surface point is the lowest-numbered face using
-// its vertex, with weight 1 on that vertex (face -1 and zero weights for a
-// sample on no face, which the builder never makes).
-void TriangulationToProto(const index::Index& index, int64_t version,
+// The geodesic triangulation held by `engine`'s index (GetTriangulation), with
+// `version`, in input ids. Each sample's surface point is in the input face
+// kept for the lowest-numbered face of the index using its vertex, with
+// weight 1 on that vertex (face -1 and zero weights for a sample on no face,
+// which the builder never makes). vertex_triangles has one entry per input
+// vertex; for a split vertex, the smallest triangle id of its copies.
+void TriangulationToProto(const query::QueryEngine& engine, int64_t version,
                           v1::TriangulationResponse* out);
 
 // A model as GetModel and ListModels describe it: `version` (a served
 // version of `model`) if given, otherwise what is known without an index
-// (state, reason, versions on disk).
+// (state, reason, versions on disk). Vertex and face counts are the input
+// mesh's.
 void ModelInfoToProto(const ModelSnapshot& model, const ServedVersion* version,
                       v1::ModelInfo* info);
 

@@ -101,7 +101,10 @@ TEST(ConvertPathTest, LengthIsTheSumOfSegments) {
   path[1].position = {3, 4, 0};
   path[2].position = {3, 4, 1};
   v1::Polyline line;
-  PathToProto(path, &line);
+  auto index = index::Index::FromBytes(testing::SphereIndexBytes());
+  ASSERT_TRUE(index.ok()) << index.status();
+  const query::InputIds ids(**index);  // identity: the sphere needed no repair
+  PathToProto(ids, path, &line);
   EXPECT_DOUBLE_EQ(line.length(), 6);
   EXPECT_EQ(line.points().faces_size(), 3);
   EXPECT_EQ(line.positions().xyz_size(), 9);
@@ -113,7 +116,7 @@ TEST(ConvertPathTest, LengthIsTheSumOfSegments) {
 TEST_F(ConvertTest, MeshChunkIsASliceOfTheIndexMesh) {
   const index::Index& ix = engine_->index();
   v1::MeshChunk chunk;
-  MeshChunkToProto(ix, 10, 5, 100, 4, 3, &chunk);
+  MeshChunkToProto(*engine_, 10, 5, 100, 4, 3, &chunk);
   EXPECT_EQ(chunk.num_vertices(), static_cast<uint32_t>(ix.num_vertices()));
   EXPECT_EQ(chunk.num_faces(), static_cast<uint32_t>(ix.num_faces()));
   EXPECT_EQ(chunk.version(), 3);
@@ -127,7 +130,7 @@ TEST_F(ConvertTest, MeshChunkIsASliceOfTheIndexMesh) {
 
   // Empty ranges at the end, as in the last chunks of a mesh with more faces
   // than vertices; a reused message is overwritten.
-  MeshChunkToProto(ix, ix.num_vertices(), 0, ix.num_faces() - 1, 1, 3, &chunk);
+  MeshChunkToProto(*engine_, ix.num_vertices(), 0, ix.num_faces() - 1, 1, 3, &chunk);
   EXPECT_EQ(chunk.vertex_offset(), static_cast<uint32_t>(ix.num_vertices()));
   EXPECT_EQ(chunk.positions_size(), 0);
   EXPECT_EQ(chunk.faces_size(), 3);

@@ -342,7 +342,7 @@ grpc::ServerUnaryReactor* GeodexService::Path(grpc::CallbackServerContext* conte
           absl::StatusOr<std::vector<query::PathPoint>> path =
               engine.Path(worker.a[i], worker.b[i], corridor);
           if (path.ok()) {
-            PathToProto(*path, response->add_paths());
+            PathToProto(engine.input_ids(), *path, response->add_paths());
           } else if (path.status().code() == absl::StatusCode::kNotFound) {
             UnreachablePathToProto(response->add_paths());  // different components
           } else {
@@ -377,7 +377,7 @@ grpc::ServerUnaryReactor* GeodexService::Locate(grpc::CallbackServerContext* con
           if (!located.ok()) {
             return WithPrefix(located.status(), absl::StrFormat("positions[%d]: ", i));
           }
-          AppendLocated(*located, response);
+          AppendLocated(engine.input_ids(), *located, response);
         }
         call.pairs = n;
         response->set_version(model.version->version());
@@ -391,9 +391,9 @@ grpc::ServerUnaryReactor* GeodexService::GetTriangulation(
   return RunUnary(context, "GetTriangulation",
                   [this, request, response](Call& call, WorkerContext&) -> absl::Status {
                     GEODEX_ASSIGN_OR_RETURN(ResolvedModel model, Resolve(request->model(), call));
-                    TriangulationToProto(model.version->index(), model.version->version(),
+                    TriangulationToProto(model.version->engine(), model.version->version(),
                                          response);
-                    call.pairs = model.version->index().num_vertices();
+                    call.pairs = model.version->engine().input_ids().num_input_vertices();
                     return absl::OkStatus();
                   });
 }

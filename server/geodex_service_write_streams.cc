@@ -225,6 +225,7 @@ class GeodexService::FieldStream final : public ChunkedWriteStream<v1::DistanceF
     const query::QueryEngine& engine = model_.version->engine();
     GEODEX_RETURN_IF_ERROR(PointsFromProto(request_->sources(), "sources", engine, &worker.a));
     GEODEX_ASSIGN_OR_RETURN(field_, engine.Field(worker.a));
+    field_ = engine.input_ids().FieldToInput(std::move(field_));
     call_.pairs = n * static_cast<int64_t>(field_.distance.size());
     chunk_vertices_ =
         std::max<int64_t>(1, kChunkBytes / (request_->with_nearest_source() ? 12 : 8));
@@ -290,7 +291,12 @@ class GeodexService::ExpMapStream final : public ChunkedWriteStream<v1::ExpMapCh
     GEODEX_ASSIGN_OR_RETURN(
         options.distance,
         DistanceOptionsFor(*model_.model, request_->near_pairs(), false, request_->tolerance()));
-    GEODEX_ASSIGN_OR_RETURN(map_, query::ExpMap(engine, worker.a[0], options, &worker.scratch));
+    // The centre as the request gives it (validated above): the map's θ runs
+    // round that input face's normal (query::ExpMapOfInput).
+    const mesh::SurfacePoint centre{request_->center().faces(0),
+                                    {request_->center().weights(0), request_->center().weights(1),
+                                     request_->center().weights(2)}};
+    GEODEX_ASSIGN_OR_RETURN(map_, query::ExpMapOfInput(engine, centre, options, &worker.scratch));
     call_.pairs = static_cast<int64_t>(map_.size());
     return absl::OkStatus();
   }
@@ -335,9 +341,10 @@ class GeodexService::MeshStream final : public ChunkedWriteStream<v1::MeshChunk>
  private:
   absl::Status Prepare() {
     GEODEX_ASSIGN_OR_RETURN(model_, service_->Resolve(request_->model(), call_));
-    const index::Index& ix = model_.version->index();
+    const query::InputIds& ids = model_.version->engine().input_ids();
     const auto chunks = [this](int64_t n) { return (n + chunk_elements_ - 1) / chunk_elements_; };
-    num_chunks_ = std::max<int64_t>({1, chunks(ix.num_vertices()), chunks(ix.num_faces())});
+    num_chunks_ =
+        std::max<int64_t>({1, chunks(ids.num_input_vertices()), chunks(ids.num_input_faces())});
     prepared_ = true;
     return absl::OkStatus();
   }
@@ -347,13 +354,17 @@ class GeodexService::MeshStream final : public ChunkedWriteStream<v1::MeshChunk>
   absl::Status ComputeNext(WorkerContext& /*worker*/) override {
     GEODEX_RETURN_IF_ERROR(CheckAlive(*context_));
     if (!prepared_) GEODEX_RETURN_IF_ERROR(Prepare());
-    const index::Index& ix = model_.version->index();
+    // The input mesh: the file's vertices and faces (core/query/input_ids.h).
+    const query::QueryEngine& engine = model_.version->engine();
+    const int64_t num_vertices = engine.input_ids().num_input_vertices();
+    const int64_t num_faces = engine.input_ids().num_input_faces();
     const int64_t begin = next_chunk_ * chunk_elements_;
-    const int64_t nv = std::clamp<int64_t>(ix.num_vertices() - begin, 0, chunk_elements_);
-    const int64_t nf = std::clamp<int64_t>(ix.num_faces() - begin, 0, chunk_elements_);
-    const int64_t vertex_offset = std::min<int64_t>(begin, ix.num_vertices());
-    const int64_t face_offset = std::min<int64_t>(begin, ix.num_faces());
-    MeshChunkToProto(ix, vertex_offset, nv, face_offset, nf, model_.version->version(), &chunk_);
+    const int64_t nv = std::clamp<int64_t>(num_vertices - begin, 0, chunk_elements_);
+    const int64_t nf = std::clamp<int64_t>(num_faces - begin, 0, chunk_elements_);
+    const int64_t vertex_offset = std::min<int64_t>(begin, num_vertices);
+    const int64_t face_offset = std::min<int64_t>(begin, num_faces);
+    MeshChunkToProto(engine, vertex_offset, nv, face_offset, nf, model_.version->version(),
+                     &chunk_);
     items_ = nv + nf;
     return absl::OkStatus();
   }

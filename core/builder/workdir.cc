@@ -21,8 +21,10 @@ namespace {
 // and the figures of the traced geodesic edges.
 constexpr char kPlanMagic[8] = {'G', 'D', 'X', 'P', 'L', 'A', 'N', '2'};
 constexpr char kRowsMagic[8] = {'G', 'D', 'X', 'R', 'O', 'W', 'S', '1'};
+constexpr char kRepairMagic[8] = {'G', 'D', 'X', 'R', 'E', 'P', 'R', '1'};
 
 std::string PlanPath(const std::string& workdir) { return workdir + "/plan.bin"; }
+std::string RepairPath(const std::string& workdir) { return workdir + "/repair.bin"; }
 
 std::string RowsPath(const std::string& workdir, int32_t shard, int32_t num_shards) {
   return absl::StrFormat("%s/rows-%05d-of-%05d.bin", workdir, shard, num_shards);
@@ -97,7 +99,13 @@ absl::Status SavePlan(const mesh::Mesh& mesh, const Plan& plan, const std::strin
 }
 
 absl::StatusOr<std::pair<mesh::Mesh, Plan>> LoadPlan(const std::string& workdir) {
-  GEODEX_ASSIGN_OR_RETURN(mesh::Mesh mesh, mesh::LoadMesh(PlanMeshPath(workdir)));
+  // The mesh as the plan repaired it: zero-area faces are part of it.
+  GEODEX_ASSIGN_OR_RETURN(mesh::RawMesh raw, mesh::LoadRawMeshFile(PlanMeshPath(workdir)));
+  mesh::MeshOptions mesh_options;
+  mesh_options.allow_zero_area_faces = true;
+  GEODEX_ASSIGN_OR_RETURN(mesh::Mesh mesh,
+                          mesh::Mesh::Create(std::move(raw.positions), std::move(raw.triangles),
+                                             raw.name, mesh_options));
   const std::string path = PlanPath(workdir);
   GEODEX_ASSIGN_OR_RETURN(const std::string bytes, ReadWholeFile(path));
   GEODEX_ASSIGN_OR_RETURN(const std::string_view payload, Unseal(bytes, kPlanMagic, path));
@@ -229,6 +237,40 @@ absl::StatusOr<std::vector<SampleRow>> LoadAllRows(const Plan& plan, const std::
     if (!r.AtEnd()) return absl::DataLossError(absl::StrFormat("%s has trailing bytes", path));
   }
   return rows;
+}
+
+absl::Status SaveRepair(const RepairRecord& record, const Plan& plan, const std::string& workdir) {
+  ByteWriter w;
+  w.bytes().append(kRepairMagic, sizeof(kRepairMagic));
+  w.Put(plan.mesh_hash);
+  w.PutVector(record.input_faces);
+  w.PutVector(record.vertex_copies);
+  w.PutVector(std::vector<char>(record.report.begin(), record.report.end()));
+  Seal(w);
+  return AtomicWriteFile(RepairPath(workdir), w.bytes());
+}
+
+absl::StatusOr<RepairRecord> LoadRepair(const Plan& plan, const std::string& workdir) {
+  const std::string path = RepairPath(workdir);
+  absl::StatusOr<std::string> bytes = ReadWholeFile(path);
+  if (absl::IsNotFound(bytes.status())) return RepairRecord{};
+  GEODEX_RETURN_IF_ERROR(bytes.status());
+  GEODEX_ASSIGN_OR_RETURN(const std::string_view payload, Unseal(*bytes, kRepairMagic, path));
+  ByteReader r(payload, path);
+  uint64_t hash = 0;
+  RepairRecord record;
+  std::vector<char> report;
+  GEODEX_RETURN_IF_ERROR(r.Get(&hash));
+  GEODEX_RETURN_IF_ERROR(r.GetVector(&record.input_faces));
+  GEODEX_RETURN_IF_ERROR(r.GetVector(&record.vertex_copies));
+  GEODEX_RETURN_IF_ERROR(r.GetVector(&report));
+  if (!r.AtEnd()) return absl::DataLossError(absl::StrFormat("%s has trailing bytes", path));
+  if (hash != plan.mesh_hash) {
+    return absl::FailedPreconditionError(
+        absl::StrFormat("%s does not belong to %s", path, PlanPath(workdir)));
+  }
+  record.report.assign(report.begin(), report.end());
+  return record;
 }
 
 }  // namespace geodex::builder

@@ -2,7 +2,7 @@
 
 // The shared work directory of a distributed build:
 //
-//   geodex-build plan MESH --samples M -o WORKDIR   writes mesh.ply, plan.bin
+//   geodex-build plan MESH --samples M -o WORKDIR   writes mesh.ply, repair.bin, plan.bin
 //   geodex-build rows WORKDIR --shard I/N           writes rows-I-of-N.bin
 //   geodex-build merge WORKDIR -o OUT.gdx           reads them all
 //
@@ -16,6 +16,7 @@
 
 #include "absl/status/statusor.h"
 #include "core/builder/builder.h"
+#include "core/builder/mesh_arrays.h"
 #include "core/mesh/mesh.h"
 
 namespace geodex::builder {
@@ -36,6 +37,15 @@ std::vector<int32_t> ShardSamples(int32_t num_samples, int32_t shard, int32_t nu
 absl::Status SavePlan(const mesh::Mesh& mesh, const Plan& plan, const std::string& workdir);
 // Loads the mesh and plan of a work directory.
 absl::StatusOr<std::pair<mesh::Mesh, Plan>> LoadPlan(const std::string& workdir);
+
+// Writes what the repair of the plan's mesh did (RecordRepair) as
+// `workdir`/repair.bin, atomically, stamped with the plan's mesh hash; the
+// directory must exist (SavePlan makes it). Errors: AtomicWriteFile's.
+absl::Status SaveRepair(const RepairRecord& record, const Plan& plan, const std::string& workdir);
+// Reads it back. A work directory without repair.bin (made before repairs
+// were recorded) gives an empty record: nothing was repaired. Errors:
+// DataLoss for a corrupt file, FailedPrecondition for one of another plan.
+absl::StatusOr<RepairRecord> LoadRepair(const Plan& plan, const std::string& workdir);
 
 // Writes the rows of shard `shard` of `num_shards` (those of ShardSamples) as
 // `workdir`/rows-SHARD-of-NUM.bin, atomically, stamped with the plan's mesh

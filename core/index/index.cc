@@ -70,6 +70,8 @@ constexpr SectionSpec kSpecs[] = {
     {SectionId::kBvhFaces, sizeof(int32_t), "BVH faces", false},
     {SectionId::kReport, 1, "report", false},
     {SectionId::kAccuracy, sizeof(AccuracyRecord), "accuracy", false},
+    {SectionId::kInputFaces, sizeof(InputFaceRecord), "input faces", false},
+    {SectionId::kVertexCopies, sizeof(int32_t), "vertex copies", false},
 };
 constexpr size_t kNumSpecs = std::size(kSpecs);
 
@@ -112,6 +114,8 @@ std::optional<uint64_t> ExpectedCount(SectionId id, const Counts& c) {
       return c.num_bvh_nodes > 0 ? c.num_faces : 0;
     case SectionId::kReport:
     case SectionId::kAccuracy:
+    case SectionId::kInputFaces:
+    case SectionId::kVertexCopies:
       return std::nullopt;
   }
   return std::nullopt;
@@ -149,6 +153,8 @@ struct Contents {
   std::span<const GeodesicTriangle> triangles;
   std::span<const BvhNode> bvh_nodes;
   std::span<const int32_t> bvh_faces;
+  std::span<const InputFaceRecord> input_faces;
+  std::span<const int32_t> vertex_copies;
 };
 
 bool InRange(int64_t x, int64_t lo, int64_t hi) { return x >= lo && x < hi; }
@@ -269,6 +275,40 @@ absl::Status CheckContents(const Contents& c, absl::StatusCode code) {
           absl::StrFormat("BVH node %d: first %d, count %d out of range (%d nodes, %d "
                           "faces)",
                           i, b.first, b.count, nb, nf));
+    }
+  }
+  // Copies come after the input's vertices and copy one of them.
+  const int64_t num_input_vertices = nv - static_cast<int64_t>(c.vertex_copies.size());
+  if (num_input_vertices < 0) {
+    return fail(absl::StrFormat("%d vertex copies but %d vertices", c.vertex_copies.size(), nv));
+  }
+  for (size_t i = 0; i < c.vertex_copies.size(); ++i) {
+    if (!InRange(c.vertex_copies[i], 0, num_input_vertices)) {
+      return fail(absl::StrFormat("vertex copy %d: input vertex %d out of range [0, %d)", i,
+                                  c.vertex_copies[i], num_input_vertices));
+    }
+  }
+  // Every internal face is the one face of exactly one input face that was
+  // not dropped, so that answers have an input face to name.
+  if (!c.input_faces.empty()) {
+    std::vector<uint8_t> kept(nf, 0);
+    for (size_t i = 0; i < c.input_faces.size(); ++i) {
+      const InputFaceRecord& r = c.input_faces[i];
+      const bool permutation = r.corner[0] < 3 && r.corner[1] < 3 && r.corner[2] < 3 &&
+                               r.corner[0] != r.corner[1] && r.corner[1] != r.corner[2] &&
+                               r.corner[0] != r.corner[2];
+      if (!InRange(r.face, 0, nf) || !permutation ||
+          (r.flags & ~(kInputFaceDropped | kInputFaceReoriented)) != 0) {
+        return fail(absl::StrFormat(
+            "input face %d: face %d (of %d), corners (%d %d %d) or flags %d invalid", i, r.face, nf,
+            r.corner[0], r.corner[1], r.corner[2], r.flags));
+      }
+      if ((r.flags & kInputFaceDropped) == 0 && kept[r.face]++ > 0) {
+        return fail(absl::StrFormat("input face %d: face %d is kept twice", i, r.face));
+      }
+    }
+    for (int64_t f = 0; f < nf; ++f) {
+      if (kept[f] == 0) return fail(absl::StrFormat("face %d is no input face's", f));
     }
   }
   if (!c.bvh_faces.empty()) {
@@ -515,13 +555,14 @@ absl::StatusOr<std::string> SerializeIndex(const IndexData& d) {
     return bad(absl::StrFormat("builder_version must be under %d bytes without NULs: \"%s\"",
                                sizeof(FileHeader::builder_version), d.builder_version));
   }
-  GEODEX_RETURN_IF_ERROR(
-      CheckContents(Contents{counts, d.positions, d.faces, d.twins, d.samples, d.sample_distances,
-                             d.vertices, d.triangles, d.bvh_nodes, d.bvh_faces},
-                    absl::StatusCode::kInvalidArgument));
+  GEODEX_RETURN_IF_ERROR(CheckContents(
+      Contents{counts, d.positions, d.faces, d.twins, d.samples, d.sample_distances, d.vertices,
+               d.triangles, d.bvh_nodes, d.bvh_faces, d.input_faces, d.vertex_copies},
+      absl::StatusCode::kInvalidArgument));
   GEODEX_RETURN_IF_ERROR(CheckAccuracy(d.accuracy, absl::StatusCode::kInvalidArgument));
 
-  // Every section is written, empty ones with size 0, in kSpecs order.
+  // Every section is written, empty ones with size 0, in kSpecs order (but the
+  // input-id sections, below).
   struct Piece {
     const void* data;
     uint64_t size;
@@ -538,19 +579,34 @@ absl::StatusOr<std::string> SerializeIndex(const IndexData& d) {
       {d.bvh_faces.data(), d.bvh_faces.size() * sizeof(int32_t)},
       {d.report.data(), d.report.size()},
       {d.accuracy.data(), d.accuracy.size() * sizeof(AccuracyRecord)},
+      {d.input_faces.data(), d.input_faces.size() * sizeof(InputFaceRecord)},
+      {d.vertex_copies.data(), d.vertex_copies.size() * sizeof(int32_t)},
   };
+  // The input-id sections (1.2) are written only when the mesh was repaired,
+  // so that the index of a mesh that needed no repair keeps the 1.1 layout.
+  auto written = [&pieces](size_t i) {
+    const SectionId id = kSpecs[i].id;
+    return pieces[i].size > 0 || (id != SectionId::kInputFaces && id != SectionId::kVertexCopies);
+  };
+  size_t num_sections = 0;
+  for (size_t i = 0; i < kNumSpecs; ++i) num_sections += written(i) ? 1 : 0;
   SectionEntry entries[kNumSpecs];
   std::memset(entries, 0, sizeof(entries));
   const uint64_t table_offset = sizeof(FileHeader);
-  uint64_t cursor = table_offset + sizeof(entries);
-  for (size_t i = 0; i < kNumSpecs; ++i) {
+  const uint64_t table_bytes = num_sections * sizeof(SectionEntry);
+  uint64_t cursor = table_offset + table_bytes;
+  size_t piece_of[kNumSpecs];
+  for (size_t i = 0, e = 0; i < kNumSpecs; ++i) {
+    if (!written(i)) continue;
     cursor = AlignUp(cursor);
-    entries[i].id = static_cast<uint32_t>(kSpecs[i].id);
-    entries[i].element_size = kSpecs[i].element_size;
-    entries[i].offset = cursor;
-    entries[i].size = pieces[i].size;
-    entries[i].checksum = Checksum(pieces[i].data, pieces[i].size);
+    piece_of[e] = i;
+    entries[e].id = static_cast<uint32_t>(kSpecs[i].id);
+    entries[e].element_size = kSpecs[i].element_size;
+    entries[e].offset = cursor;
+    entries[e].size = pieces[i].size;
+    entries[e].checksum = Checksum(pieces[i].data, pieces[i].size);
     cursor += pieces[i].size;
+    ++e;
   }
   const uint64_t file_size = cursor;
 
@@ -569,20 +625,19 @@ absl::StatusOr<std::string> SerializeIndex(const IndexData& d) {
   h.num_samples = static_cast<uint32_t>(counts.num_samples);
   h.num_triangles = static_cast<uint32_t>(counts.num_triangles);
   h.num_bvh_nodes = static_cast<uint32_t>(counts.num_bvh_nodes);
-  h.num_sections = kNumSpecs;
+  h.num_sections = static_cast<uint32_t>(num_sections);
   h.section_table_offset = table_offset;
   h.file_size = file_size;
-  h.table_checksum = Checksum(entries, sizeof(entries));
+  h.table_checksum = Checksum(entries, table_bytes);
   h.header_checksum = 0;
   h.header_checksum = HeaderChecksum(reinterpret_cast<const uint8_t*>(&h), sizeof(h));
 
   std::string out(file_size, '\0');  // zero padding everywhere
   std::memcpy(out.data(), &h, sizeof(h));
-  std::memcpy(out.data() + table_offset, entries, sizeof(entries));
-  for (size_t i = 0; i < kNumSpecs; ++i) {
-    if (pieces[i].size > 0) {
-      std::memcpy(out.data() + entries[i].offset, pieces[i].data, pieces[i].size);
-    }
+  std::memcpy(out.data() + table_offset, entries, table_bytes);
+  for (size_t e = 0; e < num_sections; ++e) {
+    const Piece& piece = pieces[piece_of[e]];
+    if (piece.size > 0) std::memcpy(out.data() + entries[e].offset, piece.data, piece.size);
   }
   return out;
 }
@@ -670,11 +725,14 @@ absl::Status Index::Validate() {
   const std::span<const char> report = SectionView<char>(p, entry(SectionId::kReport));
   report_ = std::string_view(report.data(), report.size());
   accuracy_ = SectionView<AccuracyRecord>(p, entry(SectionId::kAccuracy));
+  input_faces_ = SectionView<InputFaceRecord>(p, entry(SectionId::kInputFaces));
+  vertex_copies_ = SectionView<int32_t>(p, entry(SectionId::kVertexCopies));
   GEODEX_RETURN_IF_ERROR(CheckAccuracy(accuracy_, absl::StatusCode::kDataLoss));
 
-  return CheckContents(Contents{counts, positions_, faces_, twins_, samples_, sample_distances_,
-                                vertices_, triangles_, bvh_nodes_, bvh_faces_},
-                       absl::StatusCode::kDataLoss);
+  return CheckContents(
+      Contents{counts, positions_, faces_, twins_, samples_, sample_distances_, vertices_,
+               triangles_, bvh_nodes_, bvh_faces_, input_faces_, vertex_copies_},
+      absl::StatusCode::kDataLoss);
 }
 
 IndexData ToIndexData(const Index& index) {
@@ -694,6 +752,8 @@ IndexData ToIndexData(const Index& index) {
   d.bvh_faces = copy(index.bvh_faces());
   d.report = std::string(index.report());
   if (index.accuracy() != nullptr) d.accuracy = {*index.accuracy()};
+  d.input_faces = copy(index.input_faces());
+  d.vertex_copies = copy(index.vertex_copies());
   return d;
 }
 

@@ -39,6 +39,11 @@ struct IndexData {
   std::vector<int32_t> bvh_faces;
   std::string report;
   std::vector<AccuracyRecord> accuracy;  // empty, or one record (format 1.1)
+  // A repaired mesh's input ids (format 1.2): one record per input face, or
+  // empty for identity; the input vertex of each split vertex copy (the last
+  // vertex_copies.size() vertices), or empty.
+  std::vector<InputFaceRecord> input_faces;
+  std::vector<int32_t> vertex_copies;
 };
 
 // XXH64 of the positions and faces: identifies the source mesh.
@@ -103,6 +108,11 @@ class Index {
   // or built without it).
   const AccuracyRecord* accuracy() const { return accuracy_.empty() ? nullptr : &accuracy_[0]; }
 
+  // The input ids of a repaired mesh (format 1.2); both empty for an index
+  // of a mesh that needed no repair, or one older than 1.2.
+  std::span<const InputFaceRecord> input_faces() const { return input_faces_; }
+  std::span<const int32_t> vertex_copies() const { return vertex_copies_; }
+
   // d(sample i, sample j) from the matrix.
   float SampleDistance(int32_t i, int32_t j) const {
     return sample_distances_[static_cast<size_t>(i) * header_->num_samples + j];
@@ -135,6 +145,8 @@ class Index {
   std::span<const int32_t> bvh_faces_;
   std::string_view report_;
   std::span<const AccuracyRecord> accuracy_;
+  std::span<const InputFaceRecord> input_faces_;
+  std::span<const int32_t> vertex_copies_;
 };
 
 }  // namespace geodex::index

@@ -22,6 +22,11 @@
 //   1.1  accuracy calibration (AccuracyRecord): absolute error bounds of the
 //        answers by distance scale, measured against held-out exact
 //        propagations. Optional; 1.0 readers ignore it.
+//   1.2  input ids of a repaired mesh (core/mesh/mesh_repair.h): where each
+//        input face went (InputFaceRecord) and which input vertex each split
+//        vertex copies. Optional, written only when the mesh was repaired;
+//        absent means identity maps. A 1.0/1.1 reader loads a repaired
+//        index but answers in its internal ids.
 
 #include <cstdint>
 
@@ -29,7 +34,7 @@ namespace geodex::index {
 
 inline constexpr char kMagic[8] = {'G', 'E', 'O', 'D', 'E', 'X', 'I', 'X'};
 inline constexpr uint32_t kFormatMajor = 1;
-inline constexpr uint32_t kFormatMinor = 1;
+inline constexpr uint32_t kFormatMinor = 2;
 inline constexpr uint32_t kByteOrderMark = 0x01020304;  // reads 0x04030201 when swapped
 inline constexpr uint64_t kAlignment = 64;
 
@@ -46,6 +51,8 @@ enum class SectionId : uint32_t {
   kBvhFaces = 9,         // int32[num_faces]: faces in BVH leaf order
   kReport = 10,          // UTF-8 text: the builder's summary (key = value lines)
   kAccuracy = 11,        // AccuracyRecord[0 or 1] (1.1)
+  kInputFaces = 12,      // InputFaceRecord[num_input_faces] (1.2); absent: identity
+  kVertexCopies = 13,    // int32[k]: input vertex of vertex num_vertices - k + i (1.2)
 };
 
 // Build parameters recorded in the header.
@@ -105,6 +112,17 @@ struct GeodesicTriangle {
   int32_t neighbor[3];
 };
 static_assert(sizeof(GeodesicTriangle) == 24);
+
+// Where one face of the input mesh went when the builder repaired the mesh
+// (1.2). Faces of the index are "internal"; requests name input faces.
+struct InputFaceRecord {
+  int32_t face;       // internal face; for a dropped duplicate, its twin's
+  uint8_t corner[3];  // input corner i is corner corner[i] of the internal face
+  uint8_t flags;      // kInputFaceDropped | kInputFaceReoriented
+};
+static_assert(sizeof(InputFaceRecord) == 8);
+inline constexpr uint8_t kInputFaceDropped = 1;     // a duplicate, answered by its twin
+inline constexpr uint8_t kInputFaceReoriented = 2;  // its corners 1 and 2 swapped
 
 // Axis-aligned bounding-box hierarchy over the mesh faces. A leaf has
 // count > 0 and covers bvh_faces[first, first+count); an inner node has

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -258,6 +259,70 @@ TEST_F(IndexFileTest, OpenErrors) {
   status = Index::Open(truncated).status();
   EXPECT_EQ(status.code(), absl::StatusCode::kDataLoss) << status;
   EXPECT_THAT(status.message(), HasSubstr("truncated"));
+}
+
+// Format 1.2: the input ids of a repaired mesh (core/mesh/mesh_repair.h).
+IndexData WithInputIds(IndexData d) {
+  const int32_t nf = static_cast<int32_t>(d.faces.size() / 3);
+  for (int32_t f = 0; f < nf; ++f) d.input_faces.push_back({f, {0, 1, 2}, 0});
+  d.input_faces[3] = {3, {0, 2, 1}, kInputFaceReoriented};
+  d.input_faces.push_back({3, {1, 0, 2}, kInputFaceDropped});  // a duplicate of face 3
+  d.vertex_copies = {5};  // the last vertex is a copy of vertex 5
+  return d;
+}
+
+TEST(IndexTest, InputIdSectionsRoundTripAndAreAbsentWithoutRepair) {
+  // Not repaired: the sections are not written (the 1.1 layout).
+  EXPECT_EQ(Image::Parse(Serialize(MakeSphereIndex())).header.num_sections, 11u);
+  const IndexData d = WithInputIds(MakeSphereIndex());
+  const std::string bytes = Serialize(d);
+  Image image = Image::Parse(bytes);
+  EXPECT_EQ(image.header.num_sections, 13u);
+  EXPECT_EQ(image.header.format_minor, 2u);
+  absl::StatusOr<std::shared_ptr<const Index>> index = Index::FromBytes(bytes);
+  ASSERT_TRUE(index.ok()) << index.status();
+  ExpectSameData(**index, d);
+  EXPECT_TRUE(SameBytes((*index)->input_faces(), d.input_faces));
+  EXPECT_EQ(ToVector((*index)->vertex_copies()), d.vertex_copies);
+  const IndexData copy = ToIndexData(**index);
+  EXPECT_TRUE(SameBytes(std::span<const InputFaceRecord>(copy.input_faces), d.input_faces));
+  EXPECT_EQ(copy.vertex_copies, d.vertex_copies);
+  // An index without them (a mesh that needed no repair, or 1.1) has none:
+  // identity maps.
+  image.Remove(SectionId::kInputFaces);
+  image.Remove(SectionId::kVertexCopies);
+  index = Index::FromBytes(image.Layout());
+  ASSERT_TRUE(index.ok()) << index.status();
+  EXPECT_TRUE((*index)->input_faces().empty());
+  EXPECT_TRUE((*index)->vertex_copies().empty());
+}
+
+TEST(IndexTest, BadInputIdSectionsAreRefused) {
+  const IndexData good = WithInputIds(MakeSphereIndex());
+  const int32_t nf = static_cast<int32_t>(good.faces.size() / 3);
+  struct Case {
+    const char* what;
+    std::function<void(IndexData&)> edit;
+    const char* message;
+  };
+  const Case cases[] = {
+      {"face out of range", [&](IndexData& d) { d.input_faces[0].face = nf; }, "input face 0"},
+      {"corners not a permutation", [](IndexData& d) { d.input_faces[1].corner[2] = 1; },
+       "input face 1"},
+      {"unknown flag", [](IndexData& d) { d.input_faces[2].flags = 4; }, "input face 2"},
+      {"a face kept twice", [](IndexData& d) { d.input_faces.back().flags = 0; },
+       "face 3 is kept twice"},
+      {"a face of no input face", [](IndexData& d) { d.input_faces[7].flags = kInputFaceDropped; },
+       "face 7 is no input face's"},
+      {"copy of a copy", [](IndexData& d) { d.vertex_copies = {42}; }, "vertex copy 0"},
+  };
+  for (const Case& c : cases) {
+    IndexData d = good;
+    c.edit(d);
+    const absl::Status status = SerializeIndex(d).status();
+    EXPECT_EQ(status.code(), absl::StatusCode::kInvalidArgument) << c.what;
+    EXPECT_THAT(std::string(status.message()), HasSubstr(c.message)) << c.what;
+  }
 }
 
 }  // namespace

@@ -33,6 +33,11 @@ int32_t FindRoot(std::vector<int32_t>& parent, int32_t x) {
 
 absl::StatusOr<Mesh> Mesh::Create(std::vector<Vec3> positions, std::vector<Triangle> faces,
                                   std::string name) {
+  return Create(std::move(positions), std::move(faces), std::move(name), MeshOptions{});
+}
+
+absl::StatusOr<Mesh> Mesh::Create(std::vector<Vec3> positions, std::vector<Triangle> faces,
+                                  std::string name, const MeshOptions& options) {
   Mesh mesh;
   mesh.name_ = std::move(name);
   if (faces.empty()) {
@@ -61,13 +66,8 @@ absl::StatusOr<Mesh> Mesh::Create(std::vector<Vec3> positions, std::vector<Trian
       return absl::InvalidArgumentError(absl::StrFormat("%s: face %d repeats a vertex (%d %d %d)",
                                                         mesh.name_, f, t[0], t[1], t[2]));
     }
-    const Vec3& a = positions[t[0]];
-    const Vec3& b = positions[t[1]];
-    const Vec3& c = positions[t[2]];
-    const double twice_area = (b - a).cross(c - a).norm();
-    const double longest2 =
-        std::max({(b - a).squaredNorm(), (c - b).squaredNorm(), (a - c).squaredNorm()});
-    if (!(twice_area > kDegenerateAreaRatio * longest2)) {
+    if (!options.allow_zero_area_faces &&
+        IsZeroAreaTriangle(positions[t[0]], positions[t[1]], positions[t[2]])) {
       return absl::InvalidArgumentError(absl::StrFormat(
           "%s: face %d (%d %d %d) has zero area (its corners are collinear or coincide)",
           mesh.name_, f, t[0], t[1], t[2]));
@@ -243,6 +243,13 @@ Vec3 Mesh::BoundingBoxMax() const {
 }
 
 double Mesh::BoundingBoxDiagonal() const { return (BoundingBoxMax() - BoundingBoxMin()).norm(); }
+
+bool IsZeroAreaTriangle(const Vec3& a, const Vec3& b, const Vec3& c) {
+  const double twice_area = (b - a).cross(c - a).norm();
+  const double longest2 =
+      std::max({(b - a).squaredNorm(), (c - b).squaredNorm(), (a - c).squaredNorm()});
+  return !(twice_area > kDegenerateAreaRatio * longest2);
+}
 
 Vec3 PositionOf(const Mesh& mesh, const SurfacePoint& p) {
   const Triangle& t = mesh.face(p.face);

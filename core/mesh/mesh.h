@@ -11,9 +11,10 @@
 // Valid input: unreferenced vertices, boundaries, several connected components.
 // Rejected (InvalidArgument, naming the element): fewer than one face, indices
 // out of range or repeated within a face, NaN/Inf coordinates, faces of zero
-// area, duplicate faces, edges with more than two faces or whose two faces
-// disagree on orientation, and non-manifold vertices (faces around a vertex
-// that do not form a single fan).
+// area (unless MeshOptions::allow_zero_area_faces), duplicate faces, edges
+// with more than two faces or whose two faces disagree on orientation, and
+// non-manifold vertices (faces around a vertex that do not form a single
+// fan). core/mesh/mesh_repair.h repairs what can be repaired of these.
 //
 // Thread safety: immutable after construction; every method is const and safe
 // to call from any number of threads.
@@ -35,12 +36,23 @@ using Triangle = std::array<int32_t, 3>;
 
 inline constexpr int32_t kNone = -1;
 
+struct MeshOptions {
+  // Keep faces of zero area (collinear corners) instead of refusing them:
+  // the repaired meshes of core/mesh/mesh_repair.h, and meshes rebuilt from
+  // an index made of one. Such a face has angles 0, 0 and pi (or 0 for
+  // coincident corners) and an area of 0; it joins its neighbours as any
+  // face does.
+  bool allow_zero_area_faces = false;
+};
+
 class Mesh {
  public:
   // Builds a mesh from vertex positions and triangles. `name` is used in error
   // messages (usually the file name). Errors: InvalidArgument as listed above.
   static absl::StatusOr<Mesh> Create(std::vector<Vec3> positions, std::vector<Triangle> faces,
                                      std::string name = "mesh");
+  static absl::StatusOr<Mesh> Create(std::vector<Vec3> positions, std::vector<Triangle> faces,
+                                     std::string name, const MeshOptions& options);
 
   Mesh(const Mesh&) = default;
   Mesh(Mesh&&) = default;
@@ -119,6 +131,11 @@ struct SurfacePoint {
   int32_t face = kNone;
   std::array<double, 3> w = {1.0, 0.0, 0.0};
 };
+
+// True when a triangle's doubled area is below 1e-14 of its longest squared
+// edge: degenerate to double precision (collinear or coincident corners).
+// The test Mesh::Create refuses zero-area faces by.
+bool IsZeroAreaTriangle(const Vec3& a, const Vec3& b, const Vec3& c);
 
 // Position of a surface point in 3D.
 Vec3 PositionOf(const Mesh& mesh, const SurfacePoint& p);

@@ -8,6 +8,7 @@
 #include <utility>
 
 #include "absl/strings/ascii.h"
+#include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "absl/strings/string_view.h"
 #include "core/common/file_util.h"
@@ -26,21 +27,55 @@ std::string Extension(const std::string& path) {
 
 }  // namespace
 
-absl::StatusOr<LoadedMesh> LoadMeshFile(const std::string& path) {
+absl::StatusOr<RawMesh> LoadRawMeshFile(const std::string& path) {
   const std::string extension = Extension(path);
-  absl::StatusOr<LoadedMesh> (*parse)(std::string_view, const std::string&) = nullptr;
+  absl::StatusOr<RawMesh> (*parse)(std::string_view, const std::string&) = nullptr;
   if (extension == "obj") {
-    parse = &ParseObj;
+    parse = &ParseObjTriangles;
   } else if (extension == "ply") {
-    parse = &ParsePly;
+    parse = &ParsePlyTriangles;
   } else if (extension == "off") {
-    parse = &ParseOff;
+    parse = &ParseOffTriangles;
   } else {
     return absl::InvalidArgumentError(absl::StrFormat(
         "%s: unknown mesh file extension '%s' (expected .obj, .ply or .off)", path, extension));
   }
   GEODEX_ASSIGN_OR_RETURN(const std::string contents, ReadWholeFile(path));
   return parse(contents, path);
+}
+
+absl::StatusOr<LoadedMesh> CreateLoadedMesh(RawMesh raw) {
+  absl::StatusOr<Mesh> mesh =
+      Mesh::Create(std::move(raw.positions), std::move(raw.triangles), raw.name);
+  if (!mesh.ok()) {
+    if (raw.polygons && mesh.status().code() == absl::StatusCode::kInvalidArgument) {
+      return absl::InvalidArgumentError(absl::StrCat(
+          mesh.status().message(),
+          " [face ids count triangles after fan triangulation of the file's polygons]"));
+    }
+    return mesh.status();
+  }
+  return LoadedMesh{*std::move(mesh), std::move(raw.input_face)};
+}
+
+absl::StatusOr<LoadedMesh> LoadMeshFile(const std::string& path) {
+  GEODEX_ASSIGN_OR_RETURN(RawMesh raw, LoadRawMeshFile(path));
+  return CreateLoadedMesh(std::move(raw));
+}
+
+absl::StatusOr<LoadedMesh> ParseObj(std::string_view contents, const std::string& name) {
+  GEODEX_ASSIGN_OR_RETURN(RawMesh raw, ParseObjTriangles(contents, name));
+  return CreateLoadedMesh(std::move(raw));
+}
+
+absl::StatusOr<LoadedMesh> ParsePly(std::string_view contents, const std::string& name) {
+  GEODEX_ASSIGN_OR_RETURN(RawMesh raw, ParsePlyTriangles(contents, name));
+  return CreateLoadedMesh(std::move(raw));
+}
+
+absl::StatusOr<LoadedMesh> ParseOff(std::string_view contents, const std::string& name) {
+  GEODEX_ASSIGN_OR_RETURN(RawMesh raw, ParseOffTriangles(contents, name));
+  return CreateLoadedMesh(std::move(raw));
 }
 
 absl::StatusOr<Mesh> LoadMesh(const std::string& path) {

@@ -32,17 +32,42 @@ struct LoadedMesh {
   std::vector<int32_t> input_face;
 };
 
+// A file's triangles before any validation of their topology or geometry
+// (coordinates are finite and corner ids in range: the readers check those):
+// what core/mesh/mesh_repair.h repairs, or Mesh::Create refuses.
+struct RawMesh {
+  std::string name;  // for error messages (the file name)
+  std::vector<Vec3> positions;
+  std::vector<Triangle> triangles;  // in triangle-id order (see above)
+  // input_face[t] = index of the file face that triangle t came from.
+  std::vector<int32_t> input_face;
+  // True when a file face had more than 3 corners: error messages then say
+  // that face ids count triangles.
+  bool polygons = false;
+};
+
 // Loads the mesh file at `path` with the reader its extension names (.obj,
 // .ply, .off; case-insensitive), keeping the map from triangles to file faces.
 // Errors: InvalidArgument for another extension, and those above.
 absl::StatusOr<LoadedMesh> LoadMeshFile(const std::string& path);
 // LoadMeshFile without the face map: what most callers need.
 absl::StatusOr<Mesh> LoadMesh(const std::string& path);
+// The file's triangles without Mesh::Create's checks, for repair. Errors:
+// those of the readers (malformed files, non-finite coordinates, ids out of
+// range) and of reading the file.
+absl::StatusOr<RawMesh> LoadRawMeshFile(const std::string& path);
+// Mesh::Create on a raw mesh, its InvalidArgument messages noting when face
+// ids count triangles of fan-triangulated polygons.
+absl::StatusOr<LoadedMesh> CreateLoadedMesh(RawMesh raw);
 
 // Parse in-memory file contents; `name` is used in error messages.
 absl::StatusOr<LoadedMesh> ParseObj(std::string_view contents, const std::string& name);
 absl::StatusOr<LoadedMesh> ParsePly(std::string_view contents, const std::string& name);
 absl::StatusOr<LoadedMesh> ParseOff(std::string_view contents, const std::string& name);
+// The same without Mesh::Create's checks (see RawMesh).
+absl::StatusOr<RawMesh> ParseObjTriangles(std::string_view contents, const std::string& name);
+absl::StatusOr<RawMesh> ParsePlyTriangles(std::string_view contents, const std::string& name);
+absl::StatusOr<RawMesh> ParseOffTriangles(std::string_view contents, const std::string& name);
 
 // Writes an ASCII OBJ (v and f lines, 17 significant digits) / binary
 // little-endian PLY (double coordinates, int indices): both read back to the

@@ -17,7 +17,7 @@
 namespace geodex::mesh {
 namespace {
 
-using io_internal::FanTriangulate;
+using io_internal::FanTriangulateRaw;
 using io_internal::LineError;
 using io_internal::LineReader;
 using io_internal::NextToken;
@@ -217,12 +217,12 @@ absl::Status CrossCheckWithTinyObj(std::string_view contents, const std::string&
 
 }  // namespace
 
-absl::StatusOr<LoadedMesh> ParseObj(std::string_view contents, const std::string& name) {
+absl::StatusOr<RawMesh> ParseObjTriangles(std::string_view contents, const std::string& name) {
   std::vector<Vec3> positions;
   ObjFaces faces;
   GEODEX_RETURN_IF_ERROR(ScanObj(contents, name, &positions, &faces));
   GEODEX_RETURN_IF_ERROR(CrossCheckWithTinyObj(contents, name, positions.size(), faces));
-  return FanTriangulate(std::move(positions), faces.corners, faces.face_begin, name);
+  return FanTriangulateRaw(std::move(positions), faces.corners, faces.face_begin, name);
 }
 
 }  // namespace geodex::mesh

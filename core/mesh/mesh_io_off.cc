@@ -15,7 +15,7 @@
 namespace geodex::mesh {
 namespace {
 
-using io_internal::FanTriangulate;
+using io_internal::FanTriangulateRaw;
 using io_internal::LineError;
 using io_internal::LineReader;
 using io_internal::ParseCoordinates;
@@ -40,7 +40,7 @@ bool IsOffKeyword(std::string_view keyword) {
 
 }  // namespace
 
-absl::StatusOr<LoadedMesh> ParseOff(std::string_view contents, const std::string& name) {
+absl::StatusOr<RawMesh> ParseOffTriangles(std::string_view contents, const std::string& name) {
   LineReader reader(contents);
   std::string_view line;
   // Next line with content, comments removed; false at the end of the file.
@@ -148,7 +148,7 @@ absl::StatusOr<LoadedMesh> ParseOff(std::string_view contents, const std::string
                      "unexpected data after the last face (the header counts do not match the "
                      "data)");
   }
-  return FanTriangulate(std::move(positions), corners, face_begin, name);
+  return FanTriangulateRaw(std::move(positions), corners, face_begin, name);
 }
 
 }  // namespace geodex::mesh

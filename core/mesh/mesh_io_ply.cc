@@ -21,7 +21,7 @@
 namespace geodex::mesh {
 namespace {
 
-using io_internal::FanTriangulate;
+using io_internal::FanTriangulateRaw;
 using io_internal::IsBlankLine;
 using io_internal::LineError;
 using io_internal::LineReader;
@@ -554,7 +554,7 @@ absl::Status ReadPlyBody(const PlyHeader& header, Source& source, PlyMeshBuilder
 
 }  // namespace
 
-absl::StatusOr<LoadedMesh> ParsePly(std::string_view contents, const std::string& name) {
+absl::StatusOr<RawMesh> ParsePlyTriangles(std::string_view contents, const std::string& name) {
   GEODEX_ASSIGN_OR_RETURN(const PlyHeader header, ParsePlyHeader(contents, name));
   const std::string_view body = contents.substr(header.body_offset);
   PlyMeshBuilder builder;
@@ -565,7 +565,7 @@ absl::StatusOr<LoadedMesh> ParsePly(std::string_view contents, const std::string
     PlyBinarySource source(body, header.format == PlyFormat::kBinaryBigEndian, name);
     GEODEX_RETURN_IF_ERROR(ReadPlyBody(header, source, &builder));
   }
-  return FanTriangulate(std::move(builder.positions), builder.corners, builder.face_begin, name);
+  return FanTriangulateRaw(std::move(builder.positions), builder.corners, builder.face_begin, name);
 }
 
 }  // namespace geodex::mesh

@@ -92,33 +92,25 @@ absl::Status ParseCoordinates(std::span<const std::string_view> tokens, const st
   return absl::OkStatus();
 }
 
-absl::StatusOr<LoadedMesh> FanTriangulate(std::vector<Vec3> positions,
+absl::StatusOr<RawMesh> FanTriangulateRaw(std::vector<Vec3> positions,
                                           const std::vector<int32_t>& corners,
                                           const std::vector<size_t>& face_begin,
                                           const std::string& name) {
   const size_t num_faces = face_begin.size() - 1;
-  std::vector<Triangle> triangles;
-  std::vector<int32_t> input_face;
-  triangles.reserve(corners.size() - 2 * num_faces);
-  input_face.reserve(corners.size() - 2 * num_faces);
+  RawMesh raw;
+  raw.name = name;
+  raw.triangles.reserve(corners.size() - 2 * num_faces);
+  raw.input_face.reserve(corners.size() - 2 * num_faces);
   for (size_t f = 0; f < num_faces; ++f) {
     const size_t b = face_begin[f], e = face_begin[f + 1];
     for (size_t i = b + 1; i + 1 < e; ++i) {
-      triangles.push_back({corners[b], corners[i], corners[i + 1]});
-      input_face.push_back(static_cast<int32_t>(f));
+      raw.triangles.push_back({corners[b], corners[i], corners[i + 1]});
+      raw.input_face.push_back(static_cast<int32_t>(f));
     }
   }
-  const bool polygons = triangles.size() != num_faces;
-  absl::StatusOr<Mesh> mesh = Mesh::Create(std::move(positions), std::move(triangles), name);
-  if (!mesh.ok()) {
-    if (polygons && mesh.status().code() == absl::StatusCode::kInvalidArgument) {
-      return absl::InvalidArgumentError(absl::StrCat(
-          mesh.status().message(),
-          " [face ids count triangles after fan triangulation of the file's polygons]"));
-    }
-    return mesh.status();
-  }
-  return LoadedMesh{*std::move(mesh), std::move(input_face)};
+  raw.polygons = raw.triangles.size() != num_faces;
+  raw.positions = std::move(positions);
+  return raw;
 }
 
 }  // namespace geodex::mesh::io_internal

@@ -84,9 +84,9 @@ bool ParseInt(std::string_view token, int64_t* value);
 absl::Status ParseCoordinates(std::span<const std::string_view> tokens, const std::string& name,
                               int64_t line, Vec3* p);
 
-// Hands the parsed polygons to Mesh::Create after fan triangulation: face f
-// has the corners [face_begin[f], face_begin[f+1]) of `corners`.
-absl::StatusOr<LoadedMesh> FanTriangulate(std::vector<Vec3> positions,
+// Fan-triangulates the parsed polygons (face f has the corners
+// [face_begin[f], face_begin[f+1]) of `corners`) into a RawMesh.
+absl::StatusOr<RawMesh> FanTriangulateRaw(std::vector<Vec3> positions,
                                           const std::vector<int32_t>& corners,
                                           const std::vector<size_t>& face_begin,
                                           const std::string& name);

@@ -54,6 +54,8 @@ namespace geodex::query {
 
 using mesh::SurfacePoint;
 
+class InputIds;  // core/query/input_ids.h
+
 namespace internal {  // core/query/face_lift.h
 struct FaceLift;
 struct ApproxLift;
@@ -167,6 +169,11 @@ class QueryEngine {
 
   const index::Index& index() const { return *index_; }
   const QueryOptions& options() const { return options_; }
+  // The ids of the mesh file the index was built from (core/query/input_ids.h).
+  // Every method below takes and returns the index's internal ids, which
+  // differ from those when the builder repaired the mesh: requests in input
+  // ids go through input_ids().ToInternal, answers back through its ToInput.
+  const InputIds& input_ids() const { return *input_ids_; }
 
   // Validates a point (mesh::ValidateSurfacePoint with the index's face
   // count and QueryOptions::weight_tolerance): OutOfRange for a face id past
@@ -370,6 +377,7 @@ class QueryEngine {
 
   std::shared_ptr<const index::Index> index_;
   QueryOptions options_;
+  std::unique_ptr<const InputIds> input_ids_;
   MeshView view_;  // the index's positions, faces and twins
   std::span<const float> matrix_;
   std::span<const index::VertexRecord> records_;

@@ -22,10 +22,13 @@ const mesh::Mesh* QueryEngine::ExactMesh() const {
     for (int32_t f = 0; f < ix.num_faces(); ++f) {
       faces[f] = {ix.faces()[3 * f], ix.faces()[3 * f + 1], ix.faces()[3 * f + 2]};
     }
-    // The index was made from a valid mesh; a failure here leaves exact
-    // refinement off (the callers fall back to the other answers).
+    // The index was made from a valid mesh, repaired ones with their
+    // zero-area faces; a failure here leaves exact refinement off (the
+    // callers fall back to the other answers).
+    mesh::MeshOptions mesh_options;
+    mesh_options.allow_zero_area_faces = true;
     absl::StatusOr<mesh::Mesh> m =
-        mesh::Mesh::Create(std::move(positions), std::move(faces), "index");
+        mesh::Mesh::Create(std::move(positions), std::move(faces), "index", mesh_options);
     if (m.ok()) mesh_ = std::make_unique<mesh::Mesh>(*std::move(m));
   });
   return mesh_.get();

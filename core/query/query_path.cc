@@ -368,9 +368,11 @@ absl::StatusOr<std::vector<PathPoint>> QueryEngine::CorridorPath(const std::vect
     }
     triangles.push_back(t);
   }
-  GEODEX_ASSIGN_OR_RETURN(
-      const mesh::Mesh corridor,
-      mesh::Mesh::Create(std::move(positions), std::move(triangles), "path corridor"));
+  mesh::MeshOptions mesh_options;
+  mesh_options.allow_zero_area_faces = true;  // as in the index's mesh
+  GEODEX_ASSIGN_OR_RETURN(const mesh::Mesh corridor,
+                          mesh::Mesh::Create(std::move(positions), std::move(triangles),
+                                             "path corridor", mesh_options));
   auto local = [&](const SurfacePoint& p) { return SurfacePoint{local_face.at(p.face), p.w}; };
   const SurfacePoint from = local(path.front().point), to = local(path.back().point);
   geodesic::ExactGeodesicSolver solver(corridor);

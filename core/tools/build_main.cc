@@ -8,7 +8,11 @@
 //   geodex-build calibrate MESH INDEX.gdx -o OUT.gdx
 //
 // MESH is a .obj/.ply/.off file, or builtin:NAME for a generated demo mesh
-// (torus, sphere, cube, double-torus). --edges-obj writes the geodesic
+// (torus, sphere, cube, double-torus). A file's mesh is repaired where that
+// does not change the surface (core/mesh/mesh_repair.h: duplicate faces,
+// non-manifold edges and vertices, orientation), each repair counted in the
+// build report, and the index answers in the file's ids; --strict refuses
+// such a mesh with the first reason instead. --edges-obj writes the geodesic
 // Delaunay edges as OBJ polylines (v and l lines) to view over the mesh. Exit
 // codes: 0 success, 2 bad input or usage, 1 any other failure.
 
@@ -31,22 +35,38 @@
 #include "core/index/index.h"
 #include "core/mesh/generators.h"
 #include "core/mesh/mesh_io.h"
+#include "core/mesh/mesh_repair.h"
 #include "core/validation/calibration.h"
 #include "core/validation/target_error.h"
 
 namespace geodex {
 namespace {
 
-absl::StatusOr<mesh::Mesh> LoadInput(const std::string& path) {
+// The mesh to build from, repaired unless `strict` (then refused with the
+// first reason, as Mesh::Create gives it).
+absl::StatusOr<mesh::RepairedMesh> LoadInput(const std::string& path, bool strict) {
   const std::string prefix = "builtin:";
-  if (path.rfind(prefix, 0) != 0) return mesh::LoadMesh(path);
+  if (path.rfind(prefix, 0) != 0) {
+    mesh::RepairOptions options;
+    options.strict = strict;
+    return mesh::LoadAndRepairMesh(path, options);
+  }
   const std::string name = path.substr(prefix.size());
-  if (name == "torus") return mesh::gen::Torus(96, 48, 2.0, 0.7);
-  if (name == "sphere") return mesh::gen::Sphere(5, 1.0);
-  if (name == "cube") return mesh::gen::Cube(24, 2.0);
-  if (name == "double-torus") return mesh::gen::DoubleTorus(24, 4.0);
+  if (name == "torus") return mesh::WithoutRepairs(mesh::gen::Torus(96, 48, 2.0, 0.7));
+  if (name == "sphere") return mesh::WithoutRepairs(mesh::gen::Sphere(5, 1.0));
+  if (name == "cube") return mesh::WithoutRepairs(mesh::gen::Cube(24, 2.0));
+  if (name == "double-torus") return mesh::WithoutRepairs(mesh::gen::DoubleTorus(24, 4.0));
   return absl::InvalidArgumentError(
       absl::StrFormat("unknown built-in mesh '%s' (torus, sphere, cube, double-torus)", name));
+}
+
+// The report's mesh_repairs line: the one-line summary.
+std::string RepairLine(const std::string& report) {
+  const std::string key = "mesh_repairs = ";
+  const size_t at = report.find(key);
+  if (at == std::string::npos) return "none recorded";
+  const size_t end = report.find('\n', at);
+  return report.substr(at + key.size(), end == std::string::npos ? end : end - at - key.size());
 }
 
 std::string FormatSeconds(double s) {
@@ -93,9 +113,11 @@ std::string EdgeLine(int32_t edges, int32_t crossings, double total, double long
       edges, crossings, total, longest);
 }
 
-void PrintSummary(const builder::BuildSummary& s, const std::string& out) {
+void PrintSummary(const builder::BuildSummary& s, const std::string& out,
+                  const std::string& repairs) {
   std::printf(
       "geodex-build: wrote %s (%.1f MiB)\n"
+      "  mesh repairs     %s\n"
       "  samples          %d requested, %d final (%s)\n"
       "  triangles        %d geodesic triangles\n"
       "  edges            %s\n"
@@ -103,8 +125,8 @@ void PrintSummary(const builder::BuildSummary& s, const std::string& out) {
       "  outside [-0.01,1.01]  %.4f%% of vertices\n"
       "  longest edge     %.6g (%.4f of the bounding-box diagonal)\n"
       "  time             sampling %s, triangulation %s, rows %s, merge %s\n",
-      out.c_str(), s.index_bytes / 1048576.0, s.requested_samples, s.num_samples, s.repair.c_str(),
-      s.num_triangles,
+      out.c_str(), s.index_bytes / 1048576.0, repairs.c_str(), s.requested_samples, s.num_samples,
+      s.repair.c_str(), s.num_triangles,
       EdgeLine(s.geodesic_edges, s.edge_crossings_found, s.edge_length_total, s.edge_length_max)
           .c_str(),
       static_cast<long long>(s.referenced_vertices), static_cast<long long>(s.unassigned_vertices),
@@ -147,7 +169,7 @@ absl::Status WriteAndReport(const index::IndexData& data, builder::BuildSummary&
   GEODEX_RETURN_IF_ERROR(index::WriteIndexFile(data, out));
   GEODEX_ASSIGN_OR_RETURN(auto loaded, index::Index::Open(out));  // validate what we wrote
   summary.index_bytes = loaded->size_bytes();
-  PrintSummary(summary, out);
+  PrintSummary(summary, out, RepairLine(data.report));
   return absl::OkStatus();
 }
 
@@ -193,6 +215,11 @@ int main(int argc, char** argv) {
   app.add_option("--threads", threads, "Worker threads (0: all cores)")
       ->check(CLI::NonNegativeNumber);
   app.add_option("--edges-obj", edges_obj, "Also write the geodesic edges as OBJ polylines");
+  bool strict = false;
+  const char* kStrictHelp =
+      "Refuse a mesh that needs repair (duplicate faces, non-manifold edges or vertices, "
+      "inconsistent orientation, zero-area faces) with the first reason, instead of repairing it";
+  app.add_flag("--strict", strict, kStrictHelp);
 
   CLI::App* plan_cmd = app.add_subcommand("plan", "Distributed build, step 1: sampling");
   plan_cmd->add_option("mesh", mesh_path, "Mesh file")->required();
@@ -202,6 +229,7 @@ int main(int argc, char** argv) {
   plan_cmd->add_option("--threads", threads, "Worker threads (0: all cores)")
       ->check(CLI::NonNegativeNumber);
   plan_cmd->add_option("--edges-obj", edges_obj, "Also write the geodesic edges as OBJ polylines");
+  plan_cmd->add_flag("--strict", strict, kStrictHelp);
 
   CLI::App* rows_cmd = app.add_subcommand("rows", "Distributed build, step 2: one shard of rows");
   rows_cmd->add_option("workdir", workdir, "Work directory")->required();
@@ -223,6 +251,7 @@ int main(int argc, char** argv) {
   calibrate_cmd->add_option("mesh", mesh_path, "The mesh the index was built from")->required();
   calibrate_cmd->add_option("index", index_path, "Index file (.gdx)")->required();
   calibrate_cmd->add_option("-o,--output", out, "Output index file (.gdx)")->required();
+  calibrate_cmd->add_flag("--strict", strict, kStrictHelp);
 
   CLI11_PARSE(app, argc, argv);
 
@@ -236,9 +265,12 @@ int main(int argc, char** argv) {
   absl::Status status;
   if (*plan_cmd) {
     status = [&]() -> absl::Status {
-      GEODEX_ASSIGN_OR_RETURN(const mesh::Mesh mesh, LoadInput(mesh_path));
+      GEODEX_ASSIGN_OR_RETURN(const mesh::RepairedMesh repaired, LoadInput(mesh_path, strict));
+      const mesh::Mesh& mesh = repaired.mesh;
       GEODEX_ASSIGN_OR_RETURN(const builder::Plan plan, builder::MakePlan(mesh, options));
       GEODEX_RETURN_IF_ERROR(builder::SavePlan(mesh, plan, workdir));
+      GEODEX_RETURN_IF_ERROR(builder::SaveRepair(builder::RecordRepair(repaired), plan, workdir));
+      std::printf("geodex-build plan: mesh repairs: %s\n", repaired.report.Summary().c_str());
       std::printf("geodex-build plan: %d samples (%s), %zu triangles, edges %s, in %s\n",
                   plan.num_samples(), plan.repair.Summary().c_str(), plan.triangles.size(),
                   EdgeLine(plan.edge_stats.count, plan.repair.crossings_found,
@@ -270,13 +302,17 @@ int main(int argc, char** argv) {
       const auto& [mesh, plan] = loaded;
       GEODEX_ASSIGN_OR_RETURN(auto rows, builder::LoadAllRows(plan, workdir));
       builder::BuildSummary summary;
+      GEODEX_ASSIGN_OR_RETURN(const builder::RepairRecord repair,
+                              builder::LoadRepair(plan, workdir));
       GEODEX_ASSIGN_OR_RETURN(auto data, builder::Merge(mesh, plan, std::move(rows), &summary));
+      builder::AddRepair(repair, &data);
       if (!no_calibration) GEODEX_RETURN_IF_ERROR(AddCalibration(mesh, data));
       return WriteAndReport(data, summary, out);
     }();
   } else if (*calibrate_cmd) {
     status = [&]() -> absl::Status {
-      GEODEX_ASSIGN_OR_RETURN(const mesh::Mesh mesh, LoadInput(mesh_path));
+      GEODEX_ASSIGN_OR_RETURN(const mesh::RepairedMesh repaired, LoadInput(mesh_path, strict));
+      const mesh::Mesh& mesh = repaired.mesh;
       GEODEX_ASSIGN_OR_RETURN(auto index, index::Index::Open(index_path));
       if (index->header().mesh_hash !=
           index::MeshHash(builder::FlatPositions(mesh), builder::FlatFaces(mesh))) {
@@ -296,7 +332,9 @@ int main(int argc, char** argv) {
       return 2;
     }
     status = [&]() -> absl::Status {
-      GEODEX_ASSIGN_OR_RETURN(const mesh::Mesh mesh, LoadInput(mesh_path));
+      GEODEX_ASSIGN_OR_RETURN(const mesh::RepairedMesh repaired, LoadInput(mesh_path, strict));
+      const mesh::Mesh& mesh = repaired.mesh;
+      const builder::RepairRecord repair = builder::RecordRepair(repaired);
       if (target_error > 0) {
         validation::TargetErrorOptions target;
         target.target_rms = target_error;
@@ -310,6 +348,7 @@ int main(int argc, char** argv) {
         };
         GEODEX_ASSIGN_OR_RETURN(auto result,
                                 validation::BuildForTargetError(mesh, options, target));
+        builder::AddRepair(repair, &result.data);
         result.data.report += absl::StrFormat(
             "target_error = %.6g\ntarget_error_reached = %s\ntarget_error_rounds = %d\n",
             target_error, result.reached ? "yes" : "no (sample cap)", result.rounds.size());
@@ -325,6 +364,7 @@ int main(int argc, char** argv) {
       GEODEX_RETURN_IF_ERROR(WriteEdges(mesh, plan, edges_obj));
       builder::BuildSummary summary;
       GEODEX_ASSIGN_OR_RETURN(auto data, builder::BuildIndexFromPlan(mesh, plan, options, &summary));
+      builder::AddRepair(repair, &data);
       if (!no_calibration) GEODEX_RETURN_IF_ERROR(AddCalibration(mesh, data));
       return WriteAndReport(data, summary, out);
     }();

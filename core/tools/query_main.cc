@@ -11,7 +11,9 @@
 // FILE holds lines "fa a0 a1 a2 fb b0 b1 b2" (core/mesh/pairs_io.h); SOURCES
 // lines "f w0 w1 w2"; POINTS lines "x y z". "-" reads standard input.
 // --expmap prints "vertex u v" for every vertex within R of the centre (the
-// exponential map, core/query/exp_map.h), ascending by vertex id. Output
+// exponential map, core/query/exp_map.h), ascending by vertex id. Face and
+// vertex ids, in and out, are those of the mesh file the index was built
+// from, also when the builder repaired it (core/query/input_ids.h). Output
 // goes to standard output in input order; on a bad line nothing is printed and
 // the error names the line. Exit codes: 0 ok, 2 bad input, 1 other errors.
 
@@ -25,6 +27,7 @@
 #include "core/common/status_macros.h"
 #include "core/mesh/pairs_io.h"
 #include "core/query/exp_map.h"
+#include "core/query/input_ids.h"
 #include "core/query/query_engine.h"
 
 namespace geodex {
@@ -79,15 +82,17 @@ absl::StatusOr<std::vector<std::vector<double>>> ReadNumberLines(const std::stri
   return lines;
 }
 
-absl::Status CheckPairs(const query::QueryEngine& engine,
-                        const std::vector<mesh::PointPair>& pairs) {
-  for (const mesh::PointPair& pair : pairs) {
-    for (const mesh::SurfacePoint* p : {&pair.a, &pair.b}) {
-      const absl::Status status = engine.Validate(*p);
-      if (!status.ok()) {
-        return absl::Status(status.code(),
-                            absl::StrFormat("line %d: %s", pair.line, status.message()));
+// Validates the points (in input ids) and turns them into the index's ids.
+absl::Status CheckPairs(const query::QueryEngine& engine, std::vector<mesh::PointPair>& pairs) {
+  for (mesh::PointPair& pair : pairs) {
+    for (mesh::SurfacePoint* p : {&pair.a, &pair.b}) {
+      absl::StatusOr<mesh::SurfacePoint> internal =
+          engine.input_ids().ToInternal(*p, engine.options().weight_tolerance);
+      if (!internal.ok()) {
+        return absl::Status(internal.status().code(),
+                            absl::StrFormat("line %d: %s", pair.line, internal.status().message()));
       }
+      *p = *internal;
     }
   }
   return absl::OkStatus();
@@ -119,14 +124,21 @@ absl::Status Run(const Args& args) {
   if (args.info) {
     // The header's counts, then the builder's report (with the accuracy
     // calibration's figures when the index has one).
+    // Vertices and faces count the mesh file's; a repaired mesh's own counts
+    // follow.
     const index::FileHeader& h = index->header();
+    const query::InputIds ids(*index);
     std::string out = absl::StrFormat(
         "format = %d.%d\nbuilder = %s\nvertices = %d\nfaces = %d\nsamples = %d\n"
         "requested_samples = %d\ntriangles = %d\nbytes = %d\nerror_bounds = %s\n",
-        h.format_major, h.format_minor, index->builder_version(), index->num_vertices(),
-        index->num_faces(), index->num_samples(), h.params.requested_samples,
+        h.format_major, h.format_minor, index->builder_version(), ids.num_input_vertices(),
+        ids.num_input_faces(), index->num_samples(), h.params.requested_samples,
         index->num_triangles(), index->size_bytes(),
         index->accuracy() != nullptr ? "yes" : "no (geodex-build calibrate adds them)");
+    if (!ids.identity()) {
+      out += absl::StrFormat("repaired_vertices = %d\nrepaired_faces = %d\n", index->num_vertices(),
+                             index->num_faces());
+    }
     out += index->report();
     std::fwrite(out.data(), 1, out.size(), stdout);
     return absl::OkStatus();
@@ -145,7 +157,7 @@ absl::Status Run(const Args& args) {
     const bool paths = args.pairs.empty();
     GEODEX_ASSIGN_OR_RETURN(const std::string text,
                             mesh::ReadFileOrStdin(paths ? args.paths : args.pairs));
-    GEODEX_ASSIGN_OR_RETURN(const auto pairs, mesh::ParsePairs(text));
+    GEODEX_ASSIGN_OR_RETURN(auto pairs, mesh::ParsePairs(text));
     GEODEX_RETURN_IF_ERROR(CheckPairs(*engine, pairs));
     query::QueryScratch scratch;
     if (paths && args.format == "json") out += "[\n";
@@ -174,6 +186,7 @@ absl::Status Run(const Args& args) {
         return absl::Status(path.status().code(),
                             absl::StrFormat("line %d: %s", pair.line, path.status().message()));
       }
+      engine->input_ids().PathToInput(*path);
       if (args.format == "json") {
         out += "  [";
         for (size_t k = 0; k < path->size(); ++k) {
@@ -196,8 +209,15 @@ absl::Status Run(const Args& args) {
   } else if (!args.field.empty()) {
     GEODEX_ASSIGN_OR_RETURN(const auto lines, ReadNumberLines(args.field, 4));
     std::vector<mesh::SurfacePoint> sources;
-    for (const auto& l : lines) sources.push_back({static_cast<int32_t>(l[0]), {l[1], l[2], l[3]}});
-    GEODEX_ASSIGN_OR_RETURN(const auto field, engine->Field(sources));
+    for (const auto& l : lines) {
+      GEODEX_ASSIGN_OR_RETURN(
+          const mesh::SurfacePoint p,
+          engine->input_ids().ToInternal({static_cast<int32_t>(l[0]), {l[1], l[2], l[3]}},
+                                         engine->options().weight_tolerance));
+      sources.push_back(p);
+    }
+    GEODEX_ASSIGN_OR_RETURN(auto field, engine->Field(sources));
+    field = engine->input_ids().FieldToInput(std::move(field));
     for (size_t v = 0; v < field.distance.size(); ++v) {
       out += mesh::FormatDistance(field.distance[v]);
       if (args.nearest) out += absl::StrFormat(" %d", field.nearest[v]);
@@ -206,7 +226,8 @@ absl::Status Run(const Args& args) {
   } else if (!args.locate.empty()) {
     GEODEX_ASSIGN_OR_RETURN(const auto lines, ReadNumberLines(args.locate, 3));
     for (const auto& l : lines) {
-      GEODEX_ASSIGN_OR_RETURN(const auto located, engine->Locate({l[0], l[1], l[2]}));
+      GEODEX_ASSIGN_OR_RETURN(auto located, engine->Locate({l[0], l[1], l[2]}));
+      located.point = engine->input_ids().ToInput(located.point);
       out += absl::StrFormat("%d %.17g %.17g %.17g %.17g\n", located.point.face, located.point.w[0],
                              located.point.w[1], located.point.w[2], located.distance);
     }
@@ -220,7 +241,8 @@ absl::Status Run(const Args& args) {
           mesh::Vec3(args.direction[0], args.direction[1], args.direction[2]);
     }
     query::QueryScratch scratch;
-    GEODEX_ASSIGN_OR_RETURN(const auto map, query::ExpMap(*engine, centre, map_options, &scratch));
+    GEODEX_ASSIGN_OR_RETURN(const auto map,
+                            query::ExpMapOfInput(*engine, centre, map_options, &scratch));
     for (const query::ExpMapVertex& e : map) {
       out += absl::StrFormat("%d %.17g %.17g\n", e.vertex, e.u, e.v);
     }

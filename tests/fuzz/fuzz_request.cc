@@ -76,7 +76,7 @@ void FuzzLocate(const geodex::v1::LocateRequest& request) {
   for (const geodex::mesh::Vec3& x : positions) {
     auto located = engine.Locate(x);
     if (!located.ok()) return;
-    geodex::server::AppendLocated(*located, &response);
+    geodex::server::AppendLocated(engine.input_ids(), *located, &response);
   }
 }
 

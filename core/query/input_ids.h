@@ -1,0 +1,94 @@
+#pragma once
+
+// The input mesh's ids over an index of a repaired mesh: the one place where
+// requests in input ids become the index's internal ids and answers go back.
+//
+// An index of a mesh the builder repaired (core/mesh/mesh_repair.h, index
+// format 1.2) answers internally on the repaired mesh: duplicate faces
+// dropped, faces re-oriented, non-manifold vertices split into copies. Its
+// callers keep the ids of the file they built it from:
+//   - a point (input face f, weights w) is the point of f's internal face
+//     with the weights permuted as f's corners are (a re-oriented face swaps
+//     corners 1 and 2); a dropped duplicate answers as its twin;
+//   - an internal point goes back to the input face that was kept for its
+//     face, weights permuted back;
+//   - per-vertex answers are per input vertex; where an input vertex was
+//     split, the smallest of its copies' values is given (its distance from
+//     the nearest source, the smallest r of an exponential map): the copies
+//     are the same point of space, reached through different sheets, and the
+//     shortest way to it is the answer.
+// The face count clients see is the input's, so that face ids are validated
+// against the input's range.
+//
+// An index without the sections (not repaired, or older than 1.2) has
+// identity maps: every method returns its argument, and nothing is copied.
+//
+// Thread safety: immutable after construction; every method is const and
+// thread-safe.
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "absl/status/statusor.h"
+#include "core/index/index.h"
+#include "core/mesh/mesh.h"
+#include "core/query/exp_map.h"
+#include "core/query/query_engine.h"
+
+namespace geodex::query {
+
+class InputIds {
+ public:
+  // `index` must outlive this object.
+  explicit InputIds(const index::Index& index);
+
+  // True when input ids are internal ids.
+  bool identity() const { return input_faces_.empty() && vertex_copies_.empty(); }
+  int32_t num_input_faces() const { return num_input_faces_; }
+  int32_t num_input_vertices() const { return num_input_vertices_; }
+
+  // Validates `p` against the input's face count (mesh::ValidateSurfacePoint:
+  // OutOfRange for a face id past the end, InvalidArgument for bad weights)
+  // and returns it as an internal point.
+  absl::StatusOr<mesh::SurfacePoint> ToInternal(const mesh::SurfacePoint& p,
+                                                double tolerance = 1e-6) const;
+  // An internal point in the input face kept for its face.
+  mesh::SurfacePoint ToInput(const mesh::SurfacePoint& p) const;
+  // The input vertex internal vertex `v` is (a copy's original).
+  int32_t InputVertex(int32_t v) const {
+    return v < num_input_vertices_ ? v : vertex_copies_[v - num_input_vertices_];
+  }
+  // True when input face `f` (in range) had its corners 1 and 2 swapped.
+  bool Reoriented(int32_t f) const;
+  // The input vertices of input face `f` (in range), in the input's order.
+  mesh::Triangle InputFace(int32_t f) const;
+
+  // A per-internal-vertex field as a per-input-vertex one: at a split
+  // vertex, the smallest distance of its copies and that copy's nearest
+  // source.
+  DistanceField FieldToInput(DistanceField field) const;
+  // Path points in input faces (positions unchanged).
+  void PathToInput(std::span<PathPoint> path) const;
+
+ private:
+  const index::Index* index_;
+  std::span<const index::InputFaceRecord> input_faces_;
+  std::span<const int32_t> vertex_copies_;
+  int32_t num_input_faces_ = 0;
+  int32_t num_input_vertices_ = 0;
+  // Internal face -> the input face kept for it; empty for identity faces.
+  std::vector<int32_t> kept_input_face_;
+};
+
+// ExpMap with the centre and the answer in input ids: `centre` in an input
+// face; vertices are input vertices, ascending (a split vertex: its copy of
+// smallest r); θ counter-clockwise about the normal of the centre's input
+// face, θ = 0 by default along that face's first input edge. Errors: those
+// of InputIds::ToInternal and ExpMap.
+absl::StatusOr<std::vector<ExpMapVertex>> ExpMapOfInput(const QueryEngine& engine,
+                                                        const mesh::SurfacePoint& centre,
+                                                        ExpMapOptions options,
+                                                        QueryScratch* scratch = nullptr);
+
+}  // namespace geodex::query

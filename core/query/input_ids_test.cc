@@ -1,0 +1,248 @@
+// Queries over indexes of repaired meshes, in the input's ids: a generated
+// broken mesh of each kind is repaired, built and answered.
+
+#include "core/query/input_ids.h"
+
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <memory>
+#include <string>
+
+#include "core/builder/builder.h"
+#include "core/builder/mesh_arrays.h"
+#include "core/index/index.h"
+#include "core/mesh/broken_meshes_testing.h"
+#include "core/mesh/generators.h"
+#include "core/mesh/mesh_repair.h"
+#include "core/query/exp_map.h"
+#include "core/query/query_engine.h"
+#include "gmock/gmock.h"
+#include "gtest/gtest.h"
+
+namespace geodex::query {
+namespace {
+
+using mesh::RawMesh;
+using mesh::RepairedMesh;
+using mesh::SurfacePoint;
+using mesh::testing::AddTriangle;
+using mesh::testing::RawOf;
+
+struct Built {
+  RepairedMesh repaired;
+  std::shared_ptr<const QueryEngine> engine;
+};
+
+// Repairs, builds (as geodex-build does) and loads an index of `raw`.
+Built Build(const RawMesh& raw, int32_t samples) {
+  absl::StatusOr<RepairedMesh> repaired = mesh::RepairMesh(raw);
+  if (!repaired.ok()) throw std::runtime_error(repaired.status().ToString());
+  builder::BuildOptions options;
+  options.num_samples = samples;
+  options.threads = 2;
+  builder::BuildSummary summary;
+  absl::StatusOr<index::IndexData> data = builder::BuildIndex(repaired->mesh, options, &summary);
+  if (!data.ok()) throw std::runtime_error(data.status().ToString());
+  builder::AddRepair(builder::RecordRepair(*repaired), &*data);
+  absl::StatusOr<std::string> bytes = index::SerializeIndex(*data);
+  if (!bytes.ok()) throw std::runtime_error(bytes.status().ToString());
+  auto index = index::Index::FromBytes(*std::move(bytes));
+  if (!index.ok()) throw std::runtime_error(index.status().ToString());
+  auto engine = QueryEngine::Create(*index);
+  if (!engine.ok()) throw std::runtime_error(engine.status().ToString());
+  return {*std::move(repaired), *std::move(engine)};
+}
+
+double InputDistance(const QueryEngine& engine, const SurfacePoint& a, const SurfacePoint& b,
+                     NearPairs near = NearPairs::kPath) {
+  absl::StatusOr<SurfacePoint> p = engine.input_ids().ToInternal(a);
+  absl::StatusOr<SurfacePoint> q = engine.input_ids().ToInternal(b);
+  if (!p.ok() || !q.ok()) throw std::runtime_error("bad point");
+  DistanceOptions options;
+  options.near_pairs = near;
+  absl::StatusOr<double> d = engine.Distance(*p, *q, options);
+  if (!d.ok()) throw std::runtime_error(d.status().ToString());
+  return *d;
+}
+
+TEST(InputIdsTest, IndexWithoutRepairHasIdentityMaps) {
+  Built b = Build(RawOf(mesh::gen::Sphere(2, 1.0), "sphere"), 40);
+  const InputIds& ids = b.engine->input_ids();
+  EXPECT_TRUE(ids.identity());
+  EXPECT_TRUE(b.engine->index().input_faces().empty());
+  EXPECT_EQ(ids.num_input_faces(), 320);
+  const SurfacePoint p{17, {0.2, 0.3, 0.5}};
+  absl::StatusOr<SurfacePoint> q = ids.ToInternal(p);
+  ASSERT_TRUE(q.ok());
+  EXPECT_EQ(q->face, 17);
+  EXPECT_EQ(ids.ToInput(p).w, p.w);
+  EXPECT_EQ(ids.ToInternal({320, {1, 0, 0}}).status().code(), absl::StatusCode::kOutOfRange);
+}
+
+TEST(InputIdsTest, DroppedDuplicateAnswersAsItsTwin) {
+  const mesh::Mesh sphere = mesh::gen::Sphere(2, 1.0);
+  RawMesh raw = RawOf(sphere, "sphere");
+  const mesh::Triangle t = raw.triangles[7];
+  AddTriangle(&raw, {t[1], t[2], t[0]});  // input face 320
+  AddTriangle(&raw, {t[0], t[2], t[1]});  // input face 321
+  Built b = Build(raw, 40);
+  const QueryEngine& e = *b.engine;
+  // The input's face count, so face 321 is valid and 322 is not.
+  EXPECT_EQ(e.input_ids().num_input_faces(), 322);
+  EXPECT_EQ(e.index().num_faces(), 320);
+  EXPECT_EQ(e.input_ids().ToInternal({322, {1, 0, 0}}).status().code(),
+            absl::StatusCode::kOutOfRange);
+  const SurfacePoint far{150, {0.3, 0.3, 0.4}};
+  // The same point of space: weights follow each description's corners.
+  const SurfacePoint on_twin{7, {0.2, 0.3, 0.5}};
+  const SurfacePoint on_rotated{320, {0.3, 0.5, 0.2}};
+  const SurfacePoint on_reversed{321, {0.2, 0.5, 0.3}};
+  const double d = InputDistance(e, on_twin, far);
+  EXPECT_GT(d, 0);
+  EXPECT_EQ(InputDistance(e, on_rotated, far), d);
+  EXPECT_EQ(InputDistance(e, on_reversed, far), d);
+  // Answers name the kept face.
+  absl::StatusOr<SurfacePoint> internal = e.input_ids().ToInternal(on_reversed);
+  ASSERT_TRUE(internal.ok());
+  const SurfacePoint back = e.input_ids().ToInput(*internal);
+  EXPECT_EQ(back.face, 7);
+  EXPECT_EQ(back.w, on_twin.w);
+}
+
+TEST(InputIdsTest, ReorientedFacesKeepTheirInputWeights) {
+  const mesh::Mesh sphere = mesh::gen::Sphere(2, 1.0);
+  RawMesh raw = RawOf(sphere, "sphere");
+  for (int32_t f : {0, 5, 17, 200}) std::swap(raw.triangles[f][1], raw.triangles[f][2]);
+  Built b = Build(raw, 40);
+  const QueryEngine& e = *b.engine;
+  // Input face 5 is (a, c, b) of the sphere's (a, b, c): weights (x, y, z) on
+  // it are (x, z, y) on the sphere's face 5.
+  const SurfacePoint far{150, {0.3, 0.3, 0.4}};
+  Built reference = Build(RawOf(sphere, "sphere"), 40);
+  EXPECT_EQ(InputDistance(e, {5, {0.1, 0.2, 0.7}}, far),
+            InputDistance(*reference.engine, {5, {0.1, 0.7, 0.2}}, far));
+  // A path from a re-oriented face starts there, in its input weights.
+  absl::StatusOr<SurfacePoint> from = e.input_ids().ToInternal({5, {0.1, 0.2, 0.7}});
+  absl::StatusOr<SurfacePoint> to = e.input_ids().ToInternal(far);
+  ASSERT_TRUE(from.ok() && to.ok());
+  absl::StatusOr<std::vector<PathPoint>> path = e.Path(*from, *to);
+  ASSERT_TRUE(path.ok()) << path.status();
+  e.input_ids().PathToInput(*path);
+  EXPECT_EQ(path->front().point.face, 5);
+  EXPECT_NEAR(path->front().point.w[1], 0.2, 1e-12);
+  EXPECT_NEAR(path->front().point.w[2], 0.7, 1e-12);
+  EXPECT_EQ(path->back().point.face, 150);
+  // The exponential map's θ runs round the input face's normal: mirrored
+  // against the internal face's.
+  ExpMapOptions map_options;
+  map_options.radius = 0.5;
+  absl::StatusOr<std::vector<ExpMapVertex>> mirrored =
+      ExpMapOfInput(e, {5, {0.1, 0.2, 0.7}}, map_options);
+  absl::StatusOr<std::vector<ExpMapVertex>> plain =
+      ExpMapOfInput(*reference.engine, {5, {0.1, 0.7, 0.2}}, map_options);
+  ASSERT_TRUE(mirrored.ok() && plain.ok());
+  ASSERT_EQ(mirrored->size(), plain->size());
+  ASSERT_FALSE(plain->empty());
+  for (size_t i = 0; i < plain->size(); ++i) {
+    EXPECT_EQ((*mirrored)[i].vertex, (*plain)[i].vertex);
+    EXPECT_NEAR((*mirrored)[i].r, (*plain)[i].r, 1e-9);
+  }
+}
+
+TEST(InputIdsTest, SplitVertexFieldTakesTheSmallestCopy) {
+  const RawMesh raw = mesh::testing::TwoPyramidsApexToApex();
+  Built b = Build(raw, 10);
+  const QueryEngine& e = *b.engine;
+  ASSERT_EQ(e.index().vertex_copies().size(), 1u);
+  EXPECT_EQ(e.input_ids().num_input_vertices(), 9);
+  // A source on the first pyramid: its copy of the apex is reached, the
+  // other pyramid is another component.
+  absl::StatusOr<SurfacePoint> source = e.input_ids().ToInternal({0, {0.2, 0.3, 0.5}});
+  ASSERT_TRUE(source.ok());
+  absl::StatusOr<DistanceField> field = e.Field(std::vector<SurfacePoint>{*source});
+  ASSERT_TRUE(field.ok());
+  ASSERT_EQ(field->distance.size(), 10u);
+  const double apex_copy = field->distance[9];
+  const DistanceField input = e.input_ids().FieldToInput(*field);
+  ASSERT_EQ(input.distance.size(), 9u);
+  EXPECT_EQ(input.distance[0], std::min(field->distance[0], apex_copy));
+  EXPECT_TRUE(std::isfinite(input.distance[0]));
+  EXPECT_EQ(e.input_ids().InputVertex(9), 0);
+}
+
+TEST(InputIdsTest, CubesSharingAnEdgeBuildAndAnswer) {
+  Built b = Build(mesh::testing::TwoCubesSharingAnEdge(), 16);
+  const QueryEngine& e = *b.engine;
+  // Across one face of the first cube: a straight line.
+  const double d = InputDistance(e, {0, {1.0 / 3, 1.0 / 3, 1.0 / 3}},
+                                 {1, {1.0 / 3, 1.0 / 3, 1.0 / 3}}, NearPairs::kExact);
+  EXPECT_TRUE(std::isfinite(d));
+  // The two cubes are separate surfaces once the edge is cut.
+  EXPECT_EQ(InputDistance(e, {0, {1, 0, 0}}, {12, {0.2, 0.3, 0.5}}),
+            std::numeric_limits<double>::infinity());
+}
+
+TEST(InputIdsTest, ZeroAreaFaceBuildsAndAnswersFiniteDistances) {
+  RawMesh raw = RawOf(mesh::gen::Grid(8, 8, 1, 1), "grid");
+  const int32_t degenerate = mesh::testing::AddZeroAreaFace(&raw, 60);
+  Built b = Build(raw, 30);
+  const QueryEngine& e = *b.engine;
+  ASSERT_EQ(b.repaired.report.zero_area_faces, 1);
+  // Points on the zero-area face, and across it: the grid is flat and
+  // convex, so distances are Euclidean.
+  const std::vector<SurfacePoint> points = {
+      {degenerate, {0.2, 0.3, 0.5}}, {degenerate, {1, 0, 0}},  {60, {0.3, 0.3, 0.4}},
+      {0, {0.2, 0.2, 0.6}},          {127, {0.5, 0.25, 0.25}}, {degenerate - 1, {0.6, 0.2, 0.2}}};
+  const mesh::Mesh& m = b.repaired.mesh;
+  for (const SurfacePoint& p : points) {
+    for (const SurfacePoint& q : points) {
+      for (NearPairs near : {NearPairs::kPath, NearPairs::kUnfold, NearPairs::kExact}) {
+        const double d = InputDistance(e, p, q, near);
+        const double euclid = (mesh::PositionOf(m, p) - mesh::PositionOf(m, q)).norm();
+        EXPECT_TRUE(std::isfinite(d)) << p.face << " " << q.face;
+        EXPECT_NEAR(d, euclid, 0.05) << p.face << " " << q.face << " mode " << int(near);
+      }
+      absl::StatusOr<std::vector<PathPoint>> path = e.Path(p, q);
+      ASSERT_TRUE(path.ok()) << path.status();
+      for (const PathPoint& x : *path) EXPECT_TRUE(x.position.allFinite());
+    }
+  }
+  absl::StatusOr<DistanceField> field = e.Field(std::vector<SurfacePoint>{points[0]});
+  ASSERT_TRUE(field.ok());
+  for (double d : field->distance) EXPECT_TRUE(std::isfinite(d));
+  absl::StatusOr<LocatedPoint> located = e.Locate(mesh::PositionOf(m, points[0]));
+  ASSERT_TRUE(located.ok());
+  EXPECT_NEAR(located->distance, 0, 1e-12);
+}
+
+// The development meshes, when present: cow_nonmanifold_3k (one non-manifold
+// vertex) builds once repaired and answers.
+TEST(InputIdsTest, CowNonmanifoldBuildsAndAnswers) {
+  const char* env = std::getenv("GEODEX_SHARED_MESHES");
+  const std::string dir = env != nullptr && *env != '\0'
+                              ? std::string(env)
+                              : std::string(GEODEX_SOURCE_DIR) + "/../shared/meshes";
+  const std::string path = dir + "/cow_nonmanifold_3k.obj";
+  if (!std::filesystem::exists(path)) {
+    GTEST_SKIP() << "no " << path
+                 << " (set GEODEX_SHARED_MESHES, or place the meshes in <source>/../shared/meshes)";
+  }
+  absl::StatusOr<RawMesh> raw = mesh::LoadRawMeshFile(path);
+  ASSERT_TRUE(raw.ok()) << raw.status();
+  Built b = Build(*raw, 100);
+  EXPECT_EQ(b.repaired.report.nonmanifold_vertices, 1);
+  EXPECT_THAT(std::string(b.engine->index().report()),
+              ::testing::HasSubstr("mesh_repairs = 1 non-manifold vertex split (2 copies)"));
+  const double d = InputDistance(*b.engine, {0, {0.2, 0.3, 0.5}}, {1000, {0.3, 0.3, 0.4}});
+  EXPECT_TRUE(std::isfinite(d));
+  EXPECT_GT(d, 0);
+  mesh::RepairOptions strict;
+  strict.strict = true;
+  const absl::StatusOr<RepairedMesh> refused = mesh::RepairMesh(*raw, strict);
+  ASSERT_FALSE(refused.ok());
+  EXPECT_THAT(refused.status().message(), ::testing::HasSubstr("non-manifold vertex"));
+}
+
+}  // namespace
+}  // namespace geodex::query
