@@ -39,14 +39,20 @@ ExactGeodesicSolver::ExactGeodesicSolver(const Mesh& mesh) : mesh_(mesh) {
     const Vec3 ab = mesh.position(mesh.Dest(h)) - a;
     const Vec3 ac = mesh.position(mesh.Opposite(h)) - a;
     const double l = mesh.Length(h);
-    frame_[h] = {l, ab.dot(ac) / l, std::max(ab.cross(ac).norm() / l, 1e-300)};
+    // An edge of length 0 (two corners at one position, kept by mesh repair)
+    // carries no window; its frame only has to be free of NaN.
+    frame_[h] = l > 0 ? Frame{l, ab.dot(ac) / l, std::max(ab.cross(ac).norm() / l, 1e-300)}
+                      : Frame{0, 0, 1e-300};
   }
   corner_angle_.resize(nh);
   for (int32_t h = 0; h < nh; ++h) corner_angle_[h] = std::atan2(frame_[h].cy, frame_[h].cx);
   emits_.resize(mesh.num_vertices());
+  pinched_.resize(mesh.num_vertices());
   for (int32_t v = 0; v < mesh.num_vertices(); ++v) {
-    emits_[v] = mesh.IsReferenced(v) && (mesh.IsBoundaryVertex(v) ||
-                                         mesh.AngleSum(v) >= 2 * std::numbers::pi - kSaddleSlack);
+    pinched_[v] = mesh::TouchesZeroLengthEdge(mesh, v);
+    emits_[v] = mesh.IsReferenced(v) &&
+                (mesh.IsBoundaryVertex(v) || pinched_[v] ||
+                 mesh.AngleSum(v) >= 2 * std::numbers::pi - kSaddleSlack);
   }
 }
 
@@ -217,6 +223,9 @@ void ExactGeodesicSolver::AddFaceSource(int32_t face, const std::array<double, 3
 double ExactGeodesicSolver::BackAngle(int32_t v) const {
   // Angles around v are measured counter-clockwise from the first outgoing
   // half-edge; corner k spans [phi_k, phi_k + angle of corner k].
+  // At a pinch (an edge of length 0) the corner angles say nothing of the
+  // directions: emit everywhere.
+  if (pinched_[v]) return -1;
   const VertexOrigin& o = origin_[v];
   const auto fan = mesh_.Outgoing(v);
   if (o.via == Via::kWindow) {

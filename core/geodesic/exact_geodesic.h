@@ -176,6 +176,7 @@ class ExactGeodesicSolver {
   std::vector<Frame> frame_;
   std::vector<double> corner_angle_;  // angle at Origin(h) in FaceOf(h)
   std::vector<uint8_t> emits_;        // saddle or boundary vertex: a pseudo-source
+  std::vector<uint8_t> pinched_;      // an end of an edge of length 0
 
   std::vector<double> dist_;
   std::vector<int32_t> nearest_;

@@ -60,12 +60,18 @@ VertexGeodesicSolver::VertexGeodesicSolver(const Mesh& mesh) : mesh_(mesh) {
     const Vec3 ab = mesh.position(mesh.Dest(h)) - a;
     const Vec3 ac = mesh.position(mesh.Opposite(h)) - a;
     const double l = mesh.Length(h);
-    frame_[h] = {l, ab.dot(ac) / l, std::max(ab.cross(ac).norm() / l, 1e-300)};
+    // An edge of length 0 (two corners at one position, kept by mesh repair)
+    // carries no window; its frame only has to be free of NaN.
+    frame_[h] = l > 0 ? Frame{l, ab.dot(ac) / l, std::max(ab.cross(ac).norm() / l, 1e-300)}
+                      : Frame{0, 0, 1e-300};
   }
   emits_.resize(mesh.num_vertices());
   for (int32_t v = 0; v < mesh.num_vertices(); ++v) {
-    emits_[v] = mesh.IsReferenced(v) && (mesh.IsBoundaryVertex(v) ||
-                                         mesh.AngleSum(v) > 2 * std::numbers::pi + kSaddleSlack);
+    // A pinch (an end of an edge of length 0, kept by mesh repair) is a
+    // cone point of unknown angle: a pseudo-source, to be safe.
+    emits_[v] = mesh.IsReferenced(v) &&
+                (mesh.IsBoundaryVertex(v) || mesh::TouchesZeroLengthEdge(mesh, v) ||
+                 mesh.AngleSum(v) > 2 * std::numbers::pi + kSaddleSlack);
   }
   head_.assign(nh, kNone);
   queued_.assign(nh, 0);

@@ -302,4 +302,11 @@ absl::StatusOr<SurfacePoint> VertexPoint(const Mesh& mesh, int32_t v) {
   return p;
 }
 
+bool TouchesZeroLengthEdge(const Mesh& mesh, int32_t v) {
+  for (const int32_t o : mesh.Outgoing(v)) {
+    if (!(mesh.Length(o) > 0) || !(mesh.Length(Mesh::Prev(o)) > 0)) return true;
+  }
+  return false;
+}
+
 }  // namespace geodex::mesh

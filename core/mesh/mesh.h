@@ -153,4 +153,8 @@ absl::Status ValidateSurfacePoint(int32_t num_faces, const SurfacePoint& p,
 // OutOfRange for a bad id, FailedPrecondition for an unreferenced vertex.
 absl::StatusOr<SurfacePoint> VertexPoint(const Mesh& mesh, int32_t v);
 
+// Whether `v` is an end of an edge of length 0 (two corners at one position,
+// which mesh repair keeps).
+bool TouchesZeroLengthEdge(const Mesh& mesh, int32_t v);
+
 }  // namespace geodex::mesh
