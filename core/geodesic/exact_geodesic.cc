@@ -54,18 +54,10 @@ absl::Status ExactGeodesicSolver::Propagate(std::span<const SurfacePoint> source
   for (const SurfacePoint& s : sources) {
     GEODEX_RETURN_IF_ERROR(mesh::ValidateSurfacePoint(mesh_, s));
   }
+  GEODEX_RETURN_IF_ERROR(CheckInitialDistances(options.initial_distance, mesh_.num_vertices()));
   if (!options.initial_distance.empty()) {
-    if (options.initial_distance.size() != static_cast<size_t>(mesh_.num_vertices())) {
-      return absl::InvalidArgumentError(
-          absl::StrFormat("initial_distance has %d entries, the mesh %d vertices",
-                          options.initial_distance.size(), mesh_.num_vertices()));
-    }
     for (int32_t v = 0; v < mesh_.num_vertices(); ++v) {
       const double d = options.initial_distance[v];
-      if (std::isnan(d) || d < 0) {
-        return absl::InvalidArgumentError(
-            absl::StrFormat("initial_distance[%d] = %g is not a distance", v, d));
-      }
       if (d < kInfinity) {
         dist_[v] = d;
         origin_[v] = {Via::kInitial, kNone};

@@ -132,20 +132,9 @@ absl::Status VertexGeodesicSolver::Propagate(std::span<const SurfacePoint> sourc
 }
 
 absl::Status VertexGeodesicSolver::Start(const VertexGeodesicOptions& options) {
+  GEODEX_RETURN_IF_ERROR(CheckInitialDistances(options.initial_distance, mesh_.num_vertices()));
   if (!options.initial_distance.empty()) {
-    if (options.initial_distance.size() != static_cast<size_t>(mesh_.num_vertices())) {
-      return absl::InvalidArgumentError(
-          absl::StrFormat("initial_distance has %d entries, the mesh %d vertices",
-                          options.initial_distance.size(), mesh_.num_vertices()));
-    }
-    for (int32_t v = 0; v < mesh_.num_vertices(); ++v) {
-      const double d = options.initial_distance[v];
-      if (std::isnan(d) || d < 0) {
-        return absl::InvalidArgumentError(
-            absl::StrFormat("initial_distance[%d] = %g is not a distance", v, d));
-      }
-      dist_[v] = d;
-    }
+    std::copy(options.initial_distance.begin(), options.initial_distance.end(), dist_.begin());
   }
   for (const SurfacePoint& q : options.targets) {
     GEODEX_RETURN_IF_ERROR(mesh::ValidateSurfacePoint(mesh_, q));

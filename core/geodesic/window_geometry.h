@@ -2,7 +2,8 @@
 
 // The plane geometry both exact engines share (ExactGeodesicSolver and
 // VertexGeodesicSolver): each half-edge's frame, a window's children across
-// its face, and the filter by the face's corners. A window lies on the edge
+// its face, the filter by the face's corners, and the classification and
+// checks of what a propagation starts from. A window lies on the edge
 // of a half-edge h and looks into FaceOf(h): the interval [b0,b1] measured
 // from Origin(h), lit by a pseudo-source (sx,sy), sy <= 0, unfolded into h's
 // frame at geodesic distance sigma from the source.
@@ -11,8 +12,11 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <span>
 #include <vector>
 
+#include "absl/status/status.h"
+#include "absl/strings/str_format.h"
 #include "core/mesh/mesh.h"
 
 namespace geodex::geodesic {
@@ -167,6 +171,23 @@ inline std::array<double, 3> WeightsInTwin(int32_t h, int32_t g, const std::arra
   wg[g % 3] = w[(h + 1) % 3];  // Origin(g) = Dest(h)
   wg[(g + 1) % 3] = w[h % 3];
   return wg;
+}
+
+// Checks a propagation's initial distances: empty, or one non-negative,
+// non-NaN value per vertex (+inf allowed). InvalidArgument otherwise.
+inline absl::Status CheckInitialDistances(std::span<const double> initial, int32_t num_vertices) {
+  if (initial.empty()) return absl::OkStatus();
+  if (initial.size() != static_cast<size_t>(num_vertices)) {
+    return absl::InvalidArgumentError(absl::StrFormat(
+        "initial_distance has %d entries, the mesh %d vertices", initial.size(), num_vertices));
+  }
+  for (int32_t v = 0; v < num_vertices; ++v) {
+    if (std::isnan(initial[v]) || initial[v] < 0) {
+      return absl::InvalidArgumentError(
+          absl::StrFormat("initial_distance[%d] = %g is not a distance", v, initial[v]));
+    }
+  }
+  return absl::OkStatus();
 }
 
 }  // namespace geodex::geodesic
