@@ -13,37 +13,15 @@ namespace {
 using mesh::kNone;
 using mesh::Vec3;
 
-// A window is discarded only when a vertex offers a path shorter by more than
-// this fraction of the window's own distances, so rounding never discards a
-// window that carries a shortest path.
-constexpr double kFilterSlack = 1e-12;
-// Barycentric weights below this count as zero when classifying sources.
-constexpr double kSnap = 1e-12;
 // Vertices whose angle sum reaches 2*pi minus this are treated as saddles
 // (pseudo-sources): it keeps flat vertices exact despite rounding.
 constexpr double kSaddleSlack = 1e-9;
 
-// sqrt(x^2 + y^2): distances here never approach overflow, and std::hypot's
-// overflow care costs a third of the propagation time.
-inline double Hypot(double x, double y) { return std::sqrt(x * x + y * y); }
-
 }  // namespace
 
-ExactGeodesicSolver::ExactGeodesicSolver(const Mesh& mesh) : mesh_(mesh) {
+ExactGeodesicSolver::ExactGeodesicSolver(const Mesh& mesh)
+    : mesh_(mesh), frame_(HalfEdgeFrames(mesh)) {
   const int32_t nh = mesh.num_halfedges();
-  frame_.resize(nh);
-  for (int32_t h = 0; h < nh; ++h) {
-    // From positions rather than edge lengths: the law of cosines loses half
-    // the digits of cy on sliver triangles, the cross product does not.
-    const Vec3& a = mesh.position(mesh.Origin(h));
-    const Vec3 ab = mesh.position(mesh.Dest(h)) - a;
-    const Vec3 ac = mesh.position(mesh.Opposite(h)) - a;
-    const double l = mesh.Length(h);
-    // An edge of length 0 (two corners at one position, kept by mesh repair)
-    // carries no window; its frame only has to be free of NaN.
-    frame_[h] = l > 0 ? Frame{l, ab.dot(ac) / l, std::max(ab.cross(ac).norm() / l, 1e-300)}
-                      : Frame{0, 0, 1e-300};
-  }
   corner_angle_.resize(nh);
   for (int32_t h = 0; h < nh; ++h) corner_angle_[h] = std::atan2(frame_[h].cy, frame_[h].cx);
   emits_.resize(mesh.num_vertices());
@@ -76,18 +54,10 @@ absl::Status ExactGeodesicSolver::Propagate(std::span<const SurfacePoint> source
   for (const SurfacePoint& s : sources) {
     GEODEX_RETURN_IF_ERROR(mesh::ValidateSurfacePoint(mesh_, s));
   }
+  GEODEX_RETURN_IF_ERROR(CheckInitialDistances(options.initial_distance, mesh_.num_vertices()));
   if (!options.initial_distance.empty()) {
-    if (options.initial_distance.size() != static_cast<size_t>(mesh_.num_vertices())) {
-      return absl::InvalidArgumentError(
-          absl::StrFormat("initial_distance has %d entries, the mesh %d vertices",
-                          options.initial_distance.size(), mesh_.num_vertices()));
-    }
     for (int32_t v = 0; v < mesh_.num_vertices(); ++v) {
       const double d = options.initial_distance[v];
-      if (std::isnan(d) || d < 0) {
-        return absl::InvalidArgumentError(
-            absl::StrFormat("initial_distance[%d] = %g is not a distance", v, d));
-      }
       if (d < kInfinity) {
         dist_[v] = d;
         origin_[v] = {Via::kInitial, kNone};
@@ -147,18 +117,9 @@ absl::Status ExactGeodesicSolver::Propagate(std::span<const SurfacePoint> source
 }
 
 absl::Status ExactGeodesicSolver::AddSource(const SurfacePoint& p, int32_t source) {
-  const mesh::Triangle& t = mesh_.face(p.face);
-  int zeros = 0;
-  int nonzero = 0;
-  for (int i = 0; i < 3; ++i) {
-    if (p.w[i] <= kSnap) {
-      ++zeros;
-    } else {
-      nonzero = i;
-    }
-  }
-  if (zeros >= 2) {  // at a vertex
-    const int32_t v = t[nonzero];
+  const SourcePlace place = ClassifySource(mesh_, p);
+  if (place.kind == SourcePlace::kVertex) {
+    const int32_t v = place.vertex;
     if (dist_[v] > 0 || origin_[v].via == Via::kInitial) {
       dist_[v] = 0;
       nearest_[v] = source;
@@ -167,27 +128,15 @@ absl::Status ExactGeodesicSolver::AddSource(const SurfacePoint& p, int32_t sourc
     }
     return absl::OkStatus();
   }
-  std::array<double, 3> w = p.w;
-  const double sum = w[0] + w[1] + w[2];
-  for (double& x : w) x /= sum;
-  if (zeros == 1) {  // on an edge: both faces hold the source
-    int zero = 0;
-    for (int i = 0; i < 3; ++i) {
-      if (w[i] <= kSnap) zero = i;
-    }
-    w[zero] = 0;
-    const int32_t h = 3 * p.face + (zero + 1) % 3;  // the edge opposite the zero weight
-    AddFaceSource(p.face, w, source, h);
-    const int32_t g = mesh_.Twin(h);
-    if (g != kNone) {
-      std::array<double, 3> wg = {0, 0, 0};
-      wg[g % 3] = w[(h + 1) % 3];  // Origin(g) = Dest(h)
-      wg[(g + 1) % 3] = w[h % 3];
-      AddFaceSource(Mesh::FaceOf(g), wg, source, g);
-    }
-  } else {
-    AddFaceSource(p.face, w, source, kNone);
+  if (place.kind == SourcePlace::kFace) {
+    AddFaceSource(p.face, place.w, source, kNone);
+    return absl::OkStatus();
   }
+  // On an edge: both faces hold the source.
+  const int32_t h = place.halfedge;
+  AddFaceSource(p.face, place.w, source, h);
+  const int32_t g = mesh_.Twin(h);
+  if (g != kNone) AddFaceSource(Mesh::FaceOf(g), WeightsInTwin(h, g, place.w), source, g);
   return absl::OkStatus();
 }
 
@@ -230,7 +179,7 @@ double ExactGeodesicSolver::BackAngle(int32_t v) const {
   const auto fan = mesh_.Outgoing(v);
   if (o.via == Via::kWindow) {
     const Window& w = windows_[o.id];
-    const Frame& f = frame_[w.h];
+    const HalfEdgeFrame& f = frame_[w.h];
     // v = C of the window's face; its corner there starts at C->A.
     const int32_t corner = Mesh::Prev(w.h);
     const double ax = -f.cx, ay = -f.cy;              // A - C
@@ -295,7 +244,7 @@ void ExactGeodesicSolver::EmitFromVertex(int32_t v) {
       const double a1 = std::min(shadow[k].second - phi, theta);
       if (!(a1 > a0)) continue;
       // Fraction along Dest(o) -> Opposite(o) hit by the ray at angle a.
-      const Frame& fo = frame_[o];
+      const HalfEdgeFrame& fo = frame_[o];
       auto hit = [&](double a) {
         if (a <= 0) return 0.0;
         if (a >= theta) return 1.0;
@@ -303,7 +252,7 @@ void ExactGeodesicSolver::EmitFromVertex(int32_t v) {
         const double den = c * fo.cy - s * (fo.cx - fo.length);
         return den > 0 ? std::clamp(fo.length * s / den, 0.0, 1.0) : 1.0;
       };
-      const Frame& fg = frame_[g];
+      const HalfEdgeFrame& fg = frame_[g];
       Window win{};
       win.b0 = (1 - hit(a1)) * fg.length;
       win.b1 = (1 - hit(a0)) * fg.length;
@@ -336,26 +285,8 @@ double ExactGeodesicSolver::MinDistance(const Window& w) const {
 }
 
 bool ExactGeodesicSolver::IsUseless(const Window& w) const {
-  const Frame& f = frame_[w.h];
-  const double d0 = w.sigma + Hypot(w.b0 - w.sx, w.sy);
-  const double d1 = w.sigma + Hypot(w.b1 - w.sx, w.sy);
-  const double slack = kFilterSlack * std::max(d0, d1);
-  // Paper (Xin & Wang 2009) filter. The origin A offers d(A) + |A P| to every
-  // point P of [b0,b1]; compared with the window's sigma + |S P| the
-  // difference only grows with P, so checking the far end b1 suffices.
-  const double da = dist_[mesh_.Origin(w.h)];
-  if (da + w.b1 + slack < d1) return true;
-  const double db = dist_[mesh_.Dest(w.h)];
-  if (db + (f.length - w.b0) + slack < d0) return true;
-  // The opposite vertex C: where d(C) >= sigma the set of points that C
-  // reaches sooner is convex (bounded by a hyperbola branch around C), so
-  // both interval ends inside it put the whole interval inside.
-  const double dc = dist_[mesh_.Opposite(w.h)];
-  if (dc >= w.sigma && dc + Hypot(w.b0 - f.cx, f.cy) + slack < d0 &&
-      dc + Hypot(w.b1 - f.cx, f.cy) + slack < d1) {
-    return true;
-  }
-  return false;
+  return CornersReachSooner(frame_[w.h], dist_[mesh_.Origin(w.h)], dist_[mesh_.Dest(w.h)],
+                            dist_[mesh_.Opposite(w.h)], w.b0, w.b1, w.sx, w.sy, w.sigma);
 }
 
 void ExactGeodesicSolver::PushWindow(const Window& w) {
@@ -374,9 +305,9 @@ void ExactGeodesicSolver::PushWindow(const Window& w) {
 void ExactGeodesicSolver::PropagateWindow(int32_t index) {
   const Window w = windows_[index];
   const int32_t h = w.h;
-  const Frame& f = frame_[h];
+  const HalfEdgeFrame& f = frame_[h];
   // Where the ray from the pseudo-source through C crosses this edge.
-  const double xc = w.sx + (f.cx - w.sx) * (-w.sy) / (f.cy - w.sy);
+  const double xc = RayThroughC(f, w.sx, w.sy);
   const double eps = 1e-12 * f.length;
   if (xc >= w.b0 - eps && xc <= w.b1 + eps) {
     UpdateVertex(mesh_.Opposite(h), w.sigma + Hypot(f.cx - w.sx, f.cy - w.sy), w.source,
@@ -407,47 +338,23 @@ void ExactGeodesicSolver::PropagateWindow(int32_t index) {
   child.pseudo = kNone;
   child.source = w.source;
 
-  // Rays through [b0, left_end] leave through edge A->C (A = origin).
+  // Rays through [b0, left_end] leave through edge A->C (A = origin), those
+  // through [right_begin, b1] through C->B.
   if (w.b0 < left_end) {
     const int32_t t = mesh_.Twin(Mesh::Prev(h));
     if (t != kNone) {
-      auto hit = [&](double b) {  // fraction along A->C hit by the ray through (b,0)
-        if (b >= xc) return 1.0;
-        const double den = f.cy * (b - w.sx) + f.cx * w.sy;
-        if (!(std::abs(den) > 0)) return 0.0;
-        return std::clamp(w.sy * b / den, 0.0, 1.0);
-      };
-      const double l = frame_[t].length;
-      child.b0 = hit(w.b0) * l;
-      child.b1 = hit(left_end) * l;
-      const double ux = f.cx / l, uy = f.cy / l;
-      child.sx = ux * w.sx + uy * w.sy;
-      child.sy = std::min(ux * w.sy - uy * w.sx, 0.0);
-      child.h = t;
+      const ChildWindow c =
+          ChildAcrossAC(f, frame_[t].length, w.sx, w.sy, xc, w.b0, left_end);
+      child.b0 = c.b0, child.b1 = c.b1, child.sx = c.sx, child.sy = c.sy, child.h = t;
       PushWindow(child);
     }
   }
-  // Rays through [right_begin, b1] leave through edge C->B.
   if (right_begin < w.b1) {
     const int32_t t = mesh_.Twin(Mesh::Next(h));
     if (t != kNone) {
-      const double bx = f.length - f.cx, by = -f.cy;  // B - C
-      auto hit = [&](double b) {                      // fraction along C->B
-        if (b <= xc) return 0.0;
-        const double dx = b - w.sx, dy = -w.sy;
-        const double num = (w.sx - f.cx) * dy - (w.sy - f.cy) * dx;
-        const double den = bx * dy - by * dx;
-        if (!(std::abs(den) > 0)) return 1.0;
-        return std::clamp(num / den, 0.0, 1.0);
-      };
-      const double l = frame_[t].length;
-      child.b0 = hit(right_begin) * l;
-      child.b1 = hit(w.b1) * l;
-      const double ux = bx / l, uy = by / l;
-      const double rx = w.sx - f.cx, ry = w.sy - f.cy;
-      child.sx = ux * rx + uy * ry;
-      child.sy = std::min(ux * ry - uy * rx, 0.0);
-      child.h = t;
+      const ChildWindow c =
+          ChildAcrossCB(f, frame_[t].length, w.sx, w.sy, xc, right_begin, w.b1);
+      child.b0 = c.b0, child.b1 = c.b1, child.sx = c.sx, child.sy = c.sy, child.h = t;
       PushWindow(child);
     }
   }
@@ -464,10 +371,7 @@ bool ExactGeodesicSolver::TargetsSettled(double key) const {
 }
 
 std::array<double, 2> ExactGeodesicSolver::InFrame(int32_t h, const SurfacePoint& p) const {
-  const Frame& f = frame_[h];
-  const int i = h % 3;
-  const double wb = p.w[(i + 1) % 3], wc = p.w[(i + 2) % 3];
-  return {wb * f.length + wc * f.cx, wc * f.cy};
+  return geodesic::InFrame(frame_[h], h, p);
 }
 
 double ExactGeodesicSolver::UpperBoundAt(const SurfacePoint& p) const { return BestAt(p).distance; }

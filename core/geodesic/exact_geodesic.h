@@ -31,6 +31,7 @@
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
 #include "core/geodesic/radix_heap.h"
+#include "core/geodesic/window_geometry.h"
 #include "core/mesh/mesh.h"
 
 namespace geodex::geodesic {
@@ -106,13 +107,6 @@ class ExactGeodesicSolver {
   const Mesh& mesh() const { return mesh_; }
 
  private:
-  // Position of the opposite vertex of each half-edge in that half-edge's
-  // frame: origin at (0,0), destination at (length,0), face at y > 0.
-  struct Frame {
-    double length;
-    double cx;
-    double cy;
-  };
   // A window lies on the edge of half-edge `h` and looks into FaceOf(h). The
   // interval [b0,b1] is measured from Origin(h); the pseudo-source (sx,sy),
   // sy <= 0, is unfolded into h's frame, at geodesic distance `sigma` from
@@ -173,7 +167,7 @@ class ExactGeodesicSolver {
   std::array<double, 2> InFrame(int32_t h, const SurfacePoint& p) const;
 
   const Mesh& mesh_;
-  std::vector<Frame> frame_;
+  std::vector<HalfEdgeFrame> frame_;
   std::vector<double> corner_angle_;  // angle at Origin(h) in FaceOf(h)
   std::vector<uint8_t> emits_;        // saddle or boundary vertex: a pseudo-source
   std::vector<uint8_t> pinched_;      // an end of an edge of length 0

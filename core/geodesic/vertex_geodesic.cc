@@ -13,12 +13,6 @@ namespace {
 using mesh::kNone;
 using mesh::Vec3;
 
-// A window is discarded only when a vertex offers a path shorter by more than
-// this fraction of the window's own distances, so rounding never discards a
-// window that carries a shortest path.
-constexpr double kFilterSlack = 1e-12;
-// Barycentric weights below this count as zero when classifying sources.
-constexpr double kSnap = 1e-12;
 // Vertices whose angle sum exceeds 2*pi by more than this are saddles
 // (pseudo-sources). Flat vertices are not: a geodesic runs straight through
 // them, and the window split at the ray through a vertex hands that ray to
@@ -32,7 +26,6 @@ constexpr double kSaddleSlack = 1e-9;
 // same point for the "two sides" rule, which then keeps both sides.
 constexpr double kSideSlack = 1e-8;
 
-inline double Hypot(double x, double y) { return std::sqrt(x * x + y * y); }
 
 // Whether the segments from the pseudo-sources p and q to the points (a,0) and
 // (b,0) of the edge cross (touching counts) below it. By orientation tests:
@@ -51,20 +44,9 @@ bool CrossBelowEdge(double px, double py, double a, double qx, double qy, double
 
 }  // namespace
 
-VertexGeodesicSolver::VertexGeodesicSolver(const Mesh& mesh) : mesh_(mesh) {
+VertexGeodesicSolver::VertexGeodesicSolver(const Mesh& mesh)
+    : mesh_(mesh), frame_(HalfEdgeFrames(mesh)) {
   const int32_t nh = mesh.num_halfedges();
-  frame_.resize(nh);
-  for (int32_t h = 0; h < nh; ++h) {
-    // From positions, not edge lengths: see ExactGeodesicSolver.
-    const Vec3& a = mesh.position(mesh.Origin(h));
-    const Vec3 ab = mesh.position(mesh.Dest(h)) - a;
-    const Vec3 ac = mesh.position(mesh.Opposite(h)) - a;
-    const double l = mesh.Length(h);
-    // An edge of length 0 (two corners at one position, kept by mesh repair)
-    // carries no window; its frame only has to be free of NaN.
-    frame_[h] = l > 0 ? Frame{l, ab.dot(ac) / l, std::max(ab.cross(ac).norm() / l, 1e-300)}
-                      : Frame{0, 0, 1e-300};
-  }
   emits_.resize(mesh.num_vertices());
   for (int32_t v = 0; v < mesh.num_vertices(); ++v) {
     // A pinch (an end of an edge of length 0, kept by mesh repair) is a
@@ -132,60 +114,27 @@ absl::Status VertexGeodesicSolver::Propagate(std::span<const SurfacePoint> sourc
   GEODEX_RETURN_IF_ERROR(Start(options));
   for (int32_t s = 0; s < static_cast<int32_t>(sources.size()); ++s) {
     const SurfacePoint& p = sources[s];
-    int zeros = 0, nonzero = 0;
-    for (int i = 0; i < 3; ++i) {
-      if (p.w[i] <= kSnap) {
-        ++zeros;
-      } else {
-        nonzero = i;
-      }
-    }
-    if (zeros >= 2) {  // at a vertex
-      UpdateVertex(mesh_.face(p.face)[nonzero], 0.0, s);
-      continue;
-    }
-    std::array<double, 3> w = p.w;
-    const double sum = w[0] + w[1] + w[2];
-    for (double& x : w) x /= sum;
-    if (zeros == 0) {
-      AddFaceSource(p.face, w, s, kNone);
-      continue;
-    }
-    // On an edge: both faces hold the source, and neither sends windows
-    // across the edge itself.
-    int zero = 0;
-    for (int i = 0; i < 3; ++i) {
-      if (w[i] <= kSnap) zero = i;
-    }
-    w[zero] = 0;
-    const int32_t h = 3 * p.face + (zero + 1) % 3;  // the edge opposite the zero weight
-    AddFaceSource(p.face, w, s, h);
-    const int32_t g = mesh_.Twin(h);
-    if (g != kNone) {
-      std::array<double, 3> wg = {0, 0, 0};
-      wg[g % 3] = w[(h + 1) % 3];  // Origin(g) = Dest(h)
-      wg[(g + 1) % 3] = w[h % 3];
-      AddFaceSource(Mesh::FaceOf(g), wg, s, g);
+    const SourcePlace place = ClassifySource(mesh_, p);
+    if (place.kind == SourcePlace::kVertex) {
+      UpdateVertex(place.vertex, 0.0, s);
+    } else if (place.kind == SourcePlace::kFace) {
+      AddFaceSource(p.face, place.w, s, kNone);
+    } else {
+      // On an edge: both faces hold the source, and neither sends windows
+      // across the edge itself.
+      const int32_t h = place.halfedge;
+      AddFaceSource(p.face, place.w, s, h);
+      const int32_t g = mesh_.Twin(h);
+      if (g != kNone) AddFaceSource(Mesh::FaceOf(g), WeightsInTwin(h, g, place.w), s, g);
     }
   }
   return Run();
 }
 
 absl::Status VertexGeodesicSolver::Start(const VertexGeodesicOptions& options) {
+  GEODEX_RETURN_IF_ERROR(CheckInitialDistances(options.initial_distance, mesh_.num_vertices()));
   if (!options.initial_distance.empty()) {
-    if (options.initial_distance.size() != static_cast<size_t>(mesh_.num_vertices())) {
-      return absl::InvalidArgumentError(
-          absl::StrFormat("initial_distance has %d entries, the mesh %d vertices",
-                          options.initial_distance.size(), mesh_.num_vertices()));
-    }
-    for (int32_t v = 0; v < mesh_.num_vertices(); ++v) {
-      const double d = options.initial_distance[v];
-      if (std::isnan(d) || d < 0) {
-        return absl::InvalidArgumentError(
-            absl::StrFormat("initial_distance[%d] = %g is not a distance", v, d));
-      }
-      dist_[v] = d;
-    }
+    std::copy(options.initial_distance.begin(), options.initial_distance.end(), dist_.begin());
   }
   for (const SurfacePoint& q : options.targets) {
     GEODEX_RETURN_IF_ERROR(mesh::ValidateSurfacePoint(mesh_, q));
@@ -258,10 +207,7 @@ void VertexGeodesicSolver::AddFaceSource(int32_t face, const std::array<double, 
 }
 
 std::array<double, 2> VertexGeodesicSolver::InFrame(int32_t h, const SurfacePoint& p) const {
-  const Frame& f = frame_[h];
-  const int i = h % 3;
-  const double wb = p.w[(i + 1) % 3], wc = p.w[(i + 2) % 3];
-  return {wb * f.length + wc * f.cx, wc * f.cy};
+  return geodesic::InFrame(frame_[h], h, p);
 }
 
 void VertexGeodesicSolver::EvaluateTargets(int32_t h) {
@@ -355,7 +301,7 @@ void VertexGeodesicSolver::EmitFrom(int32_t v) {
     const int32_t g = Mesh::Next(o);  // the edge opposite v in this face
     const int32_t t = mesh_.Twin(g);
     if (t == kNone) continue;
-    const Frame& fg = frame_[g];
+    const HalfEdgeFrame& fg = frame_[g];
     Window w;
     w.b0 = 0;
     w.b1 = fg.length;
@@ -368,17 +314,8 @@ void VertexGeodesicSolver::EmitFrom(int32_t v) {
 }
 
 bool VertexGeodesicSolver::IsUseless(int32_t h, const Window& w) const {
-  const Frame& f = frame_[h];
-  const double d0 = w.sigma + Hypot(w.b0 - w.sx, w.sy);
-  const double d1 = w.sigma + Hypot(w.b1 - w.sx, w.sy);
-  const double slack = kFilterSlack * std::max(d0, d1);
-  // See ExactGeodesicSolver::IsUseless: A and B are checked at the far end of
-  // the interval, C at both ends when it is past the pseudo-source.
-  if (dist_[mesh_.Origin(h)] + w.b1 + slack < d1) return true;
-  if (dist_[mesh_.Dest(h)] + (f.length - w.b0) + slack < d0) return true;
-  const double dc = dist_[mesh_.Opposite(h)];
-  return dc >= w.sigma && dc + Hypot(w.b0 - f.cx, f.cy) + slack < d0 &&
-         dc + Hypot(w.b1 - f.cx, f.cy) + slack < d1;
+  return CornersReachSooner(frame_[h], dist_[mesh_.Origin(h)], dist_[mesh_.Dest(h)],
+                            dist_[mesh_.Opposite(h)], w.b0, w.b1, w.sx, w.sy, w.sigma);
 }
 
 int32_t VertexGeodesicSolver::Allocate() {
@@ -440,7 +377,7 @@ void VertexGeodesicSolver::PropagateList(int32_t h) {
   if (k == kNone) return;
   head_[h] = kNone;
   ++stats_.lists_propagated;
-  const Frame& f = frame_[h];
+  const HalfEdgeFrame& f = frame_[h];
   const int32_t c = mesh_.Opposite(h);
 
   // Pass 1: drop what the face's vertices reach sooner.
@@ -464,7 +401,7 @@ void VertexGeodesicSolver::PropagateList(int32_t h) {
   double best_crossing = 0, best_sx = 0, best_sy = 0;
   for (Pending& p : pending_) {
     const Window& w = p.window;
-    p.xc = w.sx + (f.cx - w.sx) * (-w.sy) / (f.cy - w.sy);
+    p.xc = RayThroughC(f, w.sx, w.sy);
     p.crossing = std::clamp(p.xc, w.b0, w.b1);
     // Straight to C when the ray through C crosses the interval, else
     // round its nearer end: either way the length of a path to C.
@@ -500,8 +437,18 @@ void VertexGeodesicSolver::PropagateList(int32_t h) {
     }
     // Rays through [b0, xc] leave through A->C, those through [xc, b1]
     // through C->B.
-    if (left && w.b0 < std::min(w.b1, p.xc)) PropagateLeft(h, w, w.b0, std::min(w.b1, p.xc));
-    if (right && std::max(w.b0, p.xc) < w.b1) PropagateRight(h, w, std::max(w.b0, p.xc), w.b1);
+    if (left && w.b0 < std::min(w.b1, p.xc)) {
+      if (const int32_t t = mesh_.Twin(Mesh::Prev(h)); t != kNone) {
+        PropagateChild(t, ChildAcrossAC(f, frame_[t].length, w.sx, w.sy, p.xc, w.b0,
+                                        std::min(w.b1, p.xc)), w);
+      }
+    }
+    if (right && std::max(w.b0, p.xc) < w.b1) {
+      if (const int32_t t = mesh_.Twin(Mesh::Next(h)); t != kNone) {
+        PropagateChild(t, ChildAcrossCB(f, frame_[t].length, w.sx, w.sy, p.xc,
+                                        std::max(w.b0, p.xc), w.b1), w);
+      }
+    }
   }
 }
 
@@ -566,47 +513,12 @@ void VertexGeodesicSolver::PruneNeighbours() {
   pending_.resize(kept);
 }
 
-void VertexGeodesicSolver::PropagateLeft(int32_t h, const Window& w, double b0, double b1) {
-  const int32_t t = mesh_.Twin(Mesh::Prev(h));
-  if (t == kNone) return;
-  const Frame& f = frame_[h];
-  auto hit = [&](double b) {  // fraction along A->C hit by the ray through (b,0)
-    const double den = f.cy * (b - w.sx) + f.cx * w.sy;
-    if (!(std::abs(den) > 0)) return 0.0;
-    return std::clamp(w.sy * b / den, 0.0, 1.0);
-  };
-  const double l = frame_[t].length;
-  const double ux = f.cx / l, uy = f.cy / l;
+void VertexGeodesicSolver::PropagateChild(int32_t t, const ChildWindow& c, const Window& w) {
   Window child;
-  child.b0 = hit(b0) * l;
-  child.b1 = hit(b1) * l;
-  child.sx = ux * w.sx + uy * w.sy;
-  child.sy = std::min(ux * w.sy - uy * w.sx, 0.0);
-  child.sigma = w.sigma;
-  child.source = w.source;
-  AddWindow(t, child);
-}
-
-void VertexGeodesicSolver::PropagateRight(int32_t h, const Window& w, double b0, double b1) {
-  const int32_t t = mesh_.Twin(Mesh::Next(h));
-  if (t == kNone) return;
-  const Frame& f = frame_[h];
-  const double bx = f.length - f.cx, by = -f.cy;  // B - C
-  auto hit = [&](double b) {                      // fraction along C->B
-    const double dx = b - w.sx, dy = -w.sy;
-    const double num = (w.sx - f.cx) * dy - (w.sy - f.cy) * dx;
-    const double den = bx * dy - by * dx;
-    if (!(std::abs(den) > 0)) return 1.0;
-    return std::clamp(num / den, 0.0, 1.0);
-  };
-  const double l = frame_[t].length;
-  const double ux = bx / l, uy = by / l;
-  const double rx = w.sx - f.cx, ry = w.sy - f.cy;
-  Window child;
-  child.b0 = hit(b0) * l;
-  child.b1 = hit(b1) * l;
-  child.sx = ux * rx + uy * ry;
-  child.sy = std::min(ux * ry - uy * rx, 0.0);
+  child.b0 = c.b0;
+  child.b1 = c.b1;
+  child.sx = c.sx;
+  child.sy = c.sy;
   child.sigma = w.sigma;
   child.source = w.source;
   AddWindow(t, child);

@@ -43,6 +43,7 @@
 #include "absl/status/status.h"
 #include "core/geodesic/exact_geodesic.h"
 #include "core/geodesic/radix_heap.h"
+#include "core/geodesic/window_geometry.h"
 #include "core/mesh/mesh.h"
 
 namespace geodex::geodesic {
@@ -117,13 +118,6 @@ class VertexGeodesicSolver {
   const Mesh& mesh() const { return mesh_; }
 
  private:
-  // Position of the opposite vertex of each half-edge in that half-edge's
-  // frame: origin at (0,0), destination at (length,0), face at y > 0.
-  struct Frame {
-    double length;
-    double cx;
-    double cy;
-  };
   // A window on the edge of a half-edge h, looking into FaceOf(h): the
   // interval [b0,b1] from Origin(h), lit by the pseudo-source (sx,sy), sy <= 0,
   // unfolded into h's frame at geodesic distance sigma from the source.
@@ -173,13 +167,12 @@ class VertexGeodesicSolver {
   void Enqueue(int32_t h);
   void WakeEnd(int32_t v);
   void PropagateList(int32_t h);
-  void PropagateLeft(int32_t h, const Window& w, double b0, double b1);
-  void PropagateRight(int32_t h, const Window& w, double b0, double b1);
+  void PropagateChild(int32_t t, const ChildWindow& c, const Window& w);
   int32_t Allocate();
   void Free(int32_t k);
 
   const Mesh& mesh_;
-  std::vector<Frame> frame_;
+  std::vector<HalfEdgeFrame> frame_;
   std::vector<uint8_t> emits_;  // saddle or boundary vertex: a pseudo-source
 
   std::vector<double> dist_;
