@@ -4,8 +4,8 @@
 //   geodex-build MESH -o OUT.gdx --target-error E [--samples M0] [--max-samples CAP]
 //   geodex-build plan MESH --samples M [--seed S] [--threads N] [--edges-obj FILE] -o WORKDIR
 //   geodex-build rows WORKDIR --shard I/N [--threads T]
-//   geodex-build merge WORKDIR -o OUT.gdx
-//   geodex-build calibrate MESH INDEX.gdx -o OUT.gdx
+//   geodex-build merge WORKDIR -o OUT.gdx [--threads T]
+//   geodex-build calibrate MESH INDEX.gdx -o OUT.gdx [--threads T]
 //
 // MESH is a .obj/.ply/.off file, or builtin:NAME for a generated demo mesh
 // (torus, sphere, cube, double-torus). A file's mesh is repaired where that
@@ -147,9 +147,11 @@ absl::Status WriteEdges(const mesh::Mesh& mesh, const builder::Plan& plan,
 
 // Measures the index against held-out exact propagations and stores its
 // accuracy calibration (error bounds) and the figures in its report.
-absl::Status AddCalibration(const mesh::Mesh& mesh, index::IndexData& data) {
+absl::Status AddCalibration(const mesh::Mesh& mesh, index::IndexData& data, int threads) {
   const auto start = std::chrono::steady_clock::now();
-  GEODEX_RETURN_IF_ERROR(validation::AddCalibration(mesh, data));
+  validation::CalibrationOptions options;
+  options.pairs.threads = threads;
+  GEODEX_RETURN_IF_ERROR(validation::AddCalibration(mesh, data, options));
   const index::AccuracyRecord& r = data.accuracy[0];
   data.report += validation::CalibrationText(r);
   std::printf(
@@ -234,11 +236,14 @@ int main(int argc, char** argv) {
   CLI::App* rows_cmd = app.add_subcommand("rows", "Distributed build, step 2: one shard of rows");
   rows_cmd->add_option("workdir", workdir, "Work directory")->required();
   rows_cmd->add_option("--shard", shard_text, "Shard I/N (0-based I)")->required();
-  rows_cmd->add_option("--threads", threads, "Worker threads (0: all cores)");
+  rows_cmd->add_option("--threads", threads, "Worker threads (0: all cores)")
+      ->check(CLI::NonNegativeNumber);
 
   CLI::App* merge_cmd = app.add_subcommand("merge", "Distributed build, step 3: the index");
   merge_cmd->add_option("workdir", workdir, "Work directory")->required();
   merge_cmd->add_option("-o,--output", out, "Output index file (.gdx)")->required();
+  merge_cmd->add_option("--threads", threads, "Calibration threads (0: all cores)")
+      ->check(CLI::NonNegativeNumber);
   bool no_calibration = false;
   for (CLI::App* cmd : {&app, merge_cmd}) {
     cmd->add_flag("--no-calibration", no_calibration,
@@ -252,6 +257,8 @@ int main(int argc, char** argv) {
   calibrate_cmd->add_option("index", index_path, "Index file (.gdx)")->required();
   calibrate_cmd->add_option("-o,--output", out, "Output index file (.gdx)")->required();
   calibrate_cmd->add_flag("--strict", strict, kStrictHelp);
+  calibrate_cmd->add_option("--threads", threads, "Calibration threads (0: all cores)")
+      ->check(CLI::NonNegativeNumber);
 
   CLI11_PARSE(app, argc, argv);
 
@@ -306,7 +313,7 @@ int main(int argc, char** argv) {
                               builder::LoadRepair(plan, workdir));
       GEODEX_ASSIGN_OR_RETURN(auto data, builder::Merge(mesh, plan, std::move(rows), &summary));
       builder::AddRepair(repair, &data);
-      if (!no_calibration) GEODEX_RETURN_IF_ERROR(AddCalibration(mesh, data));
+      if (!no_calibration) GEODEX_RETURN_IF_ERROR(AddCalibration(mesh, data, threads));
       return WriteAndReport(data, summary, out);
     }();
   } else if (*calibrate_cmd) {
@@ -320,7 +327,7 @@ int main(int argc, char** argv) {
             absl::StrFormat("%s was not built from %s", index_path, mesh_path));
       }
       index::IndexData data = index::ToIndexData(*index);
-      GEODEX_RETURN_IF_ERROR(AddCalibration(mesh, data));
+      GEODEX_RETURN_IF_ERROR(AddCalibration(mesh, data, threads));
       GEODEX_RETURN_IF_ERROR(index::WriteIndexFile(data, out));
       std::printf("geodex-build calibrate: wrote %s\n", out.c_str());
       return absl::OkStatus();
@@ -365,7 +372,7 @@ int main(int argc, char** argv) {
       builder::BuildSummary summary;
       GEODEX_ASSIGN_OR_RETURN(auto data, builder::BuildIndexFromPlan(mesh, plan, options, &summary));
       builder::AddRepair(repair, &data);
-      if (!no_calibration) GEODEX_RETURN_IF_ERROR(AddCalibration(mesh, data));
+      if (!no_calibration) GEODEX_RETURN_IF_ERROR(AddCalibration(mesh, data, threads));
       return WriteAndReport(data, summary, out);
     }();
   }

@@ -59,6 +59,36 @@ TEST(CalibrationTest, BoundsCoverHeldOutPairsOfAnotherSeed) {
   EXPECT_GT(covered, 0.97 * pairs.size());
 }
 
+TEST(CalibrationTest, PairsDoNotDependOnTheThreadCount) {
+  const mesh::Mesh m = mesh::gen::Torus(24, 12, 1.0, 0.4);
+  PairOptions options{.num_sources = 7, .uniform_points = 20, .per_bin_points = 5, .seed = 5};
+  const auto one = DrawPairs(m, 300, options);
+  options.threads = 3;
+  const auto three = DrawPairs(m, 300, options);
+  ASSERT_EQ(one.size(), three.size());
+  // Both kinds of source and every bin are drawn.
+  int vertex_pairs = 0, bins[kNumScaleBins] = {};
+  for (size_t k = 0; k < one.size(); ++k) {
+    const ExactPair &a = one[k], &b = three[k];
+    EXPECT_EQ(a.p.face, b.p.face);
+    EXPECT_EQ(a.q.face, b.q.face);
+    EXPECT_EQ(a.p.w, b.p.w);
+    EXPECT_EQ(a.q.w, b.q.w);
+    EXPECT_EQ(a.exact, b.exact);
+    EXPECT_EQ(a.bin, b.bin);
+    vertex_pairs += a.vertices;
+    ++bins[a.bin];
+  }
+  EXPECT_GT(vertex_pairs, 0);
+  EXPECT_LT(vertex_pairs, static_cast<int>(one.size()));
+  for (int b = 0; b < kNumScaleBins; ++b) EXPECT_GT(bins[b], 0) << ScaleBinName(b);
+  // Another seed draws other pairs.
+  options.seed = 6;
+  const auto other = DrawPairs(m, 300, options);
+  ASSERT_FALSE(other.empty());
+  EXPECT_NE(other[0].exact, one[0].exact);
+}
+
 TEST(CalibrationTest, RefusesAnIndexOfAnotherMesh) {
   const mesh::Mesh m = mesh::gen::Sphere(4, 1.0);
   index::IndexData data = BuildSphere(m);

@@ -1,11 +1,13 @@
 #include "core/validation/pair_sampling.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <limits>
 #include <numeric>
 #include <random>
 #include <span>
+#include <thread>
 
 #include "core/geodesic/vertex_geodesic.h"
 
@@ -65,101 +67,150 @@ std::vector<mesh::SurfacePoint> RandomSurfacePoints(const mesh::Mesh& mesh, int3
   return points;
 }
 
-std::vector<ExactPair> DrawPairs(const mesh::Mesh& mesh, int32_t num_samples,
-                                 const PairOptions& options) {
-  const double scale = ScaleLength(mesh.TotalArea(), num_samples);
-  const double tiny = 1e-9 * mesh.BoundingBoxDiagonal();
-  std::mt19937_64 rng(options.seed);
-  std::vector<int32_t> all_faces(mesh.num_faces());
-  std::iota(all_faces.begin(), all_faces.end(), 0);
-  const std::vector<double> all_cumulative = Cumulative(mesh, all_faces);
+namespace {
+
+// What every source of DrawPairs shares.
+struct PairContext {
+  const mesh::Mesh& mesh;
+  const PairOptions& options;
+  double scale = 0;  // L
+  double tiny = 0;   // pairs closer than this are left out
+  std::vector<int32_t> all_faces;
+  std::vector<double> all_cumulative;
   std::vector<int32_t> referenced;
-  for (int32_t v = 0; v < mesh.num_vertices(); ++v) {
-    if (mesh.IsReferenced(v)) referenced.push_back(v);
-  }
-  std::uniform_int_distribution<size_t> any_vertex(0, referenced.size() - 1);
-  // The wavefront engine: its memory follows the front (the window engine
-  // keeps every window, gigabytes on a large mesh), and target points are
-  // evaluated as the windows pass their faces.
-  geodesic::VertexGeodesicSolver solver(mesh);
+};
+
+// The generator of source `s`: its own, so that sources can be drawn in any
+// order and on any thread.
+std::mt19937_64 SourceGenerator(uint64_t seed, int32_t s) {
+  std::seed_seq seq{static_cast<uint32_t>(seed), static_cast<uint32_t>(seed >> 32),
+                    static_cast<uint32_t>(s)};
+  return std::mt19937_64(seq);
+}
+
+// The pairs of source `s`: a vertex paired with vertices for even s, a point
+// inside a face paired with such points for odd s. Empty when the source's
+// propagation fails.
+std::vector<ExactPair> PairsOfSource(const PairContext& c, geodesic::VertexGeodesicSolver& solver,
+                                     int32_t s) {
+  const mesh::Mesh& mesh = c.mesh;
+  const PairOptions& options = c.options;
+  std::mt19937_64 rng = SourceGenerator(options.seed, s);
+  std::uniform_int_distribution<size_t> any_vertex(0, c.referenced.size() - 1);
   std::vector<ExactPair> pairs;
   auto add = [&](const mesh::SurfacePoint& p, const mesh::SurfacePoint& q, double exact,
                  bool vertices, bool uniform) {
-    if (!(exact > tiny) || !std::isfinite(exact)) return false;
-    pairs.push_back({p, q, exact, vertices, uniform, ScaleBinOf(exact, scale)});
+    if (!(exact > c.tiny) || !std::isfinite(exact)) return false;
+    pairs.push_back({p, q, exact, vertices, uniform, ScaleBinOf(exact, c.scale)});
     return true;
   };
-  for (int32_t s = 0; s < options.num_sources; ++s) {
-    const bool vertices = s % 2 == 0;
-    if (vertices) {
-      const int32_t v = referenced[any_vertex(rng)];
-      const mesh::SurfacePoint source = AtVertex(mesh, v);
-      if (!solver.Propagate({v}).ok()) continue;
-      const std::vector<double>& dist = solver.VertexDistances();
-      for (int32_t k = 0; k < options.uniform_points; ++k) {
-        const int32_t u = referenced[any_vertex(rng)];
-        add(source, AtVertex(mesh, u), dist[u], true, true);
-      }
-      for (int b = 0; b < kNumScaleBins; ++b) {
-        const double lo = kBinEdges[b] * scale, hi = kBinEdges[b + 1] * scale;
-        std::vector<int32_t> in_bin;
-        for (int32_t u : referenced) {
-          if (dist[u] >= lo && dist[u] < hi) in_bin.push_back(u);
-        }
-        if (in_bin.empty()) continue;
-        std::uniform_int_distribution<size_t> pick(0, in_bin.size() - 1);
-        for (int32_t k = 0; k < options.per_bin_points; ++k) {
-          const int32_t u = in_bin[pick(rng)];
-          add(source, AtVertex(mesh, u), dist[u], true, false);
-        }
-      }
-      continue;
+  if (s % 2 == 0) {
+    const int32_t v = c.referenced[any_vertex(rng)];
+    const mesh::SurfacePoint source = AtVertex(mesh, v);
+    if (!solver.Propagate({v}).ok()) return {};
+    const std::vector<double>& dist = solver.VertexDistances();
+    for (int32_t k = 0; k < options.uniform_points; ++k) {
+      const int32_t u = c.referenced[any_vertex(rng)];
+      add(source, AtVertex(mesh, u), dist[u], true, true);
     }
-    // A source inside a face: one propagation for the vertex distances and
-    // the uniform points, a second for the candidates of every bin, drawn on
-    // the faces that reach into it (the first says which those are).
-    const mesh::SurfacePoint source = PointOnFaces(all_faces, all_cumulative, rng);
-    std::vector<mesh::SurfacePoint> uniform(options.uniform_points);
-    for (mesh::SurfacePoint& q : uniform) q = PointOnFaces(all_faces, all_cumulative, rng);
-    geodesic::VertexGeodesicOptions first;
-    first.targets = uniform;
-    if (!solver.Propagate({source}, first).ok()) continue;
-    for (size_t k = 0; k < uniform.size(); ++k) {
-      add(source, uniform[k], solver.TargetDistance(k), false, true);
-    }
-    const std::vector<double> dist = solver.VertexDistances();
-    std::vector<mesh::SurfacePoint> candidates;
-    std::vector<int> candidate_bin;
     for (int b = 0; b < kNumScaleBins; ++b) {
-      const double lo = kBinEdges[b] * scale, hi = kBinEdges[b + 1] * scale;
-      std::vector<int32_t> faces;
-      for (int32_t f = 0; f < mesh.num_faces(); ++f) {
-        const mesh::Triangle& t = mesh.face(f);
-        const double d0 = dist[t[0]], d1 = dist[t[1]], d2 = dist[t[2]];
-        if (f == source.face || (std::min({d0, d1, d2}) < hi && std::max({d0, d1, d2}) >= lo)) {
-          faces.push_back(f);
-        }
+      const double lo = kBinEdges[b] * c.scale, hi = kBinEdges[b + 1] * c.scale;
+      std::vector<int32_t> in_bin;
+      for (int32_t u : c.referenced) {
+        if (dist[u] >= lo && dist[u] < hi) in_bin.push_back(u);
       }
-      if (faces.empty()) continue;
-      const std::vector<double> cumulative = Cumulative(mesh, faces);
-      if (!(cumulative.back() > 0)) continue;
-      for (int32_t k = 0; k < 8 * options.per_bin_points; ++k) {
-        candidates.push_back(PointOnFaces(faces, cumulative, rng));
-        candidate_bin.push_back(b);
+      if (in_bin.empty()) continue;
+      std::uniform_int_distribution<size_t> pick(0, in_bin.size() - 1);
+      for (int32_t k = 0; k < options.per_bin_points; ++k) {
+        const int32_t u = in_bin[pick(rng)];
+        add(source, AtVertex(mesh, u), dist[u], true, false);
       }
     }
-    geodesic::VertexGeodesicOptions second;
-    second.targets = candidates;
-    if (candidates.empty() || !solver.Propagate({source}, second).ok()) continue;
-    std::vector<int32_t> found(kNumScaleBins, 0);
-    for (size_t k = 0; k < candidates.size(); ++k) {
-      const int b = candidate_bin[k];
-      const double exact = solver.TargetDistance(k);
-      if (found[b] < options.per_bin_points && exact >= kBinEdges[b] * scale &&
-          exact < kBinEdges[b + 1] * scale && add(source, candidates[k], exact, false, false)) {
-        ++found[b];
+    return pairs;
+  }
+  // A source inside a face: one propagation for the vertex distances and
+  // the uniform points, a second for the candidates of every bin, drawn on
+  // the faces that reach into it (the first says which those are).
+  const mesh::SurfacePoint source = PointOnFaces(c.all_faces, c.all_cumulative, rng);
+  std::vector<mesh::SurfacePoint> uniform(options.uniform_points);
+  for (mesh::SurfacePoint& q : uniform) q = PointOnFaces(c.all_faces, c.all_cumulative, rng);
+  geodesic::VertexGeodesicOptions first;
+  first.targets = uniform;
+  if (!solver.Propagate({source}, first).ok()) return {};
+  for (size_t k = 0; k < uniform.size(); ++k) {
+    add(source, uniform[k], solver.TargetDistance(k), false, true);
+  }
+  const std::vector<double> dist = solver.VertexDistances();
+  std::vector<mesh::SurfacePoint> candidates;
+  std::vector<int> candidate_bin;
+  for (int b = 0; b < kNumScaleBins; ++b) {
+    const double lo = kBinEdges[b] * c.scale, hi = kBinEdges[b + 1] * c.scale;
+    std::vector<int32_t> faces;
+    for (int32_t f = 0; f < mesh.num_faces(); ++f) {
+      const mesh::Triangle& t = mesh.face(f);
+      const double d0 = dist[t[0]], d1 = dist[t[1]], d2 = dist[t[2]];
+      if (f == source.face || (std::min({d0, d1, d2}) < hi && std::max({d0, d1, d2}) >= lo)) {
+        faces.push_back(f);
       }
     }
+    if (faces.empty()) continue;
+    const std::vector<double> cumulative = Cumulative(mesh, faces);
+    if (!(cumulative.back() > 0)) continue;
+    for (int32_t k = 0; k < 8 * options.per_bin_points; ++k) {
+      candidates.push_back(PointOnFaces(faces, cumulative, rng));
+      candidate_bin.push_back(b);
+    }
+  }
+  geodesic::VertexGeodesicOptions second;
+  second.targets = candidates;
+  if (candidates.empty() || !solver.Propagate({source}, second).ok()) return pairs;
+  std::vector<int32_t> found(kNumScaleBins, 0);
+  for (size_t k = 0; k < candidates.size(); ++k) {
+    const int b = candidate_bin[k];
+    const double exact = solver.TargetDistance(k);
+    if (found[b] < options.per_bin_points && exact >= kBinEdges[b] * c.scale &&
+        exact < kBinEdges[b + 1] * c.scale && add(source, candidates[k], exact, false, false)) {
+      ++found[b];
+    }
+  }
+  return pairs;
+}
+
+}  // namespace
+
+std::vector<ExactPair> DrawPairs(const mesh::Mesh& mesh, int32_t num_samples,
+                                 const PairOptions& options) {
+  PairContext c{mesh, options, 0, 0, {}, {}, {}};
+  c.scale = ScaleLength(mesh.TotalArea(), num_samples);
+  c.tiny = 1e-9 * mesh.BoundingBoxDiagonal();
+  c.all_faces.resize(mesh.num_faces());
+  std::iota(c.all_faces.begin(), c.all_faces.end(), 0);
+  c.all_cumulative = Cumulative(mesh, c.all_faces);
+  for (int32_t v = 0; v < mesh.num_vertices(); ++v) {
+    if (mesh.IsReferenced(v)) c.referenced.push_back(v);
+  }
+  if (c.referenced.empty() || options.num_sources <= 0) return {};
+  std::vector<std::vector<ExactPair>> by_source(options.num_sources);
+  std::atomic<int32_t> next{0};
+  auto worker = [&] {
+    // The wavefront engine: its memory follows the front (the window engine
+    // keeps every window, gigabytes on a large mesh), and target points are
+    // evaluated as the windows pass their faces.
+    geodesic::VertexGeodesicSolver solver(mesh);
+    for (int32_t s; (s = next.fetch_add(1)) < options.num_sources;) {
+      by_source[s] = PairsOfSource(c, solver, s);
+    }
+  };
+  const int hardware = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  const int threads =
+      std::clamp(options.threads > 0 ? options.threads : hardware, 1, options.num_sources);
+  std::vector<std::thread> pool;
+  for (int t = 1; t < threads; ++t) pool.emplace_back(worker);
+  worker();
+  for (std::thread& t : pool) t.join();
+  std::vector<ExactPair> pairs;
+  for (std::vector<ExactPair>& list : by_source) {
+    pairs.insert(pairs.end(), list.begin(), list.end());
   }
   return pairs;
 }

@@ -45,10 +45,14 @@ struct PairOptions {
   int32_t uniform_points = 300;  // area-uniform targets per source
   int32_t per_bin_points = 60;   // targets per source drawn in each bin
   uint64_t seed = 1;
+  // Threads for the propagations (0: all hardware threads). Each source
+  // draws from its own generator, seeded from `seed` and its number, so the
+  // pairs do not depend on the thread count.
+  int threads = 1;
 };
 
 // Draws pairs for an index of `num_samples` samples (which fixes L) on a
-// valid mesh: deterministic for a seed. Pairs closer than 1e-9 of the
+// valid mesh: deterministic for a seed, in the order of their sources. Pairs closer than 1e-9 of the
 // bounding box diagonal, or in different components, are left out.
 std::vector<ExactPair> DrawPairs(const mesh::Mesh& mesh, int32_t num_samples,
                                  const PairOptions& options);

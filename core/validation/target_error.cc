@@ -26,7 +26,9 @@ absl::StatusOr<TargetErrorResult> BuildForTargetError(const mesh::Mesh& mesh,
   for (int32_t round = 0;; ++round) {
     builder::BuildSummary summary;
     GEODEX_ASSIGN_OR_RETURN(index::IndexData data, builder::BuildIndex(mesh, build, &summary));
-    GEODEX_RETURN_IF_ERROR(AddCalibration(mesh, data));
+    CalibrationOptions calibration;
+    calibration.pairs.threads = build.threads;
+    GEODEX_RETURN_IF_ERROR(AddCalibration(mesh, data, calibration));
     const index::AccuracyRecord& r = data.accuracy[0];
     result.rounds.push_back({static_cast<int32_t>(data.samples.size()), r.uniform_rms,
                              r.uniform_far_p99});

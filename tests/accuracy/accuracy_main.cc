@@ -72,7 +72,9 @@ absl::Status Run(const Flags& flags) {
         GEODEX_ASSIGN_OR_RETURN(std::string bytes, index::SerializeIndex(data));
         GEODEX_ASSIGN_OR_RETURN(index, index::Index::FromBytes(std::move(bytes)));
       }
-      const auto pairs = validation::DrawPairs(m, index->num_samples(), flags.pairs);
+      validation::PairOptions pair_options = flags.pairs;
+      pair_options.threads = flags.threads;
+      const auto pairs = validation::DrawPairs(m, index->num_samples(), pair_options);
       GEODEX_ASSIGN_OR_RETURN(auto engine, query::QueryEngine::Create(index));
       for (const std::string& mode : flags.modes) {
         query::DistanceOptions options;
@@ -132,7 +134,7 @@ int main(int argc, char** argv) {
                  "Targets per source drawn in each distance bin");
   app.add_option("--seed", flags.pairs.seed, "Random seed");
   app.add_option("--index-dir", flags.index_dir, "Cache built indexes here");
-  app.add_option("--threads", flags.threads, "Builder threads (0: all)");
+  app.add_option("--threads", flags.threads, "Builder and exact-propagation threads (0: all)");
   app.add_option("--modes", flags.modes,
                  "Answer modes: unfold (pure O(1)), default, exact (near pairs exactly), bounds "
                  "(default with error bounds), tolX (tolerance X, e.g. tol0.005), trace")->delimiter(',');
