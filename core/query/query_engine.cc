@@ -145,6 +145,16 @@ QueryEngine::QueryEngine(std::shared_ptr<const index::Index> index, QueryOptions
                       .norm();
   }
   scale_length_ = std::sqrt(2 * area / (std::sqrt(3.0) * num_samples_));
+  refine_below_ = kRefineScale * scale_length_;
+  // A pair whose O(1) answer overestimates lands above 3L while the pair is
+  // closer: with a calibration, refine every pair that may be closer than 3L
+  // (its answer minus the bound of answers between 3L and 5L).
+  if (const index::AccuracyRecord* accuracy = index_->accuracy(); accuracy != nullptr) {
+    constexpr int kBin = 4;  // [3L, 5L)
+    static_assert(index::kAccuracyBinUpper[kBin - 1] == kRefineScale);
+    const double margin = std::max(accuracy->unfold_bound[0][kBin], accuracy->unfold_bound[1][kBin]);
+    if (margin > 0 && std::isfinite(margin)) refine_below_ += margin;
+  }
 }
 
 absl::Status QueryEngine::Validate(const SurfacePoint& p) const {
@@ -532,7 +542,7 @@ double QueryEngine::Refine(const SurfacePoint& p_in, const SurfacePoint& q_in, d
     return (kind == AnswerKind::kTrace || kind == AnswerKind::kWrappedTrace) &&
            d > unfolded + BoundOf(AnswerKind::kUnfold, vertex_pair, unfolded);
   };
-  if (near || unfolded < kRefineScale * scale_length_) {
+  if (near || unfolded < refine_below_) {
     switch (options.near_pairs) {
       case NearPairs::kPath:
         trace();
@@ -581,7 +591,7 @@ absl::Status QueryEngine::CheckOptions(const DistanceOptions& options, bool boun
 bool QueryEngine::NeedsRefine(const DistanceOptions& options, bool bounds, bool near,
                               double unfolded) const {
   return near || bounds || options.tolerance > 0 ||
-         (options.near_pairs != NearPairs::kUnfold && unfolded < kRefineScale * scale_length_);
+         (options.near_pairs != NearPairs::kUnfold && unfolded < refine_below_);
 }
 
 absl::StatusOr<double> QueryEngine::Distance(const SurfacePoint& p, const SurfacePoint& q,

@@ -64,7 +64,9 @@ struct FaceFrame;
 
 // How Distance and DistanceBatch answer the pairs they refine by default:
 // near pairs (points in the same or adjacent geodesic triangles) and pairs
-// whose O(1) distance is below kRefineScale * scale_length().
+// that may be closer than kRefineScale * scale_length(): their O(1) distance
+// is below it, or, in a calibrated index, below it plus the error bound of
+// O(1) answers just beyond it.
 enum class NearPairs {
   // Pure O(1): the unfolding of §5, for near pairs kept at least the
   // straight-line distance apart (no surface path is shorter). Nothing is
@@ -218,6 +220,10 @@ class QueryEngine {
   // L = sqrt(2 A / (sqrt(3) m)): the edge of an equilateral geodesic
   // triangle when the index's m samples tile the surface's area A.
   double scale_length() const { return scale_length_; }
+  // Pairs whose O(1) distance is below this are refined by default (see
+  // NearPairs): kRefineScale * scale_length(), plus the calibration's error
+  // bound of O(1) answers between 3L and 5L when the index has one.
+  double refine_below() const { return refine_below_; }
   // True when the index carries its accuracy calibration (error bounds).
   bool has_error_bounds() const { return index_->accuracy() != nullptr; }
 
@@ -388,6 +394,9 @@ class QueryEngine {
   std::vector<FaceLift> face_lifts_;           // one per face, derived at load
   std::vector<ApproxLift> approx_lifts_;       // of the approximate faces
   double scale_length_ = 0;
+  // Pairs whose O(1) answer is below this are refined by default:
+  // kRefineScale * scale_length_, plus the calibration's bound at 3L-5L.
+  double refine_below_ = 0;
   // The mesh for exact refinement, made on first use (ExactMesh).
   mutable std::once_flag mesh_once_;
   mutable std::unique_ptr<mesh::Mesh> mesh_;

@@ -268,6 +268,38 @@ TEST(QueryEngineTest, NearPairsAreThePathLengthByDefault) {
   for (size_t i = 0; i < a.size(); ++i) EXPECT_EQ(out[i], *engine->Distance(a[i], b[i]));
 }
 
+// An O(1) answer that overestimates puts a pair closer than 3L above 3L; a
+// calibrated index also refines the pairs its bound says may be closer.
+TEST(QueryEngineTest, CalibratedIndexesRefinePairsThatMayBeCloserThan3L) {
+  const Mesh m = gen::Torus(48, 24, 1.0, 0.45);
+  auto plain = MakeEngine(m, 150);
+  auto calibrated = geodex::testing::TestEngineOrThrow(m, 150, /*calibrate=*/true);
+  const double three_l = kRefineScale * plain->scale_length();
+  EXPECT_EQ(plain->refine_below(), three_l);
+  EXPECT_GT(calibrated->refine_below(), three_l);
+  EXPECT_LT(calibrated->refine_below(), 2 * three_l);
+  const DistanceOptions unfold{.near_pairs = NearPairs::kUnfold};
+  const auto points = RandomPoints(m, 3000, 21);
+  int in_margin = 0;
+  for (size_t i = 0; i + 1 < points.size(); i += 2) {
+    const SurfacePoint& p = points[i];
+    const SurfacePoint& q = points[i + 1];
+    if (plain->IsNearPair(p, q)) continue;
+    const double o1 = *plain->Distance(p, q, unfold);
+    ASSERT_EQ(o1, *calibrated->Distance(p, q, unfold));  // the same index otherwise
+    const auto traced = calibrated->TracedDistance(p, q);
+    if (!traced.ok()) continue;
+    if (o1 >= three_l && o1 < calibrated->refine_below()) {
+      ++in_margin;
+      EXPECT_EQ(*plain->Distance(p, q), o1);
+      EXPECT_EQ(*calibrated->Distance(p, q), *traced);
+    } else if (o1 >= calibrated->refine_below()) {
+      EXPECT_EQ(*calibrated->Distance(p, q), o1);
+    }
+  }
+  EXPECT_GT(in_margin, 5);
+}
+
 TEST(QueryEngineTest, PathsStayOnTheSurfaceAndAreNearlyGeodesic) {
   const Mesh m = gen::Grid(30, 30, 1.0, 1.0, 0.2, 4);
   auto engine = MakeEngine(m, 40);
