@@ -152,7 +152,8 @@ void MeshChunkToProto(const query::QueryEngine& engine, int64_t vertex_offset, i
   chunk->set_version(version);
   chunk->set_vertex_offset(static_cast<uint32_t>(vertex_offset));
   chunk->set_face_offset(static_cast<uint32_t>(face_offset));
-  // The input's vertices are the index's first ones (copies come after).
+  // The input's vertices are the index's first ones (copies and midpoints
+  // come after).
   const std::span<const double> positions =
       index.positions().subspan(3 * vertex_offset, 3 * vertex_count);
   chunk->mutable_positions()->Assign(positions.begin(), positions.end());
@@ -228,7 +229,8 @@ void TriangulationToProto(const query::QueryEngine& engine, int64_t version,
   for (int32_t v = 0; v < ids.num_input_vertices(); ++v) {
     vertex_triangles->AddAlreadyReserved(records[v].triangle);
   }
-  for (int32_t copy = ids.num_input_vertices(); copy < index.num_vertices(); ++copy) {
+  for (int32_t copy = ids.num_input_vertices();
+       copy < ids.num_input_vertices() + ids.num_vertex_copies(); ++copy) {
     int32_t& t = *vertex_triangles->Mutable(ids.InputVertex(copy));
     const int32_t c = records[copy].triangle;
     if (c >= 0 && (t < 0 || c < t)) t = c;

@@ -48,6 +48,9 @@ struct BuildOptions {
   // Trace every Delaunay edge as an exact geodesic and repair edges that cross
   // (triangulation::RepairOptions::check_edges).
   bool check_edges = true;
+  // Split long mesh edges flat before sampling (PrepareMesh in
+  // core/builder/mesh_arrays.h; geodex-build --no-refinement turns it off).
+  bool refine_long_edges = true;
   // Called from builder threads (serialised by the builder) as work advances.
   std::function<void(const Progress&)> progress;
 };

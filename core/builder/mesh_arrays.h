@@ -8,7 +8,9 @@
 #include <string>
 #include <vector>
 
+#include "absl/status/statusor.h"
 #include "core/index/index.h"
+#include "core/mesh/flat_refinement.h"
 #include "core/mesh/mesh.h"
 #include "core/mesh/mesh_repair.h"
 
@@ -17,18 +19,55 @@ namespace geodex::builder {
 std::vector<double> FlatPositions(const mesh::Mesh& mesh);
 std::vector<int32_t> FlatFaces(const mesh::Mesh& mesh);
 
-// What the repair of an index's mesh did (core/mesh/mesh_repair.h), as the
-// index records it: its input-id sections (format 1.2: input faces and vertex
-// copies, empty for identity maps) and the report's mesh_* lines.
+// What the repair of an index's mesh did (core/mesh/mesh_repair.h), and the
+// flat refinement after it, as the index records them: its input-id sections
+// (format 1.2: input faces and vertex copies, empty for identity maps; 2.0:
+// the coarse faces and the pieces, empty without refinement) and the
+// report's mesh_* lines.
 struct RepairRecord {
   std::vector<index::InputFaceRecord> input_faces;
   std::vector<int32_t> vertex_copies;
+  std::vector<int32_t> coarse_faces;
+  std::vector<index::RefinedFaceRecord> refined_faces;
+  int32_t refinement_vertices = 0;
   std::string report;
 };
 RepairRecord RecordRepair(const mesh::RepairedMesh& repaired);
 
-// Puts `record` into the index data of the repaired mesh: the sections, and
-// the report lines first in its report. Call it once.
+// Puts `record` into the index data of the (repaired, refined) mesh: the
+// sections, and the report lines first in its report. Call it once.
 void AddRepair(const RepairRecord& record, index::IndexData* data);
+
+// Samples are mesh vertices, so a geodesic triangle is no smaller than the
+// mesh edges it spans: on a coarse mesh the error stops falling with m once
+// the sample spacing L(m) = sqrt(2 A / (sqrt(3) m)) reaches the long edges.
+// The builder splits flat (core/mesh/flat_refinement.h) every edge longer
+// than this share of L(m), so that a vertex lies within about L/4 of every
+// point and farthest-point sampling can place samples L apart anywhere.
+inline constexpr double kMaxEdgeOverScaleLength = 0.5;
+
+// The refinement the builder applies before sampling `num_samples` samples:
+// RefineLongEdges at kMaxEdgeOverScaleLength * L(num_samples), adding at most
+// 4 vertices per input vertex plus 16 per sample. A mesh with no longer edge
+// comes back unchanged (new_vertices == 0). Errors: RefineLongEdges's.
+absl::StatusOr<mesh::FlatRefinement> RefineForSamples(const mesh::Mesh& mesh,
+                                                      int32_t num_samples);
+
+// Records `refinement` of `coarse` (the mesh RecordRepair's record is of)
+// into `record`: the sections and a mesh_refinement report line. Nothing for
+// a refinement that added no vertex.
+void AddRefinement(const mesh::Mesh& coarse, const mesh::FlatRefinement& refinement,
+                   RepairRecord* record);
+
+// The mesh the builder samples for `num_samples` samples and the record of
+// how it came from the input: `coarse` (the repaired input, whose repair is
+// `repair`), refined by RefineForSamples when `refine`. The index built from
+// `mesh` takes AddRepair(record).
+struct PreparedMesh {
+  mesh::Mesh mesh;
+  RepairRecord record;
+};
+absl::StatusOr<PreparedMesh> PrepareMesh(const mesh::Mesh& coarse, RepairRecord repair,
+                                         int32_t num_samples, bool refine);
 
 }  // namespace geodex::builder

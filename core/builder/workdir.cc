@@ -21,7 +21,10 @@ namespace {
 // and the figures of the traced geodesic edges.
 constexpr char kPlanMagic[8] = {'G', 'D', 'X', 'P', 'L', 'A', 'N', '2'};
 constexpr char kRowsMagic[8] = {'G', 'D', 'X', 'R', 'O', 'W', 'S', '1'};
-constexpr char kRepairMagic[8] = {'G', 'D', 'X', 'R', 'E', 'P', 'R', '1'};
+// 2 adds the flat refinement (coarse faces, pieces, midpoint count); 1 is
+// still read.
+constexpr char kRepairMagic[8] = {'G', 'D', 'X', 'R', 'E', 'P', 'R', '2'};
+constexpr char kRepairMagicV1[8] = {'G', 'D', 'X', 'R', 'E', 'P', 'R', '1'};
 
 std::string PlanPath(const std::string& workdir) { return workdir + "/plan.bin"; }
 std::string RepairPath(const std::string& workdir) { return workdir + "/repair.bin"; }
@@ -245,6 +248,9 @@ absl::Status SaveRepair(const RepairRecord& record, const Plan& plan, const std:
   w.Put(plan.mesh_hash);
   w.PutVector(record.input_faces);
   w.PutVector(record.vertex_copies);
+  w.PutVector(record.coarse_faces);
+  w.PutVector(record.refined_faces);
+  w.Put(record.refinement_vertices);
   w.PutVector(std::vector<char>(record.report.begin(), record.report.end()));
   Seal(w);
   return AtomicWriteFile(RepairPath(workdir), w.bytes());
@@ -255,7 +261,10 @@ absl::StatusOr<RepairRecord> LoadRepair(const Plan& plan, const std::string& wor
   absl::StatusOr<std::string> bytes = ReadWholeFile(path);
   if (absl::IsNotFound(bytes.status())) return RepairRecord{};
   GEODEX_RETURN_IF_ERROR(bytes.status());
-  GEODEX_ASSIGN_OR_RETURN(const std::string_view payload, Unseal(*bytes, kRepairMagic, path));
+  const bool v1 = bytes->size() >= sizeof(kRepairMagicV1) &&
+                  std::memcmp(bytes->data(), kRepairMagicV1, sizeof(kRepairMagicV1)) == 0;
+  GEODEX_ASSIGN_OR_RETURN(const std::string_view payload,
+                          Unseal(*bytes, v1 ? kRepairMagicV1 : kRepairMagic, path));
   ByteReader r(payload, path);
   uint64_t hash = 0;
   RepairRecord record;
@@ -263,6 +272,11 @@ absl::StatusOr<RepairRecord> LoadRepair(const Plan& plan, const std::string& wor
   GEODEX_RETURN_IF_ERROR(r.Get(&hash));
   GEODEX_RETURN_IF_ERROR(r.GetVector(&record.input_faces));
   GEODEX_RETURN_IF_ERROR(r.GetVector(&record.vertex_copies));
+  if (!v1) {
+    GEODEX_RETURN_IF_ERROR(r.GetVector(&record.coarse_faces));
+    GEODEX_RETURN_IF_ERROR(r.GetVector(&record.refined_faces));
+    GEODEX_RETURN_IF_ERROR(r.Get(&record.refinement_vertices));
+  }
   GEODEX_RETURN_IF_ERROR(r.GetVector(&report));
   if (!r.AtEnd()) return absl::DataLossError(absl::StrFormat("%s has trailing bytes", path));
   if (hash != plan.mesh_hash) {

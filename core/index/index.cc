@@ -72,6 +72,8 @@ constexpr SectionSpec kSpecs[] = {
     {SectionId::kAccuracy, sizeof(AccuracyRecord), "accuracy", false},
     {SectionId::kInputFaces, sizeof(InputFaceRecord), "input faces", false},
     {SectionId::kVertexCopies, sizeof(int32_t), "vertex copies", false},
+    {SectionId::kCoarseFaces, sizeof(int32_t), "coarse faces", false},
+    {SectionId::kRefinedFaces, sizeof(RefinedFaceRecord), "refined faces", false},
 };
 constexpr size_t kNumSpecs = std::size(kSpecs);
 
@@ -116,6 +118,8 @@ std::optional<uint64_t> ExpectedCount(SectionId id, const Counts& c) {
     case SectionId::kAccuracy:
     case SectionId::kInputFaces:
     case SectionId::kVertexCopies:
+    case SectionId::kCoarseFaces:
+    case SectionId::kRefinedFaces:
       return std::nullopt;
   }
   return std::nullopt;
@@ -155,6 +159,9 @@ struct Contents {
   std::span<const int32_t> bvh_faces;
   std::span<const InputFaceRecord> input_faces;
   std::span<const int32_t> vertex_copies;
+  std::span<const int32_t> coarse_faces;
+  std::span<const RefinedFaceRecord> refined_faces;
+  uint64_t refinement_vertices = 0;
 };
 
 bool InRange(int64_t x, int64_t lo, int64_t hi) { return x >= lo && x < hi; }
@@ -277,10 +284,14 @@ absl::Status CheckContents(const Contents& c, absl::StatusCode code) {
                           i, b.first, b.count, nb, nf));
     }
   }
-  // Copies come after the input's vertices and copy one of them.
-  const int64_t num_input_vertices = nv - static_cast<int64_t>(c.vertex_copies.size());
+  // Vertices: the input's, the copies, the midpoints. Copies copy an input
+  // vertex; coarse faces use no midpoint.
+  const int64_t num_coarse_vertices = nv - static_cast<int64_t>(c.refinement_vertices);
+  const int64_t num_input_vertices =
+      num_coarse_vertices - static_cast<int64_t>(c.vertex_copies.size());
   if (num_input_vertices < 0) {
-    return fail(absl::StrFormat("%d vertex copies but %d vertices", c.vertex_copies.size(), nv));
+    return fail(absl::StrFormat("%d vertex copies and %d midpoints but %d vertices",
+                                c.vertex_copies.size(), c.refinement_vertices, nv));
   }
   for (size_t i = 0; i < c.vertex_copies.size(); ++i) {
     if (!InRange(c.vertex_copies[i], 0, num_input_vertices)) {
@@ -288,26 +299,65 @@ absl::Status CheckContents(const Contents& c, absl::StatusCode code) {
                                   c.vertex_copies[i], num_input_vertices));
     }
   }
-  // Every internal face is the one face of exactly one input face that was
+  // A refined index: every face is a piece of one coarse face, given by
+  // weights in it, and every coarse face has a piece.
+  const bool refined = !c.refined_faces.empty();
+  if (refined != !c.coarse_faces.empty() || (c.refinement_vertices > 0 && !refined) ||
+      (refined && static_cast<int64_t>(c.refined_faces.size()) != nf) ||
+      c.coarse_faces.size() % 3 != 0) {
+    return fail(absl::StrFormat(
+        "refinement: %d refined face records for %d faces, %d coarse face ids, %d midpoints",
+        c.refined_faces.size(), nf, c.coarse_faces.size(), c.refinement_vertices));
+  }
+  const int64_t num_coarse_faces = refined ? static_cast<int64_t>(c.coarse_faces.size() / 3) : nf;
+  for (size_t i = 0; i < c.coarse_faces.size(); ++i) {
+    if (!InRange(c.coarse_faces[i], 0, num_coarse_vertices)) {
+      return fail(absl::StrFormat("coarse face %d: vertex id %d out of range [0, %d)", i / 3,
+                                  c.coarse_faces[i], num_coarse_vertices));
+    }
+  }
+  if (refined) {
+    std::vector<uint8_t> has_piece(num_coarse_faces, 0);
+    for (size_t f = 0; f < c.refined_faces.size(); ++f) {
+      const RefinedFaceRecord& r = c.refined_faces[f];
+      bool ok = InRange(r.coarse_face, 0, num_coarse_faces);
+      for (int i = 0; i < 3 && ok; ++i) {
+        const float* w = r.weight[i];
+        ok = std::isfinite(w[0]) && std::isfinite(w[1]) && std::isfinite(w[2]) &&
+             std::min({w[0], w[1], w[2]}) >= -1e-6f &&
+             std::fabs(w[0] + w[1] + w[2] - 1) <= 1e-5f;
+      }
+      if (!ok) {
+        return fail(absl::StrFormat(
+            "refined face %d: coarse face %d (of %d) or corner weights invalid", f,
+            r.coarse_face, num_coarse_faces));
+      }
+      has_piece[r.coarse_face] = 1;
+    }
+    for (int64_t f = 0; f < num_coarse_faces; ++f) {
+      if (has_piece[f] == 0) return fail(absl::StrFormat("coarse face %d has no piece", f));
+    }
+  }
+  // Every coarse face is the one face of exactly one input face that was
   // not dropped, so that answers have an input face to name.
   if (!c.input_faces.empty()) {
-    std::vector<uint8_t> kept(nf, 0);
+    std::vector<uint8_t> kept(num_coarse_faces, 0);
     for (size_t i = 0; i < c.input_faces.size(); ++i) {
       const InputFaceRecord& r = c.input_faces[i];
       const bool permutation = r.corner[0] < 3 && r.corner[1] < 3 && r.corner[2] < 3 &&
                                r.corner[0] != r.corner[1] && r.corner[1] != r.corner[2] &&
                                r.corner[0] != r.corner[2];
-      if (!InRange(r.face, 0, nf) || !permutation ||
+      if (!InRange(r.face, 0, num_coarse_faces) || !permutation ||
           (r.flags & ~(kInputFaceDropped | kInputFaceReoriented)) != 0) {
         return fail(absl::StrFormat(
-            "input face %d: face %d (of %d), corners (%d %d %d) or flags %d invalid", i, r.face, nf,
-            r.corner[0], r.corner[1], r.corner[2], r.flags));
+            "input face %d: face %d (of %d), corners (%d %d %d) or flags %d invalid", i, r.face,
+            num_coarse_faces, r.corner[0], r.corner[1], r.corner[2], r.flags));
       }
       if ((r.flags & kInputFaceDropped) == 0 && kept[r.face]++ > 0) {
         return fail(absl::StrFormat("input face %d: face %d is kept twice", i, r.face));
       }
     }
-    for (int64_t f = 0; f < nf; ++f) {
+    for (int64_t f = 0; f < num_coarse_faces; ++f) {
       if (kept[f] == 0) return fail(absl::StrFormat("face %d is no input face's", f));
     }
   }
@@ -365,10 +415,10 @@ absl::StatusOr<FileHeader> ValidateHeader(const uint8_t* p, size_t n) {
     return absl::FailedPreconditionError(
         absl::StrFormat("bad byte order mark 0x%08x", h.byte_order_mark));
   }
-  if (h.format_major != kFormatMajor) {
+  if (h.format_major != kFormatMajor && h.format_major != kRefinedFormatMajor) {
     return absl::FailedPreconditionError(absl::StrFormat(
         "index format version %d.%d is not supported by this reader (version %d.%d)",
-        h.format_major, h.format_minor, kFormatMajor, kFormatMinor));
+        h.format_major, h.format_minor, kRefinedFormatMajor, kRefinedFormatMinor));
   }
   if (h.header_size < kHeaderSize || h.header_size % 8 != 0) {
     return absl::DataLossError(absl::StrFormat("bad header size %d", h.header_size));
@@ -557,7 +607,8 @@ absl::StatusOr<std::string> SerializeIndex(const IndexData& d) {
   }
   GEODEX_RETURN_IF_ERROR(CheckContents(
       Contents{counts, d.positions, d.faces, d.twins, d.samples, d.sample_distances, d.vertices,
-               d.triangles, d.bvh_nodes, d.bvh_faces, d.input_faces, d.vertex_copies},
+               d.triangles, d.bvh_nodes, d.bvh_faces, d.input_faces, d.vertex_copies,
+               d.coarse_faces, d.refined_faces, d.params.refinement_vertices},
       absl::StatusCode::kInvalidArgument));
   GEODEX_RETURN_IF_ERROR(CheckAccuracy(d.accuracy, absl::StatusCode::kInvalidArgument));
 
@@ -581,13 +632,19 @@ absl::StatusOr<std::string> SerializeIndex(const IndexData& d) {
       {d.accuracy.data(), d.accuracy.size() * sizeof(AccuracyRecord)},
       {d.input_faces.data(), d.input_faces.size() * sizeof(InputFaceRecord)},
       {d.vertex_copies.data(), d.vertex_copies.size() * sizeof(int32_t)},
+      {d.coarse_faces.data(), d.coarse_faces.size() * sizeof(int32_t)},
+      {d.refined_faces.data(), d.refined_faces.size() * sizeof(RefinedFaceRecord)},
   };
-  // The input-id sections (1.2) are written only when the mesh was repaired,
-  // so that the index of a mesh that needed no repair keeps the 1.1 layout.
+  // The input-id sections (1.2, 2.0) are written only when the mesh was
+  // repaired or refined, so that the index of a mesh that needed neither
+  // keeps the 1.1 layout.
   auto written = [&pieces](size_t i) {
     const SectionId id = kSpecs[i].id;
-    return pieces[i].size > 0 || (id != SectionId::kInputFaces && id != SectionId::kVertexCopies);
+    return pieces[i].size > 0 ||
+           (id != SectionId::kInputFaces && id != SectionId::kVertexCopies &&
+            id != SectionId::kCoarseFaces && id != SectionId::kRefinedFaces);
   };
+  const bool refined = !d.refined_faces.empty();
   size_t num_sections = 0;
   for (size_t i = 0; i < kNumSpecs; ++i) num_sections += written(i) ? 1 : 0;
   SectionEntry entries[kNumSpecs];
@@ -613,8 +670,8 @@ absl::StatusOr<std::string> SerializeIndex(const IndexData& d) {
   FileHeader h;
   std::memset(static_cast<void*>(&h), 0, sizeof(h));  // padding included
   std::memcpy(h.magic, kMagic, sizeof(kMagic));
-  h.format_major = kFormatMajor;
-  h.format_minor = kFormatMinor;
+  h.format_major = refined ? kRefinedFormatMajor : kFormatMajor;
+  h.format_minor = refined ? kRefinedFormatMinor : kFormatMinor;
   h.byte_order_mark = kByteOrderMark;
   h.header_size = sizeof(FileHeader);
   std::memcpy(h.builder_version, d.builder_version.data(), d.builder_version.size());
@@ -727,11 +784,19 @@ absl::Status Index::Validate() {
   accuracy_ = SectionView<AccuracyRecord>(p, entry(SectionId::kAccuracy));
   input_faces_ = SectionView<InputFaceRecord>(p, entry(SectionId::kInputFaces));
   vertex_copies_ = SectionView<int32_t>(p, entry(SectionId::kVertexCopies));
+  coarse_faces_ = SectionView<int32_t>(p, entry(SectionId::kCoarseFaces));
+  refined_faces_ = SectionView<RefinedFaceRecord>(p, entry(SectionId::kRefinedFaces));
+  if (h.format_major < kRefinedFormatMajor &&
+      (!refined_faces_.empty() || !coarse_faces_.empty() || h.params.refinement_vertices != 0)) {
+    return absl::DataLossError(absl::StrFormat(
+        "a format %d.%d index with refinement sections", h.format_major, h.format_minor));
+  }
   GEODEX_RETURN_IF_ERROR(CheckAccuracy(accuracy_, absl::StatusCode::kDataLoss));
 
   return CheckContents(
       Contents{counts, positions_, faces_, twins_, samples_, sample_distances_, vertices_,
-               triangles_, bvh_nodes_, bvh_faces_, input_faces_, vertex_copies_},
+               triangles_, bvh_nodes_, bvh_faces_, input_faces_, vertex_copies_, coarse_faces_,
+               refined_faces_, h.params.refinement_vertices},
       absl::StatusCode::kDataLoss);
 }
 
@@ -754,6 +819,8 @@ IndexData ToIndexData(const Index& index) {
   if (index.accuracy() != nullptr) d.accuracy = {*index.accuracy()};
   d.input_faces = copy(index.input_faces());
   d.vertex_copies = copy(index.vertex_copies());
+  d.coarse_faces = copy(index.coarse_faces());
+  d.refined_faces = copy(index.refined_faces());
   return d;
 }
 

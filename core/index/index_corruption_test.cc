@@ -76,12 +76,13 @@ TEST(IndexTest, WrongMagicIsFailedPrecondition) {
 
 TEST(IndexTest, WrongMajorVersionIsFailedPrecondition) {
   Image image = Image::Parse(Serialize(MakeSphereIndex()));
-  image.header.format_major = kFormatMajor + 1;
+  image.header.format_major = kRefinedFormatMajor + 1;
   image.header.format_minor = 3;
   const absl::Status status = Index::FromBytes(image.Layout()).status();
   EXPECT_EQ(status.code(), absl::StatusCode::kFailedPrecondition);
-  EXPECT_THAT(status.message(), HasSubstr(absl::StrCat(kFormatMajor + 1, ".3")));
-  EXPECT_THAT(status.message(), HasSubstr(absl::StrCat(kFormatMajor, ".", kFormatMinor)));
+  EXPECT_THAT(status.message(), HasSubstr(absl::StrCat(kRefinedFormatMajor + 1, ".3")));
+  EXPECT_THAT(status.message(),
+              HasSubstr(absl::StrCat(kRefinedFormatMajor, ".", kRefinedFormatMinor)));
 }
 
 TEST(IndexTest, SwappedByteOrderIsFailedPrecondition) {
@@ -235,6 +236,83 @@ TEST(IndexTest, SemanticCorruptionWithValidChecksumsIsDataLoss) {
          i.Set<int32_t>(SectionId::kBvhFaces, 1, i.Get<int32_t>(SectionId::kBvhFaces, 0));
        },
        "BVH face 1"},
+  };
+  for (const Case& c : cases) {
+    Image image = Image::Parse(bytes);
+    c.corrupt(image);
+    const absl::Status status = Index::FromBytes(image.Layout()).status();
+    EXPECT_EQ(status.code(), absl::StatusCode::kDataLoss) << c.name << ": " << status;
+    EXPECT_THAT(status.message(), HasSubstr(c.message)) << c.name;
+  }
+}
+
+// The sphere index as if it were refined (format 2.0): every face its own
+// coarse face, and the unreferenced last vertex counted as a midpoint.
+IndexData MakeRefinedSphereIndex() {
+  IndexData d = MakeSphereIndex();
+  d.coarse_faces = d.faces;
+  for (size_t f = 0; f < d.faces.size() / 3; ++f) {
+    RefinedFaceRecord r{};
+    r.coarse_face = static_cast<int32_t>(f);
+    for (int i = 0; i < 3; ++i) r.weight[i][i] = 1;
+    d.refined_faces.push_back(r);
+  }
+  d.params.refinement_vertices = 1;
+  return d;
+}
+
+TEST(IndexTest, RefinedIndexIsWrittenAsVersion2AndReadBack) {
+  absl::StatusOr<std::shared_ptr<const Index>> index =
+      Index::FromBytes(Serialize(MakeRefinedSphereIndex()));
+  ASSERT_TRUE(index.ok()) << index.status();
+  EXPECT_EQ((*index)->header().format_major, kRefinedFormatMajor);
+  EXPECT_EQ((*index)->refinement_vertices(), 1);
+  EXPECT_EQ((*index)->refined_faces().size(), 80u);
+  EXPECT_EQ((*index)->coarse_faces().size(), 240u);
+  // Written again, the same bytes.
+  EXPECT_EQ(Serialize(ToIndexData(**index)), Serialize(MakeRefinedSphereIndex()));
+  // Without refinement, still the 1.x layout older readers take.
+  absl::StatusOr<std::shared_ptr<const Index>> plain = Index::FromBytes(Serialize(MakeSphereIndex()));
+  ASSERT_TRUE(plain.ok());
+  EXPECT_EQ((*plain)->header().format_major, kFormatMajor);
+}
+
+TEST(IndexTest, RefinementCorruptionWithValidChecksumsIsDataLoss) {
+  const std::string bytes = Serialize(MakeRefinedSphereIndex());
+  const int32_t nv = 43;
+  // A record is 10 four-byte words: the coarse face, then 3 x 3 weights.
+  auto weight = [](int32_t face, int corner, int k) { return 10 * face + 1 + 3 * corner + k; };
+  struct Case {
+    std::string name;
+    std::function<void(Image&)> corrupt;
+    std::string message;
+  };
+  const std::vector<Case> cases = {
+      {"piece of a coarse face out of range",
+       [&](Image& i) { i.Set<int32_t>(SectionId::kRefinedFaces, 10 * 3, 80); }, "refined face 3"},
+      {"NaN weight",
+       [&](Image& i) {
+         i.Set<float>(SectionId::kRefinedFaces, weight(4, 1, 1),
+                      std::numeric_limits<float>::quiet_NaN());
+       },
+       "refined face 4"},
+      {"weights not summing to 1",
+       [&](Image& i) { i.Set<float>(SectionId::kRefinedFaces, weight(5, 2, 0), 0.5f); },
+       "refined face 5"},
+      {"negative weight",
+       [&](Image& i) {
+         i.Set<float>(SectionId::kRefinedFaces, weight(6, 0, 0), 1.5f);
+         i.Set<float>(SectionId::kRefinedFaces, weight(6, 0, 1), -0.5f);
+       },
+       "refined face 6"},
+      {"coarse face without a piece",
+       [&](Image& i) { i.Set<int32_t>(SectionId::kRefinedFaces, 0, 1); }, "coarse face 0 has no"},
+      {"coarse face on a midpoint",
+       [&](Image& i) { i.Set<int32_t>(SectionId::kCoarseFaces, 7, nv - 1); }, "coarse face 2"},
+      {"more midpoints than vertices",
+       [&](Image& i) { i.header.params.refinement_vertices = nv + 1; }, "midpoints"},
+      {"refinement sections in a 1.x file",
+       [&](Image& i) { i.header.format_major = kFormatMajor; }, "refinement sections"},
   };
   for (const Case& c : cases) {
     Image image = Image::Parse(bytes);

@@ -1,9 +1,11 @@
 #include "core/query/input_ids.h"
 
 #include <algorithm>
+#include <limits>
 #include <numbers>
 #include <utility>
 
+#include "absl/strings/str_format.h"
 #include "core/common/status_macros.h"
 
 namespace geodex::query {
@@ -12,13 +14,31 @@ InputIds::InputIds(const index::Index& index)
     : index_(&index),
       input_faces_(index.input_faces()),
       vertex_copies_(index.vertex_copies()),
-      num_input_faces_(input_faces_.empty() ? index.num_faces()
-                                            : static_cast<int32_t>(input_faces_.size())),
-      num_input_vertices_(index.num_vertices() - static_cast<int32_t>(vertex_copies_.size())) {
+      num_input_vertices_(index.num_vertices() - index.refinement_vertices() -
+                          static_cast<int32_t>(index.vertex_copies().size())),
+      coarse_faces_(index.coarse_faces()),
+      refined_faces_(index.refined_faces()) {
+  const int32_t num_coarse_faces = refined_faces_.empty()
+                                       ? index.num_faces()
+                                       : static_cast<int32_t>(coarse_faces_.size() / 3);
+  num_input_faces_ =
+      input_faces_.empty() ? num_coarse_faces : static_cast<int32_t>(input_faces_.size());
+  if (!refined_faces_.empty()) {
+    // Index::Open checked that every piece names a coarse face and every
+    // coarse face has one.
+    piece_offset_.assign(num_coarse_faces + 1, 0);
+    for (const index::RefinedFaceRecord& r : refined_faces_) ++piece_offset_[r.coarse_face + 1];
+    for (int32_t c = 0; c < num_coarse_faces; ++c) piece_offset_[c + 1] += piece_offset_[c];
+    pieces_.resize(refined_faces_.size());
+    std::vector<int32_t> cursor(piece_offset_.begin(), piece_offset_.end() - 1);
+    for (int32_t f = 0; f < static_cast<int32_t>(refined_faces_.size()); ++f) {
+      pieces_[cursor[refined_faces_[f].coarse_face]++] = f;
+    }
+  }
   if (input_faces_.empty()) return;
-  // Index::Open checked that every internal face is kept for exactly one
+  // Index::Open checked that every coarse face is kept for exactly one
   // input face.
-  kept_input_face_.assign(index.num_faces(), mesh::kNone);
+  kept_input_face_.assign(num_coarse_faces, mesh::kNone);
   for (int32_t f = 0; f < num_input_faces_; ++f) {
     const index::InputFaceRecord& r = input_faces_[f];
     if ((r.flags & index::kInputFaceDropped) == 0) kept_input_face_[r.face] = f;
@@ -28,19 +48,59 @@ InputIds::InputIds(const index::Index& index)
 absl::StatusOr<mesh::SurfacePoint> InputIds::ToInternal(const mesh::SurfacePoint& p,
                                                         double tolerance) const {
   GEODEX_RETURN_IF_ERROR(mesh::ValidateSurfacePoint(num_input_faces_, p, tolerance));
-  if (input_faces_.empty()) return p;
-  const index::InputFaceRecord& r = input_faces_[p.face];
-  mesh::SurfacePoint out{r.face, {0, 0, 0}};
-  for (int i = 0; i < 3; ++i) out.w[r.corner[i]] = p.w[i];
-  return out;
+  mesh::SurfacePoint coarse = p;
+  if (!input_faces_.empty()) {
+    const index::InputFaceRecord& r = input_faces_[p.face];
+    coarse = {r.face, {0, 0, 0}};
+    for (int i = 0; i < 3; ++i) coarse.w[r.corner[i]] = p.w[i];
+  }
+  if (refined_faces_.empty()) return coarse;
+  // The piece whose smallest weight of the point is the largest: the one
+  // holding it (on a shared edge either is right; rounding may leave the
+  // point a hair outside every piece).
+  mesh::SurfacePoint best{mesh::kNone, {0, 0, 0}};
+  double best_min = -std::numeric_limits<double>::infinity();
+  for (int32_t k = piece_offset_[coarse.face]; k < piece_offset_[coarse.face + 1]; ++k) {
+    const index::RefinedFaceRecord& r = refined_faces_[pieces_[k]];
+    // coarse.w = a0 W0 + a1 W1 + a2 W2 with a0 + a1 + a2 = 1: two
+    // equations in the first two weights (the third follows).
+    const double e00 = r.weight[0][0] - r.weight[2][0], e01 = r.weight[1][0] - r.weight[2][0];
+    const double e10 = r.weight[0][1] - r.weight[2][1], e11 = r.weight[1][1] - r.weight[2][1];
+    const double b0 = coarse.w[0] - r.weight[2][0], b1 = coarse.w[1] - r.weight[2][1];
+    const double det = e00 * e11 - e01 * e10;
+    if (det == 0) continue;  // Index::Open does not rule out a flat piece
+    const double a0 = (b0 * e11 - e01 * b1) / det, a1 = (e00 * b1 - b0 * e10) / det;
+    const double a2 = 1 - a0 - a1;
+    const double smallest = std::min({a0, a1, a2});
+    if (smallest > best_min) {
+      best_min = smallest;
+      best = {pieces_[k], {a0, a1, a2}};
+    }
+  }
+  if (best.face == mesh::kNone) {
+    return absl::InternalError(absl::StrFormat("coarse face %d has no usable piece", coarse.face));
+  }
+  // Clamp what rounding left outside, keeping the weights a partition of 1.
+  double sum = 0;
+  for (double& w : best.w) sum += (w = std::max(w, 0.0));
+  for (double& w : best.w) w /= sum;
+  return best;
 }
 
 mesh::SurfacePoint InputIds::ToInput(const mesh::SurfacePoint& p) const {
-  if (input_faces_.empty()) return p;
-  const int32_t f = kept_input_face_[p.face];
+  mesh::SurfacePoint coarse = p;
+  if (!refined_faces_.empty()) {
+    const index::RefinedFaceRecord& r = refined_faces_[p.face];
+    coarse = {r.coarse_face, {0, 0, 0}};
+    for (int i = 0; i < 3; ++i) {
+      for (int j = 0; j < 3; ++j) coarse.w[j] += p.w[i] * r.weight[i][j];
+    }
+  }
+  if (input_faces_.empty()) return coarse;
+  const int32_t f = kept_input_face_[coarse.face];
   const index::InputFaceRecord& r = input_faces_[f];
   mesh::SurfacePoint out{f, {0, 0, 0}};
-  for (int i = 0; i < 3; ++i) out.w[i] = p.w[r.corner[i]];
+  for (int i = 0; i < 3; ++i) out.w[i] = coarse.w[r.corner[i]];
   return out;
 }
 
@@ -49,7 +109,8 @@ bool InputIds::Reoriented(int32_t f) const {
 }
 
 mesh::Triangle InputIds::InputFace(int32_t f) const {
-  const std::span<const int32_t> faces = index_->faces();
+  const std::span<const int32_t> faces =
+      refined_faces_.empty() ? index_->faces() : coarse_faces_;
   mesh::Triangle out;
   if (input_faces_.empty()) {
     for (int i = 0; i < 3; ++i) out[i] = InputVertex(faces[3 * f + i]);
@@ -61,7 +122,7 @@ mesh::Triangle InputIds::InputFace(int32_t f) const {
 }
 
 DistanceField InputIds::FieldToInput(DistanceField field) const {
-  if (vertex_copies_.empty()) return field;
+  if (vertex_copies_.empty() && refined_faces_.empty()) return field;
   for (size_t k = 0; k < vertex_copies_.size(); ++k) {
     const size_t copy = num_input_vertices_ + k, v = vertex_copies_[k];
     if (field.distance[copy] < field.distance[v]) {
@@ -75,7 +136,7 @@ DistanceField InputIds::FieldToInput(DistanceField field) const {
 }
 
 void InputIds::PathToInput(std::span<PathPoint> path) const {
-  if (input_faces_.empty()) return;
+  if (input_faces_.empty() && refined_faces_.empty()) return;
   for (PathPoint& p : path) p.point = ToInput(p.point);
 }
 
@@ -87,9 +148,10 @@ absl::StatusOr<std::vector<ExpMapVertex>> ExpMapOfInput(const QueryEngine& engin
   GEODEX_ASSIGN_OR_RETURN(const mesh::SurfacePoint internal,
                           ids.ToInternal(centre, engine.options().weight_tolerance));
   // A re-oriented face's normal is the input face's reversed, and its first
-  // edge another edge: give the input's first edge, and mirror θ.
+  // edge another edge: give the input's first edge, and mirror θ. A piece of
+  // a refined face has other edges too.
   const bool mirrored = ids.Reoriented(centre.face);
-  if (mirrored && !options.reference_direction.has_value()) {
+  if ((mirrored || ids.refined()) && !options.reference_direction.has_value()) {
     const mesh::Triangle t = ids.InputFace(centre.face);
     const std::span<const double> p = engine.index().positions();
     options.reference_direction = mesh::Vec3(p[3 * t[1]], p[3 * t[1] + 1], p[3 * t[1] + 2]) -
@@ -98,6 +160,8 @@ absl::StatusOr<std::vector<ExpMapVertex>> ExpMapOfInput(const QueryEngine& engin
   GEODEX_ASSIGN_OR_RETURN(std::vector<ExpMapVertex> map,
                           ExpMap(engine, internal, options, scratch));
   if (ids.identity()) return map;
+  // Midpoints of a refinement are no input vertices.
+  std::erase_if(map, [&ids](const ExpMapVertex& e) { return ids.InputVertex(e.vertex) == mesh::kNone; });
   for (ExpMapVertex& e : map) {
     e.vertex = ids.InputVertex(e.vertex);
     if (mirrored) {

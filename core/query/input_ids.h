@@ -20,6 +20,13 @@
 // The face count clients see is the input's, so that face ids are validated
 // against the input's range.
 //
+// An index of a refined mesh (format 2.0) adds a second step: the repaired
+// ("coarse") faces were split flat, so a coarse point is located among its
+// face's pieces (the piece whose weights hold it), and an internal point goes
+// back through its piece's corner weights. The midpoints are no input
+// vertices: per-vertex answers leave them out, and a sample placed on one is
+// named by its surface point only.
+//
 // An index without the sections (not repaired, or older than 1.2) has
 // identity maps: every method returns its argument, and nothing is copied.
 //
@@ -44,7 +51,11 @@ class InputIds {
   explicit InputIds(const index::Index& index);
 
   // True when input ids are internal ids.
-  bool identity() const { return input_faces_.empty() && vertex_copies_.empty(); }
+  bool identity() const {
+    return input_faces_.empty() && vertex_copies_.empty() && refined_faces_.empty();
+  }
+  // True for an index of a refined mesh (format 2.0).
+  bool refined() const { return !refined_faces_.empty(); }
   int32_t num_input_faces() const { return num_input_faces_; }
   int32_t num_input_vertices() const { return num_input_vertices_; }
 
@@ -55,9 +66,15 @@ class InputIds {
                                                 double tolerance = 1e-6) const;
   // An internal point in the input face kept for its face.
   mesh::SurfacePoint ToInput(const mesh::SurfacePoint& p) const;
-  // The input vertex internal vertex `v` is (a copy's original).
+  // Internal vertices that are a repair's copy of an input vertex: ids
+  // [num_input_vertices, num_input_vertices + num_vertex_copies).
+  int32_t num_vertex_copies() const { return static_cast<int32_t>(vertex_copies_.size()); }
+  // The input vertex internal vertex `v` is (a copy's original), or
+  // mesh::kNone for a refinement's midpoint.
   int32_t InputVertex(int32_t v) const {
-    return v < num_input_vertices_ ? v : vertex_copies_[v - num_input_vertices_];
+    if (v < num_input_vertices_) return v;
+    const int32_t k = v - num_input_vertices_;
+    return k < num_vertex_copies() ? vertex_copies_[k] : mesh::kNone;
   }
   // True when input face `f` (in range) had its corners 1 and 2 swapped.
   bool Reoriented(int32_t f) const;
@@ -77,8 +94,14 @@ class InputIds {
   std::span<const int32_t> vertex_copies_;
   int32_t num_input_faces_ = 0;
   int32_t num_input_vertices_ = 0;
-  // Internal face -> the input face kept for it; empty for identity faces.
+  // Coarse face -> the input face kept for it; empty for identity faces.
   std::vector<int32_t> kept_input_face_;
+  // The refinement (empty without): per coarse face, its pieces
+  // pieces_[piece_offset_[c], piece_offset_[c + 1]).
+  std::span<const int32_t> coarse_faces_;
+  std::span<const index::RefinedFaceRecord> refined_faces_;
+  std::vector<int32_t> piece_offset_;
+  std::vector<int32_t> pieces_;
 };
 
 // ExpMap with the centre and the answer in input ids: `centre` in an input

@@ -11,6 +11,7 @@
 
 #include "core/builder/builder.h"
 #include "core/builder/mesh_arrays.h"
+#include "core/geodesic/exact_geodesic.h"
 #include "core/index/index.h"
 #include "core/mesh/broken_meshes_testing.h"
 #include "core/mesh/generators.h"
@@ -34,17 +35,21 @@ struct Built {
   std::shared_ptr<const QueryEngine> engine;
 };
 
-// Repairs, builds (as geodex-build does) and loads an index of `raw`.
-Built Build(const RawMesh& raw, int32_t samples) {
+// Repairs, builds (as geodex-build does, with the flat refinement when
+// `refine`) and loads an index of `raw`.
+Built Build(const RawMesh& raw, int32_t samples, bool refine = false) {
   absl::StatusOr<RepairedMesh> repaired = mesh::RepairMesh(raw);
   if (!repaired.ok()) throw std::runtime_error(repaired.status().ToString());
+  absl::StatusOr<builder::PreparedMesh> prepared = builder::PrepareMesh(
+      repaired->mesh, builder::RecordRepair(*repaired), samples, refine);
+  if (!prepared.ok()) throw std::runtime_error(prepared.status().ToString());
   builder::BuildOptions options;
   options.num_samples = samples;
   options.threads = 2;
   builder::BuildSummary summary;
-  absl::StatusOr<index::IndexData> data = builder::BuildIndex(repaired->mesh, options, &summary);
+  absl::StatusOr<index::IndexData> data = builder::BuildIndex(prepared->mesh, options, &summary);
   if (!data.ok()) throw std::runtime_error(data.status().ToString());
-  builder::AddRepair(builder::RecordRepair(*repaired), &*data);
+  builder::AddRepair(prepared->record, &*data);
   absl::StatusOr<std::string> bytes = index::SerializeIndex(*data);
   if (!bytes.ok()) throw std::runtime_error(bytes.status().ToString());
   auto index = index::Index::FromBytes(*std::move(bytes));
@@ -242,6 +247,144 @@ TEST(InputIdsTest, CowNonmanifoldBuildsAndAnswers) {
   const absl::StatusOr<RepairedMesh> refused = mesh::RepairMesh(*raw, strict);
   ASSERT_FALSE(refused.ok());
   EXPECT_THAT(refused.status().message(), ::testing::HasSubstr("non-manifold vertex"));
+}
+
+// The point of space a surface point of `faces`/`positions` names.
+mesh::Vec3 PointOf(std::span<const double> positions, const mesh::Triangle& t,
+                   const SurfacePoint& p) {
+  mesh::Vec3 x(0, 0, 0);
+  for (int i = 0; i < 3; ++i) {
+    x += p.w[i] * mesh::Vec3(positions[3 * t[i]], positions[3 * t[i] + 1], positions[3 * t[i] + 2]);
+  }
+  return x;
+}
+
+// A coarse sphere (42 vertices, edges about 0.6) sampled more finely than it
+// has vertices: only the flat refinement makes room for the samples, and
+// every answer still speaks of the input's faces and vertices.
+TEST(InputIdsTest, RefinedIndexAnswersInTheInputIds) {
+  const mesh::Mesh coarse = mesh::gen::Sphere(1, 1.0);
+  ASSERT_EQ(coarse.num_vertices(), 42);
+  Built b = Build(RawOf(coarse, "sphere"), 120, /*refine=*/true);
+  const QueryEngine& e = *b.engine;
+  const InputIds& ids = e.input_ids();
+  EXPECT_EQ(e.index().header().format_major, index::kRefinedFormatMajor);
+  EXPECT_GT(e.index().refinement_vertices(), 0);
+  EXPECT_GE(e.index().num_samples(), 120);
+  EXPECT_TRUE(ids.refined());
+  EXPECT_FALSE(ids.identity());
+  EXPECT_EQ(ids.num_input_faces(), 80);
+  EXPECT_EQ(ids.num_input_vertices(), 42);
+  EXPECT_EQ(ids.ToInternal({80, {1, 0, 0}}).status().code(), absl::StatusCode::kOutOfRange);
+  EXPECT_THAT(std::string(e.index().report()), ::testing::HasSubstr("mesh_refinement = "));
+
+  const std::span<const double> x = e.index().positions();
+  const std::span<const int32_t> faces = e.index().faces();
+  auto internal_face = [&](int32_t f) {
+    return mesh::Triangle{faces[3 * f], faces[3 * f + 1], faces[3 * f + 2]};
+  };
+  std::vector<SurfacePoint> points;
+  for (int32_t f = 0; f < 80; ++f) {
+    EXPECT_EQ(ids.InputFace(f), coarse.face(f));
+    for (const mesh::Vec3& w : {mesh::Vec3(0.2, 0.3, 0.5), mesh::Vec3(1, 0, 0),
+                                mesh::Vec3(0.5, 0.5, 0), mesh::Vec3(0.05, 0.05, 0.9)}) {
+      const SurfacePoint p{f, {w.x(), w.y(), w.z()}};
+      absl::StatusOr<SurfacePoint> in = ids.ToInternal(p);
+      ASSERT_TRUE(in.ok()) << in.status();
+      // The same point of space, and back to the same input description.
+      EXPECT_LT((PointOf(x, internal_face(in->face), *in) - PointOf(x, coarse.face(f), p)).norm(),
+                1e-9);
+      const SurfacePoint back = ids.ToInput(*in);
+      EXPECT_EQ(back.face, f);
+      for (int i = 0; i < 3; ++i) EXPECT_NEAR(back.w[i], p.w[i], 1e-6);
+      points.push_back(p);
+    }
+  }
+  // The surface is the same: exact distances from an input point, on the
+  // refined mesh, equal those on the coarse one at every input vertex; the
+  // O(1) answers are close to them.
+  geodesic::ExactGeodesicSolver exact(coarse);
+  QueryScratch scratch;
+  int checked = 0;
+  for (size_t i = 0; i < points.size(); i += 37) {
+    ASSERT_TRUE(exact.Propagate({points[i]}).ok());
+    absl::StatusOr<SurfacePoint> internal = ids.ToInternal(points[i]);
+    ASSERT_TRUE(internal.ok());
+    absl::StatusOr<std::span<const double>> local = e.LocalExactDistances(*internal, 10, scratch);
+    ASSERT_TRUE(local.ok()) << local.status();
+    for (int32_t v = 0; v < 42; ++v) EXPECT_NEAR((*local)[v], exact.VertexDistance(v), 1e-9);
+    for (size_t j = 5; j < points.size(); j += 23) {
+      const double truth = exact.DistanceAt(points[j]);
+      if (truth < 0.3) continue;
+      EXPECT_NEAR(InputDistance(e, points[i], points[j], NearPairs::kUnfold), truth, 0.06 * truth)
+          << i << " " << j;
+      ++checked;
+    }
+  }
+  EXPECT_GT(checked, 20);
+  // Per-vertex answers cover the input's vertices only; midpoints have no
+  // input vertex.
+  EXPECT_EQ(ids.InputVertex(41), 41);
+  EXPECT_EQ(ids.InputVertex(42), mesh::kNone);
+  absl::StatusOr<SurfacePoint> source = ids.ToInternal(points[3]);
+  ASSERT_TRUE(source.ok());
+  absl::StatusOr<DistanceField> field = e.Field(std::vector<SurfacePoint>{*source});
+  ASSERT_TRUE(field.ok());
+  EXPECT_EQ(field->distance.size(), static_cast<size_t>(e.index().num_vertices()));
+  const DistanceField input = ids.FieldToInput(*field);
+  ASSERT_EQ(input.distance.size(), 42u);
+  ASSERT_TRUE(exact.Propagate({points[3]}).ok());
+  for (int32_t v = 0; v < 42; ++v) {
+    EXPECT_NEAR(input.distance[v], exact.VertexDistance(v), 0.03 * exact.VertexDistance(v) + 0.02);
+  }
+  ExpMapOptions map_options;
+  map_options.radius = 1.0;
+  absl::StatusOr<std::vector<ExpMapVertex>> map = ExpMapOfInput(e, points[3], map_options);
+  ASSERT_TRUE(map.ok()) << map.status();
+  ASSERT_FALSE(map->empty());
+  for (const ExpMapVertex& v : *map) EXPECT_LT(v.vertex, 42);
+  // A path comes back in input faces, from the first point to the second.
+  absl::StatusOr<SurfacePoint> to = ids.ToInternal(points[200]);
+  ASSERT_TRUE(to.ok());
+  absl::StatusOr<std::vector<PathPoint>> path = e.Path(*source, *to);
+  ASSERT_TRUE(path.ok()) << path.status();
+  ids.PathToInput(*path);
+  for (const PathPoint& p : *path) EXPECT_LT(p.point.face, 80);
+  EXPECT_LT((PointOf(x, coarse.face(path->front().point.face), path->front().point) -
+             PointOf(x, coarse.face(points[3].face), points[3]))
+                .norm(),
+            1e-9);
+}
+
+// Repair and refinement compose: a re-oriented, duplicated coarse mesh.
+TEST(InputIdsTest, RepairedAndRefinedIndexAnswersInTheInputIds) {
+  const mesh::Mesh coarse = mesh::gen::Sphere(1, 1.0);
+  RawMesh raw = RawOf(coarse, "sphere");
+  for (int32_t f : {0, 5, 17}) std::swap(raw.triangles[f][1], raw.triangles[f][2]);
+  const mesh::Triangle t = raw.triangles[7];
+  AddTriangle(&raw, {t[1], t[2], t[0]});  // input face 80, a duplicate of 7
+  Built b = Build(raw, 120, /*refine=*/true);
+  Built reference = Build(RawOf(coarse, "sphere"), 120, /*refine=*/true);
+  const InputIds& ids = b.engine->input_ids();
+  EXPECT_TRUE(ids.refined());
+  EXPECT_EQ(ids.num_input_faces(), 81);
+  EXPECT_EQ(ids.num_input_vertices(), 42);
+  const SurfacePoint far{40, {0.3, 0.3, 0.4}};
+  // Re-oriented face 5: (x, y, z) on the input is (x, z, y) on the sphere.
+  EXPECT_NEAR(InputDistance(*b.engine, {5, {0.1, 0.2, 0.7}}, far, NearPairs::kUnfold),
+              InputDistance(*reference.engine, {5, {0.1, 0.7, 0.2}}, far, NearPairs::kUnfold),
+              1e-9);
+  // The duplicate answers as its twin, and goes back to it.
+  const SurfacePoint on_twin{7, {0.2, 0.3, 0.5}};
+  const SurfacePoint on_rotated{80, {0.3, 0.5, 0.2}};
+  EXPECT_EQ(InputDistance(*b.engine, on_rotated, far), InputDistance(*b.engine, on_twin, far));
+  absl::StatusOr<SurfacePoint> internal = ids.ToInternal(on_rotated);
+  ASSERT_TRUE(internal.ok());
+  const SurfacePoint back = ids.ToInput(*internal);
+  EXPECT_EQ(back.face, 7);
+  for (int i = 0; i < 3; ++i) EXPECT_NEAR(back.w[i], on_twin.w[i], 1e-6);
+  EXPECT_EQ(ids.InputFace(5), (mesh::Triangle{coarse.face(5)[0], coarse.face(5)[2],
+                                              coarse.face(5)[1]}));
 }
 
 }  // namespace

@@ -12,7 +12,10 @@
 // does not change the surface (core/mesh/mesh_repair.h: duplicate faces,
 // non-manifold edges and vertices, orientation), each repair counted in the
 // build report, and the index answers in the file's ids; --strict refuses
-// such a mesh with the first reason instead. --edges-obj writes the geodesic
+// such a mesh with the first reason instead. Edges longer than half the
+// sample spacing L(m) are split flat first (core/builder/mesh_arrays.h,
+// PrepareMesh: the surface is unchanged and the index still answers in the
+// file's ids); --no-refinement keeps the mesh as it is. --edges-obj writes the geodesic
 // Delaunay edges as OBJ polylines (v and l lines) to view over the mesh. Exit
 // codes: 0 success, 2 bad input or usage, 1 any other failure.
 
@@ -61,10 +64,12 @@ absl::StatusOr<mesh::RepairedMesh> LoadInput(const std::string& path, bool stric
 }
 
 // The report's mesh_repairs line: the one-line summary.
-std::string RepairLine(const std::string& report) {
-  const std::string key = "mesh_repairs = ";
+// The value of report line `key` ("mesh_repairs"), or `absent`.
+std::string ReportLine(const std::string& report, const std::string& name,
+                       const std::string& absent) {
+  const std::string key = name + " = ";
   const size_t at = report.find(key);
-  if (at == std::string::npos) return "none recorded";
+  if (at == std::string::npos) return absent;
   const size_t end = report.find('\n', at);
   return report.substr(at + key.size(), end == std::string::npos ? end : end - at - key.size());
 }
@@ -114,10 +119,11 @@ std::string EdgeLine(int32_t edges, int32_t crossings, double total, double long
 }
 
 void PrintSummary(const builder::BuildSummary& s, const std::string& out,
-                  const std::string& repairs) {
+                  const std::string& repairs, const std::string& refinement) {
   std::printf(
       "geodex-build: wrote %s (%.1f MiB)\n"
       "  mesh repairs     %s\n"
+      "  mesh refinement  %s\n"
       "  samples          %d requested, %d final (%s)\n"
       "  triangles        %d geodesic triangles\n"
       "  edges            %s\n"
@@ -125,7 +131,8 @@ void PrintSummary(const builder::BuildSummary& s, const std::string& out,
       "  outside [-0.01,1.01]  %.4f%% of vertices\n"
       "  longest edge     %.6g (%.4f of the bounding-box diagonal)\n"
       "  time             sampling %s, triangulation %s, rows %s, merge %s\n",
-      out.c_str(), s.index_bytes / 1048576.0, repairs.c_str(), s.requested_samples, s.num_samples,
+      out.c_str(), s.index_bytes / 1048576.0, repairs.c_str(), refinement.c_str(),
+      s.requested_samples, s.num_samples,
       s.repair.c_str(), s.num_triangles,
       EdgeLine(s.geodesic_edges, s.edge_crossings_found, s.edge_length_total, s.edge_length_max)
           .c_str(),
@@ -171,7 +178,8 @@ absl::Status WriteAndReport(const index::IndexData& data, builder::BuildSummary&
   GEODEX_RETURN_IF_ERROR(index::WriteIndexFile(data, out));
   GEODEX_ASSIGN_OR_RETURN(auto loaded, index::Index::Open(out));  // validate what we wrote
   summary.index_bytes = loaded->size_bytes();
-  PrintSummary(summary, out, RepairLine(data.report));
+  PrintSummary(summary, out, ReportLine(data.report, "mesh_repairs", "none recorded"),
+               ReportLine(data.report, "mesh_refinement", "none (no edge longer than L/2)"));
   return absl::OkStatus();
 }
 
@@ -222,6 +230,11 @@ int main(int argc, char** argv) {
       "Refuse a mesh that needs repair (duplicate faces, non-manifold edges or vertices, "
       "inconsistent orientation, zero-area faces) with the first reason, instead of repairing it";
   app.add_flag("--strict", strict, kStrictHelp);
+  bool no_refinement = false;
+  const char* kNoRefinementHelp =
+      "Sample the mesh's own vertices only: do not split edges longer than half the sample "
+      "spacing (coarse meshes then stop improving with more samples)";
+  app.add_flag("--no-refinement", no_refinement, kNoRefinementHelp);
 
   CLI::App* plan_cmd = app.add_subcommand("plan", "Distributed build, step 1: sampling");
   plan_cmd->add_option("mesh", mesh_path, "Mesh file")->required();
@@ -232,6 +245,7 @@ int main(int argc, char** argv) {
       ->check(CLI::NonNegativeNumber);
   plan_cmd->add_option("--edges-obj", edges_obj, "Also write the geodesic edges as OBJ polylines");
   plan_cmd->add_flag("--strict", strict, kStrictHelp);
+  plan_cmd->add_flag("--no-refinement", no_refinement, kNoRefinementHelp);
 
   CLI::App* rows_cmd = app.add_subcommand("rows", "Distributed build, step 2: one shard of rows");
   rows_cmd->add_option("workdir", workdir, "Work directory")->required();
@@ -267,17 +281,23 @@ int main(int argc, char** argv) {
   options.num_samples = samples;
   options.seed = seed;
   options.threads = threads;
+  options.refine_long_edges = !no_refinement;
   options.progress = [&printer](const builder::Progress& p) { printer(p); };
 
   absl::Status status;
   if (*plan_cmd) {
     status = [&]() -> absl::Status {
       GEODEX_ASSIGN_OR_RETURN(const mesh::RepairedMesh repaired, LoadInput(mesh_path, strict));
-      const mesh::Mesh& mesh = repaired.mesh;
+      GEODEX_ASSIGN_OR_RETURN(const builder::PreparedMesh prepared,
+                              builder::PrepareMesh(repaired.mesh, builder::RecordRepair(repaired),
+                                                   samples, options.refine_long_edges));
+      const mesh::Mesh& mesh = prepared.mesh;
       GEODEX_ASSIGN_OR_RETURN(const builder::Plan plan, builder::MakePlan(mesh, options));
       GEODEX_RETURN_IF_ERROR(builder::SavePlan(mesh, plan, workdir));
-      GEODEX_RETURN_IF_ERROR(builder::SaveRepair(builder::RecordRepair(repaired), plan, workdir));
+      GEODEX_RETURN_IF_ERROR(builder::SaveRepair(prepared.record, plan, workdir));
       std::printf("geodex-build plan: mesh repairs: %s\n", repaired.report.Summary().c_str());
+      std::printf("geodex-build plan: %d midpoints added by the flat refinement\n",
+                  prepared.record.refinement_vertices);
       std::printf("geodex-build plan: %d samples (%s), %zu triangles, edges %s, in %s\n",
                   plan.num_samples(), plan.repair.Summary().c_str(), plan.triangles.size(),
                   EdgeLine(plan.edge_stats.count, plan.repair.crossings_found,
@@ -319,8 +339,15 @@ int main(int argc, char** argv) {
   } else if (*calibrate_cmd) {
     status = [&]() -> absl::Status {
       GEODEX_ASSIGN_OR_RETURN(const mesh::RepairedMesh repaired, LoadInput(mesh_path, strict));
-      const mesh::Mesh& mesh = repaired.mesh;
       GEODEX_ASSIGN_OR_RETURN(auto index, index::Index::Open(index_path));
+      // The mesh the index was built from: refined again as the builder did
+      // (deterministic), which the hash below confirms.
+      GEODEX_ASSIGN_OR_RETURN(
+          const builder::PreparedMesh prepared,
+          builder::PrepareMesh(repaired.mesh, {},
+                               static_cast<int32_t>(index->header().params.requested_samples),
+                               index->refinement_vertices() > 0));
+      const mesh::Mesh& mesh = prepared.mesh;
       if (index->header().mesh_hash !=
           index::MeshHash(builder::FlatPositions(mesh), builder::FlatFaces(mesh))) {
         return absl::InvalidArgumentError(
@@ -340,8 +367,6 @@ int main(int argc, char** argv) {
     }
     status = [&]() -> absl::Status {
       GEODEX_ASSIGN_OR_RETURN(const mesh::RepairedMesh repaired, LoadInput(mesh_path, strict));
-      const mesh::Mesh& mesh = repaired.mesh;
-      const builder::RepairRecord repair = builder::RecordRepair(repaired);
       if (target_error > 0) {
         validation::TargetErrorOptions target;
         target.target_rms = target_error;
@@ -354,8 +379,8 @@ int main(int argc, char** argv) {
                        400 * target_error);
         };
         GEODEX_ASSIGN_OR_RETURN(auto result,
-                                validation::BuildForTargetError(mesh, options, target));
-        builder::AddRepair(repair, &result.data);
+                                validation::BuildForTargetError(repaired.mesh, options, target,
+                                                                builder::RecordRepair(repaired)));
         result.data.report += absl::StrFormat(
             "target_error = %.6g\ntarget_error_reached = %s\ntarget_error_rounds = %d\n",
             target_error, result.reached ? "yes" : "no (sample cap)", result.rounds.size());
@@ -367,11 +392,15 @@ int main(int argc, char** argv) {
         }
         return WriteAndReport(result.data, result.summary, out);
       }
+      GEODEX_ASSIGN_OR_RETURN(const builder::PreparedMesh prepared,
+                              builder::PrepareMesh(repaired.mesh, builder::RecordRepair(repaired),
+                                                   samples, options.refine_long_edges));
+      const mesh::Mesh& mesh = prepared.mesh;
       GEODEX_ASSIGN_OR_RETURN(const builder::Plan plan, builder::MakePlan(mesh, options));
       GEODEX_RETURN_IF_ERROR(WriteEdges(mesh, plan, edges_obj));
       builder::BuildSummary summary;
       GEODEX_ASSIGN_OR_RETURN(auto data, builder::BuildIndexFromPlan(mesh, plan, options, &summary));
-      builder::AddRepair(repair, &data);
+      builder::AddRepair(prepared.record, &data);
       if (!no_calibration) GEODEX_RETURN_IF_ERROR(AddCalibration(mesh, data, threads));
       return WriteAndReport(data, summary, out);
     }();

@@ -11,7 +11,8 @@ namespace geodex::validation {
 
 absl::StatusOr<TargetErrorResult> BuildForTargetError(const mesh::Mesh& mesh,
                                                       builder::BuildOptions build,
-                                                      const TargetErrorOptions& options) {
+                                                      const TargetErrorOptions& options,
+                                                      const builder::RepairRecord& repair) {
   if (!(options.target_rms > 0) || !(options.growth > 1)) {
     return absl::InvalidArgumentError(absl::StrFormat(
         "the target error must be > 0 and the growth > 1 (got %g, %g)", options.target_rms,
@@ -25,10 +26,15 @@ absl::StatusOr<TargetErrorResult> BuildForTargetError(const mesh::Mesh& mesh,
   TargetErrorResult result;
   for (int32_t round = 0;; ++round) {
     builder::BuildSummary summary;
-    GEODEX_ASSIGN_OR_RETURN(index::IndexData data, builder::BuildIndex(mesh, build, &summary));
+    GEODEX_ASSIGN_OR_RETURN(
+        const builder::PreparedMesh prepared,
+        builder::PrepareMesh(mesh, repair, build.num_samples, build.refine_long_edges));
+    GEODEX_ASSIGN_OR_RETURN(index::IndexData data,
+                            builder::BuildIndex(prepared.mesh, build, &summary));
     CalibrationOptions calibration;
     calibration.pairs.threads = build.threads;
-    GEODEX_RETURN_IF_ERROR(AddCalibration(mesh, data, calibration));
+    GEODEX_RETURN_IF_ERROR(AddCalibration(prepared.mesh, data, calibration));
+    builder::AddRepair(prepared.record, &data);
     const index::AccuracyRecord& r = data.accuracy[0];
     result.rounds.push_back({static_cast<int32_t>(data.samples.size()), r.uniform_rms,
                              r.uniform_far_p99});

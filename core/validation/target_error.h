@@ -20,6 +20,7 @@
 
 #include "absl/status/statusor.h"
 #include "core/builder/builder.h"
+#include "core/builder/mesh_arrays.h"
 #include "core/index/index.h"
 #include "core/mesh/mesh.h"
 
@@ -45,10 +46,14 @@ struct TargetErrorResult {
   bool reached = false;  // false: stopped at the cap
 };
 
-// `build.num_samples` is the first round's m. Errors: those of the builder
-// and of calibration; InvalidArgument for a target that is not positive.
+// `build.num_samples` is the first round's m. Each round builds from
+// builder::PrepareMesh(mesh, repair, m, build.refine_long_edges): the long
+// edges are split for that round's m, and the result's data carries the
+// record (AddRepair is done). Errors: those of the builder and of
+// calibration; InvalidArgument for a target that is not positive.
 absl::StatusOr<TargetErrorResult> BuildForTargetError(const mesh::Mesh& mesh,
                                                       builder::BuildOptions build,
-                                                      const TargetErrorOptions& options);
+                                                      const TargetErrorOptions& options,
+                                                      const builder::RepairRecord& repair = {});
 
 }  // namespace geodex::validation

@@ -16,9 +16,11 @@
 #include "CLI/CLI.hpp"
 #include "absl/strings/str_format.h"
 #include "core/builder/builder.h"
+#include "core/builder/mesh_arrays.h"
 #include "core/common/status_macros.h"
 #include "core/mesh/generators.h"
 #include "core/mesh/mesh_io.h"
+#include "core/query/input_ids.h"
 #include "core/validation/calibration.h"
 #include "tests/accuracy/accuracy.h"
 
@@ -41,6 +43,7 @@ struct Flags {
   int threads = 0;
   std::vector<std::string> modes = {"unfold", "default", "bounds", "tol0.005"};
   int32_t path_sources = 0, path_points = 0;
+  bool no_refinement = false;
 };
 
 absl::Status Run(const Flags& flags) {
@@ -50,22 +53,33 @@ absl::Status Run(const Flags& flags) {
     const std::string name = std::filesystem::path(path).stem().string();
     for (int32_t count : flags.samples) {
       const std::string file = absl::StrFormat(
-          "%s/%s-m%d.gdx", flags.index_dir.empty() ? "/tmp" : flags.index_dir, name, count);
+          "%s/%s-m%d%s.gdx", flags.index_dir.empty() ? "/tmp" : flags.index_dir, name, count,
+          flags.no_refinement ? "-noref" : "");
       if (flags.index_dir.empty() || !std::filesystem::exists(file)) {
         builder::BuildOptions build_options;
         build_options.num_samples = count;
         build_options.threads = flags.threads;
+        GEODEX_ASSIGN_OR_RETURN(const builder::PreparedMesh prepared,
+                                builder::PrepareMesh(m, {}, count, !flags.no_refinement));
         builder::BuildSummary summary;
-        GEODEX_ASSIGN_OR_RETURN(const auto data, builder::BuildIndex(m, build_options, &summary));
+        GEODEX_ASSIGN_OR_RETURN(auto data,
+                                builder::BuildIndex(prepared.mesh, build_options, &summary));
+        builder::AddRepair(prepared.record, &data);
         GEODEX_RETURN_IF_ERROR(index::WriteIndexFile(data, file));
-        std::fprintf(stderr, "built %s: %s", file.c_str(), summary.ToText().c_str());
+        std::fprintf(stderr, "built %s: %s%s", file.c_str(), prepared.record.report.c_str(),
+                     summary.ToText().c_str());
       }
       GEODEX_ASSIGN_OR_RETURN(auto index, index::Index::Open(file));
       if (index->accuracy() == nullptr) {
         // An index without calibration: calibrate in memory as the builder
-        // would (its own seed), so that bounds can be measured.
+        // would (its own seed, on the mesh it sampled), so that bounds can be
+        // measured.
+        GEODEX_ASSIGN_OR_RETURN(
+            const builder::PreparedMesh prepared,
+            builder::PrepareMesh(m, {}, static_cast<int32_t>(index->header().params.requested_samples),
+                                 index->refinement_vertices() > 0));
         GEODEX_ASSIGN_OR_RETURN(const index::AccuracyRecord record,
-                                validation::Calibrate(m, index));
+                                validation::Calibrate(prepared.mesh, index));
         std::fprintf(stderr, "calibrated %s in memory\n", file.c_str());
         index::IndexData data = index::ToIndexData(*index);
         data.accuracy = {record};
@@ -93,11 +107,19 @@ absl::Status Run(const Flags& flags) {
         }
         query::QueryScratch scratch;
         int64_t failed = 0;
-        accuracy::AnswerFn answer = [&](const mesh::SurfacePoint& p, const mesh::SurfacePoint& q) {
+        // The pairs are in the file's ids, as a caller's are.
+        const query::InputIds& ids = engine->input_ids();
+        accuracy::AnswerFn answer = [&](const mesh::SurfacePoint& input_p,
+                                        const mesh::SurfacePoint& input_q) {
           accuracy::Answer a;
-          absl::StatusOr<double> d =
-              mode == "trace" ? engine->TracedDistance(p, q)
-                              : engine->Distance(p, q, options, &scratch, bounds ? &a.bound : nullptr);
+          const absl::StatusOr<mesh::SurfacePoint> p = ids.ToInternal(input_p);
+          const absl::StatusOr<mesh::SurfacePoint> q = ids.ToInternal(input_q);
+          absl::StatusOr<double> d = absl::InternalError("no internal point");
+          if (p.ok() && q.ok()) {
+            d = mode == "trace" ? engine->TracedDistance(*p, *q)
+                                : engine->Distance(*p, *q, options, &scratch,
+                                                   bounds ? &a.bound : nullptr);
+          }
           if (!d.ok()) ++failed;
           a.distance = d.value_or(std::numeric_limits<double>::quiet_NaN());
           return a;
@@ -134,6 +156,8 @@ int main(int argc, char** argv) {
                  "Targets per source drawn in each distance bin");
   app.add_option("--seed", flags.pairs.seed, "Random seed");
   app.add_option("--index-dir", flags.index_dir, "Cache built indexes here");
+  app.add_flag("--no-refinement", flags.no_refinement,
+               "Build without splitting long edges (geodex-build --no-refinement)");
   app.add_option("--threads", flags.threads, "Builder and exact-propagation threads (0: all)");
   app.add_option("--modes", flags.modes,
                  "Answer modes: unfold (pure O(1)), default, exact (near pairs exactly), bounds "
