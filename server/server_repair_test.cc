@@ -1,6 +1,8 @@
 // A model built from a repaired mesh (core/mesh/mesh_repair.h) is asked and
 // answers in the ids of its input mesh: a sphere with a duplicate face and
-// re-oriented faces, over loopback.
+// re-oriented faces, over loopback; once as it is, once also refined flat
+// (more samples than the sphere has vertices, so that its edges are split
+// and samples sit on midpoints).
 
 #include <algorithm>
 #include <cmath>
@@ -36,16 +38,21 @@ mesh::RawMesh BrokenSphere() {
   return raw;
 }
 
-std::string RepairedIndexBytes(const mesh::RawMesh& raw) {
+std::string RepairedIndexBytes(const mesh::RawMesh& raw, bool refine) {
   absl::StatusOr<mesh::RepairedMesh> repaired = mesh::RepairMesh(raw);
   EXPECT_TRUE(repaired.ok()) << repaired.status();
+  const int32_t samples = refine ? 400 : 40;
+  absl::StatusOr<builder::PreparedMesh> prepared = builder::PrepareMesh(
+      repaired->mesh, builder::RecordRepair(*repaired), samples, refine);
+  EXPECT_TRUE(prepared.ok()) << prepared.status();
+  EXPECT_EQ(prepared->record.refinement_vertices > 0, refine);
   builder::BuildOptions options;
-  options.num_samples = 40;
+  options.num_samples = samples;
   options.threads = 2;
   builder::BuildSummary summary;
-  absl::StatusOr<index::IndexData> data = builder::BuildIndex(repaired->mesh, options, &summary);
+  absl::StatusOr<index::IndexData> data = builder::BuildIndex(prepared->mesh, options, &summary);
   EXPECT_TRUE(data.ok()) << data.status();
-  builder::AddRepair(builder::RecordRepair(*repaired), &*data);
+  builder::AddRepair(prepared->record, &*data);
   absl::StatusOr<std::string> bytes = index::SerializeIndex(*data);
   EXPECT_TRUE(bytes.ok()) << bytes.status();
   return *bytes;
@@ -55,11 +62,13 @@ v1::SurfacePoints Points(std::vector<mesh::SurfacePoint> points) {
   return testing::ToProto(points);
 }
 
-class ServerRepairTest : public ::testing::Test {
+// The parameter: whether the model is refined as well.
+class ServerRepairTest : public ::testing::TestWithParam<bool> {
  protected:
   void SetUp() override {
     server_ = std::make_unique<testing::TestServer>();
-    testing::WriteModelVersion(server_->root(), "repaired", 1, RepairedIndexBytes(raw_));
+    testing::WriteModelVersion(server_->root(), "repaired", 1,
+                               RepairedIndexBytes(raw_, GetParam()));
     server_->Rescan();
     stub_ = v1::Geodex::NewStub(server_->TcpChannel());
   }
@@ -80,7 +89,7 @@ class ServerRepairTest : public ::testing::Test {
   std::unique_ptr<v1::Geodex::Stub> stub_;
 };
 
-TEST_F(ServerRepairTest, ModelCountsAndMeshAreTheInputs) {
+TEST_P(ServerRepairTest, ModelCountsAndMeshAreTheInputs) {
   v1::GetModelRequest request;
   *request.mutable_model() = Ref("repaired");
   v1::ModelInfo info;
@@ -90,6 +99,7 @@ TEST_F(ServerRepairTest, ModelCountsAndMeshAreTheInputs) {
   EXPECT_EQ(info.num_vertices(), 162);
   EXPECT_EQ(info.build_report().at("mesh_duplicate_faces_dropped"), "1");
   EXPECT_EQ(info.build_report().at("mesh_faces_reoriented"), "2");
+  EXPECT_EQ(info.build_report().contains("mesh_refinement"), GetParam());
 
   v1::GetMeshRequest mesh_request;
   *mesh_request.mutable_model() = Ref("repaired");
@@ -113,7 +123,7 @@ TEST_F(ServerRepairTest, ModelCountsAndMeshAreTheInputs) {
   }
 }
 
-TEST_F(ServerRepairTest, DuplicateAndReorientedFacesAnswerInInputIds) {
+TEST_P(ServerRepairTest, DuplicateAndReorientedFacesAnswerInInputIds) {
   const mesh::SurfacePoint far{150, {0.3, 0.3, 0.4}};
   // Face 320 is face 7 reversed: (w0, w1, w2) on 7 is (w0, w2, w1) on 320.
   EXPECT_EQ(Distance({320, {0.2, 0.5, 0.3}}, far), Distance({7, {0.2, 0.3, 0.5}}, far));
@@ -174,6 +184,52 @@ TEST_F(ServerRepairTest, DuplicateAndReorientedFacesAnswerInInputIds) {
   ASSERT_TRUE(reader->Finish().ok());
   EXPECT_EQ(values, 162);
 }
+
+// Samples are named by surface points in input faces; one on a midpoint of
+// the refinement is no input vertex (-1).
+TEST_P(ServerRepairTest, TriangulationNamesSamplesInInputIds) {
+  v1::GetTriangulationRequest request;
+  *request.mutable_model() = Ref("repaired");
+  v1::TriangulationResponse response;
+  auto context = Context();
+  ASSERT_TRUE(stub_->GetTriangulation(context.get(), request, &response).ok());
+  EXPECT_EQ(response.num_vertices(), 162);
+  EXPECT_EQ(response.vertex_triangles_size(), 162);
+  const int m = response.sample_vertices_size();
+  ASSERT_EQ(response.sample_points().faces_size(), m);
+  int midpoints = 0;
+  for (int i = 0; i < m; ++i) {
+    const int32_t v = response.sample_vertices(i);
+    const int32_t f = response.sample_points().faces(i);
+    ASSERT_TRUE(f >= 0 && f < 321) << i;
+    // The surface point is at the sample's position.
+    mesh::Vec3 x(0, 0, 0);
+    for (int k = 0; k < 3; ++k) {
+      x += response.sample_points().weights(3 * i + k) * raw_.positions[raw_.triangles[f][k]];
+    }
+    const mesh::Vec3 at(response.sample_positions().xyz(3 * i),
+                        response.sample_positions().xyz(3 * i + 1),
+                        response.sample_positions().xyz(3 * i + 2));
+    EXPECT_LT((x - at).norm(), 1e-6) << i;
+    if (v == -1) {
+      ++midpoints;
+    } else {
+      ASSERT_TRUE(v >= 0 && v < 162) << i;
+      EXPECT_LT((raw_.positions[v] - at).norm(), 1e-12) << i;
+    }
+  }
+  if (GetParam()) {
+    EXPECT_GT(m, 162);  // more samples than the input has vertices
+    EXPECT_GT(midpoints, 0);
+  } else {
+    EXPECT_EQ(midpoints, 0);
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(RepairedAndRefined, ServerRepairTest, ::testing::Bool(),
+                         [](const ::testing::TestParamInfo<bool>& info) {
+                           return info.param ? "Refined" : "Repaired";
+                         });
 
 }  // namespace
 }  // namespace geodex::server
