@@ -111,6 +111,13 @@ std::string MarkdownRows(const std::string& label, const ModeReport& report) {
                                      : absl::StrFormat("%.2f", r.median_bound / r.p90_abs_error));
     }
   }
+  // The area-uniform pairs alone, every scale: the figure a target error
+  // (geodex-build --target-error) is stated in.
+  if (report.uniform.count > 0) {
+    out += absl::StrFormat("| %s | uniform | all | %d | %s | %s | %s | - | - |\n", label,
+                           report.uniform.count, pct(report.uniform.rms), pct(report.uniform.p99),
+                           pct(report.uniform.max));
+  }
   out += absl::StrFormat("| %s | **worst** | %s | | | **%s** | | | |\n", label,
                          BinName(report.worst_bin), pct(report.worst_p99));
   return out;

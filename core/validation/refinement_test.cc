@@ -1,0 +1,86 @@
+// The flat refinement on a coarse mesh, measured as users see it: pairs in
+// the input's ids, the O(1) answer against exact distances. Samples are
+// vertices, so without refinement a coarse mesh caps m at its vertex count
+// and its geodesic triangles at its edge lengths; with it, the error keeps
+// falling as m grows past the vertex count.
+
+#include <cmath>
+#include <vector>
+
+#include "core/builder/builder.h"
+#include "core/builder/mesh_arrays.h"
+#include "core/mesh/generators.h"
+#include "core/query/input_ids.h"
+#include "core/query/query_engine.h"
+#include "core/validation/pair_sampling.h"
+#include "gtest/gtest.h"
+
+namespace geodex::validation {
+namespace {
+
+struct Measured {
+  int32_t samples = 0;      // after the triangulation's repair
+  int32_t midpoints = 0;    // added by the refinement
+  double rms = 0;           // relative, area-uniform pairs, pure O(1) answer
+};
+
+// Builds `coarse` for `m` samples as geodex-build does (refined or not) and
+// measures the pure O(1) answer on `pairs` (in `coarse`'s ids).
+Measured Measure(const mesh::Mesh& coarse, int32_t m, bool refine,
+                 const std::vector<ExactPair>& pairs) {
+  absl::StatusOr<builder::PreparedMesh> prepared = builder::PrepareMesh(coarse, {}, m, refine);
+  EXPECT_TRUE(prepared.ok()) << prepared.status();
+  builder::BuildOptions options;
+  options.num_samples = m;
+  options.threads = 2;
+  builder::BuildSummary summary;
+  absl::StatusOr<index::IndexData> data = builder::BuildIndex(prepared->mesh, options, &summary);
+  EXPECT_TRUE(data.ok()) << data.status();
+  builder::AddRepair(prepared->record, &*data);
+  auto index = index::Index::FromBytes(*index::SerializeIndex(*data));
+  EXPECT_TRUE(index.ok()) << index.status();
+  auto engine = query::QueryEngine::Create(*index);
+  EXPECT_TRUE(engine.ok()) << engine.status();
+  const query::InputIds& ids = (*engine)->input_ids();
+  query::DistanceOptions unfold;
+  unfold.near_pairs = query::NearPairs::kUnfold;
+  double sum = 0;
+  int count = 0;
+  for (const ExactPair& pair : pairs) {
+    if (!pair.uniform || pair.exact <= 0) continue;
+    const double d = *(*engine)->Distance(*ids.ToInternal(pair.p), *ids.ToInternal(pair.q), unfold);
+    const double e = (d - pair.exact) / pair.exact;
+    sum += e * e;
+    ++count;
+  }
+  return {(*index)->num_samples(), (*index)->refinement_vertices(), std::sqrt(sum / count)};
+}
+
+TEST(RefinementTest, ErrorFallsWithSamplesPastTheVertexCountOfACoarseMesh) {
+  // A coarse torus: 128 vertices, edges 0.55 and 0.79 long.
+  const mesh::Mesh torus = mesh::gen::Torus(16, 8, 2.0, 0.7);
+  const std::vector<ExactPair> pairs =
+      DrawPairs(torus, 100, {.num_sources = 8, .uniform_points = 200, .per_bin_points = 0,
+                             .seed = 5, .threads = 2});
+  std::vector<Measured> refined;
+  for (int32_t m : {50, 100, 200, 400}) {
+    refined.push_back(Measure(torus, m, /*refine=*/true, pairs));
+    const Measured& r = refined.back();
+    std::printf("refined m=%d: %d samples, %d midpoints, relative RMS %.3f%%\n", m, r.samples,
+                r.midpoints, 100 * r.rms);
+  }
+  const Measured unrefined = Measure(torus, 100, /*refine=*/false, pairs);
+  std::printf("unrefined m=100: %d samples, relative RMS %.3f%%\n", unrefined.samples,
+              100 * unrefined.rms);
+  // The torus's own vertices cannot hold many more samples than this.
+  EXPECT_LE(unrefined.samples, torus.num_vertices());
+  EXPECT_GT(refined.back().samples, 2 * torus.num_vertices());
+  for (size_t i = 1; i < refined.size(); ++i) {
+    EXPECT_LT(refined[i].rms, 0.9 * refined[i - 1].rms) << i;
+    EXPECT_GT(refined[i].midpoints, refined[i - 1].midpoints) << i;
+  }
+  EXPECT_LT(refined.back().rms, 0.5 * unrefined.rms);
+}
+
+}  // namespace
+}  // namespace geodex::validation
