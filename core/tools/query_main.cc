@@ -124,8 +124,8 @@ absl::Status Run(const Args& args) {
   if (args.info) {
     // The header's counts, then the builder's report (with the accuracy
     // calibration's figures when the index has one).
-    // Vertices and faces count the mesh file's; a repaired mesh's own counts
-    // follow.
+    // Vertices and faces count the mesh file's; the counts of the mesh the
+    // index answers on (repaired, refined) follow.
     const index::FileHeader& h = index->header();
     const query::InputIds ids(*index);
     std::string out = absl::StrFormat(
@@ -136,8 +136,8 @@ absl::Status Run(const Args& args) {
         index->num_triangles(), index->size_bytes(),
         index->accuracy() != nullptr ? "yes" : "no (geodex-build calibrate adds them)");
     if (!ids.identity()) {
-      out += absl::StrFormat("repaired_vertices = %d\nrepaired_faces = %d\n", index->num_vertices(),
-                             index->num_faces());
+      out += absl::StrFormat("internal_vertices = %d\ninternal_faces = %d\n",
+                             index->num_vertices(), index->num_faces());
     }
     out += index->report();
     std::fwrite(out.data(), 1, out.size(), stdout);

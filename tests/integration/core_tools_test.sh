@@ -74,6 +74,45 @@ check "flat grid: Euclidean to 1e-12, unreferenced vertex inf" awk '
   NR <= 81 { i = (NR - 1) % 9; j = int((NR - 1) / 9); e = sqrt((i - 4)^2 + (j - 4)^2)
              d = $1 - e; if (d < 0) d = -d; if (d > 1e-12) exit 1 }
   NR == 82 && $1 != "inf" { exit 1 }' "$work/from40.txt"
+# The flat refinement: 60 samples on the 9x9 grid (edges 1 and 1.41, longer
+# than half the sample spacing) split its edges flat; the index answers in
+# the grid's own faces and vertices, the sharded pipeline and `calibrate`
+# give the same bytes, and the answers are the flat (Euclidean) distances.
+"$tools/geodex-build" "$work/grid.obj" -o "$work/grid.gdx" --samples 60 --threads 2 \
+  >"$work/grid_build.out" 2>&1
+check "refined build exits 0" test $? -eq 0
+check "refined build reports the midpoints" grep -q "mesh refinement  [0-9]* midpoints added" "$work/grid_build.out"
+"$tools/geodex-build" plan "$work/grid.obj" --samples 60 -o "$work/gwd" >/dev/null 2>&1
+for i in 0 1; do "$tools/geodex-build" rows "$work/gwd" --shard "$i/2" --threads 1 >/dev/null 2>&1; done
+"$tools/geodex-build" merge "$work/gwd" -o "$work/grid_sharded.gdx" >/dev/null 2>&1
+check "refined sharded build is byte-identical" cmp -s "$work/grid.gdx" "$work/grid_sharded.gdx"
+"$tools/geodex-build" "$work/grid.obj" -o "$work/grid_plain.gdx" --samples 60 --threads 2 \
+  --no-calibration >/dev/null 2>&1
+"$tools/geodex-build" calibrate "$work/grid.obj" "$work/grid_plain.gdx" -o "$work/grid_cal.gdx" \
+  >/dev/null 2>&1
+check "refined: calibrate gives the one-process index" cmp -s "$work/grid.gdx" "$work/grid_cal.gdx"
+"$tools/geodex-build" "$work/grid.obj" -o "$work/grid_noref.gdx" --samples 60 --no-refinement \
+  >"$work/grid_noref.out" 2>&1
+check "--no-refinement adds no midpoint" grep -q "mesh refinement  none" "$work/grid_noref.out"
+"$tools/geodex-query" "$work/grid.gdx" --info >"$work/grid_info.txt" 2>&1
+check "--info counts the grid's faces and shows the refinement" \
+  sh -c "grep -q '^faces = 128$' '$work/grid_info.txt' && grep -q '^mesh_refinement = ' '$work/grid_info.txt'"
+printf '0 1 0 0 127 0 0 1
+5 0.2 0.3 0.5 100 0.3 0.3 0.4
+17 0.5 0.5 0 90 0.1 0.1 0.8
+' >"$work/grid_pairs.txt"
+"$tools/geodex-geodesic" "$work/grid.obj" --pairs "$work/grid_pairs.txt" >"$work/grid_exact.txt" 2>&1
+"$tools/geodex-query" "$work/grid.gdx" --pairs "$work/grid_pairs.txt" >"$work/grid_approx.txt" 2>&1
+check "refined index: input faces, flat distances within 1%" awk 'NR==FNR {e[FNR]=$1; next} {d=$1-e[FNR]; if (d<0) d=-d; if (!(e[FNR]>0) || d/e[FNR]>0.01) exit 1} END { if (FNR != 3) exit 1 }' "$work/grid_exact.txt" "$work/grid_approx.txt"
+printf '128 1 0 0 0 1 0 0
+' >"$work/grid_range.txt"
+"$tools/geodex-query" "$work/grid.gdx" --pairs "$work/grid_range.txt" >/dev/null 2>"$work/err"
+check "refined index: face 128 is past the grid's faces" test $? -eq 2
+printf '0 1 0 0
+' >"$work/grid_source.txt"
+"$tools/geodex-query" "$work/grid.gdx" --field "$work/grid_source.txt" >"$work/grid_field.txt" 2>&1
+check "refined index: a field line per grid vertex" test "$(wc -l <"$work/grid_field.txt")" -eq 82
+
 "$tools/geodex-geodesic" "$mesh" --source-vertex 7 >"$work/from7.txt" 2>"$work/err"
 check "--source-vertex to standard output" test "$(sed -n 8p "$work/from7.txt")" = "0"
 "$tools/geodex-geodesic" "$mesh" --source-vertex 100000 >/dev/null 2>"$work/err"
