@@ -42,8 +42,8 @@ std::string RepairedIndexBytes(const mesh::RawMesh& raw, bool refine) {
   absl::StatusOr<mesh::RepairedMesh> repaired = mesh::RepairMesh(raw);
   EXPECT_TRUE(repaired.ok()) << repaired.status();
   const int32_t samples = refine ? 400 : 40;
-  absl::StatusOr<builder::PreparedMesh> prepared = builder::PrepareMesh(
-      repaired->mesh, builder::RecordRepair(*repaired), samples, refine);
+  absl::StatusOr<builder::PreparedMesh> prepared =
+      builder::PrepareMesh(repaired->mesh, builder::RecordRepair(*repaired), samples, refine);
   EXPECT_TRUE(prepared.ok()) << prepared.status();
   EXPECT_EQ(prepared->record.refinement_vertices > 0, refine);
   builder::BuildOptions options;

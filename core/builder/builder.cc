@@ -12,6 +12,7 @@
 #include "core/builder/mesh_arrays.h"
 #include "core/builder/vertex_assignment.h"
 #include "core/common/status_macros.h"
+#include "core/common/threads.h"
 #include "core/geodesic/vertex_geodesic.h"
 #include "core/index/face_bvh.h"
 #include "core/sampling/farthest_point_sampling.h"
@@ -26,10 +27,7 @@ double SecondsSince(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
-int ThreadCount(const BuildOptions& options) {
-  if (options.threads > 0) return options.threads;
-  return std::max(1u, std::thread::hardware_concurrency());
-}
+int ThreadCount(const BuildOptions& options) { return common::ThreadCount(options.threads); }
 
 // Vertices whose cell is `a` or one of its neighbours, in increasing order.
 std::vector<int32_t> CellVertices(const Plan& plan, const std::vector<int32_t>& neighbors_of_a,

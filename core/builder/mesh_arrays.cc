@@ -48,8 +48,7 @@ void AddRepair(const RepairRecord& record, index::IndexData* data) {
   data->report = record.report + data->report;
 }
 
-absl::StatusOr<mesh::FlatRefinement> RefineForSamples(const mesh::Mesh& mesh,
-                                                      int32_t num_samples) {
+absl::StatusOr<mesh::FlatRefinement> RefineForSamples(const mesh::Mesh& mesh, int32_t num_samples) {
   const double scale_length =
       std::sqrt(2 * mesh.TotalArea() / (std::sqrt(3.0) * std::max(num_samples, 1)));
   const int64_t cap = 4 * int64_t{mesh.num_vertices()} + 16 * int64_t{std::max(num_samples, 0)};

@@ -50,8 +50,7 @@ inline constexpr double kMaxEdgeOverScaleLength = 0.5;
 // RefineLongEdges at kMaxEdgeOverScaleLength * L(num_samples), adding at most
 // 4 vertices per input vertex plus 16 per sample. A mesh with no longer edge
 // comes back unchanged (new_vertices == 0). Errors: RefineLongEdges's.
-absl::StatusOr<mesh::FlatRefinement> RefineForSamples(const mesh::Mesh& mesh,
-                                                      int32_t num_samples);
+absl::StatusOr<mesh::FlatRefinement> RefineForSamples(const mesh::Mesh& mesh, int32_t num_samples);
 
 // Records `refinement` of `coarse` (the mesh RecordRepair's record is of)
 // into `record`: the sections and a mesh_refinement report line. Nothing for

@@ -324,13 +324,12 @@ absl::Status CheckContents(const Contents& c, absl::StatusCode code) {
       for (int i = 0; i < 3 && ok; ++i) {
         const float* w = r.weight[i];
         ok = std::isfinite(w[0]) && std::isfinite(w[1]) && std::isfinite(w[2]) &&
-             std::min({w[0], w[1], w[2]}) >= -1e-6f &&
-             std::fabs(w[0] + w[1] + w[2] - 1) <= 1e-5f;
+             std::min({w[0], w[1], w[2]}) >= -1e-6f && std::fabs(w[0] + w[1] + w[2] - 1) <= 1e-5f;
       }
       if (!ok) {
-        return fail(absl::StrFormat(
-            "refined face %d: coarse face %d (of %d) or corner weights invalid", f,
-            r.coarse_face, num_coarse_faces));
+        return fail(
+            absl::StrFormat("refined face %d: coarse face %d (of %d) or corner weights invalid", f,
+                            r.coarse_face, num_coarse_faces));
       }
       has_piece[r.coarse_face] = 1;
     }
@@ -640,9 +639,8 @@ absl::StatusOr<std::string> SerializeIndex(const IndexData& d) {
   // keeps the 1.1 layout.
   auto written = [&pieces](size_t i) {
     const SectionId id = kSpecs[i].id;
-    return pieces[i].size > 0 ||
-           (id != SectionId::kInputFaces && id != SectionId::kVertexCopies &&
-            id != SectionId::kCoarseFaces && id != SectionId::kRefinedFaces);
+    return pieces[i].size > 0 || (id != SectionId::kInputFaces && id != SectionId::kVertexCopies &&
+                                  id != SectionId::kCoarseFaces && id != SectionId::kRefinedFaces);
   };
   const bool refined = !d.refined_faces.empty();
   size_t num_sections = 0;
@@ -788,8 +786,8 @@ absl::Status Index::Validate() {
   refined_faces_ = SectionView<RefinedFaceRecord>(p, entry(SectionId::kRefinedFaces));
   if (h.format_major < kRefinedFormatMajor &&
       (!refined_faces_.empty() || !coarse_faces_.empty() || h.params.refinement_vertices != 0)) {
-    return absl::DataLossError(absl::StrFormat(
-        "a format %d.%d index with refinement sections", h.format_major, h.format_minor));
+    return absl::DataLossError(absl::StrFormat("a format %d.%d index with refinement sections",
+                                               h.format_major, h.format_minor));
   }
   GEODEX_RETURN_IF_ERROR(CheckAccuracy(accuracy_, absl::StatusCode::kDataLoss));
 

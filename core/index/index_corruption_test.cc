@@ -272,7 +272,8 @@ TEST(IndexTest, RefinedIndexIsWrittenAsVersion2AndReadBack) {
   // Written again, the same bytes.
   EXPECT_EQ(Serialize(ToIndexData(**index)), Serialize(MakeRefinedSphereIndex()));
   // Without refinement, still the 1.x layout older readers take.
-  absl::StatusOr<std::shared_ptr<const Index>> plain = Index::FromBytes(Serialize(MakeSphereIndex()));
+  absl::StatusOr<std::shared_ptr<const Index>> plain =
+      Index::FromBytes(Serialize(MakeSphereIndex()));
   ASSERT_TRUE(plain.ok());
   EXPECT_EQ((*plain)->header().format_major, kFormatMajor);
 }
@@ -311,8 +312,8 @@ TEST(IndexTest, RefinementCorruptionWithValidChecksumsIsDataLoss) {
        [&](Image& i) { i.Set<int32_t>(SectionId::kCoarseFaces, 7, nv - 1); }, "coarse face 2"},
       {"more midpoints than vertices",
        [&](Image& i) { i.header.params.refinement_vertices = nv + 1; }, "midpoints"},
-      {"refinement sections in a 1.x file",
-       [&](Image& i) { i.header.format_major = kFormatMajor; }, "refinement sections"},
+      {"refinement sections in a 1.x file", [&](Image& i) { i.header.format_major = kFormatMajor; },
+       "refinement sections"},
   };
   for (const Case& c : cases) {
     Image image = Image::Parse(bytes);

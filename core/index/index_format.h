@@ -175,9 +175,9 @@ inline constexpr float kAccuracyBinUpper[kAccuracyBins] = {0.5f, 1, 2, 3, 5, 10,
 // the absolute error that the answers of its kind and bin stayed within for
 // all but a small share of the held-out pairs (see core/validation).
 struct AccuracyRecord {
-  float scale_length;         // L, in mesh units
-  uint32_t num_sources;       // held-out exact propagations
-  uint32_t num_pairs;         // held-out pairs measured
+  float scale_length;                // L, in mesh units
+  uint32_t num_sources;              // held-out exact propagations
+  uint32_t num_pairs;                // held-out pairs measured
   uint32_t bound_quantile_permille;  // the bounds are this quantile of the errors (e.g. 995)
   // Absolute error bounds by bin of the answered distance (kAccuracyBinUpper):
   // the O(1) unfolding for pairs of mesh vertices [0] and other pairs [1];

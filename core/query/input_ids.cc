@@ -18,9 +18,8 @@ InputIds::InputIds(const index::Index& index)
                           static_cast<int32_t>(index.vertex_copies().size())),
       coarse_faces_(index.coarse_faces()),
       refined_faces_(index.refined_faces()) {
-  const int32_t num_coarse_faces = refined_faces_.empty()
-                                       ? index.num_faces()
-                                       : static_cast<int32_t>(coarse_faces_.size() / 3);
+  const int32_t num_coarse_faces =
+      refined_faces_.empty() ? index.num_faces() : static_cast<int32_t>(coarse_faces_.size() / 3);
   num_input_faces_ =
       input_faces_.empty() ? num_coarse_faces : static_cast<int32_t>(input_faces_.size());
   if (!refined_faces_.empty()) {
@@ -109,8 +108,7 @@ bool InputIds::Reoriented(int32_t f) const {
 }
 
 mesh::Triangle InputIds::InputFace(int32_t f) const {
-  const std::span<const int32_t> faces =
-      refined_faces_.empty() ? index_->faces() : coarse_faces_;
+  const std::span<const int32_t> faces = refined_faces_.empty() ? index_->faces() : coarse_faces_;
   mesh::Triangle out;
   if (input_faces_.empty()) {
     for (int i = 0; i < 3; ++i) out[i] = InputVertex(faces[3 * f + i]);
@@ -161,7 +159,8 @@ absl::StatusOr<std::vector<ExpMapVertex>> ExpMapOfInput(const QueryEngine& engin
                           ExpMap(engine, internal, options, scratch));
   if (ids.identity()) return map;
   // Midpoints of a refinement are no input vertices.
-  std::erase_if(map, [&ids](const ExpMapVertex& e) { return ids.InputVertex(e.vertex) == mesh::kNone; });
+  std::erase_if(map,
+                [&ids](const ExpMapVertex& e) { return ids.InputVertex(e.vertex) == mesh::kNone; });
   for (ExpMapVertex& e : map) {
     e.vertex = ids.InputVertex(e.vertex);
     if (mirrored) {

@@ -40,8 +40,8 @@ struct Built {
 Built Build(const RawMesh& raw, int32_t samples, bool refine = false) {
   absl::StatusOr<RepairedMesh> repaired = mesh::RepairMesh(raw);
   if (!repaired.ok()) throw std::runtime_error(repaired.status().ToString());
-  absl::StatusOr<builder::PreparedMesh> prepared = builder::PrepareMesh(
-      repaired->mesh, builder::RecordRepair(*repaired), samples, refine);
+  absl::StatusOr<builder::PreparedMesh> prepared =
+      builder::PrepareMesh(repaired->mesh, builder::RecordRepair(*repaired), samples, refine);
   if (!prepared.ok()) throw std::runtime_error(prepared.status().ToString());
   builder::BuildOptions options;
   options.num_samples = samples;
@@ -383,8 +383,8 @@ TEST(InputIdsTest, RepairedAndRefinedIndexAnswersInTheInputIds) {
   const SurfacePoint back = ids.ToInput(*internal);
   EXPECT_EQ(back.face, 7);
   for (int i = 0; i < 3; ++i) EXPECT_NEAR(back.w[i], on_twin.w[i], 1e-6);
-  EXPECT_EQ(ids.InputFace(5), (mesh::Triangle{coarse.face(5)[0], coarse.face(5)[2],
-                                              coarse.face(5)[1]}));
+  EXPECT_EQ(ids.InputFace(5),
+            (mesh::Triangle{coarse.face(5)[0], coarse.face(5)[2], coarse.face(5)[1]}));
 }
 
 }  // namespace

@@ -132,8 +132,7 @@ void PrintSummary(const builder::BuildSummary& s, const std::string& out,
       "  longest edge     %.6g (%.4f of the bounding-box diagonal)\n"
       "  time             sampling %s, triangulation %s, rows %s, merge %s\n",
       out.c_str(), s.index_bytes / 1048576.0, repairs.c_str(), refinement.c_str(),
-      s.requested_samples, s.num_samples,
-      s.repair.c_str(), s.num_triangles,
+      s.requested_samples, s.num_samples, s.repair.c_str(), s.num_triangles,
       EdgeLine(s.geodesic_edges, s.edge_crossings_found, s.edge_length_total, s.edge_length_max)
           .c_str(),
       static_cast<long long>(s.referenced_vertices), static_cast<long long>(s.unassigned_vertices),
@@ -167,8 +166,7 @@ absl::Status AddCalibration(const mesh::Mesh& mesh, index::IndexData& data, int 
       "(d<L, L-3L, 3L-10L, >=10L; L = %.4g), calibrated in %s\n",
       100 * r.rms[0], 100 * r.rms[1], 100 * r.rms[2], 100 * r.rms[3], 100 * r.p99[0],
       100 * r.p99[1], 100 * r.p99[2], 100 * r.p99[3], r.scale_length,
-      FormatSeconds(
-          std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count())
+      FormatSeconds(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count())
           .c_str());
   return absl::OkStatus();
 }
@@ -386,8 +384,9 @@ int main(int argc, char** argv) {
             target_error, result.reached ? "yes" : "no (sample cap)", result.rounds.size());
         result.data.report += validation::CalibrationText(result.data.accuracy[0]);
         if (!result.reached) {
-          std::fprintf(stderr, "geodex-build: the target error was not reached at the cap of %d "
-                               "samples; writing the last round's index\n",
+          std::fprintf(stderr,
+                       "geodex-build: the target error was not reached at the cap of %d "
+                       "samples; writing the last round's index\n",
                        result.rounds.back().samples);
         }
         return WriteAndReport(result.data, result.summary, out);
@@ -399,7 +398,8 @@ int main(int argc, char** argv) {
       GEODEX_ASSIGN_OR_RETURN(const builder::Plan plan, builder::MakePlan(mesh, options));
       GEODEX_RETURN_IF_ERROR(WriteEdges(mesh, plan, edges_obj));
       builder::BuildSummary summary;
-      GEODEX_ASSIGN_OR_RETURN(auto data, builder::BuildIndexFromPlan(mesh, plan, options, &summary));
+      GEODEX_ASSIGN_OR_RETURN(auto data,
+                              builder::BuildIndexFromPlan(mesh, plan, options, &summary));
       builder::AddRepair(prepared.record, &data);
       if (!no_calibration) GEODEX_RETURN_IF_ERROR(AddCalibration(mesh, data, threads));
       return WriteAndReport(data, summary, out);

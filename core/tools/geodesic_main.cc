@@ -20,8 +20,8 @@
 
 #include <algorithm>
 #include <atomic>
-#include <ctime>
 #include <cstdio>
+#include <ctime>
 #include <map>
 #include <thread>
 
@@ -30,6 +30,7 @@
 #include "absl/strings/str_cat.h"
 #include "core/common/file_util.h"
 #include "core/common/status_macros.h"
+#include "core/common/threads.h"
 #include "core/geodesic/exact_geodesic.h"
 #include "core/geodesic/vertex_geodesic.h"
 #include "core/mesh/mesh_io.h"
@@ -130,7 +131,8 @@ absl::Status RunFromVertex(const std::string& mesh_path, int64_t source, const s
     text += '\n';
   }
   if (out == "-") {
-    if (std::fwrite(text.data(), 1, text.size(), stdout) != text.size() || std::fflush(stdout) != 0) {
+    if (std::fwrite(text.data(), 1, text.size(), stdout) != text.size() ||
+        std::fflush(stdout) != 0) {
       return absl::DataLossError("cannot write to standard output");
     }
     return absl::OkStatus();
@@ -145,7 +147,7 @@ int main(int argc, char** argv) {
   CLI::App app{"Exact geodesic distances (ICH window propagation, the builder's engine)."};
   std::string mesh_path, pairs_path, out = "-";
   int64_t source_vertex = -1;
-  int threads = std::max(1u, std::thread::hardware_concurrency());
+  int threads = geodex::common::ThreadCount(0);
   app.add_option("mesh", mesh_path, "Mesh file (.obj, .ply, .off)")->required();
   auto* pairs = app.add_option("--pairs", pairs_path,
                                "File of lines 'fa a0 a1 a2 fb b0 b1 b2' ('-' for standard input)");
@@ -168,9 +170,9 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "geodex-geodesic: give --pairs FILE or --source-vertex V\n");
     return 2;
   }
-  const absl::Status status = pairs->count() > 0
-                                  ? geodex::Run(mesh_path, pairs_path, threads)
-                                  : geodex::RunFromVertex(mesh_path, source_vertex, out, engine, stats);
+  const absl::Status status =
+      pairs->count() > 0 ? geodex::Run(mesh_path, pairs_path, threads)
+                         : geodex::RunFromVertex(mesh_path, source_vertex, out, engine, stats);
   if (!status.ok()) {
     std::fprintf(stderr, "geodex-geodesic: %s\n", status.ToString().c_str());
     return status.code() == absl::StatusCode::kInvalidArgument ||

@@ -136,8 +136,8 @@ absl::Status Run(const Args& args) {
         index->num_triangles(), index->size_bytes(),
         index->accuracy() != nullptr ? "yes" : "no (geodex-build calibrate adds them)");
     if (!ids.identity()) {
-      out += absl::StrFormat("internal_vertices = %d\ninternal_faces = %d\n",
-                             index->num_vertices(), index->num_faces());
+      out += absl::StrFormat("internal_vertices = %d\ninternal_faces = %d\n", index->num_vertices(),
+                             index->num_faces());
     }
     out += index->report();
     std::fwrite(out.data(), 1, out.size(), stdout);

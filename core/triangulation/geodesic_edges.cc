@@ -10,6 +10,7 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "core/common/status_macros.h"
+#include "core/common/threads.h"
 #include "core/geodesic/exact_geodesic.h"
 
 namespace geodex::triangulation {
@@ -213,11 +214,6 @@ struct Piece {
   int32_t vp, vq;              // mesh vertex at p / q, or kNone
 };
 
-int ThreadCount(int threads) {
-  if (threads > 0) return threads;
-  return static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
-}
-
 }  // namespace
 
 std::vector<std::pair<int32_t, int32_t>> DelaunayEdges(
@@ -309,7 +305,7 @@ absl::StatusOr<std::vector<GeodesicEdge>> TraceEdges(
       }();
     }
   };
-  const int count = std::min<int>(ThreadCount(threads), std::max<size_t>(1, num_sources));
+  const int count = std::min<int>(common::ThreadCount(threads), std::max<size_t>(1, num_sources));
   std::vector<std::thread> pool;
   for (int t = 0; t < count; ++t) pool.emplace_back(worker);
   for (std::thread& t : pool) t.join();

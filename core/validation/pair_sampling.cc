@@ -9,21 +9,23 @@
 #include <span>
 #include <thread>
 
+#include "core/common/threads.h"
 #include "core/geodesic/vertex_geodesic.h"
 
 namespace geodex::validation {
 namespace {
 
-constexpr double kBinEdges[kNumScaleBins + 1] = {0, 1, 3, 10, std::numeric_limits<double>::infinity()};
+constexpr double kBinEdges[kNumScaleBins + 1] = {0, 1, 3, 10,
+                                                 std::numeric_limits<double>::infinity()};
 
 // `count` area-uniform random points of `faces` (cumulative: their running
 // area sums).
 mesh::SurfacePoint PointOnFaces(std::span<const int32_t> faces,
                                 const std::vector<double>& cumulative, std::mt19937_64& rng) {
   std::uniform_real_distribution<double> u(0, 1);
-  const size_t i = std::lower_bound(cumulative.begin(), cumulative.end(),
-                                    u(rng) * cumulative.back()) -
-                   cumulative.begin();
+  const size_t i =
+      std::lower_bound(cumulative.begin(), cumulative.end(), u(rng) * cumulative.back()) -
+      cumulative.begin();
   double a = u(rng), b = u(rng);
   if (a + b > 1) a = 1 - a, b = 1 - b;  // uniform on the triangle
   return {faces[std::min(i, faces.size() - 1)], {1 - a - b, a, b}};
@@ -37,37 +39,9 @@ std::vector<double> Cumulative(const mesh::Mesh& mesh, std::span<const int32_t> 
 }
 
 // Vertex v (referenced) as a surface point of one of its faces.
-mesh::SurfacePoint AtVertex(const mesh::Mesh& mesh, int32_t v) { return *mesh::VertexPoint(mesh, v); }
-
-}  // namespace
-
-const char* ScaleBinName(int bin) {
-  static const char* const kNames[kNumScaleBins] = {"d<L", "L-3L", "3L-10L", ">=10L"};
-  return kNames[bin];
+mesh::SurfacePoint AtVertex(const mesh::Mesh& mesh, int32_t v) {
+  return *mesh::VertexPoint(mesh, v);
 }
-
-int ScaleBinOf(double d, double scale_length) {
-  int b = 0;
-  while (b + 1 < kNumScaleBins && d >= kBinEdges[b + 1] * scale_length) ++b;
-  return b;
-}
-
-double ScaleLength(double area, int32_t num_samples) {
-  return std::sqrt(2 * area / (std::sqrt(3.0) * num_samples));
-}
-
-std::vector<mesh::SurfacePoint> RandomSurfacePoints(const mesh::Mesh& mesh, int32_t count,
-                                                    uint64_t seed) {
-  std::vector<int32_t> faces(mesh.num_faces());
-  std::iota(faces.begin(), faces.end(), 0);
-  const std::vector<double> cumulative = Cumulative(mesh, faces);
-  std::mt19937_64 rng(seed);
-  std::vector<mesh::SurfacePoint> points;
-  for (int32_t k = 0; k < count; ++k) points.push_back(PointOnFaces(faces, cumulative, rng));
-  return points;
-}
-
-namespace {
 
 // What every source of DrawPairs shares.
 struct PairContext {
@@ -178,6 +152,32 @@ std::vector<ExactPair> PairsOfSource(const PairContext& c, geodesic::VertexGeode
 
 }  // namespace
 
+const char* ScaleBinName(int bin) {
+  static const char* const kNames[kNumScaleBins] = {"d<L", "L-3L", "3L-10L", ">=10L"};
+  return kNames[bin];
+}
+
+int ScaleBinOf(double d, double scale_length) {
+  int b = 0;
+  while (b + 1 < kNumScaleBins && d >= kBinEdges[b + 1] * scale_length) ++b;
+  return b;
+}
+
+double ScaleLength(double area, int32_t num_samples) {
+  return std::sqrt(2 * area / (std::sqrt(3.0) * num_samples));
+}
+
+std::vector<mesh::SurfacePoint> RandomSurfacePoints(const mesh::Mesh& mesh, int32_t count,
+                                                    uint64_t seed) {
+  std::vector<int32_t> faces(mesh.num_faces());
+  std::iota(faces.begin(), faces.end(), 0);
+  const std::vector<double> cumulative = Cumulative(mesh, faces);
+  std::mt19937_64 rng(seed);
+  std::vector<mesh::SurfacePoint> points;
+  for (int32_t k = 0; k < count; ++k) points.push_back(PointOnFaces(faces, cumulative, rng));
+  return points;
+}
+
 std::vector<ExactPair> DrawPairs(const mesh::Mesh& mesh, int32_t num_samples,
                                  const PairOptions& options) {
   PairContext c{mesh, options, 0, 0, {}, {}, {}};
@@ -201,9 +201,7 @@ std::vector<ExactPair> DrawPairs(const mesh::Mesh& mesh, int32_t num_samples,
       by_source[s] = PairsOfSource(c, solver, s);
     }
   };
-  const int hardware = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
-  const int threads =
-      std::clamp(options.threads > 0 ? options.threads : hardware, 1, options.num_sources);
+  const int threads = std::clamp(common::ThreadCount(options.threads), 1, options.num_sources);
   std::vector<std::thread> pool;
   for (int t = 1; t < threads; ++t) pool.emplace_back(worker);
   worker();

@@ -19,9 +19,9 @@ namespace geodex::validation {
 namespace {
 
 struct Measured {
-  int32_t samples = 0;      // after the triangulation's repair
-  int32_t midpoints = 0;    // added by the refinement
-  double rms = 0;           // relative, area-uniform pairs, pure O(1) answer
+  int32_t samples = 0;    // after the triangulation's repair
+  int32_t midpoints = 0;  // added by the refinement
+  double rms = 0;         // relative, area-uniform pairs, pure O(1) answer
 };
 
 // Builds `coarse` for `m` samples as geodex-build does (refined or not) and
@@ -59,9 +59,9 @@ Measured Measure(const mesh::Mesh& coarse, int32_t m, bool refine,
 TEST(RefinementTest, ErrorFallsWithSamplesPastTheVertexCountOfACoarseMesh) {
   // A coarse torus: 128 vertices, edges 0.55 and 0.79 long.
   const mesh::Mesh torus = mesh::gen::Torus(16, 8, 2.0, 0.7);
-  const std::vector<ExactPair> pairs =
-      DrawPairs(torus, 100, {.num_sources = 8, .uniform_points = 200, .per_bin_points = 0,
-                             .seed = 5, .threads = 2});
+  const std::vector<ExactPair> pairs = DrawPairs(
+      torus, 100,
+      {.num_sources = 8, .uniform_points = 200, .per_bin_points = 0, .seed = 5, .threads = 2});
   std::vector<Measured> refined;
   for (int32_t m : {50, 100, 200, 400}) {
     refined.push_back(Measure(torus, m, /*refine=*/true, pairs));

@@ -14,14 +14,14 @@ absl::StatusOr<TargetErrorResult> BuildForTargetError(const mesh::Mesh& mesh,
                                                       const TargetErrorOptions& options,
                                                       const builder::RepairRecord& repair) {
   if (!(options.target_rms > 0) || !(options.growth > 1)) {
-    return absl::InvalidArgumentError(absl::StrFormat(
-        "the target error must be > 0 and the growth > 1 (got %g, %g)", options.target_rms,
-        options.growth));
+    return absl::InvalidArgumentError(
+        absl::StrFormat("the target error must be > 0 and the growth > 1 (got %g, %g)",
+                        options.target_rms, options.growth));
   }
   int32_t referenced = 0;
   for (int32_t v = 0; v < mesh.num_vertices(); ++v) referenced += mesh.IsReferenced(v);
-  const int32_t cap = std::min(referenced, options.max_samples > 0 ? options.max_samples
-                                                                   : std::max(3, referenced / 2));
+  const int32_t cap = std::min(
+      referenced, options.max_samples > 0 ? options.max_samples : std::max(3, referenced / 2));
   build.num_samples = std::min(std::max(build.num_samples, 3), cap);
   TargetErrorResult result;
   for (int32_t round = 0;; ++round) {
@@ -36,18 +36,18 @@ absl::StatusOr<TargetErrorResult> BuildForTargetError(const mesh::Mesh& mesh,
     GEODEX_RETURN_IF_ERROR(AddCalibration(prepared.mesh, data, calibration));
     builder::AddRepair(prepared.record, &data);
     const index::AccuracyRecord& r = data.accuracy[0];
-    result.rounds.push_back({static_cast<int32_t>(data.samples.size()), r.uniform_rms,
-                             r.uniform_far_p99});
+    result.rounds.push_back(
+        {static_cast<int32_t>(data.samples.size()), r.uniform_rms, r.uniform_far_p99});
     if (options.round_done) {
       options.round_done(round, result.rounds.back().samples, r.uniform_rms, r.uniform_far_p99);
     }
     result.data = std::move(data);
     result.summary = summary;
-    result.reached = r.uniform_rms <= options.target_rms &&
-                     r.uniform_far_p99 <= 4 * options.target_rms;
+    result.reached =
+        r.uniform_rms <= options.target_rms && r.uniform_far_p99 <= 4 * options.target_rms;
     if (result.reached || build.num_samples >= cap) break;
-    build.num_samples = std::min(
-        cap, static_cast<int32_t>(std::ceil(build.num_samples * options.growth)));
+    build.num_samples =
+        std::min(cap, static_cast<int32_t>(std::ceil(build.num_samples * options.growth)));
   }
   return result;
 }

@@ -2,13 +2,13 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numeric>
 #include <random>
 #include <span>
 
 #include "absl/strings/str_format.h"
 #include "core/geodesic/exact_geodesic.h"
-#include <limits>
 
 namespace geodex::accuracy {
 namespace {
@@ -105,8 +105,7 @@ std::string MarkdownRows(const std::string& label, const ModeReport& report) {
       out += absl::StrFormat(
           "| %s | %s | %s | %d | %s | %s | %s | %s | %s |\n", label,
           kind == 0 ? "vertex" : "interior", BinName(b), r.error.count, pct(r.error.rms),
-          pct(r.error.p99), pct(r.error.max),
-          std::isnan(r.coverage) ? "-" : pct(r.coverage),
+          pct(r.error.p99), pct(r.error.max), std::isnan(r.coverage) ? "-" : pct(r.coverage),
           std::isnan(r.median_bound) ? "-"
                                      : absl::StrFormat("%.2f", r.median_bound / r.p90_abs_error));
     }
@@ -130,7 +129,8 @@ PathReport MeasurePaths(const mesh::Mesh& mesh, const query::QueryEngine& engine
   const double tiny = 1e-9 * mesh.BoundingBoxDiagonal();
   auto length = [](const std::vector<query::PathPoint>& path) {
     double sum = 0;
-    for (size_t i = 1; i < path.size(); ++i) sum += (path[i].position - path[i - 1].position).norm();
+    for (size_t i = 1; i < path.size(); ++i)
+      sum += (path[i].position - path[i - 1].position).norm();
     return sum;
   };
   std::vector<double> path_ratio, traced_ratio;

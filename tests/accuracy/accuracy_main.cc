@@ -10,8 +10,8 @@
 
 #include <chrono>
 #include <cstdio>
-#include <limits>
 #include <filesystem>
+#include <limits>
 
 #include "CLI/CLI.hpp"
 #include "absl/strings/str_format.h"
@@ -52,9 +52,9 @@ absl::Status Run(const Flags& flags) {
     GEODEX_ASSIGN_OR_RETURN(const mesh::Mesh m, LoadInput(path));
     const std::string name = std::filesystem::path(path).stem().string();
     for (int32_t count : flags.samples) {
-      const std::string file = absl::StrFormat(
-          "%s/%s-m%d%s.gdx", flags.index_dir.empty() ? "/tmp" : flags.index_dir, name, count,
-          flags.no_refinement ? "-noref" : "");
+      const std::string file =
+          absl::StrFormat("%s/%s-m%d%s.gdx", flags.index_dir.empty() ? "/tmp" : flags.index_dir,
+                          name, count, flags.no_refinement ? "-noref" : "");
       if (flags.index_dir.empty() || !std::filesystem::exists(file)) {
         builder::BuildOptions build_options;
         build_options.num_samples = count;
@@ -76,7 +76,8 @@ absl::Status Run(const Flags& flags) {
         // measured.
         GEODEX_ASSIGN_OR_RETURN(
             const builder::PreparedMesh prepared,
-            builder::PrepareMesh(m, {}, static_cast<int32_t>(index->header().params.requested_samples),
+            builder::PrepareMesh(m, {},
+                                 static_cast<int32_t>(index->header().params.requested_samples),
                                  index->refinement_vertices() > 0));
         GEODEX_ASSIGN_OR_RETURN(const index::AccuracyRecord record,
                                 validation::Calibrate(prepared.mesh, index));
@@ -116,9 +117,9 @@ absl::Status Run(const Flags& flags) {
           const absl::StatusOr<mesh::SurfacePoint> q = ids.ToInternal(input_q);
           absl::StatusOr<double> d = absl::InternalError("no internal point");
           if (p.ok() && q.ok()) {
-            d = mode == "trace" ? engine->TracedDistance(*p, *q)
-                                : engine->Distance(*p, *q, options, &scratch,
-                                                   bounds ? &a.bound : nullptr);
+            d = mode == "trace"
+                    ? engine->TracedDistance(*p, *q)
+                    : engine->Distance(*p, *q, options, &scratch, bounds ? &a.bound : nullptr);
           }
           if (!d.ok()) ++failed;
           a.distance = d.value_or(std::numeric_limits<double>::quiet_NaN());
@@ -130,10 +131,10 @@ absl::Status Run(const Flags& flags) {
             std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
         std::fprintf(stderr, "%s %s: %.2f us per pair, %lld failed\n", name.c_str(), mode.c_str(),
                      1e6 * seconds / pairs.size(), static_cast<long long>(failed));
-        std::printf("%s", accuracy::MarkdownRows(
-                              absl::StrFormat("%s m=%d %s", name, index->num_samples(), mode),
-                              report)
-                              .c_str());
+        std::printf("%s",
+                    accuracy::MarkdownRows(
+                        absl::StrFormat("%s m=%d %s", name, index->num_samples(), mode), report)
+                        .c_str());
         std::fflush(stdout);
       }
     }
@@ -161,7 +162,8 @@ int main(int argc, char** argv) {
   app.add_option("--threads", flags.threads, "Builder and exact-propagation threads (0: all)");
   app.add_option("--modes", flags.modes,
                  "Answer modes: unfold (pure O(1)), default, exact (near pairs exactly), bounds "
-                 "(default with error bounds), tolX (tolerance X, e.g. tol0.005), trace")->delimiter(',');
+                 "(default with error bounds), tolX (tolerance X, e.g. tol0.005), trace")
+      ->delimiter(',');
   CLI11_PARSE(app, argc, argv);
   const absl::Status status = geodex::Run(flags);
   if (!status.ok()) {
