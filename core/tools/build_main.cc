@@ -217,7 +217,8 @@ int main(int argc, char** argv) {
                  "p99 beyond 10L at most 4x it, growing m by 1.5x per round")
       ->check(CLI::PositiveNumber);
   app.add_option("--max-samples", max_samples,
-                 "With --target-error: the cap on m (default: half the vertices)")
+                 "With --target-error: the cap on m (default 8000; with --no-refinement, half the "
+                 "vertices)")
       ->check(CLI::PositiveNumber);
   app.add_option("--seed", seed, "Sampling seed");
   app.add_option("--threads", threads, "Worker threads (0: all cores)")

@@ -20,8 +20,15 @@ absl::StatusOr<TargetErrorResult> BuildForTargetError(const mesh::Mesh& mesh,
   }
   int32_t referenced = 0;
   for (int32_t v = 0; v < mesh.num_vertices(); ++v) referenced += mesh.IsReferenced(v);
-  const int32_t cap = std::min(
-      referenced, options.max_samples > 0 ? options.max_samples : std::max(3, referenced / 2));
+  // Samples are vertices: without the flat refinement the mesh's own
+  // vertices bound m (by default half of them); with it, midpoints make room
+  // for more.
+  const int32_t bound = build.refine_long_edges ? kDefaultMaxSamples : referenced;
+  const int32_t default_cap =
+      build.refine_long_edges ? kDefaultMaxSamples : std::max(3, referenced / 2);
+  const int32_t cap =
+      std::min(bound, options.max_samples > 0 ? options.max_samples
+                                              : std::min(default_cap, kDefaultMaxSamples));
   build.num_samples = std::min(std::max(build.num_samples, 3), cap);
   TargetErrorResult result;
   for (int32_t round = 0;; ++round) {

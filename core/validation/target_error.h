@@ -6,9 +6,9 @@
 // is at most the target and their p99 beyond 10L at most four times it, or
 // until the sample cap.
 //
-// New samples come from farthest-point sampling with a larger m (every
-// round rebuilds from scratch); placing them where the validation errs most
-// is not done here.
+// New samples come from farthest-point sampling with a larger m, on the mesh
+// refined for that m (every round rebuilds from scratch); placing them where
+// the validation errs most is not done here.
 //
 // Thread safety: reentrant. Deterministic for a seed, whatever the thread
 // count.
@@ -26,10 +26,15 @@
 
 namespace geodex::validation {
 
+// The default cap on m: its m x m float matrix is 256 MB.
+inline constexpr int32_t kDefaultMaxSamples = 8000;
+
 struct TargetErrorOptions {
   double target_rms = 0.005;  // relative RMS over area-uniform held-out pairs
-  int32_t max_samples = 0;    // cap on m; 0: half the mesh's vertices
-  double growth = 1.5;        // m grows by this factor per round
+  // Cap on m; 0: kDefaultMaxSamples, and without the flat refinement half
+  // the mesh's vertices.
+  int32_t max_samples = 0;
+  double growth = 1.5;  // m grows by this factor per round
   // Called after each round with its m and measured error.
   std::function<void(int32_t round, int32_t samples, double rms, double far_p99)> round_done;
 };
