@@ -50,9 +50,8 @@ std::string RepairedIndexBytes(const mesh::RawMesh& raw, bool refine) {
   options.num_samples = samples;
   options.threads = 2;
   builder::BuildSummary summary;
-  absl::StatusOr<index::IndexData> data = builder::BuildIndex(prepared->mesh, options, &summary);
+  absl::StatusOr<index::IndexData> data = builder::BuildPreparedIndex(*prepared, options, &summary);
   EXPECT_TRUE(data.ok()) << data.status();
-  builder::AddRepair(prepared->record, &*data);
   absl::StatusOr<std::string> bytes = index::SerializeIndex(*data);
   EXPECT_TRUE(bytes.ok()) << bytes.status();
   return *bytes;

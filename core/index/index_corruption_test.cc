@@ -108,6 +108,25 @@ TEST(IndexTest, FutureMinorVersionWithUnknownSectionIsAccepted) {
   EXPECT_EQ((*index)->header().format_minor, kFormatMinor + 1);
 }
 
+// A corruption of an index image (checksums recomputed) and what the
+// DataLoss error must say.
+struct Case {
+  std::string name;
+  std::function<void(Image&)> corrupt;
+  std::string message;
+};
+
+// Each case applied to `bytes` alone is DataLoss naming its message.
+void ExpectDataLoss(const std::string& bytes, const std::vector<Case>& cases) {
+  for (const Case& c : cases) {
+    Image image = Image::Parse(bytes);
+    c.corrupt(image);
+    const absl::Status status = Index::FromBytes(image.Layout()).status();
+    EXPECT_EQ(status.code(), absl::StatusCode::kDataLoss) << c.name << ": " << status;
+    EXPECT_THAT(status.message(), HasSubstr(c.message)) << c.name;
+  }
+}
+
 TEST(IndexTest, SemanticCorruptionWithValidChecksumsIsDataLoss) {
   const IndexData d = MakeSphereIndex();
   const std::string bytes = Serialize(d);
@@ -116,11 +135,6 @@ TEST(IndexTest, SemanticCorruptionWithValidChecksumsIsDataLoss) {
   const int32_t m = static_cast<int32_t>(d.samples.size());
   const int32_t nt = static_cast<int32_t>(d.triangles.size());
   const int32_t nb = static_cast<int32_t>(d.bvh_nodes.size());
-  struct Case {
-    std::string name;
-    std::function<void(Image&)> corrupt;
-    std::string message;
-  };
   const float kNaN = std::numeric_limits<float>::quiet_NaN();
   const std::vector<Case> cases = {
       {"face vertex out of range", [&](Image& i) { i.Set<int32_t>(SectionId::kFaces, 7, nv); },
@@ -237,13 +251,7 @@ TEST(IndexTest, SemanticCorruptionWithValidChecksumsIsDataLoss) {
        },
        "BVH face 1"},
   };
-  for (const Case& c : cases) {
-    Image image = Image::Parse(bytes);
-    c.corrupt(image);
-    const absl::Status status = Index::FromBytes(image.Layout()).status();
-    EXPECT_EQ(status.code(), absl::StatusCode::kDataLoss) << c.name << ": " << status;
-    EXPECT_THAT(status.message(), HasSubstr(c.message)) << c.name;
-  }
+  ExpectDataLoss(bytes, cases);
 }
 
 // The sphere index as if it were refined (format 2.0): every face its own
@@ -283,11 +291,6 @@ TEST(IndexTest, RefinementCorruptionWithValidChecksumsIsDataLoss) {
   const int32_t nv = 43;
   // A record is 10 four-byte words: the coarse face, then 3 x 3 weights.
   auto weight = [](int32_t face, int corner, int k) { return 10 * face + 1 + 3 * corner + k; };
-  struct Case {
-    std::string name;
-    std::function<void(Image&)> corrupt;
-    std::string message;
-  };
   const std::vector<Case> cases = {
       {"piece of a coarse face out of range",
        [&](Image& i) { i.Set<int32_t>(SectionId::kRefinedFaces, 10 * 3, 80); }, "refined face 3"},
@@ -315,13 +318,7 @@ TEST(IndexTest, RefinementCorruptionWithValidChecksumsIsDataLoss) {
       {"refinement sections in a 1.x file", [&](Image& i) { i.header.format_major = kFormatMajor; },
        "refinement sections"},
   };
-  for (const Case& c : cases) {
-    Image image = Image::Parse(bytes);
-    c.corrupt(image);
-    const absl::Status status = Index::FromBytes(image.Layout()).status();
-    EXPECT_EQ(status.code(), absl::StatusCode::kDataLoss) << c.name << ": " << status;
-    EXPECT_THAT(status.message(), HasSubstr(c.message)) << c.name;
-  }
+  ExpectDataLoss(bytes, cases);
 }
 
 TEST(IndexTest, StructuralCorruptionWithValidChecksumsIsDataLoss) {

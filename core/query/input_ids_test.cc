@@ -47,9 +47,8 @@ Built Build(const RawMesh& raw, int32_t samples, bool refine = false) {
   options.num_samples = samples;
   options.threads = 2;
   builder::BuildSummary summary;
-  absl::StatusOr<index::IndexData> data = builder::BuildIndex(prepared->mesh, options, &summary);
+  absl::StatusOr<index::IndexData> data = builder::BuildPreparedIndex(*prepared, options, &summary);
   if (!data.ok()) throw std::runtime_error(data.status().ToString());
-  builder::AddRepair(prepared->record, &*data);
   absl::StatusOr<std::string> bytes = index::SerializeIndex(*data);
   if (!bytes.ok()) throw std::runtime_error(bytes.status().ToString());
   auto index = index::Index::FromBytes(*std::move(bytes));

@@ -34,9 +34,8 @@ Measured Measure(const mesh::Mesh& coarse, int32_t m, bool refine,
   options.num_samples = m;
   options.threads = 2;
   builder::BuildSummary summary;
-  absl::StatusOr<index::IndexData> data = builder::BuildIndex(prepared->mesh, options, &summary);
+  absl::StatusOr<index::IndexData> data = builder::BuildPreparedIndex(*prepared, options, &summary);
   EXPECT_TRUE(data.ok()) << data.status();
-  builder::AddRepair(prepared->record, &*data);
   auto index = index::Index::FromBytes(*index::SerializeIndex(*data));
   EXPECT_TRUE(index.ok()) << index.status();
   auto engine = query::QueryEngine::Create(*index);

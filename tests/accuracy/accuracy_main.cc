@@ -62,9 +62,8 @@ absl::Status Run(const Flags& flags) {
         GEODEX_ASSIGN_OR_RETURN(const builder::PreparedMesh prepared,
                                 builder::PrepareMesh(m, {}, count, !flags.no_refinement));
         builder::BuildSummary summary;
-        GEODEX_ASSIGN_OR_RETURN(auto data,
-                                builder::BuildIndex(prepared.mesh, build_options, &summary));
-        builder::AddRepair(prepared.record, &data);
+        GEODEX_ASSIGN_OR_RETURN(const auto data,
+                                builder::BuildPreparedIndex(prepared, build_options, &summary));
         GEODEX_RETURN_IF_ERROR(index::WriteIndexFile(data, file));
         std::fprintf(stderr, "built %s: %s%s", file.c_str(), prepared.record.report.c_str(),
                      summary.ToText().c_str());
