@@ -69,7 +69,12 @@ absl::StatusOr<index::AccuracyRecord> Calibrate(const mesh::Mesh& mesh,
   }
   GEODEX_ASSIGN_OR_RETURN(auto engine, query::QueryEngine::Create(index));
   const double scale = engine->scale_length();
-  const std::vector<ExactPair> pairs = DrawPairs(mesh, index->num_samples(), options.pairs);
+  // Vertex pairs among the file's vertices, not a refinement's midpoints:
+  // those are flat points, and bounds fitted on them would be too tight for
+  // the corners callers ask about.
+  PairOptions pair_options = options.pairs;
+  pair_options.vertex_limit = index->num_vertices() - index->refinement_vertices();
+  const std::vector<ExactPair> pairs = DrawPairs(mesh, index->num_samples(), pair_options);
   std::vector<double> unfold[2][index::kAccuracyBins], trace[4][index::kAccuracyBins];
   std::vector<double> relative[kNumScaleBins], uniform, uniform_far;
   const query::DistanceOptions pure{.near_pairs = query::NearPairs::kUnfold};

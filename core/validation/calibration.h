@@ -28,10 +28,8 @@ struct CalibrationOptions {
   // that the harness measures on other points.
   // Many sources with few targets each: errors depend on where the source
   // lies, and the bounds must hold for sources not seen here.
-  PairOptions pairs = {.num_sources = 64,
-                       .uniform_points = 60,
-                       .per_bin_points = 15,
-                       .seed = 0x6a09e667f3bcc909ULL};
+  PairOptions pairs = {
+      .num_sources = 64, .uniform_points = 60, .per_bin_points = 15, .seed = 0x6a09e667f3bcc909ULL};
   // The bounds are this quantile of the absolute errors in their bin.
   double quantile = 0.995;
 };

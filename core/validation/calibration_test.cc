@@ -1,9 +1,9 @@
 #include "core/validation/calibration.h"
-#include "core/validation/target_error.h"
 
 #include "core/builder/builder.h"
 #include "core/mesh/generators.h"
 #include "core/query/query_engine.h"
+#include "core/validation/target_error.h"
 #include "gtest/gtest.h"
 
 namespace geodex::validation {

@@ -186,7 +186,10 @@ std::vector<ExactPair> DrawPairs(const mesh::Mesh& mesh, int32_t num_samples,
   c.all_faces.resize(mesh.num_faces());
   std::iota(c.all_faces.begin(), c.all_faces.end(), 0);
   c.all_cumulative = Cumulative(mesh, c.all_faces);
-  for (int32_t v = 0; v < mesh.num_vertices(); ++v) {
+  const int32_t vertices = options.vertex_limit > 0
+                               ? std::min(options.vertex_limit, mesh.num_vertices())
+                               : mesh.num_vertices();
+  for (int32_t v = 0; v < vertices; ++v) {
     if (mesh.IsReferenced(v)) c.referenced.push_back(v);
   }
   if (c.referenced.empty() || options.num_sources <= 0) return {};

@@ -49,11 +49,16 @@ struct PairOptions {
   // draws from its own generator, seeded from `seed` and its number, so the
   // pairs do not depend on the thread count.
   int threads = 1;
+  // Draw vertex pairs among vertices [0, vertex_limit) only (0: all). A
+  // refined mesh's midpoints come last and are no vertices of the file:
+  // vertex pairs stand for the file's vertices, the mesh's corners, where
+  // the O(1) answer errs most.
+  int32_t vertex_limit = 0;
 };
 
 // Draws pairs for an index of `num_samples` samples (which fixes L) on a
-// valid mesh: deterministic for a seed, in the order of their sources. Pairs closer than 1e-9 of the
-// bounding box diagonal, or in different components, are left out.
+// valid mesh: deterministic for a seed, in the order of their sources. Pairs closer than 1e-9 of
+// the bounding box diagonal, or in different components, are left out.
 std::vector<ExactPair> DrawPairs(const mesh::Mesh& mesh, int32_t num_samples,
                                  const PairOptions& options);
 

@@ -37,11 +37,10 @@ absl::StatusOr<TargetErrorResult> BuildForTargetError(const mesh::Mesh& mesh,
         const builder::PreparedMesh prepared,
         builder::PrepareMesh(mesh, repair, build.num_samples, build.refine_long_edges));
     GEODEX_ASSIGN_OR_RETURN(index::IndexData data,
-                            builder::BuildIndex(prepared.mesh, build, &summary));
+                            builder::BuildPreparedIndex(prepared, build, &summary));
     CalibrationOptions calibration;
     calibration.pairs.threads = build.threads;
     GEODEX_RETURN_IF_ERROR(AddCalibration(prepared.mesh, data, calibration));
-    builder::AddRepair(prepared.record, &data);
     const index::AccuracyRecord& r = data.accuracy[0];
     result.rounds.push_back(
         {static_cast<int32_t>(data.samples.size()), r.uniform_rms, r.uniform_far_p99});

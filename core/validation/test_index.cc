@@ -26,8 +26,8 @@ absl::StatusOr<std::shared_ptr<const query::QueryEngine>> BuildTestEngine(
   return query::QueryEngine::Create(std::move(index), options);
 }
 
-std::shared_ptr<const query::QueryEngine> TestEngineOrThrow(const mesh::Mesh& mesh,
-                                                            int32_t samples, bool calibrate,
+std::shared_ptr<const query::QueryEngine> TestEngineOrThrow(const mesh::Mesh& mesh, int32_t samples,
+                                                            bool calibrate,
                                                             query::QueryOptions options) {
   absl::StatusOr<std::shared_ptr<const query::QueryEngine>> engine =
       BuildTestEngine(mesh, samples, calibrate, options);

@@ -27,8 +27,7 @@ absl::StatusOr<std::shared_ptr<const query::QueryEngine>> BuildTestEngine(
 // The same, for test bodies: throws std::runtime_error with the status on
 // failure, which GoogleTest reports as the test's failure (no dereference of
 // an error).
-std::shared_ptr<const query::QueryEngine> TestEngineOrThrow(const mesh::Mesh& mesh,
-                                                            int32_t samples,
+std::shared_ptr<const query::QueryEngine> TestEngineOrThrow(const mesh::Mesh& mesh, int32_t samples,
                                                             bool calibrate = false,
                                                             query::QueryOptions options = {});
 
