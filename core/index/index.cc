@@ -21,6 +21,7 @@
 #include "absl/strings/str_format.h"
 #include "core/common/file_util.h"
 #include "core/common/status_macros.h"
+#include "core/index/input_id_checks.h"
 
 #define XXH_STATIC_LINKING_ONLY  // XXH64_state_t on the stack
 #include "xxhash.h"
@@ -284,82 +285,9 @@ absl::Status CheckContents(const Contents& c, absl::StatusCode code) {
                           i, b.first, b.count, nb, nf));
     }
   }
-  // Vertices: the input's, the copies, the midpoints. Copies copy an input
-  // vertex; coarse faces use no midpoint.
-  const int64_t num_coarse_vertices = nv - static_cast<int64_t>(c.refinement_vertices);
-  const int64_t num_input_vertices =
-      num_coarse_vertices - static_cast<int64_t>(c.vertex_copies.size());
-  if (num_input_vertices < 0) {
-    return fail(absl::StrFormat("%d vertex copies and %d midpoints but %d vertices",
-                                c.vertex_copies.size(), c.refinement_vertices, nv));
-  }
-  for (size_t i = 0; i < c.vertex_copies.size(); ++i) {
-    if (!InRange(c.vertex_copies[i], 0, num_input_vertices)) {
-      return fail(absl::StrFormat("vertex copy %d: input vertex %d out of range [0, %d)", i,
-                                  c.vertex_copies[i], num_input_vertices));
-    }
-  }
-  // A refined index: every face is a piece of one coarse face, given by
-  // weights in it, and every coarse face has a piece.
-  const bool refined = !c.refined_faces.empty();
-  if (refined != !c.coarse_faces.empty() || (c.refinement_vertices > 0 && !refined) ||
-      (refined && static_cast<int64_t>(c.refined_faces.size()) != nf) ||
-      c.coarse_faces.size() % 3 != 0) {
-    return fail(absl::StrFormat(
-        "refinement: %d refined face records for %d faces, %d coarse face ids, %d midpoints",
-        c.refined_faces.size(), nf, c.coarse_faces.size(), c.refinement_vertices));
-  }
-  const int64_t num_coarse_faces = refined ? static_cast<int64_t>(c.coarse_faces.size() / 3) : nf;
-  for (size_t i = 0; i < c.coarse_faces.size(); ++i) {
-    if (!InRange(c.coarse_faces[i], 0, num_coarse_vertices)) {
-      return fail(absl::StrFormat("coarse face %d: vertex id %d out of range [0, %d)", i / 3,
-                                  c.coarse_faces[i], num_coarse_vertices));
-    }
-  }
-  if (refined) {
-    std::vector<uint8_t> has_piece(num_coarse_faces, 0);
-    for (size_t f = 0; f < c.refined_faces.size(); ++f) {
-      const RefinedFaceRecord& r = c.refined_faces[f];
-      bool ok = InRange(r.coarse_face, 0, num_coarse_faces);
-      for (int i = 0; i < 3 && ok; ++i) {
-        const float* w = r.weight[i];
-        ok = std::isfinite(w[0]) && std::isfinite(w[1]) && std::isfinite(w[2]) &&
-             std::min({w[0], w[1], w[2]}) >= -1e-6f && std::fabs(w[0] + w[1] + w[2] - 1) <= 1e-5f;
-      }
-      if (!ok) {
-        return fail(
-            absl::StrFormat("refined face %d: coarse face %d (of %d) or corner weights invalid", f,
-                            r.coarse_face, num_coarse_faces));
-      }
-      has_piece[r.coarse_face] = 1;
-    }
-    for (int64_t f = 0; f < num_coarse_faces; ++f) {
-      if (has_piece[f] == 0) return fail(absl::StrFormat("coarse face %d has no piece", f));
-    }
-  }
-  // Every coarse face is the one face of exactly one input face that was
-  // not dropped, so that answers have an input face to name.
-  if (!c.input_faces.empty()) {
-    std::vector<uint8_t> kept(num_coarse_faces, 0);
-    for (size_t i = 0; i < c.input_faces.size(); ++i) {
-      const InputFaceRecord& r = c.input_faces[i];
-      const bool permutation = r.corner[0] < 3 && r.corner[1] < 3 && r.corner[2] < 3 &&
-                               r.corner[0] != r.corner[1] && r.corner[1] != r.corner[2] &&
-                               r.corner[0] != r.corner[2];
-      if (!InRange(r.face, 0, num_coarse_faces) || !permutation ||
-          (r.flags & ~(kInputFaceDropped | kInputFaceReoriented)) != 0) {
-        return fail(absl::StrFormat(
-            "input face %d: face %d (of %d), corners (%d %d %d) or flags %d invalid", i, r.face,
-            num_coarse_faces, r.corner[0], r.corner[1], r.corner[2], r.flags));
-      }
-      if ((r.flags & kInputFaceDropped) == 0 && kept[r.face]++ > 0) {
-        return fail(absl::StrFormat("input face %d: face %d is kept twice", i, r.face));
-      }
-    }
-    for (int64_t f = 0; f < num_coarse_faces; ++f) {
-      if (kept[f] == 0) return fail(absl::StrFormat("face %d is no input face's", f));
-    }
-  }
+  GEODEX_RETURN_IF_ERROR(CheckInputIds({nv, nf, c.input_faces, c.vertex_copies, c.coarse_faces,
+                                        c.refined_faces, c.refinement_vertices},
+                                       code));
   if (!c.bvh_faces.empty()) {
     std::vector<bool> seen(nf, false);
     for (size_t i = 0; i < c.bvh_faces.size(); ++i) {

@@ -1,0 +1,29 @@
+#pragma once
+
+// The checks of an index's input-id sections (format 1.2: input faces and
+// vertex copies; 2.0: the flat refinement's coarse faces and pieces), shared
+// by the writer (InvalidArgument) and the reader (DataLoss) through
+// index.cc's CheckContents.
+
+#include <cstdint>
+#include <span>
+
+#include "absl/status/status.h"
+#include "core/index/index_format.h"
+
+namespace geodex::index {
+
+struct InputIdSections {
+  int64_t num_vertices = 0;
+  int64_t num_faces = 0;
+  std::span<const InputFaceRecord> input_faces;
+  std::span<const int32_t> vertex_copies;
+  std::span<const int32_t> coarse_faces;
+  std::span<const RefinedFaceRecord> refined_faces;
+  uint64_t refinement_vertices = 0;
+};
+
+// OK, or `code` with a message naming the first bad element.
+absl::Status CheckInputIds(const InputIdSections& c, absl::StatusCode code);
+
+}  // namespace geodex::index
