@@ -370,12 +370,13 @@ int main(int argc, char** argv) {
         validation::TargetErrorOptions target;
         target.target_rms = target_error;
         target.max_samples = max_samples;
-        target.round_done = [&](int32_t round, int32_t m, double rms, double far_p99) {
+        target.round_done = [&](int32_t round, const validation::TargetErrorRound& r) {
           std::fprintf(stderr,
-                       "[target-error] round %d: m = %d, relative RMS %.3f%% (target %.3f%%), "
-                       "p99 beyond 10L %.3f%% (target %.3f%%)\n",
-                       round + 1, m, 100 * rms, 100 * target_error, 100 * far_p99,
-                       400 * target_error);
+                       "[target-error] round %d: m = %d, relative RMS %.3f%% (95%% upper limit "
+                       "%.3f%%, target %.3f%%), p99 beyond 10L %.3f%% (upper limit %.3f%%, "
+                       "target %.3f%%)\n",
+                       round + 1, r.samples, 100 * r.rms, 100 * r.rms_upper, 100 * target_error,
+                       100 * r.far_p99, 100 * r.far_p99_upper, 400 * target_error);
         };
         GEODEX_ASSIGN_OR_RETURN(auto result,
                                 validation::BuildForTargetError(repaired.mesh, options, target,
@@ -383,6 +384,9 @@ int main(int argc, char** argv) {
         result.data.report += absl::StrFormat(
             "target_error = %.6g\ntarget_error_reached = %s\ntarget_error_rounds = %d\n",
             target_error, result.reached ? "yes" : "no (sample cap)", result.rounds.size());
+        result.data.report += absl::StrFormat(
+            "target_error_rms_upper95 = %.6g\ntarget_error_far_p99_upper95 = %.6g\n",
+            result.rounds.back().rms_upper, result.rounds.back().far_p99_upper);
         result.data.report += validation::CalibrationText(result.data.accuracy[0]);
         if (!result.reached) {
           std::fprintf(stderr,

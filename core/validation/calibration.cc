@@ -59,11 +59,53 @@ double Rms(const std::vector<double>& x) {
   return x.empty() ? 0 : std::sqrt(sum / x.size());
 }
 
+// The one-sided 95% normal quantile.
+constexpr double kZ95 = 1.645;
+
 }  // namespace
+
+UniformConfidence UniformConfidenceOf(const std::vector<double>& errors,
+                                      const std::vector<int32_t>& source,
+                                      const std::vector<double>& far) {
+  UniformConfidence c;
+  // Per source: the sum of squared errors and the count.
+  std::vector<std::pair<double, int64_t>> by_source;
+  for (size_t k = 0; k < errors.size(); ++k) {
+    const size_t s = static_cast<size_t>(source[k]);
+    if (s >= by_source.size()) by_source.resize(s + 1, {0.0, 0});
+    by_source[s].first += errors[k] * errors[k];
+    ++by_source[s].second;
+  }
+  std::vector<double> mse;
+  for (const auto& [sum, count] : by_source) {
+    if (count > 0) mse.push_back(sum / count);
+  }
+  if (!mse.empty()) {
+    const double n = static_cast<double>(mse.size());
+    double mean = 0;
+    for (double x : mse) mean += x;
+    mean /= n;
+    double var = 0;
+    for (double x : mse) var += (x - mean) * (x - mean);
+    // One source says nothing of the spread: no margin can be had from it.
+    const double se = mse.size() > 1 ? std::sqrt(var / (n - 1) / n) : mean;
+    c.rms_upper = std::sqrt(mean + kZ95 * se);
+  }
+  if (!far.empty()) {
+    std::vector<double> sorted = far;
+    std::sort(sorted.begin(), sorted.end());
+    const double n = static_cast<double>(sorted.size());
+    const double rank = 0.99 * n + kZ95 * std::sqrt(n * 0.99 * 0.01);
+    const size_t k = std::min(sorted.size() - 1, static_cast<size_t>(std::ceil(rank)));
+    c.far_p99_upper = sorted[k];
+  }
+  return c;
+}
 
 absl::StatusOr<index::AccuracyRecord> Calibrate(const mesh::Mesh& mesh,
                                                 std::shared_ptr<const index::Index> index,
-                                                const CalibrationOptions& options) {
+                                                const CalibrationOptions& options,
+                                                UniformConfidence* confidence) {
   if (index->num_vertices() != mesh.num_vertices() || index->num_faces() != mesh.num_faces()) {
     return absl::FailedPreconditionError("the index was not built from this mesh");
   }
@@ -77,6 +119,7 @@ absl::StatusOr<index::AccuracyRecord> Calibrate(const mesh::Mesh& mesh,
   const std::vector<ExactPair> pairs = DrawPairs(mesh, index->num_samples(), pair_options);
   std::vector<double> unfold[2][index::kAccuracyBins], trace[4][index::kAccuracyBins];
   std::vector<double> relative[kNumScaleBins], uniform, uniform_far;
+  std::vector<int32_t> uniform_source;
   const query::DistanceOptions pure{.near_pairs = query::NearPairs::kUnfold};
   for (const ExactPair& pair : pairs) {
     const absl::StatusOr<double> u = engine->Distance(pair.p, pair.q, pure);
@@ -111,6 +154,7 @@ absl::StatusOr<index::AccuracyRecord> Calibrate(const mesh::Mesh& mesh,
     relative[pair.bin].push_back(e);
     if (pair.uniform && !pair.vertices) {
       uniform.push_back(e);
+      uniform_source.push_back(pair.source);
       if (pair.bin == kNumScaleBins - 1) uniform_far.push_back(std::abs(e));
     }
   }
@@ -123,16 +167,18 @@ absl::StatusOr<index::AccuracyRecord> Calibrate(const mesh::Mesh& mesh,
   }
   r.uniform_rms = static_cast<float>(Rms(uniform));
   r.uniform_far_p99 = uniform_far.empty() ? 0 : static_cast<float>(Quantile(uniform_far, 0.99));
+  if (confidence != nullptr)
+    *confidence = UniformConfidenceOf(uniform, uniform_source, uniform_far);
   return r;
 }
 
 absl::Status AddCalibration(const mesh::Mesh& mesh, index::IndexData& data,
-                            const CalibrationOptions& options) {
+                            const CalibrationOptions& options, UniformConfidence* confidence) {
   data.accuracy.clear();
   GEODEX_ASSIGN_OR_RETURN(std::string bytes, index::SerializeIndex(data));
   GEODEX_ASSIGN_OR_RETURN(auto index, index::Index::FromBytes(std::move(bytes)));
   GEODEX_ASSIGN_OR_RETURN(const index::AccuracyRecord record,
-                          Calibrate(mesh, std::move(index), options));
+                          Calibrate(mesh, std::move(index), options, confidence));
   data.accuracy = {record};
   return absl::OkStatus();
 }

@@ -15,6 +15,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <vector>
 
 #include "absl/status/statusor.h"
 #include "core/index/index.h"
@@ -34,16 +35,42 @@ struct CalibrationOptions {
   double quantile = 0.995;
 };
 
-// Measures `index` (built from `mesh`) and returns its calibration.
+// How far the held-out figures of the area-uniform pairs can be trusted:
+// one-sided 95% upper confidence limits of their relative RMS and of their
+// p99 beyond 10L. A builder that stops on the measured figures alone stops
+// as often as not just under a target that other held-out points then miss;
+// stopping on these limits leaves the margin that sampling noise needs.
+struct UniformConfidence {
+  // The pairs of one source err together (its point may lie in a bad
+  // geodesic triangle), so the sources, not the pairs, are the independent
+  // draws: sqrt of the mean of the sources' mean squared errors plus 1.645
+  // standard errors of that mean.
+  double rms_upper = 0;
+  // The order statistic that is at least the 99th percentile with 95%
+  // confidence (binomial, normal approximation).
+  double far_p99_upper = 0;
+};
+
+// Measures `index` (built from `mesh`) and returns its calibration; with
+// `confidence`, also the upper confidence limits of its uniform figures.
 // Errors: FailedPrecondition when the index was not built from this mesh or
 // has no triangles; Internal when no pair could be measured.
 absl::StatusOr<index::AccuracyRecord> Calibrate(const mesh::Mesh& mesh,
                                                 std::shared_ptr<const index::Index> index,
-                                                const CalibrationOptions& options = {});
+                                                const CalibrationOptions& options = {},
+                                                UniformConfidence* confidence = nullptr);
 
 // `data` with its calibration added (replacing any), for writing.
 absl::Status AddCalibration(const mesh::Mesh& mesh, index::IndexData& data,
-                            const CalibrationOptions& options = {});
+                            const CalibrationOptions& options = {},
+                            UniformConfidence* confidence = nullptr);
+
+// The upper confidence limits of UniformConfidence for relative errors
+// `errors` drawn from sources `source` (parallel arrays), and for the
+// absolute relative errors `far` of the pairs beyond 10L. Exposed for tests.
+UniformConfidence UniformConfidenceOf(const std::vector<double>& errors,
+                                      const std::vector<int32_t>& source,
+                                      const std::vector<double>& far);
 
 // "key = value" lines of a calibration, for build reports.
 std::string CalibrationText(const index::AccuracyRecord& record);

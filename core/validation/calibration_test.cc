@@ -1,5 +1,7 @@
 #include "core/validation/calibration.h"
 
+#include <cmath>
+
 #include "core/builder/builder.h"
 #include "core/mesh/generators.h"
 #include "core/query/query_engine.h"
@@ -120,11 +122,54 @@ TEST(TargetErrorTest, GrowsTheSamplesUntilTheTargetIsMet) {
   ASSERT_GE(result->rounds.size(), 2u);  // 60 samples are not enough
   EXPECT_LE(result->rounds.back().rms, 0.011);
   EXPECT_GT(result->rounds.front().rms, 0.011);
+  // The stop is judged by the upper confidence limits, which are never
+  // below the measured figures.
+  EXPECT_LE(result->rounds.back().rms_upper, 0.011);
+  EXPECT_LE(result->rounds.back().far_p99_upper, 4 * 0.011);
+  for (const TargetErrorRound& r : result->rounds) {
+    EXPECT_GE(r.rms_upper, r.rms);
+    EXPECT_GE(r.far_p99_upper, r.far_p99);
+  }
   ASSERT_EQ(result->data.accuracy.size(), 1u);
   EXPECT_EQ(result->data.samples.size(), static_cast<size_t>(result->rounds.back().samples));
   for (size_t k = 1; k < result->rounds.size(); ++k) {
     EXPECT_GT(result->rounds[k].samples, result->rounds[k - 1].samples);
   }
+}
+
+TEST(UniformConfidenceTest, SourcesThatAgreeLeaveNoMarginAndOneBadSourceWidensIt) {
+  // Ten sources, four pairs each, every source with relative errors +-0.01:
+  // the sources' mean squared errors agree, so the limit is the RMS itself.
+  std::vector<double> errors;
+  std::vector<int32_t> source;
+  for (int32_t s = 0; s < 10; ++s) {
+    for (double e : {0.01, -0.01, 0.01, -0.01}) {
+      errors.push_back(e);
+      source.push_back(s);
+    }
+  }
+  EXPECT_NEAR(UniformConfidenceOf(errors, source, {}).rms_upper, 0.01, 1e-12);
+  // One source errs 0.05 on every pair: mean squared error
+  // (9 * 1e-4 + 25e-4) / 10 = 3.4e-4, sample standard deviation of the
+  // sources' 1e-4 (x9) and 25e-4 (x1) = 7.589e-4, standard error 2.4e-4.
+  for (size_t k = 0; k < 4; ++k) errors[k] = 0.05;
+  const double mean = 3.4e-4;
+  const double se = std::sqrt((9 * 2.4e-4 * 2.4e-4 + 21.6e-4 * 21.6e-4) / 9 / 10);
+  EXPECT_NEAR(UniformConfidenceOf(errors, source, {}).rms_upper, std::sqrt(mean + 1.645 * se),
+              1e-12);
+  EXPECT_GT(std::sqrt(mean + 1.645 * se), std::sqrt(mean) * 1.3);
+}
+
+TEST(UniformConfidenceTest, FarP99LimitIsAHigherOrderStatistic) {
+  // 1000 errors 0.001 .. 1.000: the 99th percentile is about 0.990; with
+  // 95% confidence it is below the ceil(990 + 1.645 sqrt(9.9)) = 996th
+  // order statistic (0-based), 0.997.
+  std::vector<double> far;
+  for (int k = 1000; k >= 1; --k) far.push_back(k / 1000.0);
+  EXPECT_DOUBLE_EQ(UniformConfidenceOf({}, {}, far).far_p99_upper, 0.997);
+  EXPECT_EQ(UniformConfidenceOf({}, {}, {}).far_p99_upper, 0);
+  // Few pairs: the largest.
+  EXPECT_DOUBLE_EQ(UniformConfidenceOf({}, {}, {0.1, 0.3, 0.2}).far_p99_upper, 0.3);
 }
 
 TEST(TargetErrorTest, StopsAtTheCapAndSaysSo) {

@@ -75,7 +75,7 @@ std::vector<ExactPair> PairsOfSource(const PairContext& c, geodesic::VertexGeode
   auto add = [&](const mesh::SurfacePoint& p, const mesh::SurfacePoint& q, double exact,
                  bool vertices, bool uniform) {
     if (!(exact > c.tiny) || !std::isfinite(exact)) return false;
-    pairs.push_back({p, q, exact, vertices, uniform, ScaleBinOf(exact, c.scale)});
+    pairs.push_back({p, q, exact, vertices, uniform, ScaleBinOf(exact, c.scale), s});
     return true;
   };
   if (s % 2 == 0) {

@@ -38,6 +38,7 @@ struct ExactPair {
   bool vertices = false;  // both points are mesh vertices (else both inside faces)
   bool uniform = false;   // q drawn area-uniformly (else in a bin on purpose)
   int bin = 0;            // ScaleBinOf(exact)
+  int32_t source = 0;     // the number of p's exact propagation (pairs of one source err together)
 };
 
 struct PairOptions {

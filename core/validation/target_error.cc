@@ -40,17 +40,17 @@ absl::StatusOr<TargetErrorResult> BuildForTargetError(const mesh::Mesh& mesh,
                             builder::BuildPreparedIndex(prepared, build, &summary));
     CalibrationOptions calibration;
     calibration.pairs.threads = build.threads;
-    GEODEX_RETURN_IF_ERROR(AddCalibration(prepared.mesh, data, calibration));
+    UniformConfidence confidence;
+    GEODEX_RETURN_IF_ERROR(AddCalibration(prepared.mesh, data, calibration, &confidence));
     const index::AccuracyRecord& r = data.accuracy[0];
-    result.rounds.push_back(
-        {static_cast<int32_t>(data.samples.size()), r.uniform_rms, r.uniform_far_p99});
-    if (options.round_done) {
-      options.round_done(round, result.rounds.back().samples, r.uniform_rms, r.uniform_far_p99);
-    }
+    const TargetErrorRound done{static_cast<int32_t>(data.samples.size()), r.uniform_rms,
+                                r.uniform_far_p99, confidence.rms_upper, confidence.far_p99_upper};
+    result.rounds.push_back(done);
+    if (options.round_done) options.round_done(round, done);
     result.data = std::move(data);
     result.summary = summary;
     result.reached =
-        r.uniform_rms <= options.target_rms && r.uniform_far_p99 <= 4 * options.target_rms;
+        done.rms_upper <= options.target_rms && done.far_p99_upper <= 4 * options.target_rms;
     if (result.reached || build.num_samples >= cap) break;
     build.num_samples =
         std::min(cap, static_cast<int32_t>(std::ceil(build.num_samples * options.growth)));

@@ -4,7 +4,10 @@
 // measures the index against held-out exact propagations (calibration.h),
 // and rebuilds with more samples until the area-uniform pairs' relative RMS
 // is at most the target and their p99 beyond 10L at most four times it, or
-// until the sample cap.
+// until the sample cap. Both are judged by their 95% upper confidence limits
+// (UniformConfidence), not by the measured figures: an index that only just
+// meets the target on the held-out points misses it on others as often as
+// not.
 //
 // New samples come from farthest-point sampling with a larger m, on the mesh
 // refined for that m (every round rebuilds from scratch); placing them where
@@ -35,13 +38,14 @@ struct TargetErrorOptions {
   // the mesh's vertices.
   int32_t max_samples = 0;
   double growth = 1.5;  // m grows by this factor per round
-  // Called after each round with its m and measured error.
-  std::function<void(int32_t round, int32_t samples, double rms, double far_p99)> round_done;
+  // Called after each round (numbered from 0) with its figures.
+  std::function<void(int32_t round, const struct TargetErrorRound&)> round_done;
 };
 
 struct TargetErrorRound {
-  int32_t samples = 0;  // after repair
-  double rms = 0, far_p99 = 0;
+  int32_t samples = 0;                      // after repair
+  double rms = 0, far_p99 = 0;              // measured on the held-out pairs
+  double rms_upper = 0, far_p99_upper = 0;  // their 95% upper confidence limits
 };
 
 struct TargetErrorResult {
