@@ -237,7 +237,8 @@ absl::StatusOr<Plan> MakePlan(const Mesh& mesh, const BuildOptions& options) {
   auto start = std::chrono::steady_clock::now();
   if (options.progress) options.progress({"sampling", 0, options.num_samples});
   GEODEX_ASSIGN_OR_RETURN(sampling::SampleSet set,
-                          sampling::FarthestPointSampling(mesh, options.num_samples, options.seed));
+                          sampling::FarthestPointSampling(mesh, options.num_samples, options.seed,
+                                                          options.spacing_weight));
   plan.sampling_seconds = SecondsSince(start);
   if (options.progress) options.progress({"sampling", options.num_samples, options.num_samples});
 

@@ -51,6 +51,11 @@ struct BuildOptions {
   // Split long mesh edges flat before sampling (PrepareMesh in
   // core/builder/mesh_arrays.h; geodex-build --no-refinement turns it off).
   bool refine_long_edges = true;
+  // Error-driven placement (core/validation/error_map.h): one weight per
+  // vertex of the mesh being built; farthest-point sampling then spaces the
+  // samples about 1 / weight apart relative to elsewhere. Empty: plain
+  // farthest-point sampling.
+  std::vector<double> spacing_weight;
   // Called from builder threads (serialised by the builder) as work advances.
   std::function<void(const Progress&)> progress;
 };

@@ -1,6 +1,7 @@
 #include "core/sampling/farthest_point_sampling.h"
 
 #include <algorithm>
+#include <cmath>
 
 #include "absl/strings/str_format.h"
 #include "core/common/status_macros.h"
@@ -18,14 +19,15 @@ uint64_t SplitMix64(uint64_t x) {
 }  // namespace
 
 int32_t FarthestVertex(const mesh::Mesh& mesh, const SampleSet& set,
-                       const std::vector<uint8_t>& mask) {
+                       const std::vector<uint8_t>& mask, std::span<const double> spacing_weight) {
   int32_t best = mesh::kNone;
   double best_distance = -1;
   for (int32_t v = 0; v < mesh.num_vertices(); ++v) {
     if (!mesh.IsReferenced(v) || (!mask.empty() && !mask[v])) continue;
-    if (set.distance[v] > best_distance) {
+    const double d = spacing_weight.empty() ? set.distance[v] : spacing_weight[v] * set.distance[v];
+    if (d > best_distance) {
       best = v;
-      best_distance = set.distance[v];
+      best_distance = d;
     }
   }
   return best_distance > 0 ? best : mesh::kNone;
@@ -57,12 +59,26 @@ absl::Status AddSample(geodesic::VertexGeodesicSolver& solver, int32_t v, Sample
 }
 
 absl::StatusOr<SampleSet> FarthestPointSampling(const mesh::Mesh& mesh, int32_t num_samples,
-                                                uint64_t seed) {
+                                                uint64_t seed,
+                                                std::span<const double> spacing_weight) {
   int32_t referenced = 0;
   for (int32_t v = 0; v < mesh.num_vertices(); ++v) referenced += mesh.IsReferenced(v);
   if (num_samples < 1 || num_samples > referenced) {
     return absl::InvalidArgumentError(absl::StrFormat(
         "cannot take %d samples from a mesh with %d referenced vertices", num_samples, referenced));
+  }
+  if (!spacing_weight.empty()) {
+    if (spacing_weight.size() != static_cast<size_t>(mesh.num_vertices())) {
+      return absl::InvalidArgumentError(
+          absl::StrFormat("%d spacing weights for a mesh of %d vertices", spacing_weight.size(),
+                          mesh.num_vertices()));
+    }
+    for (size_t v = 0; v < spacing_weight.size(); ++v) {
+      if (!(spacing_weight[v] > 0) || !std::isfinite(spacing_weight[v])) {
+        return absl::InvalidArgumentError(absl::StrFormat(
+            "spacing weight %g of vertex %d is not positive and finite", spacing_weight[v], v));
+      }
+    }
   }
   geodesic::VertexGeodesicSolver solver(mesh);
   int32_t start = static_cast<int32_t>(SplitMix64(seed) % mesh.num_vertices());
@@ -79,7 +95,7 @@ absl::StatusOr<SampleSet> FarthestPointSampling(const mesh::Mesh& mesh, int32_t 
     GEODEX_RETURN_IF_ERROR(AddSample(solver, first == mesh::kNone ? start : first, &set));
   }
   while (static_cast<int32_t>(set.samples.size()) < num_samples) {
-    const int32_t next = FarthestVertex(mesh, set);
+    const int32_t next = FarthestVertex(mesh, set, {}, spacing_weight);
     if (next == mesh::kNone) break;  // every vertex is a sample
     GEODEX_RETURN_IF_ERROR(AddSample(solver, next, &set));
   }

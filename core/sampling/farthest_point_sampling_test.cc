@@ -1,6 +1,9 @@
 #include "core/sampling/farthest_point_sampling.h"
 
+#include <cmath>
+#include <limits>
 #include <set>
+#include <vector>
 
 #include "core/mesh/generators.h"
 #include "gtest/gtest.h"
@@ -71,6 +74,38 @@ TEST(FarthestPointSamplingTest, RejectsImpossibleCounts) {
   const mesh::Mesh m = gen::Grid(2, 2, 1, 1);
   EXPECT_EQ(FarthestPointSampling(m, 0, 1).status().code(), absl::StatusCode::kInvalidArgument);
   EXPECT_EQ(FarthestPointSampling(m, 10, 1).status().code(), absl::StatusCode::kInvalidArgument);
+}
+
+TEST(FarthestPointSamplingTest, SpacingWeightsCrowdSamplesWhereTheyAreLarge) {
+  // A 2 x 1 sheet whose left half weighs 3, right half 1: the left half's
+  // samples lie about three times closer together, so it takes about nine
+  // times as many (density ~ weight^2); equal weights change nothing.
+  const mesh::Mesh m = gen::Grid(80, 40, 2.0, 1.0);
+  std::vector<double> weight(m.num_vertices());
+  for (int32_t v = 0; v < m.num_vertices(); ++v) weight[v] = m.position(v).x() < 1.0 ? 3.0 : 1.0;
+  auto set = FarthestPointSampling(m, 100, 1, weight);
+  ASSERT_TRUE(set.ok()) << set.status();
+  int left = 0;
+  for (int32_t v : set->samples) left += m.position(v).x() < 1.0;
+  EXPECT_GE(left, 80);
+  EXPECT_LE(left, 95);
+  const std::vector<double> equal(m.num_vertices(), 2.5);
+  EXPECT_EQ(FarthestPointSampling(m, 100, 1, equal)->samples,
+            FarthestPointSampling(m, 100, 1)->samples);
+}
+
+TEST(FarthestPointSamplingTest, RejectsBadSpacingWeights) {
+  const mesh::Mesh m = gen::Grid(4, 4, 1, 1);
+  std::vector<double> weight(m.num_vertices(), 1.0);
+  weight.pop_back();
+  EXPECT_EQ(FarthestPointSampling(m, 3, 1, weight).status().code(),
+            absl::StatusCode::kInvalidArgument);
+  for (double bad : {0.0, -1.0, std::nan(""), std::numeric_limits<double>::infinity()}) {
+    std::vector<double> w(m.num_vertices(), 1.0);
+    w[3] = bad;
+    EXPECT_EQ(FarthestPointSampling(m, 3, 1, w).status().code(), absl::StatusCode::kInvalidArgument)
+        << bad;
+  }
 }
 
 }  // namespace
