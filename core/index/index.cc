@@ -75,6 +75,7 @@ constexpr SectionSpec kSpecs[] = {
     {SectionId::kVertexCopies, sizeof(int32_t), "vertex copies", false},
     {SectionId::kCoarseFaces, sizeof(int32_t), "coarse faces", false},
     {SectionId::kRefinedFaces, sizeof(RefinedFaceRecord), "refined faces", false},
+    {SectionId::kSpreadBounds, sizeof(SpreadBoundRecord), "spread bounds", false},
 };
 constexpr size_t kNumSpecs = std::size(kSpecs);
 
@@ -121,6 +122,7 @@ std::optional<uint64_t> ExpectedCount(SectionId id, const Counts& c) {
     case SectionId::kVertexCopies:
     case SectionId::kCoarseFaces:
     case SectionId::kRefinedFaces:
+    case SectionId::kSpreadBounds:
       return std::nullopt;
   }
   return std::nullopt;
@@ -189,6 +191,28 @@ absl::Status CheckAccuracy(std::span<const AccuracyRecord> records, absl::Status
   }
   if (!(r.scale_length > 0) || r.bound_quantile_permille > 1000) {
     return absl::Status(code, "accuracy: bad scale length or quantile");
+  }
+  return absl::OkStatus();
+}
+
+// The spread-bound section: absent, or one record of finite, non-negative
+// figures beside an accuracy record.
+absl::Status CheckSpreadBounds(std::span<const SpreadBoundRecord> records, size_t num_accuracy,
+                               absl::StatusCode code) {
+  if (records.empty()) return absl::OkStatus();
+  if (records.size() > 1 || num_accuracy != 1) {
+    return absl::Status(code,
+                        absl::StrFormat("spread bounds: %d records beside %d accuracy records",
+                                        records.size(), num_accuracy));
+  }
+  for (int k = 0; k < 2; ++k) {
+    for (int b = 0; b < kAccuracyBins; ++b) {
+      for (float v : {records[0].epsilon[k][b], records[0].factor[k][b]}) {
+        if (!(v >= 0) || !std::isfinite(v)) {
+          return absl::Status(code, "spread bounds: a figure is negative, NaN or infinite");
+        }
+      }
+    }
   }
   return absl::OkStatus();
 }
@@ -538,6 +562,8 @@ absl::StatusOr<std::string> SerializeIndex(const IndexData& d) {
                d.coarse_faces, d.refined_faces, d.params.refinement_vertices},
       absl::StatusCode::kInvalidArgument));
   GEODEX_RETURN_IF_ERROR(CheckAccuracy(d.accuracy, absl::StatusCode::kInvalidArgument));
+  GEODEX_RETURN_IF_ERROR(
+      CheckSpreadBounds(d.spread_bounds, d.accuracy.size(), absl::StatusCode::kInvalidArgument));
 
   // Every section is written, empty ones with size 0, in kSpecs order (but the
   // input-id sections, below).
@@ -561,6 +587,7 @@ absl::StatusOr<std::string> SerializeIndex(const IndexData& d) {
       {d.vertex_copies.data(), d.vertex_copies.size() * sizeof(int32_t)},
       {d.coarse_faces.data(), d.coarse_faces.size() * sizeof(int32_t)},
       {d.refined_faces.data(), d.refined_faces.size() * sizeof(RefinedFaceRecord)},
+      {d.spread_bounds.data(), d.spread_bounds.size() * sizeof(SpreadBoundRecord)},
   };
   // The input-id sections (1.2, 2.0) are written only when the mesh was
   // repaired or refined, so that the index of a mesh that needed neither
@@ -568,7 +595,8 @@ absl::StatusOr<std::string> SerializeIndex(const IndexData& d) {
   auto written = [&pieces](size_t i) {
     const SectionId id = kSpecs[i].id;
     return pieces[i].size > 0 || (id != SectionId::kInputFaces && id != SectionId::kVertexCopies &&
-                                  id != SectionId::kCoarseFaces && id != SectionId::kRefinedFaces);
+                                  id != SectionId::kCoarseFaces && id != SectionId::kRefinedFaces &&
+                                  id != SectionId::kSpreadBounds);
   };
   const bool refined = !d.refined_faces.empty();
   size_t num_sections = 0;
@@ -712,12 +740,15 @@ absl::Status Index::Validate() {
   vertex_copies_ = SectionView<int32_t>(p, entry(SectionId::kVertexCopies));
   coarse_faces_ = SectionView<int32_t>(p, entry(SectionId::kCoarseFaces));
   refined_faces_ = SectionView<RefinedFaceRecord>(p, entry(SectionId::kRefinedFaces));
+  spread_bounds_ = SectionView<SpreadBoundRecord>(p, entry(SectionId::kSpreadBounds));
   if (h.format_major < kRefinedFormatMajor &&
       (!refined_faces_.empty() || !coarse_faces_.empty() || h.params.refinement_vertices != 0)) {
     return absl::DataLossError(absl::StrFormat("a format %d.%d index with refinement sections",
                                                h.format_major, h.format_minor));
   }
   GEODEX_RETURN_IF_ERROR(CheckAccuracy(accuracy_, absl::StatusCode::kDataLoss));
+  GEODEX_RETURN_IF_ERROR(
+      CheckSpreadBounds(spread_bounds_, accuracy_.size(), absl::StatusCode::kDataLoss));
 
   return CheckContents(
       Contents{counts, positions_, faces_, twins_, samples_, sample_distances_, vertices_,
@@ -743,6 +774,7 @@ IndexData ToIndexData(const Index& index) {
   d.bvh_faces = copy(index.bvh_faces());
   d.report = std::string(index.report());
   if (index.accuracy() != nullptr) d.accuracy = {*index.accuracy()};
+  if (index.spread_bounds() != nullptr) d.spread_bounds = {*index.spread_bounds()};
   d.input_faces = copy(index.input_faces());
   d.vertex_copies = copy(index.vertex_copies());
   d.coarse_faces = copy(index.coarse_faces());

@@ -39,6 +39,8 @@ struct IndexData {
   std::vector<int32_t> bvh_faces;
   std::string report;
   std::vector<AccuracyRecord> accuracy;  // empty, or one record (format 1.1)
+  // Empty, or one record (1.3 / 2.1), only beside an accuracy record.
+  std::vector<SpreadBoundRecord> spread_bounds;
   // A repaired mesh's input ids (format 1.2): one record per input face, or
   // empty for identity; the input vertex of each split vertex copy (the last
   // vertex_copies.size() vertices), or empty.
@@ -113,6 +115,11 @@ class Index {
   // The accuracy calibration, or nullptr when the index has none (format 1.0,
   // or built without it).
   const AccuracyRecord* accuracy() const { return accuracy_.empty() ? nullptr : &accuracy_[0]; }
+  // The per-pair bounds of O(1) answers, or nullptr (before 1.3 / 2.1, or
+  // without calibration).
+  const SpreadBoundRecord* spread_bounds() const {
+    return spread_bounds_.empty() ? nullptr : &spread_bounds_[0];
+  }
 
   // The input ids of a repaired mesh (format 1.2); both empty for an index
   // of a mesh that needed no repair, or one older than 1.2.
@@ -157,6 +164,7 @@ class Index {
   std::span<const int32_t> bvh_faces_;
   std::string_view report_;
   std::span<const AccuracyRecord> accuracy_;
+  std::span<const SpreadBoundRecord> spread_bounds_;
   std::span<const InputFaceRecord> input_faces_;
   std::span<const int32_t> vertex_copies_;
   std::span<const int32_t> coarse_faces_;

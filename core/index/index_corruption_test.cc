@@ -321,6 +321,27 @@ TEST(IndexTest, RefinementCorruptionWithValidChecksumsIsDataLoss) {
   ExpectDataLoss(bytes, cases);
 }
 
+TEST(IndexTest, SpreadBoundCorruptionWithValidChecksumsIsDataLoss) {
+  IndexData d = MakeSphereIndex();
+  d.accuracy = {AccuracyRecord{}};
+  d.accuracy[0].scale_length = 0.1f;
+  d.spread_bounds = {SpreadBoundRecord{}};
+  const std::string bytes = Serialize(d);
+  // The record is epsilon[2][8] then factor[2][8], four-byte words.
+  const std::vector<Case> cases = {
+      {"NaN factor",
+       [&](Image& i) {
+         i.Set<float>(SectionId::kSpreadBounds, 16 + 3, std::numeric_limits<float>::quiet_NaN());
+       },
+       "spread bounds"},
+      {"negative epsilon", [&](Image& i) { i.Set<float>(SectionId::kSpreadBounds, 9, -1.0f); },
+       "spread bounds"},
+      {"spread bounds without a calibration", [&](Image& i) { i.Remove(SectionId::kAccuracy); },
+       "spread bounds"},
+  };
+  ExpectDataLoss(bytes, cases);
+}
+
 TEST(IndexTest, StructuralCorruptionWithValidChecksumsIsDataLoss) {
   const std::string bytes = Serialize(MakeSphereIndex());
   struct Case {

@@ -35,6 +35,10 @@
 //        vertices). A 1.x reader must refuse such a file (its face ids are
 //        not the input's), hence the major version; an index without
 //        refinement is still written as 1.2, so older readers keep reading it.
+//   1.3 / 2.1  per-pair error bounds of O(1) answers (SpreadBoundRecord),
+//        calibrated with the AccuracyRecord. Optional, written only with a
+//        calibration; older readers ignore it and use the AccuracyRecord's
+//        bounds.
 
 #include <cstdint>
 
@@ -44,9 +48,9 @@ inline constexpr char kMagic[8] = {'G', 'E', 'O', 'D', 'E', 'X', 'I', 'X'};
 // The version written when the mesh was not refined, and the newest (when it
 // was); a reader takes both majors.
 inline constexpr uint32_t kFormatMajor = 1;
-inline constexpr uint32_t kFormatMinor = 2;
+inline constexpr uint32_t kFormatMinor = 3;
 inline constexpr uint32_t kRefinedFormatMajor = 2;
-inline constexpr uint32_t kRefinedFormatMinor = 0;
+inline constexpr uint32_t kRefinedFormatMinor = 1;
 inline constexpr uint32_t kByteOrderMark = 0x01020304;  // reads 0x04030201 when swapped
 inline constexpr uint64_t kAlignment = 64;
 
@@ -67,6 +71,7 @@ enum class SectionId : uint32_t {
   kVertexCopies = 13,    // int32[k]: input vertex of the i-th copy (1.2; see InputFaceRecord)
   kCoarseFaces = 14,     // int32[num_coarse_faces][3]: the faces before refinement (2.0)
   kRefinedFaces = 15,    // RefinedFaceRecord[num_faces] (2.0); absent: not refined
+  kSpreadBounds = 16,    // SpreadBoundRecord[0 or 1] (1.3 / 2.1); absent: constant bounds
 };
 
 // Build parameters recorded in the header.
@@ -195,5 +200,23 @@ struct AccuracyRecord {
   float uniform_far_p99;
 };
 static_assert(sizeof(AccuracyRecord) == 16 + 4 * 6 * kAccuracyBins + 4 * 10);
+
+// Per-pair error bounds of the O(1) answer (1.3 / 2.1). Within one distance
+// bin the O(1) error is heavy-tailed, so a bound that is constant in the bin
+// must sit far above most of its errors to cover the tail. What flags the
+// tail is the disagreement of the two orders of the paper's case 3.2 (p's
+// distances to q's corners, then q; or the other way round): the `spread`
+// |d_pq - d_qp| of a pair (0 for points in one geodesic triangle). The bound
+// of an O(1) answer d in bin b (kAccuracyBinUpper) is
+//   factor[k][b] * (spread + epsilon[k][b] * d),
+// k = 0 for pairs of mesh vertices, 1 for other pairs: factor is the
+// calibration's quantile of |error| / (spread + epsilon * d), and epsilon is
+// the value, among a fixed grid, that makes the bin's median bound smallest
+// (core/validation/calibration.h).
+struct SpreadBoundRecord {
+  float epsilon[2][kAccuracyBins];
+  float factor[2][kAccuracyBins];
+};
+static_assert(sizeof(SpreadBoundRecord) == 4 * 4 * kAccuracyBins);
 
 }  // namespace geodex::index

@@ -71,6 +71,55 @@ TEST(IndexTest, BadAccuracyCalibrationIsRefused) {
   EXPECT_EQ(SerializeIndex(d).status().code(), absl::StatusCode::kInvalidArgument);
 }
 
+SpreadBoundRecord SomeSpreadBounds() {
+  SpreadBoundRecord r{};
+  for (int k = 0; k < 2; ++k) {
+    for (int b = 0; b < kAccuracyBins; ++b) {
+      r.epsilon[k][b] = 0.001f * (1 + b);
+      r.factor[k][b] = 2.0f + k;
+    }
+  }
+  return r;
+}
+
+TEST(IndexTest, SpreadBoundsRoundTripBesideTheCalibrationAndAreOptional) {
+  IndexData d = MakeSphereIndex();
+  d.accuracy = {SomeAccuracy()};
+  const std::string without_bytes = Serialize(d);
+  auto without = Index::FromBytes(without_bytes);
+  ASSERT_TRUE(without.ok()) << without.status();
+  EXPECT_EQ((*without)->spread_bounds(), nullptr);
+  d.spread_bounds = {SomeSpreadBounds()};
+  const std::string bytes = Serialize(d);
+  // One more section than without: it is written only when present.
+  EXPECT_EQ(Image::Parse(bytes).header.num_sections,
+            Image::Parse(without_bytes).header.num_sections + 1);
+  auto with = Index::FromBytes(bytes);
+  ASSERT_TRUE(with.ok()) << with.status();
+  ASSERT_NE((*with)->spread_bounds(), nullptr);
+  EXPECT_EQ(std::memcmp((*with)->spread_bounds(), &d.spread_bounds[0], sizeof(SpreadBoundRecord)),
+            0);
+  EXPECT_EQ(Serialize(ToIndexData(**with)), bytes);
+}
+
+TEST(IndexTest, BadSpreadBoundsAreRefused) {
+  IndexData d = MakeSphereIndex();
+  d.spread_bounds = {SomeSpreadBounds()};  // without a calibration
+  EXPECT_EQ(SerializeIndex(d).status().code(), absl::StatusCode::kInvalidArgument);
+  d.accuracy = {SomeAccuracy()};
+  d.spread_bounds = {SomeSpreadBounds(), SomeSpreadBounds()};
+  EXPECT_EQ(SerializeIndex(d).status().code(), absl::StatusCode::kInvalidArgument);
+  for (float bad :
+       {-1.0f, std::numeric_limits<float>::quiet_NaN(), std::numeric_limits<float>::infinity()}) {
+    d.spread_bounds = {SomeSpreadBounds()};
+    d.spread_bounds[0].factor[1][5] = bad;
+    EXPECT_EQ(SerializeIndex(d).status().code(), absl::StatusCode::kInvalidArgument) << bad;
+    d.spread_bounds = {SomeSpreadBounds()};
+    d.spread_bounds[0].epsilon[0][2] = bad;
+    EXPECT_EQ(SerializeIndex(d).status().code(), absl::StatusCode::kInvalidArgument) << bad;
+  }
+}
+
 TEST(IndexTest, LayoutFollowsTheFormat) {
   const std::string bytes = Serialize(MakeSphereIndex());
   const Image image = Image::Parse(bytes);
@@ -278,7 +327,7 @@ TEST(IndexTest, InputIdSectionsRoundTripAndAreAbsentWithoutRepair) {
   const std::string bytes = Serialize(d);
   Image image = Image::Parse(bytes);
   EXPECT_EQ(image.header.num_sections, 13u);
-  EXPECT_EQ(image.header.format_minor, 2u);
+  EXPECT_EQ(image.header.format_minor, kFormatMinor);
   absl::StatusOr<std::shared_ptr<const Index>> index = Index::FromBytes(bytes);
   ASSERT_TRUE(index.ok()) << index.status();
   ExpectSameData(**index, d);

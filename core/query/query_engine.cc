@@ -152,7 +152,8 @@ QueryEngine::QueryEngine(std::shared_ptr<const index::Index> index, QueryOptions
   if (const index::AccuracyRecord* accuracy = index_->accuracy(); accuracy != nullptr) {
     constexpr int kBin = 4;  // [3L, 5L)
     static_assert(index::kAccuracyBinUpper[kBin - 1] == kRefineScale);
-    const double margin = std::max(accuracy->unfold_bound[0][kBin], accuracy->unfold_bound[1][kBin]);
+    const double margin =
+        std::max(accuracy->unfold_bound[0][kBin], accuracy->unfold_bound[1][kBin]);
     if (margin > 0 && std::isfinite(margin)) refine_below_ += margin;
   }
 }
@@ -480,16 +481,29 @@ double QueryEngine::AtLeastChord(const SurfacePoint& p, const SurfacePoint& q, d
   return std::max(d, (PositionOf(p) - PositionOf(q)).norm());
 }
 
-double QueryEngine::BoundOf(AnswerKind kind, bool vertex_pair, double d) const {
+double QueryEngine::LiftedSpread(const LiftedPoint& p, const LiftedPoint& q) const {
+  if (p.triangle == q.triangle || !(Matrix(q.corner[0], p.corner[0]) < kInf)) return 0;
+  return std::abs(kernel::FarDistance(GatherFar(p, q)) - kernel::FarDistance(GatherFar(q, p)));
+}
+
+double QueryEngine::UnfoldingSpread(const SurfacePoint& p, const SurfacePoint& q) const {
+  return LiftedSpread(Lift(Canonical(p)), Lift(Canonical(q)));
+}
+
+double QueryEngine::BoundOf(AnswerKind kind, bool vertex_pair, double d, double spread) const {
   const index::AccuracyRecord* accuracy = index_->accuracy();
   if (accuracy == nullptr) return std::numeric_limits<double>::quiet_NaN();
   if (kind == AnswerKind::kExact || !(d < kInf)) return 0;
   const double x = d / accuracy->scale_length;
   int b = 0;
   while (b + 1 < index::kAccuracyBins && x >= index::kAccuracyBinUpper[b]) ++b;
+  const int k = vertex_pair ? 0 : 1;
   switch (kind) {
     case AnswerKind::kUnfold:
-      return accuracy->unfold_bound[vertex_pair ? 0 : 1][b];
+      if (const index::SpreadBoundRecord* s = index_->spread_bounds(); s != nullptr) {
+        return s->factor[k][b] * (spread + s->epsilon[k][b] * d);
+      }
+      return accuracy->unfold_bound[k][b];
     case AnswerKind::kTrace:
       return accuracy->trace_bound[vertex_pair ? 2 : 0][b];
     case AnswerKind::kWrappedTrace:
@@ -517,6 +531,15 @@ double QueryEngine::Refine(const SurfacePoint& p_in, const SurfacePoint& q_in, d
   const bool vertex_pair = at_vertex(p) && at_vertex(q);
   double d = near ? AtLeastChord(p, q, unfolded) : unfolded;
   AnswerKind kind = AnswerKind::kUnfold;
+  // The bound of an answer; the spread of an O(1) answer is computed once,
+  // when first needed.
+  double spread = -1;
+  auto bound_of = [&](AnswerKind k, double at) {
+    if (k == AnswerKind::kUnfold && spread < 0) {
+      spread = index_->spread_bounds() != nullptr ? UnfoldingSpread(p, q) : 0;
+    }
+    return BoundOf(k, vertex_pair, at, std::max(spread, 0.0));
+  };
   auto trace = [&] {
     const std::optional<Trace> t = PathNearDistance(from, to);
     if (!t) return false;
@@ -540,7 +563,7 @@ double QueryEngine::Refine(const SurfacePoint& p_in, const SurfacePoint& q_in, d
   // no trace is doubted).
   auto wrong_corridor = [&] {
     return (kind == AnswerKind::kTrace || kind == AnswerKind::kWrappedTrace) &&
-           d > unfolded + BoundOf(AnswerKind::kUnfold, vertex_pair, unfolded);
+           d > unfolded + bound_of(AnswerKind::kUnfold, unfolded);
   };
   if (near || unfolded < refine_below_) {
     switch (options.near_pairs) {
@@ -555,11 +578,11 @@ double QueryEngine::Refine(const SurfacePoint& p_in, const SurfacePoint& q_in, d
     }
   }
   if (options.tolerance > 0) {
-    auto within = [&] { return BoundOf(kind, vertex_pair, d) <= options.tolerance * d; };
+    auto within = [&] { return bound_of(kind, d) <= options.tolerance * d; };
     if (kind == AnswerKind::kUnfold && !within() && !trace()) exact();
     if (kind != AnswerKind::kExact && (!within() || wrong_corridor())) exact();
   }
-  if (bound != nullptr) *bound = BoundOf(kind, vertex_pair, d);
+  if (bound != nullptr) *bound = bound_of(kind, d);
   return d;
 }
 

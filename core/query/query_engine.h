@@ -27,7 +27,9 @@
 // (index::AccuracyRecord) gives every answer an absolute error bound: the
 // error its kind of answer (O(1), traced, exact) at its distance stayed
 // within on all but a small share of held-out exact pairs; 0 for exact
-// answers. A caller's tolerance refines every pair whose bound exceeds
+// answers. With the spread bounds (index::SpreadBoundRecord), an O(1)
+// answer's bound also grows with its UnfoldingSpread, which flags the pairs
+// it errs most on. A caller's tolerance refines every pair whose bound exceeds
 // tolerance x distance, by the trace and then exactly.
 //
 // Thread safety: a QueryEngine is immutable; all const methods are safe from
@@ -235,6 +237,14 @@ class QueryEngine {
   // True when the points lift into the same or adjacent geodesic triangles.
   bool IsNearPair(const SurfacePoint& p, const SurfacePoint& q) const;
 
+  // The spread of the O(1) answer for valid points: |d_pq - d_qp|, the two
+  // orders of case 3.2 (p's distances to q's corners, then q; or q's to p's
+  // corners, then p; DistanceUnchecked takes one fixed order). It flags the
+  // pairs whose O(1) answer errs most, and scales their error bounds
+  // (index::SpreadBoundRecord). 0 for points in one geodesic triangle or in
+  // different components.
+  double UnfoldingSpread(const SurfacePoint& p, const SurfacePoint& q) const;
+
   // The paper's linear-interpolation baseline (§6.3), for comparisons.
   double LinearInterpolationDistance(const SurfacePoint& p, const SurfacePoint& q) const;
 
@@ -332,8 +342,11 @@ class QueryEngine {
   double Refine(const SurfacePoint& p, const SurfacePoint& q, double unfolded, bool near,
                 const DistanceOptions& options, QueryScratch* scratch, double* bound) const;
   // The calibrated bound of an answer of `kind` at distance d (NaN without
-  // calibration).
-  double BoundOf(AnswerKind kind, bool vertex_pair, double d) const;
+  // calibration); `spread` (UnfoldingSpread) scales the bound of an O(1)
+  // answer when the index has spread bounds.
+  double BoundOf(AnswerKind kind, bool vertex_pair, double d, double spread = 0) const;
+  // UnfoldingSpread of lifted points.
+  double LiftedSpread(const LiftedPoint& p, const LiftedPoint& q) const;
   // InvalidArgument for a bad tolerance; FailedPrecondition for a bound or a
   // tolerance without calibration.
   absl::Status CheckOptions(const DistanceOptions& options, bool bounds) const;

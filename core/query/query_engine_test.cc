@@ -1,5 +1,4 @@
 #include "core/query/query_engine.h"
-#include "core/validation/test_index.h"
 
 #include <algorithm>
 #include <cmath>
@@ -7,6 +6,7 @@
 
 #include "core/builder/builder.h"
 #include "core/mesh/generators.h"
+#include "core/validation/test_index.h"
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
 
@@ -92,6 +92,31 @@ TEST(QueryEngineTest, DevelopableSurfacesAreExactToFloatPrecision) {
     auto engine = MakeEngine(m, 40);
     EXPECT_LT(MaxRelativeError(m, *engine, 60), 1e-5);
   }
+}
+
+TEST(QueryEngineTest, UnfoldingSpreadVanishesWhereBothOrdersAreExact) {
+  // On a developable sheet both orders of case 3.2 are exact; on a sphere
+  // they disagree, symmetrically, and never between points of one
+  // geodesic triangle.
+  const Mesh sheet = gen::FoldedSheet(24, 16, 2.0, 1.0, 1.1);
+  auto flat = MakeEngine(sheet, 40);
+  const std::vector<SurfacePoint> a = RandomPoints(sheet, 200, 3);
+  for (size_t k = 0; k + 1 < a.size(); k += 2) {
+    EXPECT_LT(flat->UnfoldingSpread(a[k], a[k + 1]),
+              1e-5 * flat->DistanceUnchecked(a[k], a[k + 1]));
+  }
+  const Mesh sphere = gen::Sphere(4, 1.0);
+  auto round = MakeEngine(sphere, 100);
+  const std::vector<SurfacePoint> b = RandomPoints(sphere, 400, 4);
+  int spread = 0;
+  for (size_t k = 0; k + 1 < b.size(); k += 2) {
+    const double s = round->UnfoldingSpread(b[k], b[k + 1]);
+    EXPECT_EQ(s, round->UnfoldingSpread(b[k + 1], b[k]));
+    EXPECT_LT(s, 0.05 * round->DistanceUnchecked(b[k], b[k + 1]));
+    if (round->Lift(b[k]).triangle == round->Lift(b[k + 1]).triangle) EXPECT_EQ(s, 0);
+    spread += s > 1e-6;
+  }
+  EXPECT_GT(spread, 150);
 }
 
 // A closed tube is developable but not simply connected: geodesic triangles
@@ -258,7 +283,8 @@ TEST(QueryEngineTest, NearPairsAreThePathLengthByDefault) {
     const double exact = Exact(m, p, q);
     EXPECT_GE(d, exact * (1 - 1e-9));  // a surface path
     worst = std::max(worst, (d - exact) / exact);
-    worst_unfold = std::max(worst_unfold, std::abs(*engine->Distance(p, q, unfold) - exact) / exact);
+    worst_unfold =
+        std::max(worst_unfold, std::abs(*engine->Distance(p, q, unfold) - exact) / exact);
   }
   EXPECT_GT(near, 10);
   EXPECT_LT(worst, 0.01);

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <vector>
 
 #include "absl/strings/str_format.h"
@@ -62,6 +63,51 @@ double Rms(const std::vector<double>& x) {
 // The one-sided 95% normal quantile.
 constexpr double kZ95 = 1.645;
 
+// An O(1) answer's absolute error, its spread and its distance.
+struct SpreadSample {
+  double error, spread, distance;
+};
+
+// Per bin (see Calibration): epsilon and factor; a bin without pairs takes
+// the fit of its nearest measured neighbour (below first), like FillBounds.
+void FitSpreadBounds(const std::vector<SpreadSample> (&samples)[index::kAccuracyBins],
+                     double quantile, float* epsilon, float* factor) {
+  bool fitted[index::kAccuracyBins] = {};
+  for (int b = 0; b < index::kAccuracyBins; ++b) {
+    epsilon[b] = 0;
+    factor[b] = 0;
+    if (samples[b].empty()) continue;
+    double best_median = std::numeric_limits<double>::infinity();
+    for (int e = -12; e <= -4; ++e) {
+      const double eps = std::ldexp(1.0, e);
+      std::vector<double> ratio, bound;
+      for (const SpreadSample& x : samples[b]) {
+        ratio.push_back(x.error / (x.spread + eps * x.distance));
+      }
+      const double k = Quantile(ratio, quantile);
+      for (const SpreadSample& x : samples[b]) bound.push_back(k * (x.spread + eps * x.distance));
+      const double median = Quantile(bound, 0.5);
+      if (std::isfinite(k) && median < best_median) {
+        best_median = median;
+        epsilon[b] = static_cast<float>(eps);
+        factor[b] = static_cast<float>(k);
+        fitted[b] = true;
+      }
+    }
+  }
+  for (int b = 0; b < index::kAccuracyBins; ++b) {
+    if (fitted[b]) continue;
+    for (int step = 1; step < index::kAccuracyBins; ++step) {
+      const int o = b - step >= 0 && fitted[b - step] ? b - step : b + step;
+      if (o < index::kAccuracyBins && fitted[o]) {
+        epsilon[b] = epsilon[o];
+        factor[b] = factor[o];
+        break;
+      }
+    }
+  }
+}
+
 }  // namespace
 
 UniformConfidence UniformConfidenceOf(const std::vector<double>& errors,
@@ -102,10 +148,9 @@ UniformConfidence UniformConfidenceOf(const std::vector<double>& errors,
   return c;
 }
 
-absl::StatusOr<index::AccuracyRecord> Calibrate(const mesh::Mesh& mesh,
-                                                std::shared_ptr<const index::Index> index,
-                                                const CalibrationOptions& options,
-                                                UniformConfidence* confidence) {
+absl::StatusOr<Calibration> Calibrate(const mesh::Mesh& mesh,
+                                      std::shared_ptr<const index::Index> index,
+                                      const CalibrationOptions& options) {
   if (index->num_vertices() != mesh.num_vertices() || index->num_faces() != mesh.num_faces()) {
     return absl::FailedPreconditionError("the index was not built from this mesh");
   }
@@ -118,6 +163,7 @@ absl::StatusOr<index::AccuracyRecord> Calibrate(const mesh::Mesh& mesh,
   pair_options.vertex_limit = index->num_vertices() - index->refinement_vertices();
   const std::vector<ExactPair> pairs = DrawPairs(mesh, index->num_samples(), pair_options);
   std::vector<double> unfold[2][index::kAccuracyBins], trace[4][index::kAccuracyBins];
+  std::vector<SpreadSample> spread[2][index::kAccuracyBins];
   std::vector<double> relative[kNumScaleBins], uniform, uniform_far;
   std::vector<int32_t> uniform_source;
   const query::DistanceOptions pure{.near_pairs = query::NearPairs::kUnfold};
@@ -126,7 +172,10 @@ absl::StatusOr<index::AccuracyRecord> Calibrate(const mesh::Mesh& mesh,
     bool wraps = false;
     const absl::StatusOr<double> t = engine->TracedDistance(pair.p, pair.q, &wraps);
     if (!u.ok()) continue;
-    unfold[pair.vertices ? 0 : 1][AccuracyBinOf(*u, scale)].push_back(std::abs(*u - pair.exact));
+    const int bin = AccuracyBinOf(*u, scale);
+    unfold[pair.vertices ? 0 : 1][bin].push_back(std::abs(*u - pair.exact));
+    spread[pair.vertices ? 0 : 1][bin].push_back(
+        {std::abs(*u - pair.exact), engine->UnfoldingSpread(pair.p, pair.q), *u});
     if (t.ok()) {
       trace[2 * pair.vertices + wraps][AccuracyBinOf(*t, scale)].push_back(
           std::abs(*t - pair.exact));
@@ -140,10 +189,15 @@ absl::StatusOr<index::AccuracyRecord> Calibrate(const mesh::Mesh& mesh,
   FillBounds(unfold[0], options.quantile, r.unfold_bound[0]);
   FillBounds(unfold[1], options.quantile, r.unfold_bound[1]);
   for (int k = 0; k < 4; ++k) FillBounds(trace[k], options.quantile, r.trace_bound[k]);
+  Calibration result;
+  for (int k = 0; k < 2; ++k) {
+    FitSpreadBounds(spread[k], options.quantile, result.spread.epsilon[k], result.spread.factor[k]);
+  }
   // The default answer's figures, from an engine that has the bounds (the
   // default mode uses them to doubt a trace).
   index::IndexData data = index::ToIndexData(*index);
   data.accuracy = {r};
+  data.spread_bounds = {result.spread};
   GEODEX_ASSIGN_OR_RETURN(std::string bytes, index::SerializeIndex(data));
   GEODEX_ASSIGN_OR_RETURN(auto calibrated, index::Index::FromBytes(std::move(bytes)));
   GEODEX_ASSIGN_OR_RETURN(engine, query::QueryEngine::Create(std::move(calibrated)));
@@ -167,19 +221,22 @@ absl::StatusOr<index::AccuracyRecord> Calibrate(const mesh::Mesh& mesh,
   }
   r.uniform_rms = static_cast<float>(Rms(uniform));
   r.uniform_far_p99 = uniform_far.empty() ? 0 : static_cast<float>(Quantile(uniform_far, 0.99));
-  if (confidence != nullptr)
-    *confidence = UniformConfidenceOf(uniform, uniform_source, uniform_far);
-  return r;
+  result.confidence = UniformConfidenceOf(uniform, uniform_source, uniform_far);
+  result.record = r;
+  return result;
 }
 
 absl::Status AddCalibration(const mesh::Mesh& mesh, index::IndexData& data,
                             const CalibrationOptions& options, UniformConfidence* confidence) {
   data.accuracy.clear();
+  data.spread_bounds.clear();
   GEODEX_ASSIGN_OR_RETURN(std::string bytes, index::SerializeIndex(data));
   GEODEX_ASSIGN_OR_RETURN(auto index, index::Index::FromBytes(std::move(bytes)));
-  GEODEX_ASSIGN_OR_RETURN(const index::AccuracyRecord record,
-                          Calibrate(mesh, std::move(index), options, confidence));
-  data.accuracy = {record};
+  GEODEX_ASSIGN_OR_RETURN(const Calibration calibration,
+                          Calibrate(mesh, std::move(index), options));
+  data.accuracy = {calibration.record};
+  data.spread_bounds = {calibration.spread};
+  if (confidence != nullptr) *confidence = calibration.confidence;
   return absl::OkStatus();
 }
 

@@ -51,16 +51,27 @@ struct UniformConfidence {
   double far_p99_upper = 0;
 };
 
-// Measures `index` (built from `mesh`) and returns its calibration; with
-// `confidence`, also the upper confidence limits of its uniform figures.
+// What a calibration measures: the record of the constant bounds and
+// figures, the per-pair bounds of O(1) answers fitted on the same pairs
+// (index::SpreadBoundRecord: per bin, epsilon from a fixed grid of powers
+// of two, 2^-12 .. 2^-4, whichever makes the bin's median bound smallest),
+// and the confidence limits of the uniform figures.
+struct Calibration {
+  index::AccuracyRecord record{};
+  index::SpreadBoundRecord spread{};
+  UniformConfidence confidence;
+};
+
+// Measures `index` (built from `mesh`) and returns its calibration.
 // Errors: FailedPrecondition when the index was not built from this mesh or
 // has no triangles; Internal when no pair could be measured.
-absl::StatusOr<index::AccuracyRecord> Calibrate(const mesh::Mesh& mesh,
-                                                std::shared_ptr<const index::Index> index,
-                                                const CalibrationOptions& options = {},
-                                                UniformConfidence* confidence = nullptr);
+absl::StatusOr<Calibration> Calibrate(const mesh::Mesh& mesh,
+                                      std::shared_ptr<const index::Index> index,
+                                      const CalibrationOptions& options = {});
 
-// `data` with its calibration added (replacing any), for writing.
+// `data` with its calibration (the accuracy and spread-bound records) added,
+// replacing any, for writing; with `confidence`, the upper confidence limits
+// of its uniform figures.
 absl::Status AddCalibration(const mesh::Mesh& mesh, index::IndexData& data,
                             const CalibrationOptions& options = {},
                             UniformConfidence* confidence = nullptr);

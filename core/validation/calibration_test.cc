@@ -1,5 +1,6 @@
 #include "core/validation/calibration.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "core/builder/builder.h"
@@ -59,6 +60,56 @@ TEST(CalibrationTest, BoundsCoverHeldOutPairsOfAnotherSeed) {
     covered += std::abs(d - pair.exact) <= bound + 1e-9 * pair.exact;
   }
   EXPECT_GT(covered, 0.97 * pairs.size());
+}
+
+TEST(CalibrationTest, SpreadBoundsAreTighterWhereTheyCoverAsWell) {
+  // On a torus (curved both ways), the per-pair bounds of O(1) answers beyond
+  // 3L cover as the constant ones do, with a smaller median bound.
+  const mesh::Mesh m = mesh::gen::Torus(64, 32, 2.0, 0.7);
+  builder::BuildOptions options;
+  options.num_samples = 150;
+  options.threads = 2;
+  builder::BuildSummary summary;
+  auto data = builder::BuildIndex(m, options, &summary);
+  ASSERT_TRUE(data.ok()) << data.status();
+  ASSERT_TRUE(AddCalibration(m, *data).ok());
+  ASSERT_EQ(data->spread_bounds.size(), 1u);
+  for (int k = 0; k < 2; ++k) {
+    for (int b = 0; b < index::kAccuracyBins; ++b) {
+      EXPECT_GT(data->spread_bounds[0].factor[k][b], 0) << k << " " << b;
+      EXPECT_GT(data->spread_bounds[0].epsilon[k][b], 0) << k << " " << b;
+    }
+  }
+  auto spread_index = index::Index::FromBytes(*index::SerializeIndex(*data));
+  data->spread_bounds.clear();
+  auto constant_index = index::Index::FromBytes(*index::SerializeIndex(*data));
+  ASSERT_TRUE(spread_index.ok() && constant_index.ok());
+  auto spread = query::QueryEngine::Create(*spread_index);
+  auto constant = query::QueryEngine::Create(*constant_index);
+  ASSERT_TRUE(spread.ok() && constant.ok());
+  const auto pairs = DrawPairs(m, 150, {.num_sources = 12, .uniform_points = 100, .seed = 99});
+  const query::DistanceOptions pure{.near_pairs = query::NearPairs::kUnfold};
+  std::vector<double> spread_bounds, constant_bounds;
+  int spread_covered = 0, constant_covered = 0;
+  for (const ExactPair& pair : pairs) {
+    if (pair.bin < 2) continue;  // beyond 3L: O(1) answers
+    double b1 = -1, b2 = -1;
+    const double d = *(*spread)->Distance(pair.p, pair.q, pure, nullptr, &b1);
+    EXPECT_EQ(*(*constant)->Distance(pair.p, pair.q, pure, nullptr, &b2), d);
+    spread_covered += std::abs(d - pair.exact) <= b1;
+    constant_covered += std::abs(d - pair.exact) <= b2;
+    spread_bounds.push_back(b1);
+    constant_bounds.push_back(b2);
+  }
+  ASSERT_GT(spread_bounds.size(), 500u);
+  const double n = static_cast<double>(spread_bounds.size());
+  EXPECT_GT(spread_covered, 0.97 * n);
+  EXPECT_GT(constant_covered, 0.97 * n);
+  auto median = [](std::vector<double> x) {
+    std::nth_element(x.begin(), x.begin() + x.size() / 2, x.end());
+    return x[x.size() / 2];
+  };
+  EXPECT_LT(median(spread_bounds), median(constant_bounds));
 }
 
 TEST(CalibrationTest, PairsDoNotDependOnTheThreadCount) {

@@ -79,11 +79,12 @@ absl::StatusOr<std::shared_ptr<const index::Index>> IndexFor(
         const builder::PreparedMesh prepared,
         builder::PrepareMesh(m, {}, static_cast<int32_t>(index->header().params.requested_samples),
                              index->refinement_vertices() > 0));
-    GEODEX_ASSIGN_OR_RETURN(const index::AccuracyRecord record,
+    GEODEX_ASSIGN_OR_RETURN(const validation::Calibration calibration,
                             validation::Calibrate(prepared.mesh, index));
     std::fprintf(stderr, "calibrated %s in memory\n", file.c_str());
     index::IndexData data = index::ToIndexData(*index);
-    data.accuracy = {record};
+    data.accuracy = {calibration.record};
+    data.spread_bounds = {calibration.spread};
     GEODEX_ASSIGN_OR_RETURN(std::string bytes, index::SerializeIndex(data));
     GEODEX_ASSIGN_OR_RETURN(index, index::Index::FromBytes(std::move(bytes)));
   }
@@ -93,17 +94,14 @@ absl::StatusOr<std::shared_ptr<const index::Index>> IndexFor(
 // Error-driven placement at the same m: the spacing weights of the error
 // map of `fps`, the farthest-point index (core/validation/error_map.h).
 absl::StatusOr<std::vector<double>> PlacementWeights(const Flags& flags, const mesh::Mesh& m,
-                                                     const index::Index& fps, int32_t count) {
+                                                     std::shared_ptr<const index::Index> fps,
+                                                     int32_t count) {
   GEODEX_ASSIGN_OR_RETURN(const builder::PreparedMesh prepared,
                           builder::PrepareMesh(m, {}, count, !flags.no_refinement));
   validation::ErrorMapOptions map_options;
   map_options.threads = flags.threads;
-  // The map needs the index without the harness's in-memory calibration:
-  // any copy of the same samples will do.
-  GEODEX_ASSIGN_OR_RETURN(std::string bytes, index::SerializeIndex(index::ToIndexData(fps)));
-  GEODEX_ASSIGN_OR_RETURN(auto copy, index::Index::FromBytes(std::move(bytes)));
   GEODEX_ASSIGN_OR_RETURN(const std::vector<double> map,
-                          validation::VertexErrorMap(prepared.mesh, copy, map_options));
+                          validation::VertexErrorMap(prepared.mesh, std::move(fps), map_options));
   return validation::SpacingWeights(prepared.mesh, map);
 }
 
@@ -172,7 +170,7 @@ absl::Status Run(const Flags& flags) {
       GEODEX_RETURN_IF_ERROR(Measure(flags, name, pairs, index));
       if (flags.error_driven) {
         GEODEX_ASSIGN_OR_RETURN(const std::vector<double> weights,
-                                PlacementWeights(flags, m, *index, count));
+                                PlacementWeights(flags, m, index, count));
         GEODEX_ASSIGN_OR_RETURN(auto placed, IndexFor(flags, m, name, count, "-placed", weights));
         // The same pairs: L differs by the few samples repair adds, so a
         // handful of pairs may sit in a neighbouring bin.
