@@ -40,6 +40,7 @@ absl::StatusOr<TargetErrorResult> BuildForTargetError(const mesh::Mesh& mesh,
                             builder::BuildPreparedIndex(prepared, build, &summary));
     CalibrationOptions calibration;
     calibration.pairs.threads = build.threads;
+    calibration.pairs.num_sources = options.validation_sources;
     UniformConfidence confidence;
     GEODEX_RETURN_IF_ERROR(AddCalibration(prepared.mesh, data, calibration, &confidence));
     const index::AccuracyRecord& r = data.accuracy[0];

@@ -40,6 +40,12 @@ struct TargetErrorOptions {
   // the mesh's vertices.
   int32_t max_samples = 0;
   double growth = 1.5;  // m grows by this factor per round
+  // Held-out sources of each round's validation (and of the index's
+  // calibration). A source's pairs err together and sources differ a lot
+  // (a few sit where the index errs most), so the stopping figures vary
+  // with the draw: twice the calibration's default 64 halves their variance
+  // for 64 more propagations a round, a few percent of the round's rows.
+  int32_t validation_sources = 128;
   // Called after each round (numbered from 0) with its figures.
   std::function<void(int32_t round, const struct TargetErrorRound&)> round_done;
 };
