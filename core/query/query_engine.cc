@@ -481,9 +481,15 @@ double QueryEngine::AtLeastChord(const SurfacePoint& p, const SurfacePoint& q, d
   return std::max(d, (PositionOf(p) - PositionOf(q)).norm());
 }
 
-double QueryEngine::LiftedSpread(const LiftedPoint& p, const LiftedPoint& q) const {
+double QueryEngine::LiftedSpread(const LiftedPoint& p, const LiftedPoint& q,
+                                 std::optional<double> unfolded) const {
   if (p.triangle == q.triangle || !(Matrix(q.corner[0], p.corner[0]) < kInf)) return 0;
-  return std::abs(kernel::FarDistance(GatherFar(p, q)) - kernel::FarDistance(GatherFar(q, p)));
+  // LiftedDistance takes the point in the triangle of smaller id first.
+  const bool swap = p.triangle > q.triangle;
+  const LiftedPoint& lo = swap ? q : p;
+  const LiftedPoint& hi = swap ? p : q;
+  const double canonical = unfolded ? *unfolded : kernel::FarDistance(GatherFar(lo, hi));
+  return std::abs(canonical - kernel::FarDistance(GatherFar(hi, lo)));
 }
 
 double QueryEngine::UnfoldingSpread(const SurfacePoint& p, const SurfacePoint& q) const {
@@ -514,8 +520,9 @@ double QueryEngine::BoundOf(AnswerKind kind, bool vertex_pair, double d, double 
   return 0;
 }
 
-double QueryEngine::Refine(const SurfacePoint& p_in, const SurfacePoint& q_in, double unfolded,
-                           bool near, const DistanceOptions& options, QueryScratch* scratch,
+double QueryEngine::Refine(const SurfacePoint& p_in, const SurfacePoint& q_in,
+                           const LiftedPoint& lp, const LiftedPoint& lq, double unfolded, bool near,
+                           const DistanceOptions& options, QueryScratch* scratch,
                            double* bound) const {
   const SurfacePoint p = InLowestFaceIfVertex(p_in), q = InLowestFaceIfVertex(q_in);
   if (!(unfolded < kInf)) {  // different components: exactly unreachable
@@ -536,7 +543,7 @@ double QueryEngine::Refine(const SurfacePoint& p_in, const SurfacePoint& q_in, d
   double spread = -1;
   auto bound_of = [&](AnswerKind k, double at) {
     if (k == AnswerKind::kUnfold && spread < 0) {
-      spread = index_->spread_bounds() != nullptr ? UnfoldingSpread(p, q) : 0;
+      spread = index_->spread_bounds() != nullptr ? LiftedSpread(lp, lq, unfolded) : 0;
     }
     return BoundOf(k, vertex_pair, at, std::max(spread, 0.0));
   };
@@ -628,7 +635,7 @@ absl::StatusOr<double> QueryEngine::Distance(const SurfacePoint& p, const Surfac
   const double d = LiftedDistance(la, lb);
   const bool near = AreNear(la, lb);
   if (!NeedsRefine(options, bound != nullptr, near, d)) return d;
-  return Refine(a, b, d, near, options, scratch, bound);
+  return Refine(a, b, la, lb, d, near, options, scratch, bound);
 }
 
 absl::Status QueryEngine::DistanceBatch(std::span<const SurfacePoint> a,
@@ -646,7 +653,7 @@ absl::Status QueryEngine::DistanceBatch(std::span<const SurfacePoint> a,
   auto refine = [&](size_t k, const LiftedPoint& p, const LiftedPoint& q) {
     const bool near = AreNear(p, q);
     if (NeedsRefine(options, want_bounds, near, out[k])) {
-      out[k] = Refine(Canonical(a[k]), Canonical(b[k]), out[k], near, options, scratch,
+      out[k] = Refine(Canonical(a[k]), Canonical(b[k]), p, q, out[k], near, options, scratch,
                       want_bounds ? &bounds[k] : nullptr);
     }
   };

@@ -336,17 +336,21 @@ class QueryEngine {
   LiftedPoint SlowLift(const SurfacePoint& p, int heaviest) const;
   // How an answer was obtained, for its bound.
   enum class AnswerKind { kUnfold, kTrace, kWrappedTrace, kExact };
-  // The answer for a pair of canonical points, valid, whose O(1) distance is
-  // `unfolded` (near: their lifts are near), refined as `options` says; its
-  // bound in *bound when not null (NaN without calibration).
-  double Refine(const SurfacePoint& p, const SurfacePoint& q, double unfolded, bool near,
-                const DistanceOptions& options, QueryScratch* scratch, double* bound) const;
+  // The answer for a pair of canonical points, valid, lifted to lp and lq,
+  // whose O(1) distance is `unfolded` = LiftedDistance(lp, lq) (near: the
+  // lifts are near), refined as `options` says; its bound in *bound when not
+  // null (NaN without calibration).
+  double Refine(const SurfacePoint& p, const SurfacePoint& q, const LiftedPoint& lp,
+                const LiftedPoint& lq, double unfolded, bool near, const DistanceOptions& options,
+                QueryScratch* scratch, double* bound) const;
   // The calibrated bound of an answer of `kind` at distance d (NaN without
   // calibration); `spread` (UnfoldingSpread) scales the bound of an O(1)
   // answer when the index has spread bounds.
   double BoundOf(AnswerKind kind, bool vertex_pair, double d, double spread = 0) const;
-  // UnfoldingSpread of lifted points.
-  double LiftedSpread(const LiftedPoint& p, const LiftedPoint& q) const;
+  // UnfoldingSpread of lifted points; `unfolded`, when given, is
+  // LiftedDistance(p, q), one of the two orders.
+  double LiftedSpread(const LiftedPoint& p, const LiftedPoint& q,
+                      std::optional<double> unfolded = std::nullopt) const;
   // InvalidArgument for a bad tolerance; FailedPrecondition for a bound or a
   // tolerance without calibration.
   absl::Status CheckOptions(const DistanceOptions& options, bool bounds) const;

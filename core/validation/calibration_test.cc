@@ -102,6 +102,19 @@ TEST(CalibrationTest, SpreadBoundsAreTighterWhereTheyCoverAsWell) {
     constant_bounds.push_back(b2);
   }
   ASSERT_GT(spread_bounds.size(), 500u);
+  // The batch gives every pair the same answer and bound as one at a time.
+  std::vector<mesh::SurfacePoint> from, to;
+  for (const ExactPair& pair : pairs) {
+    from.push_back(pair.p);
+    to.push_back(pair.q);
+  }
+  std::vector<double> out(pairs.size()), bounds(pairs.size());
+  ASSERT_TRUE((*spread)->DistanceBatch(from, to, out, {}, nullptr, bounds).ok());
+  for (size_t k = 0; k < pairs.size(); ++k) {
+    double bound = -1;
+    EXPECT_EQ(*(*spread)->Distance(from[k], to[k], {}, nullptr, &bound), out[k]);
+    EXPECT_EQ(bound, bounds[k]);
+  }
   const double n = static_cast<double>(spread_bounds.size());
   EXPECT_GT(spread_covered, 0.97 * n);
   EXPECT_GT(constant_covered, 0.97 * n);
