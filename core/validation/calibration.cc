@@ -76,14 +76,16 @@ void FitSpreadBounds(const std::vector<SpreadSample> (&samples)[index::kAccuracy
   for (int b = 0; b < index::kAccuracyBins; ++b) {
     epsilon[b] = 0;
     factor[b] = 0;
-    if (samples[b].empty()) continue;
     double best_median = std::numeric_limits<double>::infinity();
     for (int e = -12; e <= -4; ++e) {
       const double eps = std::ldexp(1.0, e);
       std::vector<double> ratio, bound;
       for (const SpreadSample& x : samples[b]) {
-        ratio.push_back(x.error / (x.spread + eps * x.distance));
+        // An answer of 0 (two points lifted onto each other) has no scale.
+        if (x.spread + eps * x.distance > 0)
+          ratio.push_back(x.error / (x.spread + eps * x.distance));
       }
+      if (ratio.empty()) break;
       const double k = Quantile(ratio, quantile);
       for (const SpreadSample& x : samples[b]) bound.push_back(k * (x.spread + eps * x.distance));
       const double median = Quantile(bound, 0.5);
