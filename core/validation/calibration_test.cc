@@ -12,9 +12,10 @@
 namespace geodex::validation {
 namespace {
 
-index::IndexData BuildSphere(const mesh::Mesh& m) {
+// The index of `m` with `samples` samples.
+index::IndexData IndexDataOf(const mesh::Mesh& m, int32_t samples = 80) {
   builder::BuildOptions options;
-  options.num_samples = 80;
+  options.num_samples = samples;
   options.threads = 2;
   builder::BuildSummary summary;
   auto data = builder::BuildIndex(m, options, &summary);
@@ -24,7 +25,7 @@ index::IndexData BuildSphere(const mesh::Mesh& m) {
 
 TEST(CalibrationTest, BoundsAreSaneAndDeterministic) {
   const mesh::Mesh m = mesh::gen::Sphere(4, 1.0);
-  index::IndexData data = BuildSphere(m);
+  index::IndexData data = IndexDataOf(m);
   ASSERT_TRUE(AddCalibration(m, data).ok());
   ASSERT_EQ(data.accuracy.size(), 1u);
   const index::AccuracyRecord& r = data.accuracy[0];
@@ -39,14 +40,14 @@ TEST(CalibrationTest, BoundsAreSaneAndDeterministic) {
   EXPECT_GT(r.unfold_bound[1][5], 0);
   EXPECT_LT(r.unfold_bound[1][5], 0.5);
   // The same input gives the same record (threads do not matter: one pass).
-  index::IndexData again = BuildSphere(m);
+  index::IndexData again = IndexDataOf(m);
   ASSERT_TRUE(AddCalibration(m, again).ok());
   EXPECT_EQ(std::memcmp(&again.accuracy[0], &r, sizeof(r)), 0);
 }
 
 TEST(CalibrationTest, BoundsCoverHeldOutPairsOfAnotherSeed) {
   const mesh::Mesh m = mesh::gen::Sphere(4, 1.0);
-  index::IndexData data = BuildSphere(m);
+  index::IndexData data = IndexDataOf(m);
   ASSERT_TRUE(AddCalibration(m, data).ok());
   auto index = index::Index::FromBytes(*index::SerializeIndex(data));
   ASSERT_TRUE(index.ok());
@@ -66,23 +67,18 @@ TEST(CalibrationTest, SpreadBoundsAreTighterWhereTheyCoverAsWell) {
   // On a torus (curved both ways), the per-pair bounds of O(1) answers beyond
   // 3L cover as the constant ones do, with a smaller median bound.
   const mesh::Mesh m = mesh::gen::Torus(64, 32, 2.0, 0.7);
-  builder::BuildOptions options;
-  options.num_samples = 150;
-  options.threads = 2;
-  builder::BuildSummary summary;
-  auto data = builder::BuildIndex(m, options, &summary);
-  ASSERT_TRUE(data.ok()) << data.status();
-  ASSERT_TRUE(AddCalibration(m, *data).ok());
-  ASSERT_EQ(data->spread_bounds.size(), 1u);
+  index::IndexData data = IndexDataOf(m, 150);
+  ASSERT_TRUE(AddCalibration(m, data).ok());
+  ASSERT_EQ(data.spread_bounds.size(), 1u);
   for (int k = 0; k < 2; ++k) {
     for (int b = 0; b < index::kAccuracyBins; ++b) {
-      EXPECT_GT(data->spread_bounds[0].factor[k][b], 0) << k << " " << b;
-      EXPECT_GT(data->spread_bounds[0].epsilon[k][b], 0) << k << " " << b;
+      EXPECT_GT(data.spread_bounds[0].factor[k][b], 0) << k << " " << b;
+      EXPECT_GT(data.spread_bounds[0].epsilon[k][b], 0) << k << " " << b;
     }
   }
-  auto spread_index = index::Index::FromBytes(*index::SerializeIndex(*data));
-  data->spread_bounds.clear();
-  auto constant_index = index::Index::FromBytes(*index::SerializeIndex(*data));
+  auto spread_index = index::Index::FromBytes(*index::SerializeIndex(data));
+  data.spread_bounds.clear();
+  auto constant_index = index::Index::FromBytes(*index::SerializeIndex(data));
   ASSERT_TRUE(spread_index.ok() && constant_index.ok());
   auto spread = query::QueryEngine::Create(*spread_index);
   auto constant = query::QueryEngine::Create(*constant_index);
@@ -157,7 +153,7 @@ TEST(CalibrationTest, PairsDoNotDependOnTheThreadCount) {
 
 TEST(CalibrationTest, RefusesAnIndexOfAnotherMesh) {
   const mesh::Mesh m = mesh::gen::Sphere(4, 1.0);
-  index::IndexData data = BuildSphere(m);
+  index::IndexData data = IndexDataOf(m);
   auto index = index::Index::FromBytes(*index::SerializeIndex(data));
   ASSERT_TRUE(index.ok());
   EXPECT_EQ(Calibrate(mesh::gen::Sphere(3, 1.0), *index).status().code(),
