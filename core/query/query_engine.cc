@@ -540,12 +540,12 @@ double QueryEngine::Refine(const SurfacePoint& p_in, const SurfacePoint& q_in,
   AnswerKind kind = AnswerKind::kUnfold;
   // The bound of an answer; the spread of an O(1) answer is computed once,
   // when first needed.
-  double spread = -1;
+  std::optional<double> spread;
   auto bound_of = [&](AnswerKind k, double at) {
-    if (k == AnswerKind::kUnfold && spread < 0) {
+    if (k == AnswerKind::kUnfold && !spread) {
       spread = index_->spread_bounds() != nullptr ? LiftedSpread(lp, lq, unfolded) : 0;
     }
-    return BoundOf(k, vertex_pair, at, std::max(spread, 0.0));
+    return BoundOf(k, vertex_pair, at, spread.value_or(0));
   };
   auto trace = [&] {
     const std::optional<Trace> t = PathNearDistance(from, to);
