@@ -4,6 +4,7 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <optional>
 
 #include "absl/container/inlined_vector.h"
 #include "core/geometry/unfolding.h"
@@ -48,6 +49,8 @@ class Straightener {
       if (!(shorter < length * (1 - 1e-14))) break;
       path = std::move(straight);
       length = shorter;
+      // Without vertex points to release, another pass builds the same strip.
+      if (!HasInteriorVertexPoint(path)) break;
     }
     return path;
   }
@@ -84,6 +87,13 @@ class Straightener {
       }
     }
     return -1;
+  }
+  static bool HasInteriorVertexPoint(const std::vector<PathPoint>& path) {
+    for (size_t i = 1; i + 1 < path.size(); ++i) {
+      const std::array<double, 3>& w = path[i].point.w;
+      if (w[0] == 1 || w[1] == 1 || w[2] == 1) return true;
+    }
+    return false;
   }
   static double Length(const std::vector<PathPoint>& path) {
     double length = 0;
@@ -413,10 +423,37 @@ class Straightener {
     return true;
   }
 
+ public:
+  // The length of the straight path through the strip of faces `run`
+  // crosses; nullopt when the funnel wraps round a strip vertex or the run
+  // is not a proper strip.
+  std::optional<double> StraightLength(const std::vector<PathPoint>& run) const {
+    const size_t k = run.size();
+    if (k < 3) return k == 2 ? std::optional((run[1].position - run[0].position).norm()) : std::nullopt;
+    Small<Support> support(k);
+    for (size_t i = 0; i < k; ++i) support[i] = SupportOf(run[i].point);
+    Small<int32_t> seg(k - 1, -1);
+    if (!SegmentFaces(run, support, &seg)) return std::nullopt;
+    Small<int32_t> strip = {seg[0]};
+    Small<std::array<int32_t, 2>> edges;
+    if (!BuildStrip(support, seg, &strip, &edges)) return std::nullopt;
+    Small<Portal> portals;
+    Vec2 start, end;
+    if (!UnfoldStrip(strip, edges, support, &portals, &start, &end)) return std::nullopt;
+    if (Funnel(portals, start).size() != 2) return std::nullopt;
+    const Vec2 d = end - start;
+    return std::sqrt(d.x * d.x + d.y * d.y);
+  }
+
+ private:
   const MeshView& mesh_;
 };
 
 }  // namespace
+
+std::optional<double> StraightLength(const MeshView& mesh, const std::vector<PathPoint>& path) {
+  return Straightener(mesh).StraightLength(path);
+}
 
 std::vector<PathPoint> StraightenPath(const MeshView& mesh, std::vector<PathPoint> path) {
   return Straightener(mesh).Run(std::move(path));

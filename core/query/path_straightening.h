@@ -15,6 +15,7 @@
 // Thread safety: reentrant.
 
 #include <cstdint>
+#include <optional>
 #include <span>
 #include <vector>
 
@@ -27,5 +28,10 @@ namespace geodex::query {
 // input points must share a face (as QueryEngine::Path produces); runs that
 // do not are returned unchanged.
 std::vector<PathPoint> StraightenPath(const MeshView& mesh, std::vector<PathPoint> path);
+
+// The length StraightenPath gives when the straightened path is one straight
+// segment through the strip (it wraps round no vertex), without building
+// it; nullopt otherwise (then StraightenPath may still shorten the path).
+std::optional<double> StraightLength(const MeshView& mesh, const std::vector<PathPoint>& path);
 
 }  // namespace geodex::query

@@ -391,6 +391,36 @@ TEST(QueryEngineTest, StraightenedPathsAreExactOnDevelopableSurfaces) {
   }
 }
 
+// The pairs the default mode refines get the length of a straight path
+// through the faces between them (the walk of the chord, or the trace), exact
+// to double precision on developable surfaces: across a sharp fold, round a
+// half cylinder, and from vertices (the O(1) answer is exact only to float
+// precision there, so it would not pass).
+TEST(QueryEngineTest, RefinedNearPairsAreExactOnDevelopableSurfaces) {
+  for (const Mesh& m : {gen::FoldedSheet(24, 16, 2.0, 1.0, 2.5), HalfCylinder(24, 16, 1.0, 3.0)}) {
+    SCOPED_TRACE(m.name());
+    auto engine = MakeEngine(m, 60);
+    const DistanceOptions unfold{.near_pairs = NearPairs::kUnfold};
+    auto points = RandomPoints(m, 1200, 5);
+    // Pairs of vertices, a vertex and an interior point, interior points.
+    for (size_t i = 0; i + 1 < points.size(); i += 2) {
+      if ((i / 2) % 3 < 2) points[i].w = {1, 0, 0};
+      if ((i / 2) % 3 < 1) points[i + 1].w = {0, 1, 0};
+    }
+    int refined = 0;
+    for (size_t i = 0; i + 1 < points.size(); i += 2) {
+      const SurfacePoint& p = points[i];
+      const SurfacePoint& q = points[i + 1];
+      if (*engine->Distance(p, q, unfold) >= engine->refine_below()) continue;
+      ++refined;
+      const double exact = Exact(m, p, q);
+      EXPECT_NEAR(*engine->Distance(p, q), exact, 1e-9 * (1 + exact)) << "pair " << i;
+      EXPECT_EQ(*engine->Distance(p, q), *engine->Distance(q, p));
+    }
+    EXPECT_GT(refined, 20);
+  }
+}
+
 // The approximate field of a coarse index has local minima and flats; path
 // tracing must still always arrive, on the surface.
 TEST(QueryEngineTest, ExactCorridorPathsAreExactWhereTheTraceIsNot) {

@@ -197,6 +197,7 @@ void BenchRefinement(const std::string& label, std::shared_ptr<const index::Inde
     return;
   }
   auto engine = *query::QueryEngine::Create(ix);
+  auto traces_only = *query::QueryEngine::Create(ix, {.walk_near_pairs = false});
   const double scale = engine->scale_length();
   const auto a = InteriorPoints(*ix, n, 1), b = InteriorPoints(*ix, n, 2);
   // Pairs at every scale: uniform pairs, and pairs of faces close in the
@@ -229,8 +230,10 @@ void BenchRefinement(const std::string& label, std::shared_ptr<const index::Inde
         BatchRate(*engine, x, y, {.near_pairs = query::NearPairs::kUnfold}, false, all);
     const double bounds = BatchRate(*engine, x, y, {}, true, all);
     const double tolerance = BatchRate(*engine, x, y, {.tolerance = 0.005}, true, 300);
-    std::printf("| %s | %s | %zu | %.3fM | %.3fM | %.2f | %.3fM | %.4fM |\n", label.c_str(), name,
-                all, def / 1e6, pure / 1e6, def / pure, bounds / 1e6, tolerance / 1e6);
+    const double traced = BatchRate(*traces_only, x, y, {}, false, all);
+    std::printf("| %s | %s | %zu | %.3fM | %.3fM | %.2f | %.3fM | %.4fM | %.3fM | %.2f |\n",
+                label.c_str(), name, all, def / 1e6, pure / 1e6, def / pure, bounds / 1e6,
+                tolerance / 1e6, traced / 1e6, traced / pure);
   };
   row("uniform", a, b);
   for (int bin = 0; bin < 4; ++bin) row(kNames[bin], bin_a[bin], bin_b[bin]);
@@ -386,7 +389,8 @@ int main(int argc, char** argv) {
   std::printf(
       "\nRefinement (DistanceOptions), batch pairs/s; tolerance: at most 300 pairs, once\n"
       "| index | pairs | count | default/s | pure O(1)/s | default / pure | default + bounds/s | "
-      "tolerance 0.005/s |\n|---|---|---|---|---|---|---|---|\n");
+      "tolerance 0.005/s | default, traces only (no walk)/s | traces only / pure |\n"
+      "|---|---|---|---|---|---|---|---|---|---|\n");
   for (size_t i = 0; i < loaded.size() && !expmap_only; ++i) {
     geodex::BenchRefinement(indexes[i], loaded[i], std::min(pairs, 200'000));
   }
