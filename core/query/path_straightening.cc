@@ -429,7 +429,8 @@ class Straightener {
   // is not a proper strip.
   std::optional<double> StraightLength(const std::vector<PathPoint>& run) const {
     const size_t k = run.size();
-    if (k < 3) return k == 2 ? std::optional((run[1].position - run[0].position).norm()) : std::nullopt;
+    if (k < 3)
+      return k == 2 ? std::optional((run[1].position - run[0].position).norm()) : std::nullopt;
     Small<Support> support(k);
     for (size_t i = 0; i < k; ++i) support[i] = SupportOf(run[i].point);
     Small<int32_t> seg(k - 1, -1);

@@ -548,7 +548,11 @@ double QueryEngine::Refine(const SurfacePoint& p_in, const SurfacePoint& q_in,
     return BoundOf(k, vertex_pair, at, spread.value_or(0));
   };
   auto trace = [&] {
-    const std::optional<Trace> t = PathNearDistance(from, to);
+    // The O(1) answer plus its bound: a straight walk longer than that is
+    // doubted (NaN without calibration: none is).
+    const double plausible = unfolded + bound_of(AnswerKind::kUnfold, unfolded);
+    const std::optional<Trace> t =
+        PathNearDistance(from, to, std::isnan(plausible) ? kInf : plausible);
     if (!t) return false;
     d = t->length;
     kind = t->wraps ? AnswerKind::kWrappedTrace : AnswerKind::kTrace;

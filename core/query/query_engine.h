@@ -38,6 +38,7 @@
 
 #include <array>
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -376,7 +377,12 @@ class QueryEngine {
     double length;
     bool wraps;
   };
-  std::optional<Trace> PathNearDistance(const SurfacePoint& from, const SurfacePoint& to) const;
+  // A walk's straight path longer than `plausible` is doubted (it may run in
+  // a wrong corridor that wraps round nothing) and only kept if nothing
+  // shorter is found.
+  std::optional<Trace> PathNearDistance(
+      const SurfacePoint& from, const SurfacePoint& to,
+      double plausible = std::numeric_limits<double>::infinity()) const;
   // The exact shortest path from `from` to `to` among the faces within
   // `steps` edge steps of the faces `path` crosses, or an error (e.g. when
   // that corridor is not a manifold mesh).

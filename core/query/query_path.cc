@@ -551,28 +551,31 @@ absl::StatusOr<std::vector<PathPoint>> QueryEngine::ShortestTrace(const SurfaceP
 }
 
 std::optional<QueryEngine::Trace> QueryEngine::PathNearDistance(const SurfacePoint& from,
-                                                                const SurfacePoint& to) const {
+                                                                const SurfacePoint& to,
+                                                                double plausible) const {
   // First the corridors of the chord, from either end. A straightened walk
   // that wraps round no vertex is a straight line through the faces it
   // crosses, a local geodesic, as the straightened trace would be, found
   // without evaluating the distance field, so at a fraction of the trace's
-  // cost.
-  // Walks that wrap are often in a wrong corridor, so the trace decides;
-  // every candidate is a surface path, so the shortest is kept (figures:
-  // tests/bench/README.md).
+  // cost. Walks that wrap are often in a wrong corridor, and so, rarely, is
+  // a straight one longer than `plausible` (across a sharp feature); then
+  // the trace decides. Every candidate is a surface path, so the shortest is
+  // kept (figures: tests/bench/README.md).
   constexpr int kMaxWalkSteps = 256;
   const PathPoint ends[2] = {{from, PositionOf(from)}, {to, PositionOf(to)}};
-  std::optional<double> wrapped;
+  std::optional<double> doubted;
   std::vector<PathPoint> walk;
   for (int start = 0; start < (options_.walk_near_pairs ? 2 : 0); ++start) {
     if (!WalkCorridor(view_, ends[start], ends[1 - start], kMaxWalkSteps, &walk)) continue;
-    if (const std::optional<double> straight = StraightLength(view_, walk)) {
-      return Trace{*straight, false};
+    std::optional<double> length = StraightLength(view_, walk);
+    bool wraps = false;
+    if (!length) {
+      walk = StraightenPath(view_, std::move(walk));
+      length = PathLength(walk);
+      wraps = WrapsRoundAVertex(walk);
     }
-    walk = StraightenPath(view_, std::move(walk));
-    const double length = PathLength(walk);
-    if (!WrapsRoundAVertex(walk)) return Trace{length, false};
-    wrapped = std::min(length, wrapped.value_or(length));
+    if (!wraps && *length <= plausible) return Trace{*length, false};
+    doubted = std::min(*length, doubted.value_or(*length));
   }
   // Without Path's restarts, which double the cost of a near pair for a
   // small gain (tests/bench/README.md).
@@ -580,9 +583,9 @@ std::optional<QueryEngine::Trace> QueryEngine::PathNearDistance(const SurfacePoi
       ShortestTrace(from, to, TraceSearch::kNearPair);
   if (path.ok()) {
     const double length = PathLength(*path);
-    if (!wrapped || length <= *wrapped) return Trace{length, WrapsRoundAVertex(*path)};
+    if (!doubted || length <= *doubted) return Trace{length, WrapsRoundAVertex(*path)};
   }
-  if (wrapped) return Trace{*wrapped, true};
+  if (doubted) return Trace{*doubted, true};
   return std::nullopt;
 }
 

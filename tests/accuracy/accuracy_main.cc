@@ -108,10 +108,13 @@ absl::StatusOr<std::vector<double>> PlacementWeights(const Flags& flags, const m
 absl::Status Measure(const Flags& flags, const std::string& label,
                      const std::vector<validation::ExactPair>& pairs,
                      std::shared_ptr<const index::Index> index) {
-  GEODEX_ASSIGN_OR_RETURN(auto engine, query::QueryEngine::Create(index));
+  GEODEX_ASSIGN_OR_RETURN(auto walking, query::QueryEngine::Create(index));
+  GEODEX_ASSIGN_OR_RETURN(auto tracing,
+                          query::QueryEngine::Create(index, {.walk_near_pairs = false}));
   for (const std::string& mode : flags.modes) {
     query::DistanceOptions options;
     bool bounds = false;
+    const auto& engine = mode == "nowalk" ? tracing : walking;
     if (mode == "unfold") {
       options.near_pairs = query::NearPairs::kUnfold;
     } else if (mode == "exact") {
@@ -121,7 +124,7 @@ absl::Status Measure(const Flags& flags, const std::string& label,
     } else if (mode.rfind("tol", 0) == 0) {
       options.tolerance = std::stod(mode.substr(3));
       bounds = true;
-    } else if (mode != "default" && mode != "trace") {
+    } else if (mode != "default" && mode != "trace" && mode != "nowalk") {
       return absl::InvalidArgumentError("unknown mode " + mode);
     }
     query::QueryScratch scratch;
@@ -202,9 +205,11 @@ int main(int argc, char** argv) {
                "Also build each m with error-driven placement (spacing weights from the "
                "farthest-point index's error map) and measure it on the same pairs");
   app.add_option("--threads", flags.threads, "Builder and exact-propagation threads (0: all)");
-  app.add_option("--modes", flags.modes,
-                 "Answer modes: unfold (pure O(1)), default, exact (near pairs exactly), bounds "
-                 "(default with error bounds), tolX (tolerance X, e.g. tol0.005), trace")
+  app.add_option(
+         "--modes", flags.modes,
+         "Answer modes: unfold (pure O(1)), default, exact (near pairs exactly), bounds "
+         "(default with error bounds), tolX (tolerance X, e.g. tol0.005), trace, nowalk (default "
+         "without the walks of near pairs: the trace only)")
       ->delimiter(',');
   CLI11_PARSE(app, argc, argv);
   const absl::Status status = geodex::Run(flags);
