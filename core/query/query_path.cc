@@ -242,6 +242,16 @@ int32_t LowestVertex(Tracer& tr, const MeshView& view, int32_t f) {
   return view.faces[3 * f + k];
 }
 
+// Barycentric weights `w` of a point on the edge of a face opposite its
+// corner `exit`, re-expressed in the face across that edge, whose half-edge
+// g (3 * face + corner) is the twin of the edge's.
+std::array<double, 3> AcrossEdge(int32_t g, int exit, const std::array<double, 3>& w) {
+  std::array<double, 3> next = {0, 0, 0};
+  next[g % 3] = w[(exit + 2) % 3];            // Origin(g) = Dest(h)
+  next[(g % 3 + 1) % 3] = w[(exit + 1) % 3];  // Dest(g) = Origin(h)
+  return next;
+}
+
 // TracePath's step inside face *f from barycentric position *b: along the
 // descent to the face's boundary, then across the edge it reaches into the
 // next face (*f and *b move there), or onto a vertex (*at_vertex: the face's
@@ -281,11 +291,8 @@ void FaceStep(Tracer& tr, const MeshView& view, int32_t* f, std::array<double, 3
     path->push_back(vertex_point(*f, *at_vertex));
     return;
   }
-  std::array<double, 3> next = {0, 0, 0};
-  next[g % 3] = w[(exit + 2) % 3];            // Origin(g) = Dest(h)
-  next[(g % 3 + 1) % 3] = w[(exit + 1) % 3];  // Dest(g) = Origin(h)
   *f = g / 3;
-  w = next;
+  w = AcrossEdge(g, exit, w);
 }
 
 // The barycentric velocity (sum 0) of moving along `dir` in face f.
@@ -379,11 +386,8 @@ bool WalkCorridor(const MeshView& view, const PathPoint& from, const PathPoint& 
     path->push_back({SurfacePoint{f, w}, x});
     const int32_t g = view.twins[3 * f + (exit + 1) % 3];  // the edge opposite `exit`
     if (g < 0) return false;
-    std::array<double, 3> next = {0, 0, 0};
-    next[g % 3] = w[(exit + 2) % 3];            // Origin(g) = Dest(h)
-    next[(g % 3 + 1) % 3] = w[(exit + 1) % 3];  // Dest(g) = Origin(h)
     f = g / 3;
-    w = next;
+    w = AcrossEdge(g, exit, w);
   }
   return false;
 }
