@@ -1,6 +1,6 @@
 #pragma once
 
-// Mesh repair (issue #18, item 5): what can be repaired of a broken triangle
+// Mesh repair: what can be repaired of a broken triangle
 // soup without changing the surface, each repair counted, with the maps back
 // to the input's ids.
 //

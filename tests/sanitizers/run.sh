@@ -16,7 +16,7 @@
 # still checks every access our code makes; TSan cannot see the
 # synchronisation inside gRPC: races reported from within those libraries are
 # suppressed by library (tests/sanitizers/tsan.supp), which does not yet
-# silence all of them (see the README, "Sanitizers"); LeakSanitizer ignores
+# silence all of them (see tests/README.md, "Sanitizers"); LeakSanitizer ignores
 # what they never free (lsan.supp). Nothing of geodex's is suppressed.
 #
 #   tests/sanitizers/run.sh [--asan] [--tsan] [--ci] [--jobs N]   (default: --asan --tsan)
@@ -105,7 +105,7 @@ if [[ $tsan -eq 1 ]]; then
   fi
   # The gRPC tests (streams, reload, shutdown, limits): TSan cannot see the
   # synchronisation inside Debian's uninstrumented gRPC, so its reports are
-  # counted, not judged (README, "Sanitizers"); a test failure still fails.
+  # counted, not judged (tests/README.md, "Sanitizers"); a test failure still fails.
   export TSAN_OPTIONS="halt_on_error=0:report_signal_unsafe=0:suppressions=$repo/tests/sanitizers/tsan.supp"
   filter='*Stream*:*Reload*:*Swap*:*Shutdown*:*Drain*:*Concurrent*:*Cancel*:*Limit*'
   start=$(date +%s)
