@@ -1,28 +1,45 @@
 #!/usr/bin/env bash
-# Offline checks of deploy/: renders every kustomize overlay with
-# `kubectl kustomize`, validates the objects against the Kubernetes schemas
-# and the deployment's own rules (validate/validate.mjs), shellchecks the
-# inline `sh -c` scripts of the Jobs, and shellchecks every script in deploy/
-# and tests/. No cluster and no network needed.
+# Offline checks of deploy/: shellchecks every script in deploy/ and tests/,
+# renders every kustomize overlay with `kubectl kustomize`, validates the
+# objects against the Kubernetes schemas and the deployment's own rules
+# (validate/validate.mjs), and shellchecks the inline `sh -c` scripts of the
+# Jobs. No cluster and no network needed.
 #
 #   deploy/k8s/check.sh
 #
-# Needs kubectl (for kustomize), node, shellcheck, and the validator's npm
-# packages (deploy/install-deps.sh installs them into deploy/k8s/validate).
-# Exit codes: 0 all good; 1 a check failed; 77 kubectl is not installed
-# (ctest reports the test as skipped: Debian 12 has no kubectl recent enough).
+# Needs shellcheck, and for the manifests kubectl (for kustomize), node and
+# the validator's npm packages (deploy/install-deps.sh installs them into
+# deploy/k8s/validate). Exit codes: 0 all good; 1 a check failed; 77 the
+# scripts are shellcheck-clean but kubectl is not installed, so the manifests
+# were not checked (ctest reports the test as skipped: Debian 12 has no
+# kubectl recent enough).
 set -euo pipefail
 
 HERE="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
 ROOT="$(cd "$HERE/../.." && pwd)"
 die() { echo "k8s-check: FAILED: $*" >&2; exit 1; }
 
+# --- shellcheck of the scripts (needs no kubectl) -----------------------------------
+command -v shellcheck > /dev/null || die "no shellcheck: run deploy/install-deps.sh"
+mapfile -t deploy_scripts < <(find "$ROOT/deploy" -name '*.sh' -not -path '*/node_modules/*' | sort)
+shellcheck "${deploy_scripts[@]}" || die "shellcheck of deploy/ (above)"
+# tests/ is not deploy's: its scripts are held to warnings and errors, and
+# the finding below is known (intended word splitting of a target list).
+# Remove the entry once the script carries its own `# shellcheck disable`.
+declare -A KNOWN=([tests/fuzz/run_fuzzers.sh]=SC2046)
+mapfile -t test_scripts < <(cd "$ROOT" && find tests -name '*.sh' | sort)
+for s in "${test_scripts[@]}"; do
+  excludes=()
+  [ -n "${KNOWN[$s]:-}" ] && excludes=(-e "${KNOWN[$s]}")
+  (cd "$ROOT" && shellcheck -S warning "${excludes[@]}" "$s") || die "shellcheck of $s (above)"
+done
+echo "k8s-check: shellcheck clean: ${#deploy_scripts[@]} scripts in deploy/, ${#test_scripts[@]} in tests/"
+
 if ! command -v kubectl > /dev/null; then
-  echo "k8s-check: SKIPPED: no kubectl (kustomize renders the overlays)"
+  echo "k8s-check: SKIPPED the manifests (render, schemas, rules, the Jobs' inline scripts): no kubectl"
   exit 77
 fi
 command -v node > /dev/null || die "no node: run deploy/install-deps.sh"
-command -v shellcheck > /dev/null || die "no shellcheck: run deploy/install-deps.sh"
 [ -d "$HERE/validate/node_modules/kubernetes-models" ] ||
   die "the validator's packages are not installed: run deploy/install-deps.sh"
 
@@ -62,19 +79,7 @@ for want in "must be integer" "allowed values" "needs restartPolicy Never" "!= c
 done
 echo "k8s-check: the validator rejects a broken render ($(grep -c '^FAIL' "$WORK/broken.out") problems found)"
 
-# --- shellcheck ------------------------------------------------------------------
+# --- shellcheck of the Jobs' inline scripts ------------------------------------------
 shellcheck -s sh "$WORK"/scripts/*.sh || die "shellcheck of the Jobs' inline scripts (above)"
-mapfile -t deploy_scripts < <(find "$ROOT/deploy" -name '*.sh' -not -path '*/node_modules/*' | sort)
-shellcheck "${deploy_scripts[@]}" || die "shellcheck of deploy/ (above)"
-# tests/ is not deploy's: its scripts are held to warnings and errors, and
-# the finding below is known (intended word splitting of a target list).
-# Remove the entry once the script carries its own `# shellcheck disable`.
-declare -A KNOWN=([tests/fuzz/run_fuzzers.sh]=SC2046)
-mapfile -t test_scripts < <(cd "$ROOT" && find tests -name '*.sh' | sort)
-for s in "${test_scripts[@]}"; do
-  excludes=()
-  [ -n "${KNOWN[$s]:-}" ] && excludes=(-e "${KNOWN[$s]}")
-  (cd "$ROOT" && shellcheck -S warning "${excludes[@]}" "$s") || die "shellcheck of $s (above)"
-done
-echo "k8s-check: shellcheck clean: ${#deploy_scripts[@]} scripts in deploy/, ${#test_scripts[@]} in tests/, $(find "$WORK/scripts" -name '*.sh' | wc -l) inline Job scripts"
+echo "k8s-check: shellcheck clean: $(find "$WORK/scripts" -name '*.sh' | wc -l) inline Job scripts"
 echo "k8s-check: PASSED"
