@@ -30,6 +30,9 @@ BUILD_PACKAGES=(
   prometheus-cpp-dev
   libcpp-httplib-dev  # the HTTP server of `geodex web`
   libjs-three         # three.js for the web viewer, copied into the build and install trees
+  # The Python package geodex: its stubs (grpc_tools), the in-process module
+  # (pybind11, python3-dev) and what it imports at run time.
+  python3-dev pybind11-dev python3-numpy python3-grpcio python3-grpc-tools python3-protobuf
 )
 # Tests, benchmarks, reference cross-checks and tooling.
 DEV_PACKAGES=(
@@ -39,6 +42,7 @@ DEV_PACKAGES=(
   clang-format
   clang libclang-rt-14-dev  # the libFuzzer targets (tests/fuzz)
   openssl  # server tests generate TLS certificates with it
+  python3-pytest  # the Python package's tests (client/python/tests)
   shellcheck  # deploy/k8s/check.sh lints every script in deploy/ and tests/
   chromium chromium-driver python3-selenium  # the web viewer's browser test
 )

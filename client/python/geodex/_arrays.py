@@ -1,0 +1,285 @@
+"""Arrays at the package's boundary: the point, position and mesh types, and
+their validation.
+
+Everything a caller passes is checked here, before anything is sent or
+computed, with vectorised numpy (no per-element Python loop). What only the
+index can judge (a face id past the model's face count, weights that do not
+sum to 1 within the engine's tolerance) is left to it; what no index could
+accept (a wrong shape, NaN, a negative face id) is refused here with
+:class:`geodex.InvalidArgument`, naming the array and the index of the first
+bad element.
+"""
+
+from __future__ import annotations
+
+import os
+from typing import Any, NamedTuple, Optional, Tuple, Union
+
+import numpy as np
+
+from .errors import InvalidArgument, OutOfRange
+
+__all__ = [
+    "SurfacePoints",
+    "Located",
+    "Path",
+    "as_points",
+    "as_positions",
+    "as_mesh",
+    "as_near_pairs",
+    "is_pathlike",
+]
+
+_INT32_MAX = 2**31 - 1
+
+
+class SurfacePoints(NamedTuple):
+    """Points on a mesh: point i lies in face ``faces[i]`` with barycentric
+    weights ``weights[i]`` of that face's three vertices (in the mesh file's
+    order; polygons fan-triangulated in order).
+
+    Attributes
+    ----------
+    faces : numpy.ndarray
+        (N,) int32 face ids, as in the mesh file the index was built from.
+    weights : numpy.ndarray
+        (N, 3) float64 barycentric weights, each row >= 0 and summing to 1.
+    """
+
+    faces: np.ndarray
+    weights: np.ndarray
+
+
+class Located(NamedTuple):
+    """The closest surface points of 3D positions (``locate``): usable
+    wherever points are (its ``faces`` and ``weights``).
+
+    Attributes
+    ----------
+    faces : numpy.ndarray
+        (N,) int32 face ids.
+    weights : numpy.ndarray
+        (N, 3) float64 barycentric weights.
+    distances : numpy.ndarray
+        (N,) float64 Euclidean distance from each position to its point.
+    """
+
+    faces: np.ndarray
+    weights: np.ndarray
+    distances: np.ndarray
+
+
+class Path(NamedTuple):
+    """A geodesic path between two surface points.
+
+    Attributes
+    ----------
+    positions : numpy.ndarray
+        (K, 3) float64 positions along the path, the start first and the end
+        last; consecutive points share a mesh face.
+    faces : numpy.ndarray
+        (K,) int32 the face of each point (the mesh file's ids).
+    weights : numpy.ndarray
+        (K, 3) float64 the barycentric weights of each point in its face.
+    length : float
+        The sum of the path's 3D segments; ``inf`` (and K = 0) when the two
+        points lie on different connected components.
+    """
+
+    positions: np.ndarray
+    faces: np.ndarray
+    weights: np.ndarray
+    length: float
+
+
+PointsLike = Union[SurfacePoints, Located, Tuple[Any, Any], Any]
+
+
+def _first(mask: np.ndarray) -> int:
+    """The index of the first True of a 1-D mask (which has one)."""
+    return int(np.argmax(mask))
+
+
+def as_points(points: PointsLike, name: str) -> SurfacePoints:
+    """Validates surface points and returns them as C-contiguous arrays.
+
+    Parameters
+    ----------
+    points : tuple or object
+        ``(faces, weights)``: faces an integer array of shape (N,) and weights
+        a float array of shape (N, 3); or anything with ``.faces`` and
+        ``.weights`` (a :class:`SurfacePoints`, a :class:`Located`). A single
+        point may be given as ``(face, (w0, w1, w2))``.
+    name : str
+        How error messages name the points ("a", "sources", ...).
+
+    Returns
+    -------
+    SurfacePoints
+        faces (N,) int32 and weights (N, 3) float64.
+
+    Raises
+    ------
+    InvalidArgument
+        A wrong shape or type, a negative face id, a weight that is NaN or
+        infinite; the message names the array and the first bad index.
+    OutOfRange
+        A face id beyond int32 (no mesh has that many faces).
+    """
+    if hasattr(points, "faces") and hasattr(points, "weights"):
+        faces, weights = points.faces, points.weights
+    elif isinstance(points, (tuple, list)) and len(points) == 2:
+        faces, weights = points
+    else:
+        raise InvalidArgument(
+            f"{name}: want (faces, weights) arrays or an object with .faces and .weights, "
+            f"got {type(points).__name__}"
+        )
+    faces = np.asarray(faces)
+    try:
+        weights = np.asarray(weights, dtype=np.float64)
+    except (TypeError, ValueError) as e:
+        raise InvalidArgument(f"{name}.weights: not a float array ({e})") from None
+    if faces.ndim == 0 and weights.shape == (3,):  # one point
+        faces, weights = faces.reshape(1), weights.reshape(1, 3)
+    if faces.ndim != 1:
+        raise InvalidArgument(f"{name}.faces has shape {faces.shape}, want (N,)")
+    n = faces.shape[0]
+    if n > 0 and not (np.issubdtype(faces.dtype, np.integer) and faces.dtype != np.bool_):
+        raise InvalidArgument(f"{name}.faces must be an integer array, not {faces.dtype}")
+    if weights.shape != (n, 3):
+        raise InvalidArgument(f"{name}.weights has shape {weights.shape}, want ({n}, 3)")
+    if n > 0:
+        negative = faces < 0
+        if negative.any():
+            i = _first(negative)
+            raise InvalidArgument(f"{name}.faces[{i}] is {int(faces[i])}: face ids are >= 0")
+        large = faces > _INT32_MAX
+        if large.any():
+            i = _first(large)
+            raise OutOfRange(f"{name}.faces[{i}] is {int(faces[i])}, past any face id (int32)")
+        bad = ~np.isfinite(weights).all(axis=1)
+        if bad.any():
+            i = _first(bad)
+            raise InvalidArgument(
+                f"{name}.weights[{i}] is {weights[i].tolist()}: weights must be finite"
+            )
+    return SurfacePoints(
+        np.ascontiguousarray(faces, dtype=np.int32), np.ascontiguousarray(weights)
+    )
+
+
+def as_positions(xyz: Any, name: str) -> np.ndarray:
+    """Validates 3D positions: an (N, 3) array of finite floats.
+
+    Returns
+    -------
+    numpy.ndarray
+        (N, 3) float64, C-contiguous. A single position (3,) becomes (1, 3).
+
+    Raises
+    ------
+    InvalidArgument
+        Not a float array of shape (N, 3), or a coordinate that is not
+        finite (naming the first such row).
+    """
+    try:
+        xyz = np.asarray(xyz, dtype=np.float64)
+    except (TypeError, ValueError) as e:
+        raise InvalidArgument(f"{name}: not a float array ({e})") from None
+    if xyz.shape == (3,):
+        xyz = xyz.reshape(1, 3)
+    if xyz.ndim != 2 or xyz.shape[1] != 3:
+        raise InvalidArgument(f"{name} has shape {xyz.shape}, want (N, 3)")
+    bad = ~np.isfinite(xyz).all(axis=1)
+    if bad.any():
+        i = _first(bad)
+        raise InvalidArgument(f"{name}[{i}] is {xyz[i].tolist()}: coordinates must be finite")
+    return np.ascontiguousarray(xyz)
+
+
+def _triangles_from_flat(faces: np.ndarray, name: str) -> np.ndarray:
+    """pyvista's flat face array [3, a, b, c, 3, ...] as (M, 3)."""
+    if faces.size % 4 != 0 or not (faces.reshape(-1, 4)[:, 0] == 3).all():
+        raise InvalidArgument(
+            f"{name}: a flat face array must be [3, a, b, c, 3, ...] (triangles only)"
+        )
+    return faces.reshape(-1, 4)[:, 1:]
+
+
+def as_mesh(mesh: Any, faces: Any = None) -> Tuple[np.ndarray, np.ndarray]:
+    """A triangle mesh as (vertices (V, 3) float64, faces (F, 3) int32).
+
+    Parameters
+    ----------
+    mesh : array or object
+        The vertices, an (V, 3) float array (then ``faces`` is required), or
+        anything with ``.vertices`` (or ``.points``) and ``.faces``: a trimesh
+        Trimesh, a pyvista PolyData of triangles (flat face array), ...
+    faces : array, optional
+        (F, 3) integer vertex ids, 0-based.
+
+    Raises
+    ------
+    InvalidArgument
+        Wrong shapes or types, non-finite coordinates, vertex ids out of
+        [0, V) (naming the first bad face).
+    """
+    if faces is None:
+        vertices = getattr(mesh, "vertices", None)
+        if vertices is None:
+            vertices = getattr(mesh, "points", None)
+        faces = getattr(mesh, "faces", None)
+        if vertices is None or faces is None:
+            raise InvalidArgument(
+                "mesh: want vertices and faces arrays, or an object with .vertices (or "
+                f".points) and .faces, got {type(mesh).__name__}"
+            )
+    else:
+        vertices = mesh
+    vertices = as_positions(vertices, "vertices")
+    faces = np.asarray(faces)
+    if faces.ndim == 1:
+        faces = _triangles_from_flat(faces, "faces")
+    if faces.ndim != 2 or faces.shape[1] != 3:
+        raise InvalidArgument(f"faces has shape {faces.shape}, want (F, 3)")
+    if faces.shape[0] > 0 and not (
+        np.issubdtype(faces.dtype, np.integer) and faces.dtype != np.bool_
+    ):
+        raise InvalidArgument(f"faces must be an integer array, not {faces.dtype}")
+    bad = ((faces < 0) | (faces >= vertices.shape[0])).any(axis=1)
+    if bad.any():
+        i = _first(bad)
+        raise InvalidArgument(
+            f"faces[{i}] is {faces[i].tolist()}: vertex ids must be in [0, {vertices.shape[0]})"
+        )
+    return vertices, np.ascontiguousarray(faces, dtype=np.int32)
+
+
+_NEAR_PAIRS = ("path", "unfold", "exact")
+
+
+def as_near_pairs(near_pairs: Optional[str]) -> Optional[str]:
+    """Validates a near-pair mode: None (the default), "path", "unfold" or
+    "exact" (see geodex.v1.NearPairs)."""
+    if near_pairs is not None and near_pairs not in _NEAR_PAIRS:
+        raise InvalidArgument(
+            f"near_pairs must be one of {', '.join(_NEAR_PAIRS)} or None, not {near_pairs!r}"
+        )
+    return near_pairs
+
+
+def check_tolerance(tolerance: float) -> float:
+    """A relative error tolerance: finite and >= 0 (0: none)."""
+    try:
+        t = float(tolerance)
+    except (TypeError, ValueError):
+        raise InvalidArgument(f"tolerance must be a number, not {tolerance!r}") from None
+    if not (np.isfinite(t) and t >= 0):
+        raise InvalidArgument(f"tolerance must be finite and >= 0, not {t}")
+    return t
+
+
+def is_pathlike(x: Any) -> bool:
+    """True for a str, bytes or os.PathLike (a file name)."""
+    return isinstance(x, (str, bytes, os.PathLike))

@@ -1,0 +1,409 @@
+"""Indexes in this process: :class:`Index` and :func:`build`, over the
+compiled bindings of geodex's core (``geodex._core``, core/python/).
+
+This is the only module of the package that imports ``geodex._core``; the
+rest of the package (the gRPC client) works without it. An Index takes the
+same arguments as the Client's methods, without the model name, and gives
+the same answers to the bit: the server answers with the same engine, in the
+same ids (the mesh file's, also when the builder repaired the mesh).
+"""
+
+from __future__ import annotations
+
+import os
+import sys
+import time
+from typing import Any, Callable, Dict, List, NamedTuple, Optional, Sequence, Tuple, Union
+
+import numpy as np
+
+from ._arrays import (
+    Located,
+    Path,
+    SurfacePoints,
+    as_mesh,
+    as_near_pairs,
+    as_points,
+    as_positions,
+    check_tolerance,
+    is_pathlike,
+)
+from .errors import InvalidArgument
+
+try:
+    from . import _core
+except ImportError as e:  # the package was installed without its compiled part
+    _core = None
+    _core_error: Optional[ImportError] = e
+else:
+    _core_error = None
+
+__all__ = ["Index", "build", "BuildProgress", "has_in_process"]
+
+_NEAR_PAIRS = {None: 0, "path": 1, "unfold": 2, "exact": 3}
+
+
+def has_in_process() -> bool:
+    """True when the compiled module (geodex._core) is installed, so that
+    :class:`Index` and :func:`build` work."""
+    return _core is not None
+
+
+def _require_core() -> Any:
+    if _core is None:
+        raise ImportError(
+            "geodex.Index and geodex.build need the compiled module geodex._core, which "
+            f"this installation lacks ({_core_error}); the client (geodex.connect) works "
+            "without it"
+        )
+    return _core
+
+
+class BuildProgress(NamedTuple):
+    """How far :func:`build` has come: ``done`` of ``total`` steps of
+    ``phase`` ("sampling", "repair", "rows", "merge", "calibration", ...)."""
+
+    phase: str
+    done: int
+    total: int
+
+
+class Index:
+    """An index file, mapped read-only, answering queries in this process.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        A .gdx file (geodex-build, or :func:`build`).
+    threads : int
+        Threads for large batches (``distance``, ``matrix``); 0: one per
+        core. The answers do not depend on it.
+
+    Raises
+    ------
+    NotFound
+        No such file.
+    DataLoss, FailedPrecondition, InvalidArgument
+        A corrupt file, another format version, or not an index.
+
+    Notes
+    -----
+    Thread safety: an Index is immutable; its methods may be called from
+    several threads at once (they release the GIL while they compute).
+    """
+
+    def __init__(self, path: Union[str, "os.PathLike[str]"], *, threads: int = 0) -> None:
+        core = _require_core()
+        if int(threads) < 0:
+            raise InvalidArgument(f"threads must be >= 0, not {threads}")
+        self.path = os.fspath(path)
+        self._index = core.Index(self.path, int(threads))
+
+    def __repr__(self) -> str:
+        return (
+            f"geodex.Index({self.path!r}: {self.num_vertices} vertices, {self.num_faces} faces, "
+            f"{self.num_samples} samples)"
+        )
+
+    # --- what the index holds -----------------------------------------------
+
+    @property
+    def num_vertices(self) -> int:
+        """Vertices of the mesh file (what vertex ids are checked against)."""
+        return self._index.num_vertices
+
+    @property
+    def num_faces(self) -> int:
+        """Faces of the mesh file (what face ids are checked against)."""
+        return self._index.num_faces
+
+    @property
+    def num_samples(self) -> int:
+        """m, the samples of the geodesic triangulation."""
+        return self._index.num_samples
+
+    @property
+    def has_error_bounds(self) -> bool:
+        """True when the index carries its accuracy calibration (``bounds``
+        and ``tolerance`` need it)."""
+        return self._index.has_error_bounds
+
+    @property
+    def report(self) -> Dict[str, str]:
+        """The builder's report ("key" -> "value"), as Client.model gives it."""
+        out: Dict[str, str] = {}
+        for line in self._index.report.splitlines():
+            key, eq, value = line.partition("=")
+            if eq and key.strip():
+                out[key.strip()] = value.strip()
+        return out
+
+    # --- queries ------------------------------------------------------------
+
+    def distance(
+        self,
+        a: Any,
+        b: Any,
+        bounds: bool = False,
+        tolerance: float = 0.0,
+        *,
+        near_pairs: Optional[str] = None,
+        xyz: bool = False,
+    ) -> Union[np.ndarray, Tuple[np.ndarray, np.ndarray]]:
+        """Geodesic distances of pairs, ``d[i] = d(a[i], b[i])``, as
+        :meth:`geodex.Client.distance` (without the model).
+
+        Returns
+        -------
+        numpy.ndarray or (numpy.ndarray, numpy.ndarray)
+            (N,) float64 distances (``inf`` between components); with
+            ``bounds``, also (N,) float64 absolute error bounds.
+
+        Raises
+        ------
+        InvalidArgument, OutOfRange
+            Bad points (naming the first: "a[17]: ...").
+        FailedPrecondition
+            ``bounds`` or ``tolerance`` of an index without calibration.
+        """
+        check_tolerance(tolerance)
+        as_near_pairs(near_pairs)
+        pa, pb = self._points(a, "a", xyz), self._points(b, "b", xyz)
+        if pa.faces.shape[0] != pb.faces.shape[0]:
+            raise InvalidArgument(
+                f"a has {pa.faces.shape[0]} points but b has {pb.faces.shape[0]}; they must pair up"
+            )
+        d, bnd = self._index.distance(
+            pa.faces, pa.weights, pb.faces, pb.weights,
+            _NEAR_PAIRS[near_pairs], float(tolerance), bool(bounds),
+        )
+        return (d, bnd) if bounds else d
+
+    def matrix(
+        self,
+        sources: Any,
+        targets: Any,
+        bounds: bool = False,
+        tolerance: float = 0.0,
+        *,
+        near_pairs: Optional[str] = None,
+        xyz: bool = False,
+    ) -> Union[np.ndarray, Tuple[np.ndarray, np.ndarray]]:
+        """All sources x targets distances, (S, T) float64 (and the bounds
+        with ``bounds``), as :meth:`geodex.Client.matrix`."""
+        check_tolerance(tolerance)
+        as_near_pairs(near_pairs)
+        src, tgt = self._points(sources, "sources", xyz), self._points(targets, "targets", xyz)
+        m, bnd = self._index.matrix(
+            src.faces, src.weights, tgt.faces, tgt.weights,
+            _NEAR_PAIRS[near_pairs], float(tolerance), bool(bounds),
+        )
+        return (m, bnd) if bounds else m
+
+    def path(self, a: Any, b: Any, *, exact_corridor: int = 0, xyz: bool = False) -> List[Path]:
+        """Geodesic paths from a[i] to b[i], as :meth:`geodex.Client.path`:
+        one :class:`geodex.Path` per pair (K = 0, length ``inf`` between
+        components)."""
+        if not 0 <= int(exact_corridor) <= 64:
+            raise InvalidArgument(f"exact_corridor must be in [0, 64], not {exact_corridor}")
+        pa, pb = self._points(a, "a", xyz), self._points(b, "b", xyz)
+        if pa.faces.shape[0] != pb.faces.shape[0]:
+            raise InvalidArgument(
+                f"a has {pa.faces.shape[0]} points but b has {pb.faces.shape[0]}; they must pair up"
+            )
+        raw = self._index.path(pa.faces, pa.weights, pb.faces, pb.weights, int(exact_corridor))
+        return [Path(positions, faces, weights, length) for positions, faces, weights, length in raw]
+
+    def field(
+        self, sources: Any, *, nearest: bool = False, xyz: bool = False
+    ) -> Union[np.ndarray, Tuple[np.ndarray, np.ndarray]]:
+        """The distance from the nearest source to every vertex of the mesh
+        file, (n,) float64; with ``nearest``, also the (n,) int32 index of
+        each vertex's nearest source (-1 if none)."""
+        src = self._points(sources, "sources", xyz)
+        d, near = self._index.field(src.faces, src.weights)
+        return (d, near) if nearest else d
+
+    def expmap(
+        self,
+        centre: Any,
+        radius: float,
+        *,
+        direction: Optional[Sequence[float]] = None,
+        polar: bool = False,
+        near_pairs: Optional[str] = None,
+        tolerance: float = 0.0,
+        xyz: bool = False,
+    ) -> Tuple[np.ndarray, np.ndarray]:
+        """The exponential map round one point, as
+        :meth:`geodex.Client.expmap`: (k,) int32 vertex ids, ascending, and
+        (k, 2) float64 (u, v), or (r, theta) with ``polar``."""
+        check_tolerance(tolerance)
+        as_near_pairs(near_pairs)
+        c = self._points(centre, "centre", xyz)
+        if c.faces.shape[0] != 1:
+            raise InvalidArgument(f"centre must be one point, not {c.faces.shape[0]}")
+        ref = None if direction is None else as_positions(direction, "direction")[0]
+        vertices, r, theta, u, v = self._index.expmap(
+            int(c.faces[0]), c.weights[0], float(radius), ref,
+            _NEAR_PAIRS[near_pairs], float(tolerance),
+        )
+        coords = np.stack([r, theta] if polar else [u, v], axis=1).reshape(-1, 2)
+        return vertices, coords
+
+    def locate(self, xyz: Any) -> Located:
+        """The closest surface point of each (N, 3) position: faces,
+        weights (usable as points) and the distances to them."""
+        faces, weights, distances = self._index.locate(as_positions(xyz, "xyz"))
+        return Located(faces, weights, distances)
+
+    def mesh(self) -> Tuple[np.ndarray, np.ndarray]:
+        """The mesh file's (V, 3) float64 vertices and (F, 3) int32 faces
+        (polygons fan-triangulated), as :meth:`geodex.Client.mesh`."""
+        return self._index.mesh()
+
+    def _points(self, points: Any, name: str, xyz: bool) -> SurfacePoints:
+        if not xyz:
+            return as_points(points, name)
+        located = self.locate(as_positions(points, name))
+        return SurfacePoints(located.faces, located.weights)
+
+
+class _ProgressBar:
+    """A one-line progress bar on stderr (a log line every 10 s when stderr
+    is not a terminal)."""
+
+    def __init__(self) -> None:
+        self._tty = sys.stderr.isatty()
+        self._last = 0.0
+
+    def __call__(self, p: BuildProgress) -> None:
+        fraction = p.done / p.total if p.total > 0 else 1.0
+        line = f"[{p.phase}] {p.done}/{p.total} ({100 * fraction:.1f}%)"
+        now = time.monotonic()
+        if self._tty:
+            bar = "#" * int(30 * fraction)
+            sys.stderr.write(f"\r\033[K{line} [{bar:<30}]" + ("\n" if p.done >= p.total else ""))
+            sys.stderr.flush()
+        elif p.done >= p.total or now - self._last >= 10:
+            sys.stderr.write(line + "\n")
+            self._last = now
+
+
+def build(
+    mesh: Any,
+    faces: Any = None,
+    path: Union[None, str, "os.PathLike[str]"] = None,
+    *,
+    samples: Optional[int] = None,
+    target_error: Optional[float] = None,
+    max_samples: Optional[int] = None,
+    seed: int = 1,
+    threads: int = 0,
+    strict: bool = False,
+    refine: bool = True,
+    calibrate: bool = True,
+    progress: Union[None, bool, Callable[[BuildProgress], Any]] = None,
+) -> Index:
+    """Builds an index, writes it to ``path`` and opens it.
+
+    Parameters
+    ----------
+    mesh : str, os.PathLike, array or object
+        A mesh file (.obj, .ply, .off; ids in answers are the file's), or
+        the vertices as a (V, 3) float array with ``faces``, or anything
+        with ``.vertices`` (or ``.points``) and ``.faces`` (trimesh,
+        pyvista-like).
+    faces : array, optional
+        (F, 3) integer vertex ids when ``mesh`` is the vertices. With a file
+        or a mesh object, the output path may be given here instead.
+    path : str or os.PathLike
+        Where to write the index (.gdx); written atomically.
+    samples : int, optional
+        m, the number of samples; with ``target_error``, the first round's.
+        Default: the builder's (1000).
+    target_error : float, optional
+        Build until the held-out relative RMS error is at most this (e.g.
+        0.005), growing m round by round up to ``max_samples``.
+    seed : int
+        The sampling seed: the same mesh and options give the same bytes.
+    threads : int
+        Worker threads (0: one per core).
+    strict : bool
+        Refuse a mesh that needs repair (duplicate faces, non-manifold
+        edges or vertices, inconsistent orientation) instead of repairing it;
+        a repaired mesh keeps its ids in every answer.
+    refine : bool
+        Split edges longer than half the sample spacing flat first (the
+        surface is unchanged).
+    calibrate : bool
+        Measure the index against held-out exact propagations and store its
+        error bounds (``bounds`` and ``tolerance`` need them).
+    progress : None, True or callable
+        True: a progress bar on stderr. A callable gets a
+        :class:`BuildProgress` now and then (from the building thread, with
+        the GIL held; an exception it raises is raised by ``build`` once the
+        build is over).
+
+    Returns
+    -------
+    Index
+        The new index, opened.
+
+    Raises
+    ------
+    InvalidArgument
+        Bad arrays or options, or a mesh that cannot be built from (with
+        ``strict``: one that needs repair), naming the reason.
+    NotFound
+        No such mesh file.
+    FailedPrecondition
+        No valid geodesic triangulation within the builder's limits.
+    """
+    core = _require_core()
+    if path is None and faces is not None and is_pathlike(faces):
+        faces, path = None, faces
+    if path is None:
+        raise InvalidArgument("build: the output path (.gdx) is required")
+    if samples is not None and int(samples) < 1:
+        raise InvalidArgument(f"samples must be >= 1, not {samples}")
+    if target_error is not None and not (float(target_error) > 0):
+        raise InvalidArgument(f"target_error must be > 0, not {target_error}")
+    if max_samples is not None and int(max_samples) < 1:
+        raise InvalidArgument(f"max_samples must be >= 1, not {max_samples}")
+    if int(threads) < 0:
+        raise InvalidArgument(f"threads must be >= 0, not {threads}")
+    if progress is True:
+        callback: Optional[Callable[[BuildProgress], Any]] = _ProgressBar()
+    elif progress is None or progress is False:
+        callback = None
+    elif callable(progress):
+        callback = progress
+    else:
+        raise InvalidArgument(f"progress must be None, True or a callable, not {progress!r}")
+
+    def report(phase: str, done: int, total: int) -> None:
+        assert callback is not None
+        callback(BuildProgress(phase, done, total))
+
+    if faces is None and is_pathlike(mesh):
+        vertices, face_array, mesh_path = None, None, os.fsdecode(mesh)
+    else:
+        vertices, face_array = as_mesh(mesh, faces)
+        mesh_path = None
+    core.build(
+        vertices,
+        face_array,
+        mesh_path,
+        os.fsdecode(path),
+        0 if samples is None else int(samples),
+        0.0 if target_error is None else float(target_error),
+        0 if max_samples is None else int(max_samples),
+        int(seed),
+        int(threads),
+        bool(strict),
+        bool(refine),
+        bool(calibrate),
+        None if callback is None else report,
+    )
+    return Index(path, threads=threads)
