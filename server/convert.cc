@@ -4,7 +4,6 @@
 #include <cassert>
 #include <cmath>
 #include <limits>
-#include <unordered_map>
 #include <vector>
 
 #include "absl/strings/ascii.h"
@@ -14,31 +13,16 @@
 namespace geodex::server {
 
 absl::Status PointsFromProto(const v1::SurfacePoints& points, std::string_view name,
-                             const query::QueryEngine& engine,
-                             std::vector<mesh::SurfacePoint>* out) {
+                             const query::InputQueries& queries, query::EnginePoints* out) {
   const int64_t n = points.faces_size();
   if (points.weights_size() != 3 * n) {
     return absl::InvalidArgumentError(absl::StrFormat("%s: %d faces but %d weights (want %d)",
                                                       std::string(name), n, points.weights_size(),
                                                       3 * n));
   }
-  out->resize(n);
-  const int32_t* faces = points.faces().data();
-  const double* weights = points.weights().data();
-  for (int64_t i = 0; i < n; ++i) {
-    mesh::SurfacePoint& p = (*out)[i];
-    p.face = faces[i];
-    p.w = {weights[3 * i], weights[3 * i + 1], weights[3 * i + 2]};
-    absl::StatusOr<mesh::SurfacePoint> internal =
-        engine.input_ids().ToInternal(p, engine.options().weight_tolerance);
-    if (!internal.ok()) {
-      return absl::Status(internal.status().code(),
-                          absl::StrFormat("%s[%d]: %s", std::string(name), i,
-                                          std::string(internal.status().message())));
-    }
-    p = *internal;
-  }
-  return absl::OkStatus();
+  return queries.Read({points.faces().data(), static_cast<size_t>(n)},
+                      {points.weights().data(), static_cast<size_t>(3 * n)}, query::Named(name),
+                      out);
 }
 
 absl::Status PositionsFromProto(const v1::Positions& positions, std::string_view name,
@@ -73,8 +57,7 @@ std::span<double> ResizeForOutput(google::protobuf::RepeatedField<double>* value
   return {values->mutable_data(), static_cast<size_t>(n)};
 }
 
-void PathToProto(const query::InputIds& ids, std::span<const query::PathPoint> path,
-                 v1::Polyline* polyline) {
+void PathToProto(std::span<const query::PathPoint> path, v1::Polyline* polyline) {
   polyline->Clear();
   v1::SurfacePoints* points = polyline->mutable_points();
   google::protobuf::RepeatedField<double>* xyz = polyline->mutable_positions()->mutable_xyz();
@@ -83,7 +66,7 @@ void PathToProto(const query::InputIds& ids, std::span<const query::PathPoint> p
   xyz->Reserve(static_cast<int>(3 * path.size()));
   double length = 0;
   for (size_t i = 0; i < path.size(); ++i) {
-    AppendPoint(ids.ToInput(path[i].point), points);
+    AppendPoint(path[i].point, points);
     for (int c = 0; c < 3; ++c) xyz->Add(path[i].position[c]);
     if (i > 0) length += (path[i].position - path[i - 1].position).norm();
   }
@@ -95,9 +78,8 @@ void UnreachablePathToProto(v1::Polyline* polyline) {
   polyline->set_length(std::numeric_limits<double>::infinity());
 }
 
-void AppendLocated(const query::InputIds& ids, const query::LocatedPoint& located,
-                   v1::LocateResponse* response) {
-  AppendPoint(ids.ToInput(located.point), response->mutable_points());
+void AppendLocated(const query::LocatedPoint& located, v1::LocateResponse* response) {
+  AppendPoint(located.point, response->mutable_points());
   response->add_distances(located.distance);
 }
 
@@ -139,16 +121,15 @@ void ExpMapChunkToProto(std::span<const query::ExpMapVertex> map, int64_t offset
   }
 }
 
-void MeshChunkToProto(const query::QueryEngine& engine, int64_t vertex_offset, int64_t vertex_count,
-                      int64_t face_offset, int64_t face_count, int64_t version,
-                      v1::MeshChunk* chunk) {
-  const index::Index& index = engine.index();
-  const query::InputIds& ids = engine.input_ids();
+void MeshChunkToProto(const query::InputQueries& queries, int64_t vertex_offset,
+                      int64_t vertex_count, int64_t face_offset, int64_t face_count,
+                      int64_t version, v1::MeshChunk* chunk) {
+  const index::Index& index = queries.index();
   assert(vertex_offset >= 0 && vertex_count >= 0 &&
-         vertex_offset + vertex_count <= ids.num_input_vertices());
-  assert(face_offset >= 0 && face_count >= 0 && face_offset + face_count <= ids.num_input_faces());
-  chunk->set_num_vertices(static_cast<uint32_t>(ids.num_input_vertices()));
-  chunk->set_num_faces(static_cast<uint32_t>(ids.num_input_faces()));
+         vertex_offset + vertex_count <= queries.num_vertices());
+  assert(face_offset >= 0 && face_count >= 0 && face_offset + face_count <= queries.num_faces());
+  chunk->set_num_vertices(static_cast<uint32_t>(queries.num_vertices()));
+  chunk->set_num_faces(static_cast<uint32_t>(queries.num_faces()));
   chunk->set_version(version);
   chunk->set_vertex_offset(static_cast<uint32_t>(vertex_offset));
   chunk->set_face_offset(static_cast<uint32_t>(face_offset));
@@ -160,60 +141,32 @@ void MeshChunkToProto(const query::QueryEngine& engine, int64_t vertex_offset, i
   google::protobuf::RepeatedField<uint32_t>* out = chunk->mutable_faces();
   out->Clear();
   out->Reserve(static_cast<int>(3 * face_count));
-  if (ids.identity()) {
+  if (queries.identity()) {
     // Vertex ids are int32 in the index and >= 0 (Index::Open checks them).
     const std::span<const int32_t> faces = index.faces().subspan(3 * face_offset, 3 * face_count);
     for (const int32_t v : faces) out->AddAlreadyReserved(static_cast<uint32_t>(v));
     return;
   }
   for (int64_t f = face_offset; f < face_offset + face_count; ++f) {
-    for (const int32_t v : ids.InputFace(static_cast<int32_t>(f))) {
+    for (const int32_t v : queries.InputFace(static_cast<int32_t>(f))) {
       out->AddAlreadyReserved(static_cast<uint32_t>(v));
     }
   }
 }
 
-void TriangulationToProto(const query::QueryEngine& engine, int64_t version,
+void TriangulationToProto(const query::InputQueries& queries, int64_t version,
                           v1::TriangulationResponse* out) {
-  const index::Index& index = engine.index();
-  const query::InputIds& ids = engine.input_ids();
+  const index::Index& index = queries.index();
   out->set_version(version);
-  out->set_num_vertices(ids.num_input_vertices());
+  out->set_num_vertices(queries.num_vertices());
   const std::span<const int32_t> samples = index.samples();
-  // Sample vertex -> sample ids, to find a face for each in one pass over
-  // the faces (a vertex may in principle be two samples).
-  std::vector<int32_t> face_of_sample(samples.size(), -1);
-  std::unordered_multimap<int32_t, int32_t> samples_at;
-  samples_at.reserve(samples.size());
-  for (size_t i = 0; i < samples.size(); ++i) {
-    samples_at.emplace(samples[i], static_cast<int32_t>(i));
-  }
-  const std::span<const int32_t> faces = index.faces();
-  v1::SurfacePoints* points = out->mutable_sample_points();
-  std::vector<std::array<double, 3>> weights(samples.size(), {0, 0, 0});
-  for (int32_t f = 0; f < index.num_faces(); ++f) {
-    for (int k = 0; k < 3; ++k) {
-      auto [begin, end] = samples_at.equal_range(faces[3 * f + k]);
-      for (auto it = begin; it != end; ++it) {
-        if (face_of_sample[it->second] >= 0) continue;
-        face_of_sample[it->second] = f;
-        weights[it->second][k] = 1;
-      }
-    }
-  }
   const std::span<const double> positions = index.positions();
+  const std::vector<mesh::SurfacePoint> points = queries.SamplePoints();
   for (size_t i = 0; i < samples.size(); ++i) {
     const size_t v = static_cast<size_t>(samples[i]);
-    out->add_sample_vertices(ids.InputVertex(samples[i]));
+    out->add_sample_vertices(queries.InputVertex(samples[i]));
     for (int k = 0; k < 3; ++k) out->mutable_sample_positions()->add_xyz(positions[3 * v + k]);
-    // A sample on no face (the builder never makes one) keeps face -1 and
-    // zero weights, which every query rejects rather than misreads.
-    if (face_of_sample[i] < 0) {
-      points->add_faces(-1);
-      for (int k = 0; k < 3; ++k) points->add_weights(0);
-      continue;
-    }
-    AppendPoint(ids.ToInput({face_of_sample[i], weights[i]}), points);
+    AppendPoint(points[i], out->mutable_sample_points());
   }
   for (const index::GeodesicTriangle& t : index.triangles()) {
     for (int k = 0; k < 3; ++k) {
@@ -221,20 +174,8 @@ void TriangulationToProto(const query::QueryEngine& engine, int64_t version,
       out->add_triangle_neighbors(t.neighbor[k]);
     }
   }
-  // Per input vertex; a split vertex takes the smallest triangle of its
-  // copies (the copies are one point of space; any of their triangles holds it).
-  const std::span<const index::VertexRecord> records = index.vertices();
-  google::protobuf::RepeatedField<int32_t>* vertex_triangles = out->mutable_vertex_triangles();
-  vertex_triangles->Reserve(ids.num_input_vertices());
-  for (int32_t v = 0; v < ids.num_input_vertices(); ++v) {
-    vertex_triangles->AddAlreadyReserved(records[v].triangle);
-  }
-  for (int32_t copy = ids.num_input_vertices();
-       copy < ids.num_input_vertices() + ids.num_vertex_copies(); ++copy) {
-    int32_t& t = *vertex_triangles->Mutable(ids.InputVertex(copy));
-    const int32_t c = records[copy].triangle;
-    if (c >= 0 && (t < 0 || c < t)) t = c;
-  }
+  const std::vector<int32_t> vertex_triangles = queries.VertexTriangles();
+  out->mutable_vertex_triangles()->Assign(vertex_triangles.begin(), vertex_triangles.end());
 }
 
 namespace {
@@ -266,10 +207,9 @@ void ModelInfoToProto(const ModelSnapshot& model, const ServedVersion* version,
   }
   const index::Index& ix = version->index();
   const index::FileHeader& h = ix.header();
-  const query::InputIds& ids = version->engine().input_ids();
   info->set_version(version->version());
-  info->set_num_vertices(ids.num_input_vertices());
-  info->set_num_faces(ids.num_input_faces());
+  info->set_num_vertices(version->queries().num_vertices());
+  info->set_num_faces(version->queries().num_faces());
   info->set_num_samples(ix.num_samples());
   info->set_num_triangles(ix.num_triangles());
   if (ix.num_vertices() > 0) {

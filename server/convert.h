@@ -25,7 +25,7 @@
 #include "core/index/index.h"
 #include "core/mesh/mesh.h"
 #include "core/query/exp_map.h"
-#include "core/query/input_ids.h"
+#include "core/query/input_queries.h"
 #include "core/query/query_engine.h"
 #include "geodex/v1/geodex.pb.h"
 #include "server/model_registry.h"
@@ -39,8 +39,7 @@ namespace geodex::server {
 // past the end and InvalidArgument for NaN, infinite or negative weights or
 // weights not summing to 1, both naming the point ("a[17]: ...").
 absl::Status PointsFromProto(const v1::SurfacePoints& points, std::string_view name,
-                             const query::QueryEngine& engine,
-                             std::vector<mesh::SurfacePoint>* out);
+                             const query::InputQueries& queries, query::EnginePoints* out);
 
 // Number of points in `points` (faces; weights are checked by PointsFromProto).
 inline int64_t PointCount(const v1::SurfacePoints& points) { return points.faces_size(); }
@@ -56,48 +55,43 @@ void AppendPoint(const mesh::SurfacePoint& point, v1::SurfacePoints* points);
 // Resizes `values` to `n` and returns its storage, for the engine to fill.
 std::span<double> ResizeForOutput(google::protobuf::RepeatedField<double>* values, int64_t n);
 
-// A path from QueryEngine::Path (in the index's ids), with its points in
-// input faces; `length` is the sum of its 3D segments.
-void PathToProto(const query::InputIds& ids, std::span<const query::PathPoint> path,
-                 v1::Polyline* polyline);
+// A path from InputQueries::Path (in input ids); `length` is the sum of its
+// 3D segments.
+void PathToProto(std::span<const query::PathPoint> path, v1::Polyline* polyline);
 // The answer for a pair on different connected components: no points,
 // length +Infinity.
 void UnreachablePathToProto(v1::Polyline* polyline);
 
-// A located point (QueryEngine::Locate, in the index's ids) appended to a
-// LocateResponse in input ids.
-void AppendLocated(const query::InputIds& ids, const query::LocatedPoint& located,
-                   v1::LocateResponse* response);
+// A located point (InputQueries::Locate, in input ids) appended to a
+// LocateResponse.
+void AppendLocated(const query::LocatedPoint& located, v1::LocateResponse* response);
 
 // Rows [row_offset, row_offset + rows) of a matrix, `values` row-major.
 void MatrixBlockToProto(int64_t row_offset, int64_t rows, int64_t num_targets,
                         std::span<const double> values, int64_t version, v1::MatrixBlock* block);
 
 // Vertices [offset, offset + count) of a distance field (per input vertex:
-// InputIds::FieldToInput).
+// InputQueries::Field).
 void FieldChunkToProto(const query::DistanceField& field, int64_t offset, int64_t count,
                        bool with_nearest_source, int64_t version, v1::DistanceFieldChunk* chunk);
 
 // Entries [offset, offset + count) of an exponential map (in input ids:
-// query::ExpMapOfInput).
+// InputQueries::ExpMap).
 void ExpMapChunkToProto(std::span<const query::ExpMapVertex> map, int64_t offset, int64_t count,
                         int64_t version, v1::ExpMapChunk* chunk);
 
 // Vertices [vertex_offset, vertex_offset + vertex_count) and faces
-// [face_offset, face_offset + face_count) of the input mesh of `engine`'s
+// [face_offset, face_offset + face_count) of the input mesh of `queries`'
 // index (the mesh file's vertices and faces, also when it was repaired), with
 // the mesh's totals and `version`. The ranges must lie within the input mesh.
-void MeshChunkToProto(const query::QueryEngine& engine, int64_t vertex_offset, int64_t vertex_count,
+void MeshChunkToProto(const query::InputQueries& queries, int64_t vertex_offset,
+                      int64_t vertex_count,
                       int64_t face_offset, int64_t face_count, int64_t version,
                       v1::MeshChunk* chunk);
 
-// The geodesic triangulation held by `engine`'s index (GetTriangulation), with
-// `version`, in input ids. Each sample's surface point is in the input face
-// kept for the lowest-numbered face of the index using its vertex, with
-// weight 1 on that vertex (face -1 and zero weights for a sample on no face,
-// which the builder never makes). vertex_triangles has one entry per input
-// vertex; for a split vertex, the smallest triangle id of its copies.
-void TriangulationToProto(const query::QueryEngine& engine, int64_t version,
+// The geodesic triangulation held by `queries`' index (GetTriangulation), with
+// `version`, in input ids (InputQueries::SamplePoints, VertexTriangles).
+void TriangulationToProto(const query::InputQueries& queries, int64_t version,
                           v1::TriangulationResponse* out);
 
 // A model as GetModel and ListModels describe it: `version` (a served

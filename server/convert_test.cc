@@ -21,7 +21,9 @@ class ConvertTest : public ::testing::Test {
     ASSERT_TRUE(index.ok()) << index.status();
     auto engine = query::QueryEngine::Create(*index);
     ASSERT_TRUE(engine.ok()) << engine.status();
-    engine_ = *engine;
+    auto queries = query::InputQueries::Create(*engine);
+    ASSERT_TRUE(queries.ok()) << queries.status();
+    queries_ = *queries;
   }
   v1::SurfacePoints Points(std::vector<int32_t> faces, std::vector<double> weights) {
     v1::SurfacePoints p;
@@ -30,21 +32,24 @@ class ConvertTest : public ::testing::Test {
     return p;
   }
   absl::Status Read(const v1::SurfacePoints& p, const char* name = "a") {
-    return PointsFromProto(p, name, *engine_, &out_);
+    return PointsFromProto(p, name, *queries_, &out_);
   }
-  std::shared_ptr<const query::QueryEngine> engine_;
-  std::vector<mesh::SurfacePoint> out_;
+  std::shared_ptr<const query::InputQueries> queries_;
+  query::EnginePoints out_;
 };
 
 TEST_F(ConvertTest, ReadsValidPoints) {
   ASSERT_TRUE(Read(Points({0, 5}, {1, 0, 0, 0.25, 0.25, 0.5})).ok());
   ASSERT_EQ(out_.size(), 2u);
-  EXPECT_EQ(out_[1].face, 5);
-  EXPECT_EQ(out_[1].w[2], 0.5);
+  // The sphere needed no repair: the points are the engine's as given.
+  const absl::StatusOr<double> want =
+      queries_->engine().Distance({0, {1, 0, 0}}, {5, {0.25, 0.25, 0.5}});
+  ASSERT_TRUE(want.ok()) << want.status();
+  EXPECT_EQ(*queries_->Distance(out_, 0, out_, 1), *want);
 }
 
 TEST_F(ConvertTest, NamesTheOffendingPoint) {
-  const int32_t n = engine_->index().num_faces();
+  const int32_t n = queries_->index().num_faces();
   absl::Status s = Read(Points({0, 99999}, {1, 0, 0, 1, 0, 0}));
   EXPECT_EQ(s.code(), absl::StatusCode::kOutOfRange);
   EXPECT_EQ(std::string(s.message()),
@@ -101,10 +106,7 @@ TEST(ConvertPathTest, LengthIsTheSumOfSegments) {
   path[1].position = {3, 4, 0};
   path[2].position = {3, 4, 1};
   v1::Polyline line;
-  auto index = index::Index::FromBytes(testing::SphereIndexBytes());
-  ASSERT_TRUE(index.ok()) << index.status();
-  const query::InputIds ids(**index);  // identity: the sphere needed no repair
-  PathToProto(ids, path, &line);
+  PathToProto(path, &line);
   EXPECT_DOUBLE_EQ(line.length(), 6);
   EXPECT_EQ(line.points().faces_size(), 3);
   EXPECT_EQ(line.positions().xyz_size(), 9);
@@ -114,9 +116,9 @@ TEST(ConvertPathTest, LengthIsTheSumOfSegments) {
 }
 
 TEST_F(ConvertTest, MeshChunkIsASliceOfTheIndexMesh) {
-  const index::Index& ix = engine_->index();
+  const index::Index& ix = queries_->index();
   v1::MeshChunk chunk;
-  MeshChunkToProto(*engine_, 10, 5, 100, 4, 3, &chunk);
+  MeshChunkToProto(*queries_, 10, 5, 100, 4, 3, &chunk);
   EXPECT_EQ(chunk.num_vertices(), static_cast<uint32_t>(ix.num_vertices()));
   EXPECT_EQ(chunk.num_faces(), static_cast<uint32_t>(ix.num_faces()));
   EXPECT_EQ(chunk.version(), 3);
@@ -130,7 +132,7 @@ TEST_F(ConvertTest, MeshChunkIsASliceOfTheIndexMesh) {
 
   // Empty ranges at the end, as in the last chunks of a mesh with more faces
   // than vertices; a reused message is overwritten.
-  MeshChunkToProto(*engine_, ix.num_vertices(), 0, ix.num_faces() - 1, 1, 3, &chunk);
+  MeshChunkToProto(*queries_, ix.num_vertices(), 0, ix.num_faces() - 1, 1, 3, &chunk);
   EXPECT_EQ(chunk.vertex_offset(), static_cast<uint32_t>(ix.num_vertices()));
   EXPECT_EQ(chunk.positions_size(), 0);
   EXPECT_EQ(chunk.faces_size(), 3);

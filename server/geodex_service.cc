@@ -197,13 +197,13 @@ absl::Status GeodexService::ComputeDistances(const ResolvedModel& model, const v
   GEODEX_ASSIGN_OR_RETURN(const query::DistanceOptions options,
                           DistanceOptionsFor(*model.model, choice.near_pairs,
                                              choice.exact_near_pairs, choice.tolerance));
-  const query::QueryEngine& engine = model.version->engine();
-  GEODEX_RETURN_IF_ERROR(PointsFromProto(a, "a", engine, &worker.a));
-  GEODEX_RETURN_IF_ERROR(PointsFromProto(b, "b", engine, &worker.b));
-  return engine.DistanceBatch(worker.a, worker.b, ResizeForOutput(out, na), options,
-                              &worker.scratch,
-                              choice.error_bounds ? ResizeForOutput(bounds, na)
-                                                  : std::span<double>());
+  const query::InputQueries& queries = model.version->queries();
+  GEODEX_RETURN_IF_ERROR(PointsFromProto(a, "a", queries, &worker.a));
+  GEODEX_RETURN_IF_ERROR(PointsFromProto(b, "b", queries, &worker.b));
+  return queries.DistanceBatch(worker.a, worker.b, ResizeForOutput(out, na), options,
+                               &worker.scratch,
+                               choice.error_bounds ? ResizeForOutput(bounds, na)
+                                                   : std::span<double>());
 }
 
 // A unary call's reactor. It counts the call from its start until gRPC is
@@ -333,16 +333,16 @@ grpc::ServerUnaryReactor* GeodexService::Path(grpc::CallbackServerContext* conte
             request->exact_corridor() > 0
                 ? static_cast<int32_t>(request->exact_corridor())
                 : std::clamp<int32_t>(model.model->config.exact_path_corridor(), 0, kMaxCorridor);
-        const query::QueryEngine& engine = model.version->engine();
-        GEODEX_RETURN_IF_ERROR(PointsFromProto(request->a(), "a", engine, &worker.a));
-        GEODEX_RETURN_IF_ERROR(PointsFromProto(request->b(), "b", engine, &worker.b));
+        const query::InputQueries& queries = model.version->queries();
+        GEODEX_RETURN_IF_ERROR(PointsFromProto(request->a(), "a", queries, &worker.a));
+        GEODEX_RETURN_IF_ERROR(PointsFromProto(request->b(), "b", queries, &worker.b));
         response->mutable_paths()->Reserve(static_cast<int>(na));
         for (int64_t i = 0; i < na; ++i) {
           GEODEX_RETURN_IF_ERROR(CheckAlive(*context));
           absl::StatusOr<std::vector<query::PathPoint>> path =
-              engine.Path(worker.a[i], worker.b[i], corridor);
+              queries.Path(worker.a, i, worker.b, i, corridor);
           if (path.ok()) {
-            PathToProto(engine.input_ids(), *path, response->add_paths());
+            PathToProto(*path, response->add_paths());
           } else if (path.status().code() == absl::StatusCode::kNotFound) {
             UnreachablePathToProto(response->add_paths());  // different components
           } else {
@@ -371,13 +371,13 @@ grpc::ServerUnaryReactor* GeodexService::Locate(grpc::CallbackServerContext* con
         }
         std::vector<mesh::Vec3> positions;
         GEODEX_RETURN_IF_ERROR(PositionsFromProto(request->positions(), "positions", &positions));
-        const query::QueryEngine& engine = model.version->engine();
+        const query::InputQueries& queries = model.version->queries();
         for (size_t i = 0; i < positions.size(); ++i) {
-          absl::StatusOr<query::LocatedPoint> located = engine.Locate(positions[i]);
+          absl::StatusOr<query::LocatedPoint> located = queries.Locate(positions[i]);
           if (!located.ok()) {
             return WithPrefix(located.status(), absl::StrFormat("positions[%d]: ", i));
           }
-          AppendLocated(engine.input_ids(), *located, response);
+          AppendLocated(*located, response);
         }
         call.pairs = n;
         response->set_version(model.version->version());
@@ -391,9 +391,9 @@ grpc::ServerUnaryReactor* GeodexService::GetTriangulation(
   return RunUnary(context, "GetTriangulation",
                   [this, request, response](Call& call, WorkerContext&) -> absl::Status {
                     GEODEX_ASSIGN_OR_RETURN(ResolvedModel model, Resolve(request->model(), call));
-                    TriangulationToProto(model.version->engine(), model.version->version(),
+                    TriangulationToProto(model.version->queries(), model.version->version(),
                                          response);
-                    call.pairs = model.version->engine().input_ids().num_input_vertices();
+                    call.pairs = model.version->queries().num_vertices();
                     return absl::OkStatus();
                   });
 }

@@ -137,9 +137,9 @@ class GeodexService::MatrixStream final : public ChunkedWriteStream<v1::MatrixBl
     }
     GEODEX_ASSIGN_OR_RETURN(options_, DistanceOptionsFor(*model_.model, request_->near_pairs(),
                                                          false, request_->tolerance()));
-    engine_ = &model_.version->engine();
-    GEODEX_RETURN_IF_ERROR(PointsFromProto(request_->sources(), "sources", *engine_, &sources_));
-    GEODEX_RETURN_IF_ERROR(PointsFromProto(request_->targets(), "targets", *engine_, &targets_));
+    queries_ = &model_.version->queries();
+    GEODEX_RETURN_IF_ERROR(PointsFromProto(request_->sources(), "sources", *queries_, &sources_));
+    GEODEX_RETURN_IF_ERROR(PointsFromProto(request_->targets(), "targets", *queries_, &targets_));
     // At most kChunkBytes a block, whole rows (at least one).
     block_rows_ = std::max<int64_t>(1, kChunkBytes / 8 / std::max<int64_t>(1, t));
     if (request_->block_rows() > 0)
@@ -158,11 +158,10 @@ class GeodexService::MatrixStream final : public ChunkedWriteStream<v1::MatrixBl
     const bool bounds = request_->error_bounds();
     values_.resize(rows_ * t);
     bounds_.resize(bounds ? rows_ * t : 0);
-    worker.a.resize(t);
     for (int64_t r = 0; r < rows_; ++r) {
       GEODEX_RETURN_IF_ERROR(CheckAlive(*context_));
-      std::fill(worker.a.begin(), worker.a.end(), sources_[next_row_ + r]);
-      GEODEX_RETURN_IF_ERROR(engine_->DistanceBatch(
+      worker.a.AssignRepeated(sources_, next_row_ + r, t);
+      GEODEX_RETURN_IF_ERROR(queries_->DistanceBatch(
           worker.a, targets_, std::span<double>(values_.data() + r * t, t), options_,
           &worker.scratch,
           bounds ? std::span<double>(bounds_.data() + r * t, t) : std::span<double>()));
@@ -186,10 +185,10 @@ class GeodexService::MatrixStream final : public ChunkedWriteStream<v1::MatrixBl
   // Used by one job at a time (jobs are sequential).
   bool prepared_ = false;
   ResolvedModel model_;
-  const query::QueryEngine* engine_ = nullptr;
+  const query::InputQueries* queries_ = nullptr;
   query::DistanceOptions options_;
   std::vector<double> bounds_;
-  std::vector<mesh::SurfacePoint> sources_, targets_;
+  query::EnginePoints sources_, targets_;
   int64_t block_rows_ = 1;
   int64_t next_row_ = 0;
   int64_t rows_ = 0;  // in block_
@@ -222,10 +221,9 @@ class GeodexService::FieldStream final : public ChunkedWriteStream<v1::DistanceF
           "%d sources exceed the limit of %d (max_field_sources)", n, limits.max_field_sources));
     }
     if (n == 0) return absl::InvalidArgumentError("sources: no source given");
-    const query::QueryEngine& engine = model_.version->engine();
-    GEODEX_RETURN_IF_ERROR(PointsFromProto(request_->sources(), "sources", engine, &worker.a));
-    GEODEX_ASSIGN_OR_RETURN(field_, engine.Field(worker.a));
-    field_ = engine.input_ids().FieldToInput(std::move(field_));
+    const query::InputQueries& queries = model_.version->queries();
+    GEODEX_RETURN_IF_ERROR(PointsFromProto(request_->sources(), "sources", queries, &worker.a));
+    GEODEX_ASSIGN_OR_RETURN(field_, queries.Field(worker.a));
     call_.pairs = n * static_cast<int64_t>(field_.distance.size());
     chunk_vertices_ =
         std::max<int64_t>(1, kChunkBytes / (request_->with_nearest_source() ? 12 : 8));
@@ -277,8 +275,8 @@ class GeodexService::ExpMapStream final : public ChunkedWriteStream<v1::ExpMapCh
       return absl::InvalidArgumentError(absl::StrFormat("center: give exactly one point, got %d",
                                                         PointCount(request_->center())));
     }
-    const query::QueryEngine& engine = model_.version->engine();
-    GEODEX_RETURN_IF_ERROR(PointsFromProto(request_->center(), "center", engine, &worker.a));
+    const query::InputQueries& queries = model_.version->queries();
+    GEODEX_RETURN_IF_ERROR(PointsFromProto(request_->center(), "center", queries, &worker.a));
     query::ExpMapOptions options;
     options.radius = request_->radius();
     const auto& direction = request_->reference_direction().xyz();
@@ -292,11 +290,11 @@ class GeodexService::ExpMapStream final : public ChunkedWriteStream<v1::ExpMapCh
         options.distance,
         DistanceOptionsFor(*model_.model, request_->near_pairs(), false, request_->tolerance()));
     // The centre as the request gives it (validated above): the map's θ runs
-    // round that input face's normal (query::ExpMapOfInput).
+    // round that input face's normal (InputQueries::ExpMap).
     const mesh::SurfacePoint centre{request_->center().faces(0),
                                     {request_->center().weights(0), request_->center().weights(1),
                                      request_->center().weights(2)}};
-    GEODEX_ASSIGN_OR_RETURN(map_, query::ExpMapOfInput(engine, centre, options, &worker.scratch));
+    GEODEX_ASSIGN_OR_RETURN(map_, queries.ExpMap(centre, options, &worker.scratch));
     call_.pairs = static_cast<int64_t>(map_.size());
     return absl::OkStatus();
   }
@@ -341,10 +339,9 @@ class GeodexService::MeshStream final : public ChunkedWriteStream<v1::MeshChunk>
  private:
   absl::Status Prepare() {
     GEODEX_ASSIGN_OR_RETURN(model_, service_->Resolve(request_->model(), call_));
-    const query::InputIds& ids = model_.version->engine().input_ids();
+    const query::InputQueries& queries = model_.version->queries();
     const auto chunks = [this](int64_t n) { return (n + chunk_elements_ - 1) / chunk_elements_; };
-    num_chunks_ =
-        std::max<int64_t>({1, chunks(ids.num_input_vertices()), chunks(ids.num_input_faces())});
+    num_chunks_ = std::max<int64_t>({1, chunks(queries.num_vertices()), chunks(queries.num_faces())});
     prepared_ = true;
     return absl::OkStatus();
   }
@@ -354,16 +351,16 @@ class GeodexService::MeshStream final : public ChunkedWriteStream<v1::MeshChunk>
   absl::Status ComputeNext(WorkerContext& /*worker*/) override {
     GEODEX_RETURN_IF_ERROR(CheckAlive(*context_));
     if (!prepared_) GEODEX_RETURN_IF_ERROR(Prepare());
-    // The input mesh: the file's vertices and faces (core/query/input_ids.h).
-    const query::QueryEngine& engine = model_.version->engine();
-    const int64_t num_vertices = engine.input_ids().num_input_vertices();
-    const int64_t num_faces = engine.input_ids().num_input_faces();
+    // The input mesh: the file's vertices and faces (core/query/input_queries.h).
+    const query::InputQueries& queries = model_.version->queries();
+    const int64_t num_vertices = queries.num_vertices();
+    const int64_t num_faces = queries.num_faces();
     const int64_t begin = next_chunk_ * chunk_elements_;
     const int64_t nv = std::clamp<int64_t>(num_vertices - begin, 0, chunk_elements_);
     const int64_t nf = std::clamp<int64_t>(num_faces - begin, 0, chunk_elements_);
     const int64_t vertex_offset = std::min<int64_t>(begin, num_vertices);
     const int64_t face_offset = std::min<int64_t>(begin, num_faces);
-    MeshChunkToProto(engine, vertex_offset, nv, face_offset, nf, model_.version->version(),
+    MeshChunkToProto(queries, vertex_offset, nv, face_offset, nf, model_.version->version(),
                      &chunk_);
     items_ = nv + nf;
     return absl::OkStatus();

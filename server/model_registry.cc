@@ -60,12 +60,14 @@ absl::StatusOr<std::shared_ptr<const ServedVersion>> ServedVersion::Load(int64_t
   if (!index.ok()) return index.status();
   auto engine = query::QueryEngine::Create(*index, {});
   if (!engine.ok()) return engine.status();
+  auto queries = query::InputQueries::Create(*std::move(engine));
+  if (!queries.ok()) return queries.status();
   std::shared_ptr<ServedVersion> served(new ServedVersion());
   served->version_ = version;
   served->path_ = path;
   served->file_id_ = file_id;
   served->index_ = *std::move(index);
-  served->engine_ = *std::move(engine);
+  served->queries_ = *std::move(queries);
   served->mapped_notice_ = std::make_unique<MappedFileNotice>(served->index_->image(), path);
   return std::shared_ptr<const ServedVersion>(std::move(served));
 }

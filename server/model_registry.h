@@ -60,7 +60,7 @@
 #include "absl/status/statusor.h"
 #include "absl/time/time.h"
 #include "core/index/index.h"
-#include "core/query/query_engine.h"
+#include "core/query/input_queries.h"
 #include "server/mapped_files.h"
 #include "server/model_config.pb.h"
 
@@ -92,9 +92,10 @@ class ServedVersion {
   const index::Index& index() const { return *index_; }
   // Bytes of the mapped index file.
   int64_t mapped_bytes() const { return static_cast<int64_t>(index_->size_bytes()); }
-  // The engine; each call chooses how its pairs are refined
-  // (query::DistanceOptions).
-  const query::QueryEngine& engine() const { return *engine_; }
+  // The queries in the mesh file's ids (what every call answers with); each
+  // call chooses how its pairs are refined (query::DistanceOptions).
+  const query::InputQueries& queries() const { return *queries_; }
+  const query::QueryEngine& engine() const { return queries_->engine(); }
 
  private:
   ServedVersion() = default;
@@ -103,7 +104,7 @@ class ServedVersion {
   std::string path_;
   FileId file_id_;
   std::shared_ptr<const index::Index> index_;
-  std::shared_ptr<const query::QueryEngine> engine_;
+  std::shared_ptr<const query::InputQueries> queries_;
   // Names this file in a SIGBUS report; released before index_ unmaps it.
   std::unique_ptr<MappedFileNotice> mapped_notice_;
 };

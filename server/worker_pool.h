@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "core/mesh/mesh.h"
+#include "core/query/input_queries.h"
 #include "core/query/query_engine.h"
 
 namespace geodex::server {
@@ -28,7 +29,7 @@ namespace geodex::server {
 struct WorkerContext {
   int worker_id = 0;
   query::QueryScratch scratch;
-  std::vector<mesh::SurfacePoint> a, b;  // reusable point arrays
+  query::EnginePoints a, b;  // reusable point arrays
 };
 
 class WorkerPool {

@@ -80,6 +80,42 @@ absl::StatusOr<std::vector<PointPair>> ParsePairs(std::string_view contents) {
   return pairs;
 }
 
+absl::StatusOr<std::vector<NumberLine>> ParseNumberLines(std::string_view contents,
+                                                         size_t width) {
+  std::vector<NumberLine> lines;
+  int64_t line_number = 0;
+  size_t begin = 0;
+  while (begin < contents.size()) {
+    size_t end = contents.find('\n', begin);
+    if (end == std::string_view::npos) end = contents.size();
+    const std::string_view line = contents.substr(begin, end - begin);
+    begin = end + 1;
+    ++line_number;
+    const std::vector<std::string_view> fields = Fields(line);
+    if (fields.empty() || fields[0][0] == '#') continue;
+    NumberLine out;
+    out.line = line_number;
+    for (const std::string_view text : fields) {
+      double value = 0;
+      const auto [ptr, ec] = std::from_chars(text.data(), text.data() + text.size(), value);
+      if (ec != std::errc() || ptr != text.data() + text.size()) break;
+      out.values.push_back(value);
+    }
+    if (out.values.size() != fields.size() || fields.size() != width) {
+      return absl::InvalidArgumentError(
+          absl::StrFormat("line %d: expected %d numbers", line_number, width));
+    }
+    for (const double v : out.values) {
+      if (!std::isfinite(v)) {
+        return absl::InvalidArgumentError(
+            absl::StrFormat("line %d: non-finite number", line_number));
+      }
+    }
+    lines.push_back(std::move(out));
+  }
+  return lines;
+}
+
 absl::Status ValidatePairs(const Mesh& mesh, const std::vector<PointPair>& pairs) {
   for (const PointPair& pair : pairs) {
     for (const SurfacePoint* p : {&pair.a, &pair.b}) {

@@ -34,6 +34,17 @@ absl::StatusOr<std::vector<PointPair>> ParsePairs(std::string_view contents);
 // Errors: the first failure, its message prefixed with "line N: ".
 absl::Status ValidatePairs(const Mesh& mesh, const std::vector<PointPair>& pairs);
 
+// A line of numbers (ParseNumberLines).
+struct NumberLine {
+  std::vector<double> values;
+  int64_t line = 0;  // 1-based line number in the input
+};
+
+// Parses lines of exactly `width` finite numbers each (separated as pairs
+// are), skipping blank and '#' lines: source points "f w0 w1 w2", positions
+// "x y z". Errors: InvalidArgument naming the first bad line.
+absl::StatusOr<std::vector<NumberLine>> ParseNumberLines(std::string_view contents, size_t width);
+
 // Reads a whole file (ReadWholeFile, with its errors), or standard input for
 // "-".
 absl::StatusOr<std::string> ReadFileOrStdin(const std::string& path);

@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <limits>
-#include <numbers>
 #include <utility>
 
 #include "absl/strings/str_format.h"
@@ -136,47 +135,6 @@ DistanceField InputIds::FieldToInput(DistanceField field) const {
 void InputIds::PathToInput(std::span<PathPoint> path) const {
   if (input_faces_.empty() && refined_faces_.empty()) return;
   for (PathPoint& p : path) p.point = ToInput(p.point);
-}
-
-absl::StatusOr<std::vector<ExpMapVertex>> ExpMapOfInput(const QueryEngine& engine,
-                                                        const mesh::SurfacePoint& centre,
-                                                        ExpMapOptions options,
-                                                        QueryScratch* scratch) {
-  const InputIds& ids = engine.input_ids();
-  GEODEX_ASSIGN_OR_RETURN(const mesh::SurfacePoint internal,
-                          ids.ToInternal(centre, engine.options().weight_tolerance));
-  // A re-oriented face's normal is the input face's reversed, and its first
-  // edge another edge: give the input's first edge, and mirror θ. A piece of
-  // a refined face has other edges too.
-  const bool mirrored = ids.Reoriented(centre.face);
-  if ((mirrored || ids.refined()) && !options.reference_direction.has_value()) {
-    const mesh::Triangle t = ids.InputFace(centre.face);
-    const std::span<const double> p = engine.index().positions();
-    options.reference_direction = mesh::Vec3(p[3 * t[1]], p[3 * t[1] + 1], p[3 * t[1] + 2]) -
-                                  mesh::Vec3(p[3 * t[0]], p[3 * t[0] + 1], p[3 * t[0] + 2]);
-  }
-  GEODEX_ASSIGN_OR_RETURN(std::vector<ExpMapVertex> map,
-                          ExpMap(engine, internal, options, scratch));
-  if (ids.identity()) return map;
-  // Midpoints of a refinement are no input vertices.
-  std::erase_if(map,
-                [&ids](const ExpMapVertex& e) { return ids.InputVertex(e.vertex) == mesh::kNone; });
-  for (ExpMapVertex& e : map) {
-    e.vertex = ids.InputVertex(e.vertex);
-    if (mirrored) {
-      e.theta = e.theta == 0 || e.theta == std::numbers::pi ? e.theta : -e.theta;
-      e.v = -e.v;
-    }
-  }
-  // One entry per input vertex: the copy of smallest r.
-  std::stable_sort(map.begin(), map.end(), [](const ExpMapVertex& a, const ExpMapVertex& b) {
-    return a.vertex != b.vertex ? a.vertex < b.vertex : a.r < b.r;
-  });
-  map.erase(std::unique(
-                map.begin(), map.end(),
-                [](const ExpMapVertex& a, const ExpMapVertex& b) { return a.vertex == b.vertex; }),
-            map.end());
-  return map;
 }
 
 }  // namespace geodex::query

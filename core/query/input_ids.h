@@ -40,8 +40,7 @@
 #include "absl/status/statusor.h"
 #include "core/index/index.h"
 #include "core/mesh/mesh.h"
-#include "core/query/exp_map.h"
-#include "core/query/query_engine.h"
+#include "core/query/query_types.h"
 
 namespace geodex::query {
 
@@ -103,15 +102,5 @@ class InputIds {
   std::vector<int32_t> piece_offset_;
   std::vector<int32_t> pieces_;
 };
-
-// ExpMap with the centre and the answer in input ids: `centre` in an input
-// face; vertices are input vertices, ascending (a split vertex: its copy of
-// smallest r); θ counter-clockwise about the normal of the centre's input
-// face, θ = 0 by default along that face's first input edge. Errors: those
-// of InputIds::ToInternal and ExpMap.
-absl::StatusOr<std::vector<ExpMapVertex>> ExpMapOfInput(const QueryEngine& engine,
-                                                        const mesh::SurfacePoint& centre,
-                                                        ExpMapOptions options,
-                                                        QueryScratch* scratch = nullptr);
 
 }  // namespace geodex::query

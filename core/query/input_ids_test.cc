@@ -2,6 +2,7 @@
 // broken mesh of each kind is repaired, built and answered.
 
 #include "core/query/input_ids.h"
+#include "core/query/input_queries.h"
 
 #include <cmath>
 #include <cstdlib>
@@ -58,10 +59,21 @@ Built Build(const RawMesh& raw, int32_t samples, bool refine = false) {
   return {*std::move(repaired), *std::move(engine)};
 }
 
+// The exponential map of `e` round an input point (InputQueries::ExpMap).
+absl::StatusOr<std::vector<ExpMapVertex>> ExpMapOfInput(const QueryEngine& e,
+                                                        const SurfacePoint& centre,
+                                                        const ExpMapOptions& options) {
+  // The engine outlives the call: a non-owning pointer.
+  auto queries =
+      InputQueries::Create(std::shared_ptr<const QueryEngine>(&e, [](const QueryEngine*) {}));
+  if (!queries.ok()) return queries.status();
+  return (*queries)->ExpMap(centre, options);
+}
+
 double InputDistance(const QueryEngine& engine, const SurfacePoint& a, const SurfacePoint& b,
                      NearPairs near = NearPairs::kPath) {
-  absl::StatusOr<SurfacePoint> p = engine.input_ids().ToInternal(a);
-  absl::StatusOr<SurfacePoint> q = engine.input_ids().ToInternal(b);
+  absl::StatusOr<SurfacePoint> p = InputIds(engine.index()).ToInternal(a);
+  absl::StatusOr<SurfacePoint> q = InputIds(engine.index()).ToInternal(b);
   if (!p.ok() || !q.ok()) throw std::runtime_error("bad point");
   DistanceOptions options;
   options.near_pairs = near;
@@ -72,7 +84,7 @@ double InputDistance(const QueryEngine& engine, const SurfacePoint& a, const Sur
 
 TEST(InputIdsTest, IndexWithoutRepairHasIdentityMaps) {
   Built b = Build(RawOf(mesh::gen::Sphere(2, 1.0), "sphere"), 40);
-  const InputIds& ids = b.engine->input_ids();
+  const InputIds ids(b.engine->index());
   EXPECT_TRUE(ids.identity());
   EXPECT_TRUE(b.engine->index().input_faces().empty());
   EXPECT_EQ(ids.num_input_faces(), 320);
@@ -93,9 +105,9 @@ TEST(InputIdsTest, DroppedDuplicateAnswersAsItsTwin) {
   Built b = Build(raw, 40);
   const QueryEngine& e = *b.engine;
   // The input's face count, so face 321 is valid and 322 is not.
-  EXPECT_EQ(e.input_ids().num_input_faces(), 322);
+  EXPECT_EQ(InputIds(e.index()).num_input_faces(), 322);
   EXPECT_EQ(e.index().num_faces(), 320);
-  EXPECT_EQ(e.input_ids().ToInternal({322, {1, 0, 0}}).status().code(),
+  EXPECT_EQ(InputIds(e.index()).ToInternal({322, {1, 0, 0}}).status().code(),
             absl::StatusCode::kOutOfRange);
   const SurfacePoint far{150, {0.3, 0.3, 0.4}};
   // The same point of space: weights follow each description's corners.
@@ -107,9 +119,9 @@ TEST(InputIdsTest, DroppedDuplicateAnswersAsItsTwin) {
   EXPECT_EQ(InputDistance(e, on_rotated, far), d);
   EXPECT_EQ(InputDistance(e, on_reversed, far), d);
   // Answers name the kept face.
-  absl::StatusOr<SurfacePoint> internal = e.input_ids().ToInternal(on_reversed);
+  absl::StatusOr<SurfacePoint> internal = InputIds(e.index()).ToInternal(on_reversed);
   ASSERT_TRUE(internal.ok());
-  const SurfacePoint back = e.input_ids().ToInput(*internal);
+  const SurfacePoint back = InputIds(e.index()).ToInput(*internal);
   EXPECT_EQ(back.face, 7);
   EXPECT_EQ(back.w, on_twin.w);
 }
@@ -127,12 +139,12 @@ TEST(InputIdsTest, ReorientedFacesKeepTheirInputWeights) {
   EXPECT_EQ(InputDistance(e, {5, {0.1, 0.2, 0.7}}, far),
             InputDistance(*reference.engine, {5, {0.1, 0.7, 0.2}}, far));
   // A path from a re-oriented face starts there, in its input weights.
-  absl::StatusOr<SurfacePoint> from = e.input_ids().ToInternal({5, {0.1, 0.2, 0.7}});
-  absl::StatusOr<SurfacePoint> to = e.input_ids().ToInternal(far);
+  absl::StatusOr<SurfacePoint> from = InputIds(e.index()).ToInternal({5, {0.1, 0.2, 0.7}});
+  absl::StatusOr<SurfacePoint> to = InputIds(e.index()).ToInternal(far);
   ASSERT_TRUE(from.ok() && to.ok());
   absl::StatusOr<std::vector<PathPoint>> path = e.Path(*from, *to);
   ASSERT_TRUE(path.ok()) << path.status();
-  e.input_ids().PathToInput(*path);
+  InputIds(e.index()).PathToInput(*path);
   EXPECT_EQ(path->front().point.face, 5);
   EXPECT_NEAR(path->front().point.w[1], 0.2, 1e-12);
   EXPECT_NEAR(path->front().point.w[2], 0.7, 1e-12);
@@ -159,20 +171,20 @@ TEST(InputIdsTest, SplitVertexFieldTakesTheSmallestCopy) {
   Built b = Build(raw, 10);
   const QueryEngine& e = *b.engine;
   ASSERT_EQ(e.index().vertex_copies().size(), 1u);
-  EXPECT_EQ(e.input_ids().num_input_vertices(), 9);
+  EXPECT_EQ(InputIds(e.index()).num_input_vertices(), 9);
   // A source on the first pyramid: its copy of the apex is reached, the
   // other pyramid is another component.
-  absl::StatusOr<SurfacePoint> source = e.input_ids().ToInternal({0, {0.2, 0.3, 0.5}});
+  absl::StatusOr<SurfacePoint> source = InputIds(e.index()).ToInternal({0, {0.2, 0.3, 0.5}});
   ASSERT_TRUE(source.ok());
   absl::StatusOr<DistanceField> field = e.Field(std::vector<SurfacePoint>{*source});
   ASSERT_TRUE(field.ok());
   ASSERT_EQ(field->distance.size(), 10u);
   const double apex_copy = field->distance[9];
-  const DistanceField input = e.input_ids().FieldToInput(*field);
+  const DistanceField input = InputIds(e.index()).FieldToInput(*field);
   ASSERT_EQ(input.distance.size(), 9u);
   EXPECT_EQ(input.distance[0], std::min(field->distance[0], apex_copy));
   EXPECT_TRUE(std::isfinite(input.distance[0]));
-  EXPECT_EQ(e.input_ids().InputVertex(9), 0);
+  EXPECT_EQ(InputIds(e.index()).InputVertex(9), 0);
 }
 
 TEST(InputIdsTest, CubesSharingAnEdgeBuildAndAnswer) {
@@ -266,7 +278,7 @@ TEST(InputIdsTest, RefinedIndexAnswersInTheInputIds) {
   ASSERT_EQ(coarse.num_vertices(), 42);
   Built b = Build(RawOf(coarse, "sphere"), 120, /*refine=*/true);
   const QueryEngine& e = *b.engine;
-  const InputIds& ids = e.input_ids();
+  const InputIds ids(e.index());
   EXPECT_EQ(e.index().header().format_major, index::kRefinedFormatMajor);
   EXPECT_GT(e.index().refinement_vertices(), 0);
   EXPECT_GE(e.index().num_samples(), 120);
@@ -364,7 +376,7 @@ TEST(InputIdsTest, RepairedAndRefinedIndexAnswersInTheInputIds) {
   AddTriangle(&raw, {t[1], t[2], t[0]});  // input face 80, a duplicate of 7
   Built b = Build(raw, 120, /*refine=*/true);
   Built reference = Build(RawOf(coarse, "sphere"), 120, /*refine=*/true);
-  const InputIds& ids = b.engine->input_ids();
+  const InputIds ids(b.engine->index());
   EXPECT_TRUE(ids.refined());
   EXPECT_EQ(ids.num_input_faces(), 81);
   EXPECT_EQ(ids.num_input_vertices(), 42);

@@ -11,7 +11,6 @@
 #include "core/common/status_macros.h"
 #include "core/geometry/unfolding.h"
 #include "core/query/face_lift.h"
-#include "core/query/input_ids.h"
 #include "core/query/unfold_kernel.h"
 
 namespace geodex::query {
@@ -113,7 +112,6 @@ const QueryEngine::ApproxLift& QueryEngine::ApproxLiftOf(const FaceLift& fl, int
 QueryEngine::QueryEngine(std::shared_ptr<const index::Index> index, QueryOptions options)
     : index_(std::move(index)),
       options_(options),
-      input_ids_(std::make_unique<const InputIds>(*index_)),
       view_{index_->positions(), index_->faces(), index_->twins()},
       matrix_(index_->sample_distances()),
       records_(index_->vertices()),

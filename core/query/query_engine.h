@@ -51,78 +51,16 @@
 #include "core/mesh/mesh.h"
 #include "core/query/mesh_view.h"
 #include "core/query/point_locator.h"
+#include "core/query/query_types.h"
 #include "core/query/unfold_kernel.h"
 
 namespace geodex::query {
-
-using mesh::SurfacePoint;
-
-class InputIds;  // core/query/input_ids.h
 
 namespace internal {  // core/query/face_lift.h
 struct FaceLift;
 struct ApproxLift;
 struct FaceFrame;
 }  // namespace internal
-
-// How Distance and DistanceBatch answer the pairs they refine by default:
-// near pairs (points in the same or adjacent geodesic triangles) and pairs
-// that may be closer than kRefineScale * scale_length(): their O(1) distance
-// is below it, or, in a calibrated index, below it plus the error bound of
-// O(1) answers just beyond it.
-enum class NearPairs {
-  // Pure O(1): the unfolding of §5, for near pairs kept at least the
-  // straight-line distance apart (no surface path is shorter). Nothing is
-  // refined.
-  kUnfold,
-  // The length of the straightened gradient trace of p's field, and of
-  // q's when that one wraps round a vertex (Path without its restarts, so
-  // Path can be shorter): a surface path, never below the geodesic
-  // distance; O(k) in the faces it crosses. With straighten_paths off, the
-  // raw traces (longer).
-  kPath,
-  // A local exact propagation from one point that stops when it reaches the
-  // other.
-  kExact,
-};
-
-// Pairs whose O(1) distance is below this many scale lengths are refined by
-// default. The bins of §6.5's weak spot: the O(1) answer's relative error
-// grows fastest below 3L, where a trace crosses few faces.
-inline constexpr double kRefineScale = 3;
-
-// Per-call choices of Distance and DistanceBatch.
-struct DistanceOptions {
-  NearPairs near_pairs = NearPairs::kPath;
-  // Relative error tolerance. > 0: every pair whose error bound exceeds
-  // tolerance x distance is refined further, by the straightened trace and
-  // then by a local exact propagation (bound 0), so that its bound meets the
-  // tolerance. Needs the index's accuracy calibration.
-  double tolerance = 0;
-};
-
-struct QueryOptions {
-  // Straighten traced paths through the faces they cross (funnel algorithm,
-  // see path_straightening.h). Off: the raw gradient trace of §6.2.
-  bool straighten_paths = true;
-  // When > 0, Path also solves exactly (the ICH engine) inside a corridor
-  // round the traced path, the faces at most this many edge steps from the
-  // faces it crosses, and returns the exact path when it is shorter. This
-  // finds the side of a bump that a trace of the approximate field can miss;
-  // it costs a propagation over the corridor (not O(k)). 0: off.
-  int32_t exact_path_corridor = 0;
-  // The pairs the near-pair mode kPath refines first try the corridors of
-  // the chord (walked from either end, straightened), then the gradient
-  // trace; off: the trace only, as before the walk existed. Both are
-  // surface paths; the switch is for benchmarks.
-  bool walk_near_pairs = true;
-  // DistanceBatch computes far pairs four at a time with AVX2 when the CPU
-  // has it (kernel::FarDistances); off: one at a time. The answers are the
-  // same to the bit either way; the switch is for benchmarks.
-  bool vector_lanes = true;
-  // Barycentric tolerance for validation (weights >= -tol, |sum - 1| <= tol).
-  double weight_tolerance = 1e-6;
-};
 
 // Per-thread working memory for exact refinement.
 class QueryScratch {
@@ -133,23 +71,6 @@ class QueryScratch {
   friend class QueryEngine;
   std::unique_ptr<geodesic::ExactGeodesicSolver> solver_;
   const mesh::Mesh* mesh_ = nullptr;
-};
-
-// A point lifted into a geodesic triangle (see the header comment).
-struct LiftedPoint {
-  int32_t triangle = -1;
-  std::array<int32_t, 3> corner = {-1, -1, -1};
-  std::array<double, 3> distance = {0, 0, 0};
-};
-
-struct PathPoint {
-  SurfacePoint point;
-  mesh::Vec3 position;
-};
-
-struct DistanceField {
-  std::vector<double> distance;  // per vertex; +inf when unreachable or unreferenced
-  std::vector<int32_t> nearest;  // per vertex: index of the nearest source (-1 if none)
 };
 
 // QueryEngine answers approximate geodesic queries over one loaded index:
@@ -179,11 +100,9 @@ class QueryEngine {
 
   const index::Index& index() const { return *index_; }
   const QueryOptions& options() const { return options_; }
-  // The ids of the mesh file the index was built from (core/query/input_ids.h).
   // Every method below takes and returns the index's internal ids, which
-  // differ from those when the builder repaired the mesh: requests in input
-  // ids go through input_ids().ToInternal, answers back through its ToInput.
-  const InputIds& input_ids() const { return *input_ids_; }
+  // differ from the mesh file's when the builder repaired or refined it:
+  // callers in the file's ids use InputQueries (input_queries.h).
 
   // Validates a point (mesh::ValidateSurfacePoint with the index's face
   // count and QueryOptions::weight_tolerance): OutOfRange for a face id past
@@ -411,7 +330,6 @@ class QueryEngine {
 
   std::shared_ptr<const index::Index> index_;
   QueryOptions options_;
-  std::unique_ptr<const InputIds> input_ids_;
   MeshView view_;  // the index's positions, faces and twins
   std::span<const float> matrix_;
   std::span<const index::VertexRecord> records_;

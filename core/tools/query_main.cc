@@ -26,88 +26,10 @@
 #include "absl/strings/str_format.h"
 #include "core/common/status_macros.h"
 #include "core/mesh/pairs_io.h"
-#include "core/query/exp_map.h"
-#include "core/query/input_ids.h"
-#include "core/query/query_engine.h"
+#include "core/query/input_queries.h"
 
 namespace geodex {
 namespace {
-
-// The whitespace-separated numbers of `text`; nullopt when something else
-// follows them.
-std::optional<std::vector<double>> ParseNumbers(const std::string& text) {
-  std::vector<double> values;
-  const char* p = text.c_str();
-  char* next = nullptr;
-  while (true) {
-    const double v = std::strtod(p, &next);
-    if (next == p) break;
-    values.push_back(v);
-    p = next;
-  }
-  while (*p == ' ' || *p == '\t' || *p == '\r') ++p;
-  if (*p != '\0') return std::nullopt;
-  return values;
-}
-
-// Lines of `width` numbers; errors name the line.
-absl::StatusOr<std::vector<std::vector<double>>> ReadNumberLines(const std::string& path,
-                                                                 size_t width) {
-  GEODEX_ASSIGN_OR_RETURN(const std::string text, mesh::ReadFileOrStdin(path));
-  std::vector<std::vector<double>> lines;
-  size_t begin = 0;
-  int64_t number = 0;
-  while (begin < text.size()) {
-    size_t end = text.find('\n', begin);
-    if (end == std::string::npos) end = text.size();
-    const std::string line = text.substr(begin, end - begin);
-    begin = end + 1;
-    ++number;
-    if (line.find_first_not_of(" \t\r") == std::string::npos ||
-        line[line.find_first_not_of(" \t")] == '#') {
-      continue;
-    }
-    const std::optional<std::vector<double>> values = ParseNumbers(line);
-    if (!values || values->size() != width) {
-      return absl::InvalidArgumentError(
-          absl::StrFormat("line %d: expected %d numbers", number, width));
-    }
-    for (double v : *values) {
-      if (!std::isfinite(v)) {
-        return absl::InvalidArgumentError(absl::StrFormat("line %d: non-finite number", number));
-      }
-    }
-    lines.push_back(*values);
-  }
-  return lines;
-}
-
-// Validates the points (in input ids) and turns them into the index's ids.
-absl::Status CheckPairs(const query::QueryEngine& engine, std::vector<mesh::PointPair>& pairs) {
-  for (mesh::PointPair& pair : pairs) {
-    for (mesh::SurfacePoint* p : {&pair.a, &pair.b}) {
-      absl::StatusOr<mesh::SurfacePoint> internal =
-          engine.input_ids().ToInternal(*p, engine.options().weight_tolerance);
-      if (!internal.ok()) {
-        return absl::Status(internal.status().code(),
-                            absl::StrFormat("line %d: %s", pair.line, internal.status().message()));
-      }
-      *p = *internal;
-    }
-  }
-  return absl::OkStatus();
-}
-
-// "F W0 W1 W2" as a surface point.
-absl::StatusOr<mesh::SurfacePoint> ParseCentre(const std::string& text) {
-  const std::vector<double> values = ParseNumbers(text).value_or(std::vector<double>{});
-  if (values.size() != 4 || values[0] != std::floor(values[0]) ||
-      !(std::abs(values[0]) < 2147483648.0)) {
-    return absl::InvalidArgumentError(absl::StrFormat(
-        "--expmap wants \"F W0 W1 W2\" (a face id and three weights), got \"%s\"", text));
-  }
-  return mesh::SurfacePoint{static_cast<int32_t>(values[0]), {values[1], values[2], values[3]}};
-}
 
 struct Args {
   std::string expmap;
@@ -119,137 +41,197 @@ struct Args {
   int32_t exact_path_corridor = 0;
 };
 
-absl::Status Run(const Args& args) {
-  GEODEX_ASSIGN_OR_RETURN(auto index, index::Index::Open(args.index));
-  if (args.info) {
-    // The header's counts, then the builder's report (with the accuracy
-    // calibration's figures when the index has one).
-    // Vertices and faces count the mesh file's; the counts of the mesh the
-    // index answers on (repaired, refined) follow.
-    const index::FileHeader& h = index->header();
-    const query::InputIds ids(*index);
-    std::string out = absl::StrFormat(
-        "format = %d.%d\nbuilder = %s\nvertices = %d\nfaces = %d\nsamples = %d\n"
-        "requested_samples = %d\ntriangles = %d\nbytes = %d\nerror_bounds = %s\n",
-        h.format_major, h.format_minor, index->builder_version(), ids.num_input_vertices(),
-        ids.num_input_faces(), index->num_samples(), h.params.requested_samples,
-        index->num_triangles(), index->size_bytes(),
-        index->accuracy() != nullptr ? "yes" : "no (geodex-build calibrate adds them)");
-    if (!ids.identity()) {
-      out += absl::StrFormat("internal_vertices = %d\ninternal_faces = %d\n", index->num_vertices(),
-                             index->num_faces());
-    }
-    out += index->report();
-    std::fwrite(out.data(), 1, out.size(), stdout);
-    return absl::OkStatus();
+// The header's counts, then the builder's report (with the accuracy
+// calibration's figures when the index has one). Vertices and faces count
+// the mesh file's; the counts of the mesh the index answers on (repaired,
+// refined) follow.
+std::string Info(const query::InputQueries& queries) {
+  const index::Index& index = queries.index();
+  const index::FileHeader& h = index.header();
+  std::string out = absl::StrFormat(
+      "format = %d.%d\nbuilder = %s\nvertices = %d\nfaces = %d\nsamples = %d\n"
+      "requested_samples = %d\ntriangles = %d\nbytes = %d\nerror_bounds = %s\n",
+      h.format_major, h.format_minor, index.builder_version(), queries.num_vertices(),
+      queries.num_faces(), index.num_samples(), h.params.requested_samples, index.num_triangles(),
+      index.size_bytes(),
+      index.accuracy() != nullptr ? "yes" : "no (geodex-build calibrate adds them)");
+  if (!queries.identity()) {
+    out += absl::StrFormat("internal_vertices = %d\ninternal_faces = %d\n", index.num_vertices(),
+                           index.num_faces());
   }
+  return out + std::string(index.report());
+}
+
+// The pairs of `path`, read into `a` and `b`; errors name the line.
+absl::StatusOr<std::vector<mesh::PointPair>> ReadPairs(const query::InputQueries& queries,
+                                                       const std::string& path,
+                                                       query::EnginePoints* a,
+                                                       query::EnginePoints* b) {
+  GEODEX_ASSIGN_OR_RETURN(const std::string text, mesh::ReadFileOrStdin(path));
+  GEODEX_ASSIGN_OR_RETURN(std::vector<mesh::PointPair> pairs, mesh::ParsePairs(text));
+  // Both points of a line are checked before the next line's, as the
+  // errors name lines.
+  std::vector<mesh::SurfacePoint> both, pa, pb;
+  for (const mesh::PointPair& pair : pairs) {
+    both.insert(both.end(), {pair.a, pair.b});
+    pa.push_back(pair.a);
+    pb.push_back(pair.b);
+  }
+  GEODEX_RETURN_IF_ERROR(queries.Read(
+      both, [&](size_t i) { return absl::StrFormat("line %d", pairs[i / 2].line); }, a));
+  GEODEX_RETURN_IF_ERROR(queries.Read(pa, nullptr, a));
+  GEODEX_RETURN_IF_ERROR(queries.Read(pb, nullptr, b));
+  return pairs;
+}
+
+// Prefixes a status with the line of the pair it is about.
+absl::Status AtLine(const absl::Status& status, int64_t line) {
+  return absl::Status(status.code(), absl::StrFormat("line %d: %s", line, status.message()));
+}
+
+absl::StatusOr<std::string> Distances(const query::InputQueries& queries, const Args& args,
+                                      const query::DistanceOptions& options) {
+  query::EnginePoints a, b;
+  GEODEX_ASSIGN_OR_RETURN(const auto pairs, ReadPairs(queries, args.pairs, &a, &b));
+  query::QueryScratch scratch;
+  std::string out;
+  for (size_t i = 0; i < pairs.size(); ++i) {
+    double d, bound = 0;
+    if (args.baseline) {
+      d = queries.LinearInterpolationDistance(a, i, b, i);
+    } else {
+      absl::StatusOr<double> answer =
+          queries.Distance(a, i, b, i, options, &scratch, args.error_bounds ? &bound : nullptr);
+      if (!answer.ok()) return AtLine(answer.status(), pairs[i].line);
+      d = *answer;
+    }
+    out += mesh::FormatDistance(d);
+    if (args.error_bounds) out += " " + mesh::FormatDistance(bound);
+    out += "\n";
+  }
+  return out;
+}
+
+absl::StatusOr<std::string> Paths(const query::InputQueries& queries, const Args& args) {
+  query::EnginePoints a, b;
+  GEODEX_ASSIGN_OR_RETURN(const auto pairs, ReadPairs(queries, args.paths, &a, &b));
+  const bool json = args.format == "json";
+  std::string out = json ? "[\n" : "";
+  for (size_t i = 0; i < pairs.size(); ++i) {
+    absl::StatusOr<std::vector<query::PathPoint>> path =
+        queries.Path(a, i, b, i, args.exact_path_corridor);
+    if (!path.ok()) return AtLine(path.status(), pairs[i].line);
+    if (json) {
+      out += "  [";
+      for (size_t k = 0; k < path->size(); ++k) {
+        const query::PathPoint& p = (*path)[k];
+        out += absl::StrFormat(
+            "%s{\"face\": %d, \"w\": [%.17g, %.17g, %.17g], \"xyz\": [%.17g, %.17g, %.17g]}",
+            k ? ", " : "", p.point.face, p.point.w[0], p.point.w[1], p.point.w[2], p.position.x(),
+            p.position.y(), p.position.z());
+      }
+      out += i + 1 < pairs.size() ? "],\n" : "]\n";
+      continue;
+    }
+    for (const query::PathPoint& p : *path) {
+      out += absl::StrFormat("%.17g %.17g %.17g\n", p.position.x(), p.position.y(),
+                             p.position.z());
+    }
+    out += "\n";
+  }
+  return json ? out + "]\n" : out;
+}
+
+absl::StatusOr<std::string> Field(const query::InputQueries& queries, const Args& args) {
+  GEODEX_ASSIGN_OR_RETURN(const std::string text, mesh::ReadFileOrStdin(args.field));
+  GEODEX_ASSIGN_OR_RETURN(const auto lines, mesh::ParseNumberLines(text, 4));
+  std::vector<mesh::SurfacePoint> points;
+  for (const mesh::NumberLine& l : lines) {
+    const std::vector<double>& v = l.values;
+    points.push_back({static_cast<int32_t>(v[0]), {v[1], v[2], v[3]}});
+  }
+  query::EnginePoints sources;
+  GEODEX_RETURN_IF_ERROR(queries.Read(points, nullptr, &sources));
+  GEODEX_ASSIGN_OR_RETURN(const query::DistanceField field, queries.Field(sources));
+  std::string out;
+  for (size_t v = 0; v < field.distance.size(); ++v) {
+    out += mesh::FormatDistance(field.distance[v]);
+    if (args.nearest) out += absl::StrFormat(" %d", field.nearest[v]);
+    out += "\n";
+  }
+  return out;
+}
+
+absl::StatusOr<std::string> Locate(const query::InputQueries& queries, const Args& args) {
+  GEODEX_ASSIGN_OR_RETURN(const std::string text, mesh::ReadFileOrStdin(args.locate));
+  GEODEX_ASSIGN_OR_RETURN(const auto lines, mesh::ParseNumberLines(text, 3));
+  std::string out;
+  for (const mesh::NumberLine& l : lines) {
+    GEODEX_ASSIGN_OR_RETURN(const query::LocatedPoint located,
+                            queries.Locate({l.values[0], l.values[1], l.values[2]}));
+    out += absl::StrFormat("%d %.17g %.17g %.17g %.17g\n", located.point.face, located.point.w[0],
+                           located.point.w[1], located.point.w[2], located.distance);
+  }
+  return out;
+}
+
+absl::StatusOr<std::string> ExpMap(const query::InputQueries& queries, const Args& args,
+                                   const query::DistanceOptions& options) {
+  const absl::StatusOr<std::vector<mesh::NumberLine>> centre =
+      mesh::ParseNumberLines(args.expmap, 4);
+  if (!centre.ok() || centre->size() != 1 ||
+      (*centre)[0].values[0] != std::floor((*centre)[0].values[0]) ||
+      !(std::abs((*centre)[0].values[0]) < 2147483648.0)) {
+    return absl::InvalidArgumentError(absl::StrFormat(
+        "--expmap wants \"F W0 W1 W2\" (a face id and three weights), got \"%s\"", args.expmap));
+  }
+  const std::vector<double>& c = (*centre)[0].values;
+  query::ExpMapOptions map_options;
+  map_options.radius = args.radius;
+  map_options.distance = options;
+  if (!args.direction.empty()) {
+    map_options.reference_direction =
+        mesh::Vec3(args.direction[0], args.direction[1], args.direction[2]);
+  }
+  query::QueryScratch scratch;
+  GEODEX_ASSIGN_OR_RETURN(
+      const auto map,
+      queries.ExpMap({static_cast<int32_t>(c[0]), {c[1], c[2], c[3]}}, map_options, &scratch));
+  std::string out;
+  for (const query::ExpMapVertex& e : map) {
+    out += absl::StrFormat("%d %.17g %.17g\n", e.vertex, e.u, e.v);
+  }
+  return out;
+}
+
+absl::Status Run(const Args& args) {
   query::QueryOptions options;
+  options.exact_path_corridor = args.exact_path_corridor;
+  GEODEX_ASSIGN_OR_RETURN(const auto queries, query::InputQueries::Open(args.index, options));
   query::DistanceOptions distance_options;
   distance_options.near_pairs = args.exact_near || args.near_pairs == "exact"
                                     ? query::NearPairs::kExact
                                 : args.near_pairs == "unfold" ? query::NearPairs::kUnfold
                                                               : query::NearPairs::kPath;
   distance_options.tolerance = args.tolerance;
-  options.exact_path_corridor = args.exact_path_corridor;
-  GEODEX_ASSIGN_OR_RETURN(auto engine, query::QueryEngine::Create(index, options));
-  std::string out;
-  if (!args.pairs.empty() || !args.paths.empty()) {
-    const bool paths = args.pairs.empty();
-    GEODEX_ASSIGN_OR_RETURN(const std::string text,
-                            mesh::ReadFileOrStdin(paths ? args.paths : args.pairs));
-    GEODEX_ASSIGN_OR_RETURN(auto pairs, mesh::ParsePairs(text));
-    GEODEX_RETURN_IF_ERROR(CheckPairs(*engine, pairs));
-    query::QueryScratch scratch;
-    if (paths && args.format == "json") out += "[\n";
-    for (size_t i = 0; i < pairs.size(); ++i) {
-      const mesh::PointPair& pair = pairs[i];
-      if (!paths) {
-        double d, bound = 0;
-        if (args.baseline) {
-          d = engine->LinearInterpolationDistance(pair.a, pair.b);
-        } else {
-          auto answer = engine->Distance(pair.a, pair.b, distance_options, &scratch,
-                                         args.error_bounds ? &bound : nullptr);
-          if (!answer.ok()) {
-            return absl::Status(answer.status().code(), absl::StrFormat("line %d: %s", pair.line,
-                                                                        answer.status().message()));
-          }
-          d = *answer;
-        }
-        out += mesh::FormatDistance(d);
-        if (args.error_bounds) out += " " + mesh::FormatDistance(bound);
-        out += "\n";
-        continue;
-      }
-      auto path = engine->Path(pair.a, pair.b);
-      if (!path.ok()) {
-        return absl::Status(path.status().code(),
-                            absl::StrFormat("line %d: %s", pair.line, path.status().message()));
-      }
-      engine->input_ids().PathToInput(*path);
-      if (args.format == "json") {
-        out += "  [";
-        for (size_t k = 0; k < path->size(); ++k) {
-          const auto& p = (*path)[k];
-          out += absl::StrFormat(
-              "%s{\"face\": %d, \"w\": [%.17g, %.17g, %.17g], \"xyz\": [%.17g, %.17g, %.17g]}",
-              k ? ", " : "", p.point.face, p.point.w[0], p.point.w[1], p.point.w[2], p.position.x(),
-              p.position.y(), p.position.z());
-        }
-        out += i + 1 < pairs.size() ? "],\n" : "]\n";
-      } else {
-        for (const auto& p : *path) {
-          out += absl::StrFormat("%.17g %.17g %.17g\n", p.position.x(), p.position.y(),
-                                 p.position.z());
-        }
-        out += "\n";
-      }
-    }
-    if (paths && args.format == "json") out += "]\n";
+  absl::StatusOr<std::string> out;
+  if (args.info) {
+    out = Info(*queries);
+  } else if (!args.pairs.empty()) {
+    out = Distances(*queries, args, distance_options);
+  } else if (!args.paths.empty()) {
+    out = Paths(*queries, args);
   } else if (!args.field.empty()) {
-    GEODEX_ASSIGN_OR_RETURN(const auto lines, ReadNumberLines(args.field, 4));
-    std::vector<mesh::SurfacePoint> sources;
-    for (const auto& l : lines) {
-      GEODEX_ASSIGN_OR_RETURN(
-          const mesh::SurfacePoint p,
-          engine->input_ids().ToInternal({static_cast<int32_t>(l[0]), {l[1], l[2], l[3]}},
-                                         engine->options().weight_tolerance));
-      sources.push_back(p);
-    }
-    GEODEX_ASSIGN_OR_RETURN(auto field, engine->Field(sources));
-    field = engine->input_ids().FieldToInput(std::move(field));
-    for (size_t v = 0; v < field.distance.size(); ++v) {
-      out += mesh::FormatDistance(field.distance[v]);
-      if (args.nearest) out += absl::StrFormat(" %d", field.nearest[v]);
-      out += "\n";
-    }
+    out = Field(*queries, args);
   } else if (!args.locate.empty()) {
-    GEODEX_ASSIGN_OR_RETURN(const auto lines, ReadNumberLines(args.locate, 3));
-    for (const auto& l : lines) {
-      GEODEX_ASSIGN_OR_RETURN(auto located, engine->Locate({l[0], l[1], l[2]}));
-      located.point = engine->input_ids().ToInput(located.point);
-      out += absl::StrFormat("%d %.17g %.17g %.17g %.17g\n", located.point.face, located.point.w[0],
-                             located.point.w[1], located.point.w[2], located.distance);
-    }
+    out = Locate(*queries, args);
   } else if (!args.expmap.empty()) {
-    GEODEX_ASSIGN_OR_RETURN(const mesh::SurfacePoint centre, ParseCentre(args.expmap));
-    query::ExpMapOptions map_options;
-    map_options.radius = args.radius;
-    map_options.distance = distance_options;
-    if (!args.direction.empty()) {
-      map_options.reference_direction =
-          mesh::Vec3(args.direction[0], args.direction[1], args.direction[2]);
-    }
-    query::QueryScratch scratch;
-    GEODEX_ASSIGN_OR_RETURN(const auto map,
-                            query::ExpMapOfInput(*engine, centre, map_options, &scratch));
-    for (const query::ExpMapVertex& e : map) {
-      out += absl::StrFormat("%d %.17g %.17g\n", e.vertex, e.u, e.v);
-    }
+    out = ExpMap(*queries, args, distance_options);
   } else {
     return absl::InvalidArgumentError("give one of --pairs, --paths, --field, --locate, --expmap");
   }
-  std::fwrite(out.data(), 1, out.size(), stdout);
+  if (!out.ok()) return out.status();
+  std::fwrite(out->data(), 1, out->size(), stdout);
   return absl::OkStatus();
 }
 

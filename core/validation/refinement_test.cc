@@ -40,7 +40,7 @@ Measured Measure(const mesh::Mesh& coarse, int32_t m, bool refine,
   EXPECT_TRUE(index.ok()) << index.status();
   auto engine = query::QueryEngine::Create(*index);
   EXPECT_TRUE(engine.ok()) << engine.status();
-  const query::InputIds& ids = (*engine)->input_ids();
+  const query::InputIds ids((*engine)->index());
   query::DistanceOptions unfold;
   unfold.near_pairs = query::NearPairs::kUnfold;
   double sum = 0;

@@ -20,7 +20,7 @@
 #include "core/common/status_macros.h"
 #include "core/mesh/generators.h"
 #include "core/mesh/mesh_io.h"
-#include "core/query/input_ids.h"
+#include "core/query/input_queries.h"
 #include "core/validation/calibration.h"
 #include "core/validation/error_map.h"
 #include "tests/accuracy/accuracy.h"
@@ -130,17 +130,17 @@ absl::Status Measure(const Flags& flags, const std::string& label,
     query::QueryScratch scratch;
     int64_t failed = 0;
     // The pairs are in the file's ids, as a caller's are.
-    const query::InputIds& ids = engine->input_ids();
+    GEODEX_ASSIGN_OR_RETURN(const auto queries, query::InputQueries::Create(engine));
+    query::EnginePoints p, q;
     accuracy::AnswerFn answer = [&](const mesh::SurfacePoint& input_p,
                                     const mesh::SurfacePoint& input_q) {
       accuracy::Answer a;
-      const absl::StatusOr<mesh::SurfacePoint> p = ids.ToInternal(input_p);
-      const absl::StatusOr<mesh::SurfacePoint> q = ids.ToInternal(input_q);
       absl::StatusOr<double> d = absl::InternalError("no internal point");
-      if (p.ok() && q.ok()) {
-        d = mode == "trace"
-                ? engine->TracedDistance(*p, *q)
-                : engine->Distance(*p, *q, options, &scratch, bounds ? &a.bound : nullptr);
+      if (queries->Read({&input_p, 1}, nullptr, &p).ok() &&
+          queries->Read({&input_q, 1}, nullptr, &q).ok()) {
+        d = mode == "trace" ? queries->TracedDistance(p, 0, q, 0)
+                            : queries->Distance(p, 0, q, 0, options, &scratch,
+                                                bounds ? &a.bound : nullptr);
       }
       if (!d.ok()) ++failed;
       a.distance = d.value_or(std::numeric_limits<double>::quiet_NaN());

@@ -39,17 +39,19 @@ const std::string& FuzzIndexBytes() {
   return *bytes;
 }
 
-const query::QueryEngine& FuzzEngine() {
+const query::InputQueries& FuzzQueries() {
   // Held for the process, like the server's loaded model (and reachable, so
   // LeakSanitizer does not count it).
-  static const std::shared_ptr<const query::QueryEngine>* const engine = [] {
+  static const std::shared_ptr<const query::InputQueries>* const queries = [] {
     auto index = index::Index::FromBytes(FuzzIndexBytes());
     if (!index.ok()) Die(index.status());
-    auto created = query::QueryEngine::Create(*std::move(index));
+    auto engine = query::QueryEngine::Create(*std::move(index));
+    if (!engine.ok()) Die(engine.status());
+    auto created = query::InputQueries::Create(*std::move(engine));
     if (!created.ok()) Die(created.status());
-    return new std::shared_ptr<const query::QueryEngine>(*std::move(created));
+    return new std::shared_ptr<const query::InputQueries>(*std::move(created));
   }();
-  return **engine;
+  return **queries;
 }
 
 }  // namespace geodex::fuzz

@@ -7,14 +7,14 @@
 #include <memory>
 #include <string>
 
-#include "core/query/query_engine.h"
+#include "core/query/input_queries.h"
 
 namespace geodex::fuzz {
 
 // Bytes of the index (built once per process; thread-safe). Aborts on error:
 // a fuzz target cannot run without it.
 const std::string& FuzzIndexBytes();
-// An engine over FuzzIndexBytes() (built once per process; thread-safe).
-const query::QueryEngine& FuzzEngine();
+// The queries of FuzzIndexBytes() (built once per process; thread-safe).
+const query::InputQueries& FuzzQueries();
 
 }  // namespace geodex::fuzz

@@ -49,17 +49,17 @@ bool OptionsFor(const geodex::v1::DistanceRequest& request, DistanceOptions* opt
 }
 
 void FuzzDistance(const geodex::v1::DistanceRequest& request) {
-  const geodex::query::QueryEngine& engine = geodex::fuzz::FuzzEngine();
+  const geodex::query::InputQueries& queries = geodex::fuzz::FuzzQueries();
   const int64_t n = geodex::server::PointCount(request.a());
   if (n != geodex::server::PointCount(request.b())) return;
   DistanceOptions options;
   if (!OptionsFor(request, &options)) return;
-  std::vector<geodex::mesh::SurfacePoint> a, b;
-  if (!geodex::server::PointsFromProto(request.a(), "a", engine, &a).ok()) return;
-  if (!geodex::server::PointsFromProto(request.b(), "b", engine, &b).ok()) return;
+  geodex::query::EnginePoints a, b;
+  if (!geodex::server::PointsFromProto(request.a(), "a", queries, &a).ok()) return;
+  if (!geodex::server::PointsFromProto(request.b(), "b", queries, &b).ok()) return;
   geodex::v1::DistanceResponse response;
   geodex::query::QueryScratch scratch;
-  const absl::Status status = engine.DistanceBatch(
+  const absl::Status status = queries.DistanceBatch(
       a, b, geodex::server::ResizeForOutput(response.mutable_distances(), n), options, &scratch,
       request.error_bounds() ? geodex::server::ResizeForOutput(response.mutable_bounds(), n)
                              : std::span<double>());
@@ -67,23 +67,23 @@ void FuzzDistance(const geodex::v1::DistanceRequest& request) {
 }
 
 void FuzzLocate(const geodex::v1::LocateRequest& request) {
-  const geodex::query::QueryEngine& engine = geodex::fuzz::FuzzEngine();
+  const geodex::query::InputQueries& queries = geodex::fuzz::FuzzQueries();
   std::vector<geodex::mesh::Vec3> positions;
   if (!geodex::server::PositionsFromProto(request.positions(), "positions", &positions).ok()) {
     return;
   }
   geodex::v1::LocateResponse response;
   for (const geodex::mesh::Vec3& x : positions) {
-    auto located = engine.Locate(x);
+    auto located = queries.Locate(x);
     if (!located.ok()) return;
-    geodex::server::AppendLocated(engine.input_ids(), *located, &response);
+    geodex::server::AppendLocated(*located, &response);
   }
 }
 
 }  // namespace
 
 extern "C" int LLVMFuzzerInitialize(int*, char***) {
-  geodex::fuzz::FuzzEngine();  // built before the first input is timed
+  geodex::fuzz::FuzzQueries();  // built before the first input is timed
   return 0;
 }
 

@@ -1,0 +1,197 @@
+#include "core/query/input_queries.h"
+
+#include <algorithm>
+#include <array>
+#include <numbers>
+#include <unordered_map>
+#include <utility>
+
+#include "absl/strings/str_format.h"
+#include "core/common/status_macros.h"
+
+namespace geodex::query {
+
+PointName Named(std::string_view name) {
+  return [name = std::string(name)](size_t i) { return absl::StrFormat("%s[%d]", name, i); };
+}
+
+absl::StatusOr<std::shared_ptr<const InputQueries>> InputQueries::Open(const std::string& path,
+                                                                       QueryOptions options) {
+  GEODEX_ASSIGN_OR_RETURN(std::shared_ptr<const index::Index> index, index::Index::Open(path));
+  GEODEX_ASSIGN_OR_RETURN(std::shared_ptr<const QueryEngine> engine,
+                          QueryEngine::Create(std::move(index), options));
+  return Create(std::move(engine));
+}
+
+absl::StatusOr<std::shared_ptr<const InputQueries>> InputQueries::Create(
+    std::shared_ptr<const QueryEngine> engine) {
+  if (engine == nullptr) return absl::InvalidArgumentError("no engine");
+  return std::shared_ptr<const InputQueries>(new InputQueries(std::move(engine)));
+}
+
+InputQueries::InputQueries(std::shared_ptr<const QueryEngine> engine)
+    : engine_(std::move(engine)), ids_(engine_->index()) {}
+
+namespace {
+
+// `status` with the point's name in front, when it has one.
+absl::Status Prefixed(const absl::Status& status, const PointName& name, size_t i) {
+  const std::string prefix = name ? name(i) : std::string();
+  if (prefix.empty()) return status;
+  return absl::Status(status.code(), absl::StrFormat("%s: %s", prefix, status.message()));
+}
+
+}  // namespace
+
+absl::Status InputQueries::Read(std::span<const SurfacePoint> input, const PointName& name,
+                                EnginePoints* out) const {
+  out->points_.resize(input.size());
+  const double tolerance = engine_->options().weight_tolerance;
+  for (size_t i = 0; i < input.size(); ++i) {
+    absl::StatusOr<SurfacePoint> internal = ids_.ToInternal(input[i], tolerance);
+    if (!internal.ok()) return Prefixed(internal.status(), name, i);
+    out->points_[i] = *internal;
+  }
+  return absl::OkStatus();
+}
+
+absl::Status InputQueries::Read(std::span<const int32_t> faces, std::span<const double> weights,
+                                const PointName& name, EnginePoints* out) const {
+  if (weights.size() != 3 * faces.size()) {
+    return absl::InvalidArgumentError(
+        absl::StrFormat("%d points but %d weights (want %d)", faces.size(), weights.size(),
+                        3 * faces.size()));
+  }
+  out->points_.resize(faces.size());
+  const double tolerance = engine_->options().weight_tolerance;
+  for (size_t i = 0; i < faces.size(); ++i) {
+    absl::StatusOr<SurfacePoint> internal = ids_.ToInternal(
+        {faces[i], {weights[3 * i], weights[3 * i + 1], weights[3 * i + 2]}}, tolerance);
+    if (!internal.ok()) return Prefixed(internal.status(), name, i);
+    out->points_[i] = *internal;
+  }
+  return absl::OkStatus();
+}
+
+absl::Status InputQueries::DistanceBatch(const EnginePoints& a, const EnginePoints& b,
+                                         std::span<double> out, const DistanceOptions& options,
+                                         QueryScratch* scratch, std::span<double> bounds) const {
+  return engine_->DistanceBatch(a.points_, b.points_, out, options, scratch, bounds);
+}
+
+absl::StatusOr<double> InputQueries::Distance(const EnginePoints& a, size_t i,
+                                              const EnginePoints& b, size_t j,
+                                              const DistanceOptions& options,
+                                              QueryScratch* scratch, double* bound) const {
+  return engine_->Distance(a.points_.at(i), b.points_.at(j), options, scratch, bound);
+}
+
+absl::StatusOr<double> InputQueries::TracedDistance(const EnginePoints& a, size_t i,
+                                                    const EnginePoints& b, size_t j) const {
+  return engine_->TracedDistance(a.points_.at(i), b.points_.at(j));
+}
+
+absl::StatusOr<std::vector<PathPoint>> InputQueries::Path(const EnginePoints& a, size_t i,
+                                                          const EnginePoints& b, size_t j,
+                                                          int32_t exact_corridor) const {
+  GEODEX_ASSIGN_OR_RETURN(std::vector<PathPoint> path,
+                          engine_->Path(a.points_.at(i), b.points_.at(j), exact_corridor));
+  ids_.PathToInput(path);
+  return path;
+}
+
+absl::StatusOr<DistanceField> InputQueries::Field(const EnginePoints& sources) const {
+  GEODEX_ASSIGN_OR_RETURN(DistanceField field, engine_->Field(sources.points_));
+  return ids_.FieldToInput(std::move(field));
+}
+
+absl::StatusOr<std::vector<ExpMapVertex>> InputQueries::ExpMap(const SurfacePoint& centre,
+                                                               ExpMapOptions options,
+                                                               QueryScratch* scratch) const {
+  GEODEX_ASSIGN_OR_RETURN(const SurfacePoint internal,
+                          ids_.ToInternal(centre, engine_->options().weight_tolerance));
+  // A re-oriented face's normal is the input face's reversed, and its first
+  // edge another edge: give the input's first edge, and mirror θ. A piece of
+  // a refined face has other edges too.
+  const bool mirrored = ids_.Reoriented(centre.face);
+  if ((mirrored || ids_.refined()) && !options.reference_direction.has_value()) {
+    const mesh::Triangle t = ids_.InputFace(centre.face);
+    const std::span<const double> p = index().positions();
+    options.reference_direction = mesh::Vec3(p[3 * t[1]], p[3 * t[1] + 1], p[3 * t[1] + 2]) -
+                                  mesh::Vec3(p[3 * t[0]], p[3 * t[0] + 1], p[3 * t[0] + 2]);
+  }
+  GEODEX_ASSIGN_OR_RETURN(std::vector<ExpMapVertex> map,
+                          query::ExpMap(*engine_, internal, options, scratch));
+  if (ids_.identity()) return map;
+  // Midpoints of a refinement are no input vertices.
+  std::erase_if(map, [this](const ExpMapVertex& e) {
+    return ids_.InputVertex(e.vertex) == mesh::kNone;
+  });
+  for (ExpMapVertex& e : map) {
+    e.vertex = ids_.InputVertex(e.vertex);
+    if (mirrored) {
+      e.theta = e.theta == 0 || e.theta == std::numbers::pi ? e.theta : -e.theta;
+      e.v = -e.v;
+    }
+  }
+  // One entry per input vertex: the copy of smallest r.
+  std::stable_sort(map.begin(), map.end(), [](const ExpMapVertex& a, const ExpMapVertex& b) {
+    return a.vertex != b.vertex ? a.vertex < b.vertex : a.r < b.r;
+  });
+  map.erase(std::unique(
+                map.begin(), map.end(),
+                [](const ExpMapVertex& a, const ExpMapVertex& b) { return a.vertex == b.vertex; }),
+            map.end());
+  return map;
+}
+
+absl::StatusOr<LocatedPoint> InputQueries::Locate(const mesh::Vec3& x) const {
+  GEODEX_ASSIGN_OR_RETURN(LocatedPoint located, engine_->Locate(x));
+  located.point = ids_.ToInput(located.point);
+  return located;
+}
+
+std::vector<SurfacePoint> InputQueries::SamplePoints() const {
+  const index::Index& ix = index();
+  const std::span<const int32_t> samples = ix.samples();
+  // Sample vertex -> sample ids, to find a face for each in one pass over
+  // the faces (a vertex may in principle be two samples).
+  std::vector<int32_t> face_of_sample(samples.size(), -1);
+  std::unordered_multimap<int32_t, int32_t> samples_at;
+  samples_at.reserve(samples.size());
+  for (size_t i = 0; i < samples.size(); ++i) {
+    samples_at.emplace(samples[i], static_cast<int32_t>(i));
+  }
+  const std::span<const int32_t> faces = ix.faces();
+  std::vector<std::array<double, 3>> weights(samples.size(), {0, 0, 0});
+  for (int32_t f = 0; f < ix.num_faces(); ++f) {
+    for (int k = 0; k < 3; ++k) {
+      auto [begin, end] = samples_at.equal_range(faces[3 * f + k]);
+      for (auto it = begin; it != end; ++it) {
+        if (face_of_sample[it->second] >= 0) continue;
+        face_of_sample[it->second] = f;
+        weights[it->second][k] = 1;
+      }
+    }
+  }
+  std::vector<SurfacePoint> out(samples.size(), SurfacePoint{-1, {0, 0, 0}});
+  for (size_t i = 0; i < samples.size(); ++i) {
+    if (face_of_sample[i] >= 0) out[i] = ids_.ToInput({face_of_sample[i], weights[i]});
+  }
+  return out;
+}
+
+std::vector<int32_t> InputQueries::VertexTriangles() const {
+  // The copies are one point of space; any of their triangles holds it.
+  const std::span<const index::VertexRecord> records = index().vertices();
+  std::vector<int32_t> out(num_vertices());
+  for (int32_t v = 0; v < num_vertices(); ++v) out[v] = records[v].triangle;
+  for (int32_t copy = num_vertices(); copy < num_vertices() + ids_.num_vertex_copies(); ++copy) {
+    int32_t& t = out[ids_.InputVertex(copy)];
+    const int32_t c = records[copy].triangle;
+    if (c >= 0 && (t < 0 || c < t)) t = c;
+  }
+  return out;
+}
+
+}  // namespace geodex::query

@@ -1,0 +1,161 @@
+#pragma once
+
+// The queries of one index in the ids of the mesh file it was built from.
+//
+// QueryEngine answers on the index's internal mesh, whose ids differ from the
+// file's when the builder repaired or refined it (input_ids.h says how).
+// InputQueries is the one layer that speaks the file's ids: every caller that
+// takes points from a user or gives answers back (the server, geodex-query,
+// the accuracy harness, the Python bindings) goes through it, and nothing
+// else translates ids.
+//
+// Points enter once: Read validates a span of points in input ids and keeps
+// them, translated, in an EnginePoints, which the queries take. Answers that
+// name faces or vertices (paths, located points, fields, exponential maps,
+// the triangulation) come back in input ids.
+//
+//   GEODEX_ASSIGN_OR_RETURN(auto queries, query::InputQueries::Open(path));
+//   query::EnginePoints a, b;
+//   GEODEX_RETURN_IF_ERROR(queries->Read(input_a, query::Named("a"), &a));
+//   GEODEX_RETURN_IF_ERROR(queries->Read(input_b, query::Named("b"), &b));
+//   std::vector<double> d(a.size());
+//   GEODEX_RETURN_IF_ERROR(queries->DistanceBatch(a, b, d));
+//
+// Thread safety: immutable; every const method is thread-safe. Scratch space
+// is the caller's (QueryScratch, one per thread).
+
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "absl/status/statusor.h"
+#include "core/index/index.h"
+#include "core/mesh/mesh.h"
+#include "core/query/exp_map.h"
+#include "core/query/input_ids.h"
+#include "core/query/point_locator.h"
+#include "core/query/query_engine.h"
+#include "core/query/query_types.h"
+
+namespace geodex::query {
+
+// Points read by InputQueries::Read: validated, in the engine's ids. Only
+// InputQueries looks inside; callers keep them between calls (reusing one
+// avoids an allocation per batch).
+class EnginePoints {
+ public:
+  size_t size() const { return points_.size(); }
+  bool empty() const { return points_.empty(); }
+  // n copies of from's point i (a matrix row's source against its targets).
+  void AssignRepeated(const EnginePoints& from, size_t i, size_t n) {
+    points_.assign(n, from.points_.at(i));
+  }
+
+ private:
+  friend class InputQueries;
+  std::vector<SurfacePoint> points_;
+};
+
+// How Read names the i-th point in an error message ("a[17]", "line 5").
+using PointName = std::function<std::string(size_t)>;
+// "name[i]".
+PointName Named(std::string_view name);
+
+class InputQueries {
+ public:
+  // Opens the index file at `path` and makes its engine. Errors: those of
+  // index::Index::Open and QueryEngine::Create.
+  static absl::StatusOr<std::shared_ptr<const InputQueries>> Open(const std::string& path,
+                                                                  QueryOptions options = {});
+  // Over an engine, sharing it. Errors: InvalidArgument for a null engine.
+  static absl::StatusOr<std::shared_ptr<const InputQueries>> Create(
+      std::shared_ptr<const QueryEngine> engine);
+
+  const QueryEngine& engine() const { return *engine_; }
+  const index::Index& index() const { return engine_->index(); }
+
+  // The input mesh's counts: what face and vertex ids are checked against.
+  int32_t num_vertices() const { return ids_.num_input_vertices(); }
+  int32_t num_faces() const { return ids_.num_input_faces(); }
+  // True when the index answers on the file's own mesh (no repair, no
+  // refinement): input ids are internal ids.
+  bool identity() const { return ids_.identity(); }
+  // The vertices of input face `f` (in [0, num_faces())), in the file's order.
+  mesh::Triangle InputFace(int32_t f) const { return ids_.InputFace(f); }
+
+  // Validates `input` (in input ids) against the input's face count and the
+  // engine's weight tolerance and keeps it in `out`. Errors: OutOfRange for
+  // a face id past the end, InvalidArgument for NaN, infinite or negative
+  // weights or weights not summing to 1, each prefixed by the point's name
+  // ("a[17]: face id 99999 out of range [0, 5000)").
+  absl::Status Read(std::span<const SurfacePoint> input, const PointName& name,
+                    EnginePoints* out) const;
+  // The same for points given as arrays: `faces` (N) and `weights` (3N, three
+  // a point). InvalidArgument when the lengths do not match.
+  absl::Status Read(std::span<const int32_t> faces, std::span<const double> weights,
+                    const PointName& name, EnginePoints* out) const;
+
+  // Distances of pairs (a[i], b[i]) as QueryEngine::DistanceBatch, with its
+  // errors (the points are valid already).
+  absl::Status DistanceBatch(const EnginePoints& a, const EnginePoints& b, std::span<double> out,
+                             const DistanceOptions& options = {}, QueryScratch* scratch = nullptr,
+                             std::span<double> bounds = {}) const;
+  // One pair, a[i] to b[j], as QueryEngine::Distance.
+  absl::StatusOr<double> Distance(const EnginePoints& a, size_t i, const EnginePoints& b, size_t j,
+                                  const DistanceOptions& options = {},
+                                  QueryScratch* scratch = nullptr, double* bound = nullptr) const;
+  // The paper's linear-interpolation baseline (§6.3) for a[i] and b[j].
+  double LinearInterpolationDistance(const EnginePoints& a, size_t i, const EnginePoints& b,
+                                     size_t j) const {
+    return engine_->LinearInterpolationDistance(a.points_.at(i), b.points_.at(j));
+  }
+  // QueryEngine::TracedDistance of a[i] and b[j].
+  absl::StatusOr<double> TracedDistance(const EnginePoints& a, size_t i, const EnginePoints& b,
+                                        size_t j) const;
+
+  // The geodesic path from a[i] to b[j] (QueryEngine::Path with this exact
+  // corridor), its points in input faces. Errors: as QueryEngine::Path.
+  absl::StatusOr<std::vector<PathPoint>> Path(const EnginePoints& a, size_t i,
+                                              const EnginePoints& b, size_t j,
+                                              int32_t exact_corridor) const;
+
+  // The distance field of `sources` (QueryEngine::Field) per input vertex: at
+  // a vertex the repair split, the smallest distance of its copies and that
+  // copy's nearest source.
+  absl::StatusOr<DistanceField> Field(const EnginePoints& sources) const;
+
+  // The exponential map round `centre` (in input ids; validated): vertices
+  // are input vertices, ascending (a split vertex: its copy of smallest r); θ
+  // counter-clockwise about the normal of the centre's input face, θ = 0 by
+  // default along that face's first input edge. Errors: those of Read and
+  // query::ExpMap.
+  absl::StatusOr<std::vector<ExpMapVertex>> ExpMap(const SurfacePoint& centre,
+                                                   ExpMapOptions options,
+                                                   QueryScratch* scratch = nullptr) const;
+
+  // The closest surface point to `x`, in an input face.
+  absl::StatusOr<LocatedPoint> Locate(const mesh::Vec3& x) const;
+
+  // The samples of the geodesic triangulation as surface points in input
+  // ids: each in the input face kept for the lowest-numbered face using its
+  // vertex, weight 1 on that vertex (face -1 and zero weights for a sample
+  // on no face, which the builder never makes).
+  std::vector<SurfacePoint> SamplePoints() const;
+  // The input vertex each sample is (mesh::kNone for a refinement's midpoint).
+  int32_t InputVertex(int32_t internal_vertex) const { return ids_.InputVertex(internal_vertex); }
+  // Per input vertex, its geodesic triangle; for a split vertex, the
+  // smallest triangle id of its copies.
+  std::vector<int32_t> VertexTriangles() const;
+
+ private:
+  explicit InputQueries(std::shared_ptr<const QueryEngine> engine);
+
+  std::shared_ptr<const QueryEngine> engine_;
+  InputIds ids_;
+};
+
+}  // namespace geodex::query

@@ -1,0 +1,95 @@
+#pragma once
+
+// The value types of geodex's queries (core/query): how a distance is asked
+// for (DistanceOptions, NearPairs), how an engine is set up (QueryOptions),
+// and what comes back (PathPoint, DistanceField). Plain data, shared by the
+// engine (query_engine.h), its layer in input ids (input_queries.h) and the
+// id maps (input_ids.h), so that none of them needs another's header.
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "core/mesh/mesh.h"
+
+namespace geodex::query {
+
+using mesh::SurfacePoint;
+
+// How Distance and DistanceBatch answer the pairs they refine by default:
+// near pairs (points in the same or adjacent geodesic triangles) and pairs
+// that may be closer than kRefineScale * scale_length(): their O(1) distance
+// is below it, or, in a calibrated index, below it plus the error bound of
+// O(1) answers just beyond it.
+enum class NearPairs {
+  // Pure O(1): the unfolding of §5, for near pairs kept at least the
+  // straight-line distance apart (no surface path is shorter). Nothing is
+  // refined.
+  kUnfold,
+  // The length of the straightened gradient trace of p's field, and of
+  // q's when that one wraps round a vertex (Path without its restarts, so
+  // Path can be shorter): a surface path, never below the geodesic
+  // distance; O(k) in the faces it crosses. With straighten_paths off, the
+  // raw traces (longer).
+  kPath,
+  // A local exact propagation from one point that stops when it reaches the
+  // other.
+  kExact,
+};
+
+// Pairs whose O(1) distance is below this many scale lengths are refined by
+// default. The bins of §6.5's weak spot: the O(1) answer's relative error
+// grows fastest below 3L, where a trace crosses few faces.
+inline constexpr double kRefineScale = 3;
+
+// Per-call choices of Distance and DistanceBatch.
+struct DistanceOptions {
+  NearPairs near_pairs = NearPairs::kPath;
+  // Relative error tolerance. > 0: every pair whose error bound exceeds
+  // tolerance x distance is refined further, by the straightened trace and
+  // then by a local exact propagation (bound 0), so that its bound meets the
+  // tolerance. Needs the index's accuracy calibration.
+  double tolerance = 0;
+};
+
+struct QueryOptions {
+  // Straighten traced paths through the faces they cross (funnel algorithm,
+  // see path_straightening.h). Off: the raw gradient trace of §6.2.
+  bool straighten_paths = true;
+  // When > 0, Path also solves exactly (the ICH engine) inside a corridor
+  // round the traced path, the faces at most this many edge steps from the
+  // faces it crosses, and returns the exact path when it is shorter. This
+  // finds the side of a bump that a trace of the approximate field can miss;
+  // it costs a propagation over the corridor (not O(k)). 0: off.
+  int32_t exact_path_corridor = 0;
+  // The pairs the near-pair mode kPath refines first try the corridors of
+  // the chord (walked from either end, straightened), then the gradient
+  // trace; off: the trace only, as before the walk existed. Both are
+  // surface paths; the switch is for benchmarks.
+  bool walk_near_pairs = true;
+  // DistanceBatch computes far pairs four at a time with AVX2 when the CPU
+  // has it (kernel::FarDistances); off: one at a time. The answers are the
+  // same to the bit either way; the switch is for benchmarks.
+  bool vector_lanes = true;
+  // Barycentric tolerance for validation (weights >= -tol, |sum - 1| <= tol).
+  double weight_tolerance = 1e-6;
+};
+
+// A point lifted into a geodesic triangle (see the header comment).
+struct LiftedPoint {
+  int32_t triangle = -1;
+  std::array<int32_t, 3> corner = {-1, -1, -1};
+  std::array<double, 3> distance = {0, 0, 0};
+};
+
+struct PathPoint {
+  SurfacePoint point;
+  mesh::Vec3 position;
+};
+
+struct DistanceField {
+  std::vector<double> distance;  // per vertex; +inf when unreachable or unreferenced
+  std::vector<int32_t> nearest;  // per vertex: index of the nearest source (-1 if none)
+};
+
+}  // namespace geodex::query
