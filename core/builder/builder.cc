@@ -29,19 +29,6 @@ double SecondsSince(std::chrono::steady_clock::time_point start) {
 
 int ThreadCount(const BuildOptions& options) { return common::ThreadCount(options.threads); }
 
-// Vertices whose cell is `a` or one of its neighbours, in increasing order.
-std::vector<int32_t> CellVertices(const Plan& plan, const std::vector<int32_t>& neighbors_of_a,
-                                  int32_t a) {
-  std::vector<uint8_t> member(plan.num_samples(), 0);
-  member[a] = 1;
-  for (int32_t b : neighbors_of_a) member[b] = 1;
-  std::vector<int32_t> out;
-  for (int32_t v = 0; v < static_cast<int32_t>(plan.nearest.size()); ++v) {
-    if (plan.nearest[v] != kNone && member[plan.nearest[v]]) out.push_back(v);
-  }
-  return out;
-}
-
 // Merge's steps.
 
 // Sorts the rows by sample and checks there is one per sample, each with a
@@ -202,21 +189,6 @@ void Summarize(const Mesh& mesh, const Plan& plan, const SampleDistances& sample
 
 }  // namespace
 
-std::vector<std::vector<int32_t>> Plan::SampleNeighbors() const {
-  std::vector<std::vector<int32_t>> out(num_samples());
-  for (const auto& t : triangles) {
-    for (int i = 0; i < 3; ++i) {
-      out[t[i]].push_back(t[(i + 1) % 3]);
-      out[t[i]].push_back(t[(i + 2) % 3]);
-    }
-  }
-  for (auto& list : out) {
-    std::sort(list.begin(), list.end());
-    list.erase(std::unique(list.begin(), list.end()), list.end());
-  }
-  return out;
-}
-
 std::string BuildSummary::ToText() const {
   return absl::StrFormat(
       "requested_samples = %d\nsamples = %d\nrepair = %s\ntriangles = %d\n"
@@ -351,6 +323,14 @@ absl::StatusOr<index::IndexData> BuildIndexFromPlan(const Mesh& mesh, const Plan
   const double rows_seconds = SecondsSince(start);
   GEODEX_ASSIGN_OR_RETURN(index::IndexData data, Merge(mesh, plan, std::move(rows), summary));
   summary->rows_seconds = rows_seconds;
+  return data;
+}
+
+absl::StatusOr<index::IndexData> BuildPreparedIndex(const PreparedMesh& prepared,
+                                                    const BuildOptions& options,
+                                                    BuildSummary* summary) {
+  absl::StatusOr<index::IndexData> data = BuildIndex(prepared.mesh, options, summary);
+  if (data.ok()) AddRepair(prepared.record, &*data);
   return data;
 }
 

@@ -18,7 +18,6 @@
 //
 // Thread safety: functions are reentrant; a Plan is immutable once made.
 
-#include <array>
 #include <cstdint>
 #include <functional>
 #include <span>
@@ -26,9 +25,10 @@
 #include <vector>
 
 #include "absl/status/statusor.h"
+#include "core/builder/mesh_arrays.h"
+#include "core/builder/plan.h"
 #include "core/index/index.h"
 #include "core/mesh/mesh.h"
-#include "core/triangulation/geodesic_triangulation.h"
 
 namespace geodex::builder {
 
@@ -58,27 +58,6 @@ struct BuildOptions {
   std::vector<double> spacing_weight;
   // Called from builder threads (serialised by the builder) as work advances.
   std::function<void(const Progress&)> progress;
-};
-
-struct Plan {
-  uint64_t mesh_hash = 0;
-  int32_t requested_samples = 0;
-  uint64_t seed = 0;
-  std::vector<int32_t> samples;  // vertex of each sample
-  std::vector<int32_t> nearest;  // Voronoi cell (sample) of each vertex, kNone if unreferenced
-  std::vector<std::array<int32_t, 3>> triangles;
-  std::vector<std::array<int32_t, 3>> neighbors;
-  triangulation::RepairReport repair;
-  triangulation::EdgeStats edge_stats;  // of the final geodesic edges
-  // The final geodesic edges when traced. Only in the process that made the
-  // plan: the work directory keeps edge_stats, not the paths.
-  std::vector<triangulation::GeodesicEdge> edges;
-  double sampling_seconds = 0;
-  double triangulation_seconds = 0;
-
-  int32_t num_samples() const { return static_cast<int32_t>(samples.size()); }
-  // Samples adjacent to `a` in the triangulation, sorted.
-  std::vector<std::vector<int32_t>> SampleNeighbors() const;
 };
 
 // Exact distances computed from one sample.
@@ -158,6 +137,12 @@ absl::StatusOr<index::IndexData> BuildIndex(const mesh::Mesh& mesh, const BuildO
                                             BuildSummary* summary);
 // The rows and merge phases in one process, for a plan already made.
 absl::StatusOr<index::IndexData> BuildIndexFromPlan(const mesh::Mesh& mesh, const Plan& plan,
+                                                    const BuildOptions& options,
+                                                    BuildSummary* summary);
+
+// BuildIndex on `prepared.mesh` with `prepared.record` added (AddRepair): the
+// index a whole geodex-build makes, before its calibration.
+absl::StatusOr<index::IndexData> BuildPreparedIndex(const PreparedMesh& prepared,
                                                     const BuildOptions& options,
                                                     BuildSummary* summary);
 

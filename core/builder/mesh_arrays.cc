@@ -87,12 +87,4 @@ absl::StatusOr<PreparedMesh> PrepareMesh(const mesh::Mesh& coarse, RepairRecord 
   return PreparedMesh{std::move(refinement->mesh), std::move(repair)};
 }
 
-absl::StatusOr<index::IndexData> BuildPreparedIndex(const PreparedMesh& prepared,
-                                                    const BuildOptions& options,
-                                                    BuildSummary* summary) {
-  absl::StatusOr<index::IndexData> data = BuildIndex(prepared.mesh, options, summary);
-  if (data.ok()) AddRepair(prepared.record, &*data);
-  return data;
-}
-
 }  // namespace geodex::builder

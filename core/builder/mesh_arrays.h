@@ -9,7 +9,6 @@
 #include <vector>
 
 #include "absl/status/statusor.h"
-#include "core/builder/builder.h"
 #include "core/index/index.h"
 #include "core/mesh/flat_refinement.h"
 #include "core/mesh/mesh.h"
@@ -69,11 +68,5 @@ struct PreparedMesh {
 };
 absl::StatusOr<PreparedMesh> PrepareMesh(const mesh::Mesh& coarse, RepairRecord repair,
                                          int32_t num_samples, bool refine);
-
-// BuildIndex on `prepared.mesh` with `prepared.record` added (AddRepair): the
-// index a whole geodex-build makes, before its calibration.
-absl::StatusOr<index::IndexData> BuildPreparedIndex(const PreparedMesh& prepared,
-                                                    const BuildOptions& options,
-                                                    BuildSummary* summary);
 
 }  // namespace geodex::builder

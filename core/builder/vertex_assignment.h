@@ -17,7 +17,7 @@
 #include <vector>
 
 #include "absl/functional/function_ref.h"
-#include "core/builder/builder.h"
+#include "core/builder/plan.h"
 #include "core/index/index_format.h"
 #include "core/mesh/mesh.h"
 

@@ -1,0 +1,98 @@
+#pragma once
+
+// The geodex-build job as library calls; core/tools/build_main.cc is only
+// their command line.
+//
+//   BuildIndexFile      mesh -> repair -> flat refinement -> plan -> rows ->
+//                       merge -> calibration -> index file; to a fixed sample
+//                       count, or to a target error in rounds
+//   PlanBuild           the distributed build's step 1 (work directory, workdir.h)
+//   ComputeShardRows    step 2, one shard of the rows
+//   MergeBuild          step 3, the index
+//   CalibrateIndexFile  the calibration of an index built without it
+//
+// Each returns the report geodex-build prints on stdout, or the first error.
+// Errors: InvalidArgument for bad input (an unknown built-in mesh, a mesh the
+// repair refuses or --strict refuses, a malformed shard, an index of another
+// mesh), NotFound for a missing file, and the errors of the phases they run
+// (builder.h, workdir.h, core/validation/calibration.h).
+//
+// This unit is its own CMake target above geodex_builder and
+// geodex_validation: the calibration measures an index with the query
+// engine, which the builder proper does not link.
+//
+// Thread safety: reentrant; concurrent calls must not share output paths or
+// work directories.
+
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <string_view>
+#include <utility>
+
+#include "absl/status/statusor.h"
+#include "core/builder/builder.h"
+#include "core/mesh/mesh_repair.h"
+
+namespace geodex::builder {
+
+struct PipelineOptions {
+  // m (the first round's with a target error), seed, threads, the flat
+  // refinement, progress.
+  BuildOptions build;
+  // How the input mesh is repaired (strict: refused instead).
+  mesh::RepairOptions repair;
+  // Measure the index against held-out exact propagations and store its
+  // error bounds (core/validation/calibration.h).
+  bool calibrate = true;
+  // > 0: build until the held-out error meets this target
+  // (core/validation/target_error.h); 0: build build.num_samples samples.
+  double target_error = 0;
+  // With a target error: the cap on m (0: the default cap).
+  int32_t max_samples = 0;
+  // Also write the geodesic Delaunay edges as OBJ polylines here.
+  std::string edges_obj;
+  // Lines for the user about the rounds of a target-error build (stderr in
+  // geodex-build); may be empty.
+  std::function<void(const std::string&)> log;
+};
+
+struct BuildReport {
+  std::string text;  // what geodex-build prints on stdout, line by line
+  int32_t num_samples = 0;
+  uint64_t index_bytes = 0;
+};
+
+// The mesh at `path` (.obj/.ply/.off, or builtin:NAME for a generated demo
+// mesh: torus, sphere, cube, double-torus), repaired as `options` says.
+absl::StatusOr<mesh::RepairedMesh> LoadBuildInput(const std::string& path,
+                                                  const mesh::RepairOptions& options);
+
+// The whole build in one process: writes the index of `mesh_path` to `out`.
+absl::StatusOr<BuildReport> BuildIndexFile(const std::string& mesh_path, const std::string& out,
+                                           const PipelineOptions& options);
+
+// Step 1 of the distributed build: the (repaired, refined) mesh, its plan and
+// the repair record into `workdir`.
+absl::StatusOr<BuildReport> PlanBuild(const std::string& mesh_path, const std::string& workdir,
+                                      const PipelineOptions& options);
+
+// "I/N" with 0 <= I < N. Errors: InvalidArgument.
+absl::StatusOr<std::pair<int32_t, int32_t>> ParseShard(std::string_view text);
+
+// Step 2: the rows of shard `shard` ("I/N") of the plan in `workdir`.
+absl::StatusOr<BuildReport> ComputeShardRows(const std::string& workdir, std::string_view shard,
+                                             const PipelineOptions& options);
+
+// Step 3: the index of `workdir` (its plan and every shard's rows) to `out`.
+absl::StatusOr<BuildReport> MergeBuild(const std::string& workdir, const std::string& out,
+                                       const PipelineOptions& options);
+
+// Adds the calibration to `index_path`, built from `mesh_path` (refined again
+// as the builder did; the mesh hash must match), and writes it to `out`.
+absl::StatusOr<BuildReport> CalibrateIndexFile(const std::string& mesh_path,
+                                               const std::string& index_path,
+                                               const std::string& out,
+                                               const PipelineOptions& options);
+
+}  // namespace geodex::builder
