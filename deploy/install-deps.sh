@@ -26,6 +26,7 @@ BUILD_PACKAGES=(
   build-essential cmake ninja-build pkg-config
   libabsl-dev libeigen3-dev libspdlog-dev libfmt-dev
   libtinyobjloader-dev libcli11-dev libxxhash-dev
+  libtinygltf-dev     # the glTF reader (core/mesh/mesh_io_gltf.cc)
   libprotobuf-dev protobuf-compiler libgrpc++-dev protobuf-compiler-grpc
   prometheus-cpp-dev
   libcpp-httplib-dev  # the HTTP server of `geodex web`

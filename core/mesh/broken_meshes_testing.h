@@ -159,6 +159,45 @@ inline RawMesh MobiusStrip(int n = 24) {
   return raw;
 }
 
+// Two flat square sheets, [-1, 1]^2 in the planes y = 0 (sheet A) and x = 0
+// (sheet B), each a (2n+1) x (2n+1) grid of right triangles, crossing along
+// the z axis and sharing only the vertices a = 0 (the origin) and b = 1
+// (0, 0, 1/n): edge (a, b) has four faces, two a->b and two b->a, in the
+// angular order a->b, a->b, b->a, b->a round it (sheet B turned by
+// `flip_second` gives a->b, b->a, b->a, a->b). Elsewhere on the axis each
+// sheet has vertices of its own at the same positions. A scan that passes
+// through itself looks like this. Faces of sheet A come first.
+inline RawMesh TwoSheetsCrossingAlongAnEdge(int n, bool flip_second = false) {
+  RawMesh raw;
+  raw.name = "crossing sheets";
+  AddVertex(&raw, Vec3(0, 0, 0));
+  AddVertex(&raw, Vec3(0, 0, 1.0 / n));
+  for (int sheet = 0; sheet < 2; ++sheet) {
+    const Vec3 across = sheet == 0 ? Vec3(1, 0, 0) : Vec3(0, 1, 0);
+    std::vector<std::vector<int32_t>> id(2 * n + 1, std::vector<int32_t>(2 * n + 1));
+    for (int i = -n; i <= n; ++i) {
+      for (int j = -n; j <= n; ++j) {
+        const bool shared = i == 0 && (j == 0 || j == 1);
+        id[i + n][j + n] = shared ? j
+                                  : AddVertex(&raw, (static_cast<double>(i) / n) * across +
+                                                        Vec3(0, 0, static_cast<double>(j) / n));
+      }
+    }
+    const bool flip = sheet == 1 && flip_second;
+    for (int i = 0; i < 2 * n; ++i) {
+      for (int j = 0; j < 2 * n; ++j) {
+        // Counter-clockwise seen from +y (sheet A) or -x (sheet B): the face
+        // on the +across side of the axis runs up it (a -> b).
+        const int32_t p00 = id[i][j], p10 = id[i + 1][j], p01 = id[i][j + 1],
+                      p11 = id[i + 1][j + 1];
+        AddTriangle(&raw, flip ? Triangle{p00, p10, p11} : Triangle{p00, p11, p10});
+        AddTriangle(&raw, flip ? Triangle{p00, p11, p01} : Triangle{p00, p01, p11});
+      }
+    }
+  }
+  return raw;
+}
+
 // A flat n x n grid of the unit square whose face `face` is split along its
 // first edge (a, c) at the edge's midpoint b, with the zero-area triangle
 // (a, c, b) between it and its neighbour across that edge: the new

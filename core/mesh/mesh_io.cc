@@ -1,5 +1,5 @@
 // LoadMeshFile: picks the reader by extension (mesh_io_obj.cc, mesh_io_ply.cc,
-// mesh_io_off.cc).
+// mesh_io_off.cc, mesh_io_stl.cc, mesh_io_gltf.cc).
 
 #include "core/mesh/mesh_io.h"
 
@@ -27,7 +27,7 @@ std::string Extension(const std::string& path) {
 
 }  // namespace
 
-absl::StatusOr<RawMesh> LoadRawMeshFile(const std::string& path) {
+absl::StatusOr<RawMesh> LoadRawMeshFile(const std::string& path, const ReadOptions& options) {
   const std::string extension = Extension(path);
   absl::StatusOr<RawMesh> (*parse)(std::string_view, const std::string&) = nullptr;
   if (extension == "obj") {
@@ -36,12 +36,26 @@ absl::StatusOr<RawMesh> LoadRawMeshFile(const std::string& path) {
     parse = &ParsePlyTriangles;
   } else if (extension == "off") {
     parse = &ParseOffTriangles;
-  } else {
+  } else if (extension != "stl" && extension != "gltf" && extension != "glb") {
+    return absl::InvalidArgumentError(
+        absl::StrFormat("%s: unknown mesh file extension '%s' (expected .obj, .ply, .off, .stl, "
+                        ".gltf or .glb)",
+                        path, extension));
+  }
+  GEODEX_RETURN_IF_ERROR(ValidateWeldTolerance(options.weld_tolerance));
+  if (parse != nullptr && options.weld_tolerance != 0) {
     return absl::InvalidArgumentError(absl::StrFormat(
-        "%s: unknown mesh file extension '%s' (expected .obj, .ply or .off)", path, extension));
+        "%s: a weld tolerance applies to STL and glTF files, whose corners name no vertices; "
+        ".%s files name theirs",
+        path, extension));
   }
   GEODEX_ASSIGN_OR_RETURN(const std::string contents, ReadWholeFile(path));
-  return parse(contents, path);
+  if (parse != nullptr) return parse(contents, path);
+  if (extension == "stl") return ParseStlTriangles(contents, path, options);
+  // External buffers are named relative to the glTF file.
+  const size_t slash = path.find_last_of('/');
+  const std::string base_dir = slash == std::string::npos ? "." : path.substr(0, slash + 1);
+  return ParseGltfTriangles(contents, path, base_dir, options);
 }
 
 absl::StatusOr<LoadedMesh> CreateLoadedMesh(RawMesh raw) {
@@ -58,8 +72,8 @@ absl::StatusOr<LoadedMesh> CreateLoadedMesh(RawMesh raw) {
   return LoadedMesh{*std::move(mesh), std::move(raw.input_face)};
 }
 
-absl::StatusOr<LoadedMesh> LoadMeshFile(const std::string& path) {
-  GEODEX_ASSIGN_OR_RETURN(RawMesh raw, LoadRawMeshFile(path));
+absl::StatusOr<LoadedMesh> LoadMeshFile(const std::string& path, const ReadOptions& options) {
+  GEODEX_ASSIGN_OR_RETURN(RawMesh raw, LoadRawMeshFile(path, options));
   return CreateLoadedMesh(std::move(raw));
 }
 
@@ -78,8 +92,8 @@ absl::StatusOr<LoadedMesh> ParseOff(std::string_view contents, const std::string
   return CreateLoadedMesh(std::move(raw));
 }
 
-absl::StatusOr<Mesh> LoadMesh(const std::string& path) {
-  GEODEX_ASSIGN_OR_RETURN(LoadedMesh loaded, LoadMeshFile(path));
+absl::StatusOr<Mesh> LoadMesh(const std::string& path, const ReadOptions& options) {
+  GEODEX_ASSIGN_OR_RETURN(LoadedMesh loaded, LoadMeshFile(path, options));
   return std::move(loaded.mesh);
 }
 

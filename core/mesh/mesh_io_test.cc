@@ -659,7 +659,7 @@ TEST(MeshFileTest, MissingFileIsNotFound) {
 }
 
 TEST(MeshFileTest, UnknownExtensionIsInvalidArgument) {
-  for (const std::string path : {"mesh.stl", "mesh", "dir.obj/mesh"}) {
+  for (const std::string path : {"mesh.3ds", "mesh", "dir.obj/mesh"}) {
     const absl::StatusOr<Mesh> loaded = LoadMesh(path);
     EXPECT_EQ(loaded.status().code(), absl::StatusCode::kInvalidArgument) << path;
     EXPECT_THAT(std::string(loaded.status().message()), HasSubstr("unknown mesh file extension"))

@@ -66,48 +66,134 @@ struct Soup {
   int32_t Opposite(int32_t h) const { return tri(h / 3)[(h % 3 + 2) % 3]; }
 };
 
-// Pairs the half-edges of one non-manifold edge (a, b), a < b, in *mate.
-// Ordered by angle round a->b, a face that runs b->a followed
-// counter-clockwise by one that runs a->b encloses, with their orientations,
-// the inside of a solid between them (a face's normal points
-// counter-clockwise round a->b when it runs a->b): they are one sheet.
-// Returns how many copies the edge becomes (pairs and single faces).
-int32_t PairRoundEdge(const Soup& soup, std::span<const int32_t> halfedges,
-                      std::vector<int32_t>* mate) {
+// Pairs the half-edges of one non-manifold edge (a, b), a < b, in *mate,
+// with the faces oriented as `flip` says. Ordered by angle round a->b, a
+// face that runs b->a followed counter-clockwise by one that runs a->b
+// encloses, with their orientations, the inside of a solid between them (a
+// face's normal points counter-clockwise round a->b when it runs a->b): they
+// are one sheet. Both directions follow the orientation, so every pair made
+// agrees with `flip`.
+void PairRoundEdge(const Soup& soup, std::span<const int32_t> halfedges,
+                   const std::vector<uint8_t>& flip, std::vector<int32_t>* mate) {
   const auto& positions = soup.raw->positions;
   const int32_t a = std::min(soup.Origin(halfedges[0]), soup.Dest(halfedges[0]));
   const int32_t b = std::max(soup.Origin(halfedges[0]), soup.Dest(halfedges[0]));
   const Vec3 e = positions[b] - positions[a];
   const int n = static_cast<int>(halfedges.size());
-  if (e.norm() > 0) {
-    const Vec3 axis = e.normalized();
-    std::vector<Vec3> across(n);  // the face's direction away from the edge
-    Vec3 x = Vec3::Zero();
-    for (int i = 0; i < n; ++i) {
-      const Vec3 u = positions[soup.Opposite(halfedges[i])] - positions[a];
-      across[i] = u - u.dot(axis) * axis;
-      if (x.isZero() && across[i].norm() > 0) x = across[i].normalized();
-    }
-    const Vec3 y = axis.cross(x);
-    std::vector<std::pair<double, int32_t>> order(n);
-    for (int i = 0; i < n; ++i) {
-      double angle = std::atan2(across[i].dot(y), across[i].dot(x));
-      if (angle < 0) angle += 2 * std::numbers::pi;
-      order[i] = {angle, halfedges[i]};
-    }
-    std::sort(order.begin(), order.end());
-    for (int i = 0; i < n; ++i) {
-      const int32_t h = order[i].second, g = order[(i + 1) % n].second;
-      if ((*mate)[h] != kNone || (*mate)[g] != kNone || h == g) continue;
-      if (soup.Origin(h) == b && soup.Origin(g) == a) {
-        (*mate)[h] = g;
-        (*mate)[g] = h;
-      }
+  if (!(e.norm() > 0)) return;  // no direction to order the faces round
+  const Vec3 axis = e.normalized();
+  std::vector<Vec3> across(n);  // the face's direction away from the edge
+  Vec3 x = Vec3::Zero();
+  for (int i = 0; i < n; ++i) {
+    const Vec3 u = positions[soup.Opposite(halfedges[i])] - positions[a];
+    across[i] = u - u.dot(axis) * axis;
+    if (x.isZero() && across[i].norm() > 0) x = across[i].normalized();
+  }
+  const Vec3 y = axis.cross(x);
+  std::vector<std::pair<double, int32_t>> order(n);
+  for (int i = 0; i < n; ++i) {
+    double angle = std::atan2(across[i].dot(y), across[i].dot(x));
+    if (angle < 0) angle += 2 * std::numbers::pi;
+    order[i] = {angle, halfedges[i]};
+  }
+  std::sort(order.begin(), order.end());
+  auto runs_from = [&](int32_t h) { return flip[h / 3] ? soup.Dest(h) : soup.Origin(h); };
+  for (int i = 0; i < n; ++i) {
+    const int32_t h = order[i].second, g = order[(i + 1) % n].second;
+    if ((*mate)[h] != kNone || (*mate)[g] != kNone || h == g) continue;
+    if (runs_from(h) == b && runs_from(g) == a) {
+      (*mate)[h] = g;
+      (*mate)[g] = h;
     }
   }
-  int32_t copies = 0;
-  for (int32_t h : halfedges) copies += (*mate)[h] == kNone || (*mate)[h] > h ? 1 : 0;
-  return copies;
+}
+
+// The corner of kept triangle k at input vertex v (one of its corners).
+int CornerAt(const Soup& soup, int32_t k, int32_t v) {
+  const Triangle& t = soup.tri(k);
+  return t[0] == v ? 0 : t[1] == v ? 1 : 2;
+}
+
+// The fans of the kept triangles' corners (corner 3k+c: corner c of kept
+// triangle k, input order): two corners at one vertex are in one fan when a
+// chain of paired edges round the vertex joins them.
+DisjointSets Fans(const Soup& soup, const std::vector<int32_t>& mate) {
+  const int32_t nh = static_cast<int32_t>(mate.size());
+  DisjointSets fans(nh);
+  for (int32_t h = 0; h < nh; ++h) {
+    const int32_t g = mate[h];
+    if (g == kNone || g < h) continue;
+    const int32_t kh = h / 3, kg = g / 3;
+    fans.Union(h, 3 * kg + CornerAt(soup, kg, soup.Origin(h)));
+    fans.Union(3 * kh + (h % 3 + 1) % 3, 3 * kg + CornerAt(soup, kg, soup.Dest(h)));
+  }
+  return fans;
+}
+
+// The half-edges in order of the two fans they join (their vertices once
+// split), with the bounds of each run of one pair of fans.
+struct FanEdges {
+  std::vector<int32_t> order;
+  std::vector<int32_t> run_begin;  // runs [run_begin[r], run_begin[r + 1])
+};
+
+FanEdges GroupByFans(const std::vector<int32_t>& mate, DisjointSets& fans) {
+  const int32_t nh = static_cast<int32_t>(mate.size());
+  std::vector<std::pair<int64_t, int32_t>> keyed(nh);
+  for (int32_t h = 0; h < nh; ++h) {
+    const int64_t u = fans.Find(h), w = fans.Find(h - h % 3 + (h % 3 + 1) % 3);
+    keyed[h] = {std::min(u, w) * nh + std::max(u, w), h};
+  }
+  std::sort(keyed.begin(), keyed.end());
+  FanEdges out;
+  out.order.resize(nh);
+  for (int32_t i = 0; i < nh; ++i) {
+    out.order[i] = keyed[i].second;
+    if (i == 0 || keyed[i].first != keyed[i - 1].first) out.run_begin.push_back(i);
+  }
+  out.run_begin.push_back(nh);
+  return out;
+}
+
+// Makes every copy of an edge join its own two vertices once vertices are
+// split by fans. The pairing round non-manifold edges can leave two copies
+// whose faces still meet round both ends (two sheets crossing along the edge,
+// paired across the sheets): the edge would join the same two vertices
+// twice. Such copies are undone; then two unpaired half-edges that join the
+// same two fans are the two ends of those fans (a fan has at most two free
+// edges) and, the fans being consistently oriented, run in opposite
+// directions: they are paired, which closes both fans and changes no vertex.
+// Cuts only split fans, so one round of cuts and one of pairings is enough.
+void SeparateCopies(const Soup& soup, const std::vector<uint8_t>& flip,
+                    std::vector<int32_t>* mate) {
+  std::vector<int32_t>& m = *mate;
+  DisjointSets fans = Fans(soup, m);
+  FanEdges runs = GroupByFans(m, fans);
+  bool cut = false;
+  for (size_t r = 0; r + 1 < runs.run_begin.size(); ++r) {
+    const int32_t begin = runs.run_begin[r], end = runs.run_begin[r + 1];
+    if (end - begin <= 2) continue;
+    for (int32_t i = begin; i < end; ++i) {
+      const int32_t h = runs.order[i];
+      if (m[h] == kNone) continue;
+      m[m[h]] = kNone;
+      m[h] = kNone;
+      cut = true;
+    }
+  }
+  if (cut) {
+    fans = Fans(soup, m);
+    runs = GroupByFans(m, fans);
+  }
+  auto runs_from = [&](int32_t h) { return flip[h / 3] ? soup.Dest(h) : soup.Origin(h); };
+  for (size_t r = 0; r + 1 < runs.run_begin.size(); ++r) {
+    const int32_t begin = runs.run_begin[r], end = runs.run_begin[r + 1];
+    if (end - begin != 2) continue;
+    const int32_t h = runs.order[begin], g = runs.order[begin + 1];
+    if (m[h] != kNone || m[g] != kNone || runs_from(h) == runs_from(g)) continue;
+    m[h] = g;
+    m[g] = h;
+  }
 }
 
 // Checks what cannot be repaired, as Mesh::Create does and with its
@@ -199,9 +285,11 @@ void DropDuplicates(const RawMesh& raw, Soup* soup, std::vector<int32_t>* group_
   }
 }
 
-// Pairs the half-edges of the kept triangles into edges (mate[h], kNone on a
-// boundary), cutting non-manifold edges.
-std::vector<int32_t> PairHalfedges(const Soup& soup, RepairReport* report) {
+// Pairs the half-edges of the kept triangles on edges of exactly two faces
+// (mate[h], kNone otherwise) and lists the half-edges of each non-manifold
+// edge (more than two faces) in *nonmanifold.
+std::vector<int32_t> PairManifoldEdges(const Soup& soup,
+                                       std::vector<std::vector<int32_t>>* nonmanifold) {
   const int32_t nh = 3 * static_cast<int32_t>(soup.kept.size());
   auto key = [&](int32_t h) {
     const int64_t a = soup.Origin(h), b = soup.Dest(h);
@@ -221,9 +309,7 @@ std::vector<int32_t> PairHalfedges(const Soup& soup, RepairReport* report) {
       mate[order[i]] = order[i + 1];
       mate[order[i + 1]] = order[i];
     } else if (j - i > 2) {
-      ++report->nonmanifold_edges;
-      report->edge_copies +=
-          PairRoundEdge(soup, std::span<const int32_t>(order.data() + i, j - i), &mate);
+      nonmanifold->emplace_back(order.begin() + i, order.begin() + j);
     }
     i = j;
   }
@@ -232,10 +318,9 @@ std::vector<int32_t> PairHalfedges(const Soup& soup, RepairReport* report) {
 
 // Chooses which kept triangles to flip so that paired half-edges run in
 // opposite directions, keeping in each connected part the orientation most
-// of its faces have. Errors: InvalidArgument when the surface is not
-// orientable.
-absl::StatusOr<std::vector<uint8_t>> Orient(const Soup& soup, const std::vector<int32_t>& mate,
-                                            RepairReport* report) {
+// of its faces have (the lowest face's on a tie). Errors: InvalidArgument
+// when no orientation agrees across every paired edge.
+absl::StatusOr<std::vector<uint8_t>> Orient(const Soup& soup, const std::vector<int32_t>& mate) {
   const int32_t nk = static_cast<int32_t>(soup.kept.size());
   std::vector<int8_t> flip(nk, -1);
   std::vector<int32_t> part;
@@ -267,9 +352,7 @@ absl::StatusOr<std::vector<uint8_t>> Orient(const Soup& soup, const std::vector<
     for (int32_t k : part) flipped += flip[k];
     if (2 * flipped > static_cast<int32_t>(part.size())) {
       for (int32_t k : part) flip[k] ^= 1;
-      flipped = static_cast<int32_t>(part.size()) - flipped;
     }
-    report->reoriented_faces += flipped;
   }
   return std::vector<uint8_t>(flip.begin(), flip.end());
 }
@@ -277,25 +360,38 @@ absl::StatusOr<std::vector<uint8_t>> Orient(const Soup& soup, const std::vector<
 }  // namespace
 
 std::string RepairReport::Summary() const {
-  return absl::StrCat(Count(nonmanifold_vertices, "non-manifold vertex", "non-manifold vertices"),
-                      " split (", Count(vertex_copies, "copy", "copies"), "), ",
-                      Count(nonmanifold_edges, "non-manifold edge", "non-manifold edges"), " cut (",
-                      Count(edge_copies, "copy", "copies"), "), ",
-                      Count(duplicate_faces, "duplicate face", "duplicate faces"), " dropped, ",
-                      Count(reoriented_faces, "face", "faces"), " re-oriented, ",
-                      Count(unreferenced_vertices, "unreferenced vertex", "unreferenced vertices"),
-                      " ignored, ", Count(zero_area_faces, "zero-area face", "zero-area faces"),
-                      " and ", Count(sliver_faces, "sliver", "slivers"), " kept");
+  std::string out =
+      absl::StrCat(Count(nonmanifold_vertices, "non-manifold vertex", "non-manifold vertices"),
+                   " split (", Count(vertex_copies, "copy", "copies"), "), ",
+                   Count(nonmanifold_edges, "non-manifold edge", "non-manifold edges"), " cut (",
+                   Count(edge_copies, "copy", "copies"), "), ",
+                   Count(duplicate_faces, "duplicate face", "duplicate faces"), " dropped, ",
+                   Count(reoriented_faces, "face", "faces"), " re-oriented, ",
+                   Count(unreferenced_vertices, "unreferenced vertex", "unreferenced vertices"),
+                   " ignored, ", Count(zero_area_faces, "zero-area face", "zero-area faces"),
+                   " and ", Count(sliver_faces, "sliver", "slivers"), " kept");
+  if (weld.welded) {
+    absl::StrAppend(&out, "; ", weld.welded_corners,
+                    weld.welded_corners == 1 ? " corner welded" : " corners welded");
+  }
+  return out;
 }
 
 std::string RepairReport::ToText() const {
-  return absl::StrFormat(
+  std::string out = absl::StrFormat(
       "mesh_repairs = %s\nmesh_nonmanifold_vertices_split = %d\nmesh_nonmanifold_vertex_copies = "
       "%d\nmesh_nonmanifold_edges_cut = %d\nmesh_nonmanifold_edge_copies = %d\n"
       "mesh_duplicate_faces_dropped = %d\nmesh_faces_reoriented = %d\n"
       "mesh_unreferenced_vertices = %d\nmesh_zero_area_faces = %d\nmesh_sliver_faces = %d\n",
       Summary(), nonmanifold_vertices, vertex_copies, nonmanifold_edges, edge_copies,
       duplicate_faces, reoriented_faces, unreferenced_vertices, zero_area_faces, sliver_faces);
+  if (weld.welded) {
+    absl::StrAppendFormat(&out,
+                          "mesh_welded_corners = %d\nmesh_weld_tolerance = %.17g\n"
+                          "mesh_degenerate_corners_unwelded = %d\n",
+                          weld.welded_corners, weld.tolerance, weld.degenerate_corners);
+  }
+  return out;
 }
 
 absl::StatusOr<RepairedMesh> RepairMesh(RawMesh raw, const RepairOptions& options) {
@@ -308,44 +404,53 @@ absl::StatusOr<RepairedMesh> RepairMesh(RawMesh raw, const RepairOptions& option
     return static_cast<int32_t>(std::count(used.begin(), used.end(), 0));
   };
   if (options.strict) {
+    const WeldReport weld = raw.weld;
     GEODEX_ASSIGN_OR_RETURN(LoadedMesh loaded, CreateLoadedMesh(std::move(raw)));
-    return WithoutRepairs(std::move(loaded.mesh));
+    RepairedMesh out = WithoutRepairs(std::move(loaded.mesh));
+    out.report.weld = weld;
+    return out;
   }
   RepairReport report;
   GEODEX_RETURN_IF_ERROR(CheckUnrepairable(raw, &report));
   report.unreferenced_vertices = count_unreferenced(raw.triangles);
 
+  report.weld = raw.weld;
+
   Soup soup{&raw, {}};
   std::vector<int32_t> group_keeper;
   DropDuplicates(raw, &soup, &group_keeper, &report);
-  const std::vector<int32_t> mate = PairHalfedges(soup, &report);
-  GEODEX_ASSIGN_OR_RETURN(const std::vector<uint8_t> flip, Orient(soup, mate, &report));
+  // Orientation first, from the edges of two faces only: what is refused is
+  // a surface not orientable once its non-manifold edges are cut. The pairs
+  // made round non-manifold edges then follow that orientation.
+  std::vector<std::vector<int32_t>> nonmanifold;
+  std::vector<int32_t> mate = PairManifoldEdges(soup, &nonmanifold);
+  GEODEX_ASSIGN_OR_RETURN(std::vector<uint8_t> flip, Orient(soup, mate));
+  for (const std::vector<int32_t>& halfedges : nonmanifold) {
+    PairRoundEdge(soup, halfedges, flip, &mate);
+  }
+  SeparateCopies(soup, flip, &mate);
+  // Parts joined round non-manifold edges keep their majority's orientation.
+  absl::StatusOr<std::vector<uint8_t>> final_flip = Orient(soup, mate);
+  if (!final_flip.ok()) {
+    return absl::InternalError(absl::StrCat("mesh repair paired faces against their orientation: ",
+                                            final_flip.status().message()));
+  }
+  flip = *std::move(final_flip);
+  report.nonmanifold_edges = static_cast<int32_t>(nonmanifold.size());
+  for (const std::vector<int32_t>& halfedges : nonmanifold) {
+    for (int32_t h : halfedges) report.edge_copies += mate[h] == kNone || mate[h] > h ? 1 : 0;
+  }
+  const int32_t nk = static_cast<int32_t>(soup.kept.size());
+  for (int32_t k = 0; k < nk; ++k) report.reoriented_faces += flip[k];
 
   // The oriented faces. Flipping (a, b, c) to (a, c, b) turns input corner i
-  // into corner kFlipCorner[i], and input half-edge i (corner i to i+1) into
-  // half-edge kFlipEdge[i].
+  // into corner kFlipCorner[i].
   constexpr std::array<uint8_t, 3> kSameCorner = {0, 1, 2}, kFlipCorner = {0, 2, 1};
-  constexpr int kFlipEdge[3] = {2, 1, 0};
-  const int32_t nk = static_cast<int32_t>(soup.kept.size());
   std::vector<Triangle> faces(nk);
-  for (int32_t k = 0; k < nk; ++k) {
-    const Triangle& t = soup.tri(k);
-    faces[k] = flip[k] ? Triangle{t[0], t[2], t[1]} : t;
-  }
-  auto internal_halfedge = [&](int32_t h) {
-    return h - h % 3 + (flip[h / 3] ? kFlipEdge[h % 3] : h % 3);
-  };
 
-  // One vertex per fan: corners 3k+c (corner c of face k) joined across
-  // every paired edge; the fan of a vertex's first corner keeps its id.
-  DisjointSets fans(3 * nk);
-  for (int32_t h = 0; h < 3 * nk; ++h) {
-    if (mate[h] == kNone) continue;
-    const int32_t x = internal_halfedge(h), y = internal_halfedge(mate[h]);
-    // x runs u -> w in its face, y runs w -> u in its own.
-    fans.Union(x, y - y % 3 + (y % 3 + 1) % 3);
-    fans.Union(x - x % 3 + (x % 3 + 1) % 3, y);
-  }
+  // One vertex per fan; the fan of a vertex's first corner (in face order)
+  // keeps its id.
+  DisjointSets fans = Fans(soup, mate);
   std::vector<Vec3> positions = std::move(raw.positions);
   std::vector<int32_t> fan_vertex(3 * nk, kNone);
   std::vector<int32_t> fans_of(num_input_vertices, 0);
@@ -353,7 +458,7 @@ absl::StatusOr<RepairedMesh> RepairMesh(RawMesh raw, const RepairOptions& option
   maps.num_input_vertices = num_input_vertices;
   for (int32_t x = 0; x < 3 * nk; ++x) {
     if (fans.Find(x) != x) continue;  // not the first corner of its fan
-    const int32_t v = faces[x / 3][x % 3];
+    const int32_t v = soup.tri(x / 3)[x % 3];
     if (fans_of[v]++ == 0) {
       fan_vertex[x] = v;
     } else {
@@ -363,7 +468,10 @@ absl::StatusOr<RepairedMesh> RepairMesh(RawMesh raw, const RepairOptions& option
       maps.vertex_copies.push_back(v);
     }
   }
-  for (int32_t x = 0; x < 3 * nk; ++x) faces[x / 3][x % 3] = fan_vertex[fans.Find(x)];
+  for (int32_t x = 0; x < 3 * nk; ++x) {
+    const int32_t k = x / 3;
+    faces[k][flip[k] ? kFlipCorner[x % 3] : x % 3] = fan_vertex[fans.Find(x)];
+  }
   for (int32_t count : fans_of) {
     if (count > 1) {
       ++report.nonmanifold_vertices;
@@ -404,16 +512,18 @@ absl::StatusOr<RepairedMesh> RepairMesh(RawMesh raw, const RepairOptions& option
   absl::StatusOr<Mesh> mesh =
       Mesh::Create(std::move(positions), std::move(faces), raw.name, mesh_options);
   if (!mesh.ok()) {
-    // A configuration the cuts above do not separate (faces left unpaired on
-    // an edge that still meet round both its ends): refused, with the reason.
-    return Refuse(raw, absl::StrCat("cannot repair: ", mesh.status().message()));
+    // The steps above make a valid mesh of every soup they accept; this is a
+    // defect of the repair, not of the input.
+    return absl::InternalError(
+        absl::StrCat("mesh repair made an invalid mesh: ", mesh.status().message()));
   }
   return RepairedMesh{*std::move(mesh), std::move(maps), report};
 }
 
 absl::StatusOr<RepairedMesh> LoadAndRepairMesh(const std::string& path,
-                                               const RepairOptions& options) {
-  GEODEX_ASSIGN_OR_RETURN(RawMesh raw, LoadRawMeshFile(path));
+                                               const RepairOptions& options,
+                                               const ReadOptions& read) {
+  GEODEX_ASSIGN_OR_RETURN(RawMesh raw, LoadRawMeshFile(path, read));
   return RepairMesh(std::move(raw), options);
 }
 

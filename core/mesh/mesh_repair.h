@@ -1,39 +1,48 @@
 #pragma once
 
-// Mesh repair: what can be repaired of a broken triangle
-// soup without changing the surface, each repair counted, with the maps back
-// to the input's ids.
+// Mesh repair: what can be repaired of a broken triangle soup without
+// changing the surface, each repair counted, with the maps back to the
+// input's ids.
 //
 //   - Duplicate faces (the same three vertices, in any order) are dropped: the
 //     first of each group in input order stays and answers for the others.
 //   - Unreferenced vertices are ignored (kept, on no face; Mesh allows them).
-//   - Non-manifold edges (more than two faces) are cut. The faces are ordered
-//     round the edge, and a face is paired with the next one
+//   - Inconsistently oriented faces are re-oriented (corners 1 and 2 swapped)
+//     so that faces agree across every edge they share, each connected part
+//     keeping the orientation most of its faces have.
+//   - Non-manifold edges (more than two faces, in any orientations) are cut:
+//     every face round such an edge is paired with at most one other, and a
+//     face left unpaired keeps the edge as a boundary (its own copy). Faces
+//     are ordered round the edge, and a face is paired with the next one
 //     counter-clockwise when their orientations say the space between them
-//     is the inside of one solid; the others keep the edge as a boundary. So
-//     two closed solids touching along an edge each keep their own copy of
-//     it, and the pages of a "book" become sheets of their own.
+//     is the inside of one solid: two closed solids touching along an edge
+//     each keep their own copy of it, and the pages of a "book" become
+//     sheets of their own. Then, where two copies of the edge would still
+//     join the same two vertices (two sheets crossing along the edge, whose
+//     faces the solid rule paired across the sheets), those copies are undone
+//     and the faces that meet round both ends are paired instead: each sheet
+//     keeps its own copy.
 //   - Non-manifold vertices (faces round a vertex in several fans, including
 //     the fans the edge cuts make) are split into one vertex per fan: the fan
 //     of the lowest face keeps the id, the copies are appended after the
 //     input's vertices, at the same position.
-//   - Inconsistently oriented faces are re-oriented (corners 1 and 2 swapped)
-//     so that every connected part agrees with the majority of its faces.
 //   - Zero-area and sliver faces are kept (MeshOptions::allow_zero_area_faces).
 //
 // Refused (InvalidArgument, with the reason, messages as Mesh::Create's): no
 // faces, NaN or infinite coordinates, corner ids out of range, a triangle (or
 // a file polygon) with a repeated vertex, and a surface that is not orientable
-// once its non-manifold edges are cut (a Möbius strip). With
+// once its non-manifold edges are cut (a Möbius strip). Never because a cut
+// could not be made: any other soup of triangles becomes a valid Mesh. With
 // RepairOptions::strict nothing is repaired: the mesh is refused with the
 // first reason Mesh::Create finds, exactly as before repair existed
 // (unreferenced vertices, which were always accepted, stay accepted).
 //
-// Ids. The internal mesh's faces are the kept input triangles in input order;
-// its vertices are the input's, then the copies. RepairMaps says where each
-// input triangle went and how its corners permute, and which input vertex
-// each copy stands for. Input ids are those of mesh_io.h (triangles after
-// fan triangulation of the file's polygons).
+// Ids. The internal mesh's faces are the kept input triangles in input order,
+// each with its three input positions; its vertices are the input's, then the
+// copies. RepairMaps says where each input triangle went and how its corners
+// permute, and which input vertex each copy stands for. Input ids are those
+// of mesh_io.h (triangles after fan triangulation of the file's polygons; the
+// welded vertices of STL and glTF files).
 //
 // Thread safety: pure functions.
 
@@ -64,16 +73,21 @@ struct RepairReport {
   int32_t reoriented_faces = 0;
   int32_t zero_area_faces = 0;  // kept
   int32_t sliver_faces = 0;     // kept: doubled area under 1e-6 of the longest squared edge
+  // What the reader's welding did (RawMesh::weld; STL and glTF files only).
+  WeldReport weld;
 
   // True when the internal mesh differs from the input's triangles.
   bool changed() const {
     return duplicate_faces + nonmanifold_edges + nonmanifold_vertices + reoriented_faces > 0;
   }
   // One line: "1 non-manifold vertex split (2 copies), 0 non-manifold edges
-  // cut (0 copies), 0 duplicate faces dropped, ...".
+  // cut (0 copies), 0 duplicate faces dropped, ...", ending, for a welded
+  // file, with "; 1234 corners welded".
   std::string Summary() const;
   // "key = value" lines for the build report: mesh_repairs = Summary(), then
-  // one count per key (mesh_duplicate_faces_dropped, ...).
+  // one count per key (mesh_duplicate_faces_dropped, ...), and for a welded
+  // file mesh_welded_corners, mesh_weld_tolerance and
+  // mesh_degenerate_corners_unwelded.
   std::string ToText() const;
 };
 
@@ -108,12 +122,14 @@ struct RepairedMesh {
 // Repairs `raw` (see the header comment). Errors: InvalidArgument for what
 // cannot be repaired, or with options.strict for anything that needs a repair,
 // naming the element ("<name>: non-manifold vertex 12: ..."); a file of
-// polygons adds that face ids count triangles.
+// polygons adds that face ids count triangles. Internal would be a defect of
+// the repair (it made a mesh Mesh::Create refuses), never of the input.
 absl::StatusOr<RepairedMesh> RepairMesh(RawMesh raw, const RepairOptions& options = {});
 
-// LoadRawMeshFile, then RepairMesh.
+// LoadRawMeshFile (read as `read` says), then RepairMesh.
 absl::StatusOr<RepairedMesh> LoadAndRepairMesh(const std::string& path,
-                                               const RepairOptions& options = {});
+                                               const RepairOptions& options = {},
+                                               const ReadOptions& read = {});
 
 // A valid mesh as a repaired one with nothing repaired (identity maps), e.g.
 // a generated mesh.

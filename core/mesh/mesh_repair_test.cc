@@ -3,7 +3,9 @@
 #include <algorithm>
 #include <cstdlib>
 #include <filesystem>
+#include <numbers>
 #include <string>
+#include <vector>
 
 #include "core/mesh/broken_meshes_testing.h"
 #include "core/mesh/generators.h"
@@ -168,6 +170,70 @@ TEST(MeshRepairTest, BookPagesBecomeSheetsOfTheirOwn) {
   ExpectMapsRecoverInput(raw, *r);
   EXPECT_THAT(RepairMesh(raw, Strict()).status().message(),
               HasSubstr("non-manifold edge (0, 1) is shared by 3 faces"));
+}
+
+// The faces of internal face f's sheet: sheet A's faces come first.
+bool InSheetA(const RawMesh& raw, int32_t f) {
+  return f < static_cast<int32_t>(raw.triangles.size()) / 2;
+}
+
+// Two sheets crossing along an edge, four faces in crossing orientations
+// (a->b, a->b, b->a, b->a round it): the solid rule pairs a face of one
+// sheet with a face of the other, which left the edge joining the same two
+// vertices twice; now each sheet keeps its own copy and is whole.
+TEST(MeshRepairTest, SheetsCrossingAlongAnEdgeEachKeepTheirOwnCopy) {
+  for (bool flip_second : {false, true}) {
+    const RawMesh raw = testing::TwoSheetsCrossingAlongAnEdge(3, flip_second);
+    absl::StatusOr<RepairedMesh> r = RepairMesh(raw);
+    ASSERT_TRUE(r.ok()) << r.status();
+    EXPECT_EQ(r->report.nonmanifold_edges, 1);
+    EXPECT_EQ(r->report.edge_copies, 2);
+    EXPECT_EQ(r->report.nonmanifold_vertices, 2);  // a and b
+    EXPECT_EQ(r->report.vertex_copies, 4);
+    EXPECT_EQ(r->report.reoriented_faces, 0);
+    EXPECT_TRUE(r->maps.faces.empty());  // face ids and corners are the input's
+    EXPECT_EQ(r->mesh.num_components(), 2);
+    // Each sheet is a whole square: its perimeter is the only boundary, and
+    // every paired edge joins two faces of one sheet.
+    EXPECT_EQ(r->mesh.num_boundary_edges(), 2 * 4 * 6);
+    for (int32_t h = 0; h < r->mesh.num_halfedges(); ++h) {
+      const int32_t twin = r->mesh.Twin(h);
+      if (twin == kNone) continue;
+      EXPECT_EQ(InSheetA(raw, Mesh::FaceOf(h)), InSheetA(raw, Mesh::FaceOf(twin))) << h;
+    }
+    EXPECT_NEAR(r->mesh.TotalArea(), 8, 1e-12);
+    ExpectMapsRecoverInput(raw, *r);
+    const absl::StatusOr<RepairedMesh> strict = RepairMesh(raw, Strict());
+    ASSERT_FALSE(strict.ok());
+    EXPECT_THAT(strict.status().message(),
+                HasSubstr("non-manifold edge (0, 1) is shared by 4 faces"));
+  }
+}
+
+// Three sheets of pages and a crossing sheet on one edge: six faces round
+// it in every orientation mix; the repair always ends with a valid mesh.
+TEST(MeshRepairTest, EdgeOfSixFacesInAnyOrientationIsCut) {
+  for (int mask = 0; mask < 64; ++mask) {
+    RawMesh raw = testing::BookOfThreeSheets();
+    // Three more single faces on the spine, and the pages' faces on it
+    // turned as `mask` says.
+    for (int k = 0; k < 3; ++k) {
+      const double angle = 2 * std::numbers::pi * (k + 0.5) / 3;
+      const int32_t p = AddVertex(&raw, Vec3(std::cos(angle), std::sin(angle), 0.5));
+      AddTriangle(&raw, {0, 1, p});
+    }
+    std::vector<int32_t> spine_faces = {1, 3, 5, 6, 7, 8};
+    for (int bit = 0; bit < 6; ++bit) {
+      if (mask & (1 << bit)) {
+        Triangle& t = raw.triangles[spine_faces[bit]];
+        std::swap(t[1], t[2]);
+      }
+    }
+    absl::StatusOr<RepairedMesh> r = RepairMesh(raw);
+    ASSERT_TRUE(r.ok()) << "mask " << mask << ": " << r.status();
+    EXPECT_EQ(r->report.nonmanifold_edges, 1) << mask;
+    ExpectMapsRecoverInput(raw, *r);
+  }
 }
 
 TEST(MeshRepairTest, FlippedFacesOfASphereAreReoriented) {
