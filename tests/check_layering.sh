@@ -6,9 +6,14 @@
 #                 point locator); the face BVH it stores is in core/index;
 #   client/       nothing from core/ or server/;
 #   server/       not the client library.
-# The link graph is read from the target_link_libraries calls of the
-# CMakeLists.txt files of core/, proto/, client/ and server/; a target belongs
-# to the layer whose CMakeLists.txt adds it.
+# The Python package keeps the same direction: client/python/geodex imports
+# core only through the optional in-process module geodex._core, in
+# _inprocess.py alone and inside a try (the client works without it), and
+# never by loading a library itself; core/python (the bindings) imports
+# nothing of gRPC, protobuf, the generated stubs or the client.
+# The link graph is read from the target_link_libraries calls of every
+# CMakeLists.txt under core/, proto/, client/ and server/; a target belongs
+# to the layer whose directory adds it.
 set -uo pipefail
 root="${1:-$(dirname "$0")/..}"
 status=0
@@ -24,6 +29,35 @@ if [ -d "$root/client" ] && grep -rnE '#include\s*[<"](core|server)/' "$root/cli
   status=1
 fi
 
+# --- the Python package ----------------------------------------------------------
+pkg="$root/client/python/geodex"
+if [ -d "$pkg" ]; then
+  if grep -rnE '^\s*(from|import)\s.*\b_core\b' --include='*.py' "$pkg" | grep -v '/_inprocess\.py:'; then
+    echo "layering: client/python imports geodex._core outside _inprocess.py" >&2
+    status=1
+  fi
+  # The one import of the compiled module is optional: the line before it is "try:".
+  if [ -f "$pkg/_inprocess.py" ] && ! awk '
+      /^[[:space:]]*(from|import)[[:space:]].*[^[:alnum:]_]_core([^[:alnum:]_]|$)/ {
+        if (prev !~ /^[[:space:]]*try:[[:space:]]*$/) bad = 1
+        seen = 1
+      }
+      { prev = $0 }
+      END { exit !(seen && !bad) }' "$pkg/_inprocess.py"; then
+    echo "layering: client/python/geodex/_inprocess.py must import _core inside a try" >&2
+    status=1
+  fi
+  if grep -rnE '\b(ctypes|cffi|ExtensionFileLoader)\b' --include='*.py' "$pkg"; then
+    echo "layering: client/python must not load core's libraries itself (ctypes, cffi, loaders)" >&2
+    status=1
+  fi
+fi
+if [ -d "$root/core/python" ] && grep -rnE 'import\("(grpc|google\.protobuf|geodex\.v1|geodex\.client)|_pb2|\.pb\.h|#include\s*[<"](grpc|grpcpp|google/protobuf|server|client|proto)/' \
+    "$root/core/python"; then
+  echo "layering: core/python must not use gRPC, protobuf, the generated stubs or the client" >&2
+  status=1
+fi
+
 # --- links ---------------------------------------------------------------------
 # Prints "def TARGET LAYER" for add_library / add_executable, "src TARGET
 # FILE" for every source of add_library / add_executable / target_sources that
@@ -35,7 +69,7 @@ FNR == 1 { call = ""; depth = 0 }
   line = $0
   sub(/#.*/, "", line)
   if (depth == 0) {
-    if (!match(line, /(add_library|add_executable|target_sources|target_link_libraries)[ \t]*\(/)) next
+    if (!match(line, /(add_library|add_executable|pybind11_add_module|target_sources|target_link_libraries)[ \t]*\(/)) next
     call = substr(line, RSTART)
     depth = 1
   } else {
@@ -45,7 +79,8 @@ FNR == 1 { call = ""; depth = 0 }
   call = substr(call, 1, index(call, ")") - 1)
   gsub(/\(/, " ", call)
   n = split(call, w, /[ \t]+/)
-  if (w[1] == "add_library" || w[1] == "add_executable" || w[1] == "target_sources") {
+  if (w[1] == "add_library" || w[1] == "add_executable" || w[1] == "pybind11_add_module" ||
+      w[1] == "target_sources") {
     if (w[1] != "target_sources") print "def", w[2], layer
     for (i = 3; i <= n; i++) {
       if (layer == "core" && w[i] ~ /^query\//) print "src", w[2], w[i]
@@ -116,9 +151,10 @@ AWK
 
 graph=""
 for layer in core proto client server; do
-  file="$root/$layer/CMakeLists.txt"
-  [ -f "$file" ] || continue
-  graph+="$(awk -v layer="$layer" "$links_awk" "$file")"$'\n'
+  [ -d "$root/$layer" ] || continue
+  while IFS= read -r file; do
+    graph+="$(awk -v layer="$layer" "$links_awk" "$file")"$'\n'
+  done < <(find "$root/$layer" -name CMakeLists.txt | sort)
 done
 if ! grep -q '^def geodex_builder ' <<<"$graph"; then
   echo "layering: no geodex_builder target found; update tests/check_layering.sh" >&2
