@@ -2,12 +2,13 @@
 
 // A read-only view of a mesh as the index stores it, with the few walks the
 // query code needs: vertex positions, face corners, twins, and the fan of
-// faces round a vertex. Internal to core/query (QueryEngine, the path
-// tracer, the path straightener).
+// faces round a vertex, and the canonical form of a surface point. Internal
+// to core/query (the engine, the lifting, the path tracer and straightener).
 //
 // Thread safety: a view of immutable arrays; every method is const and
 // thread-safe.
 
+#include <array>
 #include <cstdint>
 #include <span>
 
@@ -25,6 +26,19 @@ struct MeshView {
   std::span<const double> positions;
   std::span<const int32_t> faces;
   std::span<const int32_t> twins;
+
+  // The 3D position of a surface point.
+  mesh::Vec3 PositionOf(const mesh::SurfacePoint& p) const;
+  // A valid point with its weights clamped to >= 0 and summing to 1, and,
+  // on an edge, expressed in the face of lower id, so that both
+  // descriptions of a point give the same answers.
+  mesh::SurfacePoint Canonical(const mesh::SurfacePoint& p) const;
+  // A canonical vertex point re-expressed in the vertex's face of lowest id,
+  // other points unchanged. The traces start from a point's face, so they
+  // need it; the O(1) lift of a vertex is its record, whatever the face.
+  mesh::SurfacePoint InLowestFaceIfVertex(const mesh::SurfacePoint& c) const;
+  // The total area of the faces.
+  double Area() const;
 
   mesh::Vec3 Position(int32_t v) const {
     return {positions[3 * v], positions[3 * v + 1], positions[3 * v + 2]};
@@ -65,5 +79,17 @@ struct MeshView {
     }
   }
 };
+
+// Walking across the faces of a MeshView in barycentric coordinates.
+
+// Where the descent `beta` (barycentric velocities, sum 0) from barycentric
+// position `b` leaves the face: the corner whose weight reaches 0 first (-1
+// if none decreases) and the step *t to it.
+int DescentExit(const std::array<double, 3>& beta, const std::array<double, 3>& b, double* t);
+
+// Barycentric weights `w` of a point on the edge of a face opposite its
+// corner `exit`, re-expressed in the face across that edge, whose half-edge
+// g (3 * face + corner) is the twin of the edge's.
+std::array<double, 3> AcrossEdge(int32_t g, int exit, const std::array<double, 3>& w);
 
 }  // namespace geodex::query

@@ -460,4 +460,18 @@ std::vector<PathPoint> StraightenPath(const MeshView& mesh, std::vector<PathPoin
   return Straightener(mesh).Run(std::move(path));
 }
 
+bool WrapsRoundAVertex(const std::vector<PathPoint>& path) {
+  for (size_t i = 1; i + 1 < path.size(); ++i) {
+    const std::array<double, 3>& w = path[i].point.w;
+    if (w[0] == 1 || w[1] == 1 || w[2] == 1) return true;
+  }
+  return false;
+}
+
+double PathLength(const std::vector<PathPoint>& path) {
+  double sum = 0;
+  for (size_t i = 1; i < path.size(); ++i) sum += (path[i].position - path[i - 1].position).norm();
+  return sum;
+}
+
 }  // namespace geodex::query

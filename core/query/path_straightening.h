@@ -20,13 +20,20 @@
 #include <vector>
 
 #include "core/query/mesh_view.h"
-#include "core/query/query_engine.h"
+#include "core/query/query_types.h"
 
 namespace geodex::query {
 
 // Returns the straightened path; the endpoints are kept exactly. Consecutive
 // input points must share a face (as QueryEngine::Path produces); runs that
 // do not are returned unchanged.
+// True when a point strictly inside the path is a mesh vertex: there the
+// funnel of StraightenPath wrapped round the vertex.
+bool WrapsRoundAVertex(const std::vector<PathPoint>& path);
+
+// The sum of the path's 3D segments.
+double PathLength(const std::vector<PathPoint>& path);
+
 std::vector<PathPoint> StraightenPath(const MeshView& mesh, std::vector<PathPoint> path);
 
 // The length StraightenPath gives when the straightened path is one straight

@@ -1,0 +1,79 @@
+#pragma once
+
+// The unfolding of lifted points (Xin, Ying & He 2012, §5.2): the O(1)
+// distance between two points that each know their geodesic triangle and
+// their distances to its three corner samples (lifting.h), from those
+// distances and the sample distance matrix alone.
+//
+//  - Same triangle (case 3.1): both placed in the triangle's plane, one-side.
+//  - Otherwise (case 3.2): p's distances to q's corners by two-side
+//    unfolding across each edge of p's triangle (case 2.2), then q from
+//    those. Computed in a fixed order (the point in the triangle of smaller
+//    id first) so that the answer is symmetric.
+//
+// The per-edge frames of every geodesic triangle (its corners placed in the
+// plane) are derived once, at load.
+//
+// Thread safety: immutable after construction; every method is const and
+// thread-safe.
+
+#include <cstdint>
+#include <optional>
+#include <span>
+#include <vector>
+
+#include "core/index/index.h"
+#include "core/query/query_types.h"
+#include "core/query/unfold_kernel.h"
+
+namespace geodex::query {
+
+class Unfolding {
+ public:
+  // Over `index`'s matrix and triangles, which must outlive this object.
+  // `vector_lanes`: DistanceLanes uses the AVX2 kernel when the CPU has it
+  // (the answers are the same to the bit either way).
+  Unfolding(const index::Index& index, bool vector_lanes);
+
+  // The exact geodesic distance between samples a and b.
+  double Matrix(int32_t a, int32_t b) const {
+    return static_cast<double>(matrix_[static_cast<size_t>(a) * num_samples_ + b]);
+  }
+  // The frames of triangle t's three edges.
+  const kernel::Frame<double>* Frames(int32_t t) const { return &frames_[3 * t]; }
+
+  // The O(1) distance between lifted points (case 3.1 or 3.2); +inf between
+  // components.
+  double Distance(const LiftedPoint& p, const LiftedPoint& q) const;
+  // out[k] = Distance(a[k], b[k]) for kernel::kLanes pairs, the far ones
+  // computed together.
+  void DistanceLanes(const LiftedPoint* a, const LiftedPoint* b, double* out) const;
+  // The approximate distance from a lifted point to sample `s` (case 2.1:
+  // one of its corners; else case 2.2).
+  double ToSample(const LiftedPoint& p, int32_t s) const;
+  // |d_pq - d_qp|: Distance's order of case 3.2 against the other one. It
+  // flags the pairs whose answer errs most (error_bounds.h). 0 for points in
+  // one triangle or in different components. `unfolded`, when given, is
+  // Distance(p, q).
+  double Spread(const LiftedPoint& p, const LiftedPoint& q,
+                std::optional<double> unfolded = std::nullopt) const;
+  // True when the lifts share a geodesic triangle or are in adjacent ones.
+  bool AreNear(const LiftedPoint& a, const LiftedPoint& b) const;
+  // Prefetches what Distance(p, q) will read: the frames and the matrix
+  // entries (rows of the corners of the point in the triangle of larger id).
+  void Prefetch(const LiftedPoint& p, const LiftedPoint& q) const;
+  // The paper's linear-interpolation baseline (§6.3), for comparisons.
+  double LinearInterpolation(const LiftedPoint& p, const LiftedPoint& q) const;
+
+ private:
+  // What case 3.2 reads for a pair, p in the triangle of smaller id.
+  kernel::FarPair GatherFar(const LiftedPoint& p, const LiftedPoint& q) const;
+
+  std::span<const float> matrix_;
+  std::span<const index::GeodesicTriangle> triangles_;
+  int32_t num_samples_ = 0;
+  bool vector_lanes_ = true;
+  std::vector<kernel::Frame<double>> frames_;  // 3 per geodesic triangle
+};
+
+}  // namespace geodex::query
