@@ -25,6 +25,19 @@ absl::Status PointsFromProto(const v1::SurfacePoints& points, std::string_view n
                       out);
 }
 
+absl::Status CheckPairedUp(const v1::SurfacePoints& a, const v1::SurfacePoints& b) {
+  const int64_t na = PointCount(a), nb = PointCount(b);
+  if (na == nb) return absl::OkStatus();
+  return absl::InvalidArgumentError(
+      absl::StrFormat("a has %d points but b has %d; they must pair up", na, nb));
+}
+
+mesh::SurfacePoint InputPointAt(const v1::SurfacePoints& points, int64_t i) {
+  const int k = static_cast<int>(i);
+  return {points.faces(k),
+          {points.weights(3 * k), points.weights(3 * k + 1), points.weights(3 * k + 2)}};
+}
+
 absl::Status PositionsFromProto(const v1::Positions& positions, std::string_view name,
                                 std::vector<mesh::Vec3>* out) {
   const int64_t size = positions.xyz_size();

@@ -44,6 +44,15 @@ absl::Status PointsFromProto(const v1::SurfacePoints& points, std::string_view n
 // Number of points in `points` (faces; weights are checked by PointsFromProto).
 inline int64_t PointCount(const v1::SurfacePoints& points) { return points.faces_size(); }
 
+// OK when `a` and `b` hold as many points each (pairs a[i], b[i]). Errors:
+// InvalidArgument ("a has 3 points but b has 2; they must pair up").
+absl::Status CheckPairedUp(const v1::SurfacePoints& a, const v1::SurfacePoints& b);
+
+// Point `i` of `points` as the request gives it (input ids), for calls that
+// take input points (InputQueries::ExpMap). `points` must have passed
+// PointsFromProto.
+mesh::SurfacePoint InputPointAt(const v1::SurfacePoints& points, int64_t i);
+
 // Reads packed 3D positions. Errors: InvalidArgument if xyz is not a multiple
 // of 3 long or a coordinate is not finite ("positions[4]: y is nan").
 absl::Status PositionsFromProto(const v1::Positions& positions, std::string_view name,
@@ -85,9 +94,8 @@ void ExpMapChunkToProto(std::span<const query::ExpMapVertex> map, int64_t offset
 // index (the mesh file's vertices and faces, also when it was repaired), with
 // the mesh's totals and `version`. The ranges must lie within the input mesh.
 void MeshChunkToProto(const query::InputQueries& queries, int64_t vertex_offset,
-                      int64_t vertex_count,
-                      int64_t face_offset, int64_t face_count, int64_t version,
-                      v1::MeshChunk* chunk);
+                      int64_t vertex_count, int64_t face_offset, int64_t face_count,
+                      int64_t version, v1::MeshChunk* chunk);
 
 // The geodesic triangulation held by `queries`' index (GetTriangulation), with
 // `version`, in input ids (InputQueries::SamplePoints, VertexTriangles).

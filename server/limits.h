@@ -1,11 +1,15 @@
 #pragma once
 
-// Request limits of the Geodex service. Beyond any of them a call fails with
-// RESOURCE_EXHAUSTED, naming the limit. Server-wide values come from flags; a
-// model's config.textproto may lower them (server/model_config.proto).
+// Request limits of the Geodex service, and the one place they are checked.
+// Beyond any of them a call fails with RESOURCE_EXHAUSTED, naming the limit.
+// Server-wide values come from flags; a model's config.textproto may lower
+// them (server/model_config.proto).
+//
+// Thread safety: pure functions.
 
 #include <cstdint>
 
+#include "absl/status/status.h"
 #include "server/model_config.pb.h"
 
 namespace geodex::server {
@@ -41,5 +45,22 @@ inline ServiceLimits WithModelLimits(ServiceLimits server, const ModelLimits& mo
   lower(&server.max_locate_positions, model.max_locate_positions());
   return server;
 }
+
+// The checks. Each returns OK within its limit, else ResourceExhausted with
+// the count, the limit and its name ("12 pairs exceed the limit of 10 per
+// message (max_pairs_per_message)").
+
+// `pairs` of one Distance call or StreamDistances batch.
+absl::Status CheckPairsPerMessage(const ServiceLimits& limits, int64_t pairs);
+// `sources` x `targets` of one Matrix call (without overflow).
+absl::Status CheckMatrixCells(const ServiceLimits& limits, int64_t sources, int64_t targets);
+// `sources` of one DistanceField call.
+absl::Status CheckFieldSources(const ServiceLimits& limits, int64_t sources);
+// `pairs` of one Path call.
+absl::Status CheckPathPairs(const ServiceLimits& limits, int64_t pairs);
+// `positions` of one Locate call.
+absl::Status CheckLocatePositions(const ServiceLimits& limits, int64_t positions);
+// Admitting one more streaming call while `running` run.
+absl::Status CheckConcurrentStreams(const ServiceLimits& limits, int64_t running);
 
 }  // namespace geodex::server
