@@ -22,29 +22,36 @@ double ScaleLength(const MeshView& view, int32_t num_samples) {
 
 absl::StatusOr<std::shared_ptr<const QueryEngine>> QueryEngine::Create(
     std::shared_ptr<const index::Index> index, QueryOptions options) {
+  return CreateQueryEngine(std::move(index), options, {});
+}
+
+absl::StatusOr<std::shared_ptr<const QueryEngine>> CreateQueryEngine(
+    std::shared_ptr<const index::Index> index, QueryOptions options, QueryKnobs knobs) {
   if (index == nullptr) return absl::InvalidArgumentError("no index");
   if (index->num_triangles() == 0 || index->num_samples() == 0) {
     return absl::FailedPreconditionError("the index has no geodesic triangles");
   }
-  return std::shared_ptr<const QueryEngine>(new QueryEngine(std::move(index), options));
+  return std::shared_ptr<const QueryEngine>(new QueryEngine(std::move(index), options, knobs));
 }
 
-QueryEngine::QueryEngine(std::shared_ptr<const index::Index> index, QueryOptions options)
+QueryEngine::QueryEngine(std::shared_ptr<const index::Index> index, QueryOptions options,
+                         QueryKnobs knobs)
     : index_(std::move(index)),
       options_(options),
+      knobs_(knobs),
       view_{index_->positions(), index_->faces(), index_->twins()},
-      unfolding_(*index_, options_.vector_lanes),
+      unfolding_(*index_, knobs_.vector_lanes),
       lifting_(view_, index_->vertices(), unfolding_),
       bounds_(*index_),
       exact_(*index_, view_),
-      paths_(view_, lifting_, unfolding_, options_.straighten_paths),
+      paths_(view_, lifting_, unfolding_, knobs_.straighten_paths),
       locator_(index_->positions(), index_->faces(), index_->bvh_nodes(), index_->bvh_faces()),
       scale_length_(ScaleLength(view_, index_->num_samples())),
       // A pair whose O(1) answer overestimates lands above 3L while the pair
       // is closer: with a calibration, refine every pair that may be closer
       // than 3L (its answer minus the bound of answers between 3L and 5L).
       refine_below_(kRefineScale * scale_length_ + bounds_.RefineMargin()),
-      refiner_(view_, unfolding_, bounds_, paths_, exact_, options_.walk_near_pairs,
+      refiner_(view_, unfolding_, bounds_, paths_, exact_, knobs_.walk_near_pairs,
                refine_below_) {}
 
 absl::Status QueryEngine::Validate(const SurfacePoint& p) const {
@@ -150,7 +157,7 @@ absl::StatusOr<double> QueryEngine::TracedDistance(const SurfacePoint& p, const 
                      b = view_.InLowestFaceIfVertex(view_.Canonical(q));
   const bool swap = std::tie(b.face, b.w) < std::tie(a.face, a.w);
   const std::optional<NearPath> t =
-      NearPathLength(view_, paths_, swap ? b : a, swap ? a : b, options_.walk_near_pairs);
+      NearPathLength(view_, paths_, swap ? b : a, swap ? a : b, knobs_.walk_near_pairs);
   if (!t) return absl::NotFoundError("no trace between the points");
   if (wraps != nullptr) *wraps = t->wraps;
   return t->length;

@@ -46,6 +46,7 @@
 #include "core/query/local_exact.h"
 #include "core/query/mesh_view.h"
 #include "core/query/point_locator.h"
+#include "core/query/query_knobs.h"
 #include "core/query/query_types.h"
 #include "core/query/refinement.h"
 #include "core/query/unfolding.h"
@@ -153,10 +154,13 @@ class QueryEngine {
   }
 
  private:
-  QueryEngine(std::shared_ptr<const index::Index> index, QueryOptions options);
+  friend absl::StatusOr<std::shared_ptr<const QueryEngine>> CreateQueryEngine(
+      std::shared_ptr<const index::Index>, QueryOptions, QueryKnobs);
+  QueryEngine(std::shared_ptr<const index::Index> index, QueryOptions options, QueryKnobs knobs);
 
   std::shared_ptr<const index::Index> index_;
   QueryOptions options_;
+  QueryKnobs knobs_;
   MeshView view_;  // the index's positions, faces and twins
   // The parts, in the order they are made (each uses those above it).
   Unfolding unfolding_;

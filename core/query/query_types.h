@@ -53,24 +53,12 @@ struct DistanceOptions {
 };
 
 struct QueryOptions {
-  // Straighten traced paths through the faces they cross (funnel algorithm,
-  // see path_straightening.h). Off: the raw gradient trace of §6.2.
-  bool straighten_paths = true;
   // When > 0, Path also solves exactly (the ICH engine) inside a corridor
   // round the traced path, the faces at most this many edge steps from the
   // faces it crosses, and returns the exact path when it is shorter. This
   // finds the side of a bump that a trace of the approximate field can miss;
   // it costs a propagation over the corridor (not O(k)). 0: off.
   int32_t exact_path_corridor = 0;
-  // The pairs the near-pair mode kPath refines first try the corridors of
-  // the chord (walked from either end, straightened), then the gradient
-  // trace; off: the trace only, as before the walk existed. Both are
-  // surface paths; the switch is for benchmarks.
-  bool walk_near_pairs = true;
-  // DistanceBatch computes far pairs four at a time with AVX2 when the CPU
-  // has it (kernel::FarDistances); off: one at a time. The answers are the
-  // same to the bit either way; the switch is for benchmarks.
-  bool vector_lanes = true;
   // Barycentric tolerance for validation (weights >= -tol, |sum - 1| <= tol).
   double weight_tolerance = 1e-6;
 };

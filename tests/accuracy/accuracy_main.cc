@@ -21,6 +21,7 @@
 #include "core/mesh/generators.h"
 #include "core/mesh/mesh_io.h"
 #include "core/query/input_queries.h"
+#include "core/query/query_knobs.h"
 #include "core/validation/calibration.h"
 #include "core/validation/error_map.h"
 #include "tests/accuracy/accuracy.h"
@@ -110,7 +111,7 @@ absl::Status Measure(const Flags& flags, const std::string& label,
                      std::shared_ptr<const index::Index> index) {
   GEODEX_ASSIGN_OR_RETURN(auto walking, query::QueryEngine::Create(index));
   GEODEX_ASSIGN_OR_RETURN(auto tracing,
-                          query::QueryEngine::Create(index, {.walk_near_pairs = false}));
+                          query::CreateQueryEngine(index, {}, {.walk_near_pairs = false}));
   for (const std::string& mode : flags.modes) {
     query::DistanceOptions options;
     bool bounds = false;

@@ -35,6 +35,7 @@
 #include "core/mesh/generators.h"
 #include "core/query/exp_map.h"
 #include "core/query/query_engine.h"
+#include "core/query/query_knobs.h"
 #include "core/query/unfold_kernel.h"
 
 namespace geodex {
@@ -197,7 +198,7 @@ void BenchRefinement(const std::string& label, std::shared_ptr<const index::Inde
     return;
   }
   auto engine = *query::QueryEngine::Create(ix);
-  auto traces_only = *query::QueryEngine::Create(ix, {.walk_near_pairs = false});
+  auto traces_only = *query::CreateQueryEngine(ix, {}, {.walk_near_pairs = false});
   const double scale = engine->scale_length();
   const auto a = InteriorPoints(*ix, n, 1), b = InteriorPoints(*ix, n, 2);
   // Pairs at every scale: uniform pairs, and pairs of faces close in the
@@ -263,9 +264,7 @@ void Bench(const std::string& label, std::shared_ptr<const index::Index> ix, int
   });
   int near = 0;
   for (int i = 0; i < n; ++i) near += engine->IsNearPair(a[i], b[i]);
-  query::QueryOptions one_by_one;
-  one_by_one.vector_lanes = false;
-  auto scalar_engine = *query::QueryEngine::Create(ix, one_by_one);
+  auto scalar_engine = *query::CreateQueryEngine(ix, {}, {.vector_lanes = false});
   const double scalar_batch_rate = Rate(n, [&] {
     (void)scalar_engine->DistanceBatch(a, b, out);
     sink = sink + out[n - 1];
