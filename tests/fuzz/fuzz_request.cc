@@ -1,69 +1,54 @@
-// libFuzzer target: the server's reading of requests (server/convert.h)
-// and the engine calls behind them, in process (no gRPC). The first byte
-// picks the message, the rest is its wire encoding:
-//   even: geodex.v1.DistanceRequest -> options, PointsFromProto,
-//         QueryEngine::DistanceBatch (GeodexService::ComputeDistances)
-//   odd:  geodex.v1.LocateRequest -> PositionsFromProto, QueryEngine::Locate
-// against a small generated model (fuzz_model.h).
+// libFuzzer target: the server's reading of requests (server/convert.h,
+// server/convert_options.h) and the engine calls behind them, in process (no
+// gRPC). The first byte picks the message, the rest is its wire encoding:
+//   even: geodex.v1.DistanceRequest -> CheckPairedUp, DistanceOptionsFor,
+//         PointsFromProto, InputQueries::DistanceBatch (as
+//         server/compute_distances.cc runs them)
+//   odd:  geodex.v1.LocateRequest -> PositionsFromProto, InputQueries::Locate
+// against a small generated model (fuzz_model.h) with the default
+// configuration. A request the conversion accepts must be answered: an error
+// from the engine then aborts, and libFuzzer reports the input.
 
-#include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <span>
 #include <vector>
 
+#include "absl/status/statusor.h"
 #include "geodex/v1/geodex.pb.h"
 #include "server/convert.h"
+#include "server/convert_options.h"
+#include "server/model_config.pb.h"
 #include "tests/fuzz/fuzz_model.h"
 
 namespace {
 
-using geodex::query::DistanceOptions;
-using geodex::query::NearPairs;
-
-// GeodexService's DistanceOptionsFor for a model whose config sets nothing
-// (that function lives in the gRPC service library, which the fuzz tree does
-// not build): unknown or contradictory modes and bad tolerances are refused.
-bool OptionsFor(const geodex::v1::DistanceRequest& request, DistanceOptions* options) {
-  const int requested = request.near_pairs();
-  if (!geodex::v1::NearPairs_IsValid(requested)) return false;
-  if (request.exact_near_pairs() && requested != geodex::v1::NEAR_PAIRS_UNSPECIFIED &&
-      requested != geodex::v1::NEAR_PAIRS_EXACT) {
-    return false;
-  }
-  switch (static_cast<geodex::v1::NearPairs>(requested)) {
-    case geodex::v1::NEAR_PAIRS_UNFOLD:
-      options->near_pairs = NearPairs::kUnfold;
-      break;
-    case geodex::v1::NEAR_PAIRS_EXACT:
-      options->near_pairs = NearPairs::kExact;
-      break;
-    default:
-      options->near_pairs = NearPairs::kPath;
-      break;
-  }
-  if (request.exact_near_pairs()) options->near_pairs = NearPairs::kExact;
-  const double tolerance = request.tolerance();
-  if (!(tolerance >= 0) || !std::isfinite(tolerance)) return false;
-  options->tolerance = tolerance;
-  return true;
+// Aborts with `status` (an engine error on input the conversion accepted).
+[[noreturn]] void Fail(const char* what, const absl::Status& status) {
+  std::fprintf(stderr, "%s failed on a request the server accepts: %s\n", what,
+               status.ToString().c_str());
+  std::abort();
 }
 
 void FuzzDistance(const geodex::v1::DistanceRequest& request) {
   const geodex::query::InputQueries& queries = geodex::fuzz::FuzzQueries();
-  const int64_t n = geodex::server::PointCount(request.a());
-  if (n != geodex::server::PointCount(request.b())) return;
-  DistanceOptions options;
-  if (!OptionsFor(request, &options)) return;
+  if (!geodex::server::CheckPairedUp(request.a(), request.b()).ok()) return;
+  const absl::StatusOr<geodex::query::DistanceOptions> options = geodex::server::DistanceOptionsFor(
+      geodex::server::ModelConfig(), geodex::server::DistanceChoice::Of(request));
+  if (!options.ok()) return;  // an unknown or contradictory choice
   geodex::query::EnginePoints a, b;
   if (!geodex::server::PointsFromProto(request.a(), "a", queries, &a).ok()) return;
   if (!geodex::server::PointsFromProto(request.b(), "b", queries, &b).ok()) return;
+  const int64_t n = geodex::server::PointCount(request.a());
   geodex::v1::DistanceResponse response;
   geodex::query::QueryScratch scratch;
   const absl::Status status = queries.DistanceBatch(
-      a, b, geodex::server::ResizeForOutput(response.mutable_distances(), n), options, &scratch,
+      a, b, geodex::server::ResizeForOutput(response.mutable_distances(), n), *options, &scratch,
       request.error_bounds() ? geodex::server::ResizeForOutput(response.mutable_bounds(), n)
                              : std::span<double>());
-  (void)status;
+  if (!status.ok()) Fail("DistanceBatch", status);
 }
 
 void FuzzLocate(const geodex::v1::LocateRequest& request) {
@@ -74,8 +59,8 @@ void FuzzLocate(const geodex::v1::LocateRequest& request) {
   }
   geodex::v1::LocateResponse response;
   for (const geodex::mesh::Vec3& x : positions) {
-    auto located = queries.Locate(x);
-    if (!located.ok()) return;
+    const absl::StatusOr<geodex::query::LocatedPoint> located = queries.Locate(x);
+    if (!located.ok()) Fail("Locate", located.status());
     geodex::server::AppendLocated(*located, &response);
   }
 }
