@@ -11,15 +11,7 @@ namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
-// The face vertex of largest weight: the anchor of points of faces whose
-// vertices lie in three different triangles.
-inline int Heaviest(const SurfacePoint& p) {
-  int k = 0;
-  for (int i = 1; i < 3; ++i) {
-    if (p.w[i] > p.w[k]) k = i;
-  }
-  return k;
-}
+using internal::Heaviest;
 
 // Loads the first and last byte of [p, p + size) and discards them: a
 // prefetch that works. Software prefetches of the ApproxLifts were found to
@@ -30,9 +22,7 @@ inline void Touch(const void* p, size_t size) {
   asm volatile("" : : "r"(c[0]), "r"(c[size - 1]));
 }
 
-// sqrt(x^2 + y^2) without std::hypot's overflow care, which costs more than
-// the rest of a query.
-inline double Norm2(double x, double y) { return std::sqrt(x * x + y * y); }
+using internal::Norm2;
 
 using geometry::Place;
 using geometry::Trilaterate;
@@ -95,9 +85,6 @@ Lifting::Lifting(const MeshView& view, std::span<const index::VertexRecord> reco
   }
 }
 
-const Lifting::ApproxLift& Lifting::ApproxLiftOf(const FaceLift& fl, int heaviest) const {
-  return approx_lifts_[fl.approx + (fl.anchors == 3 ? heaviest : 0)];
-}
 
 bool Lifting::FaceDistances(const int32_t* f, const LiftedPoint& anchor,
                                 double (&d)[3][3]) const {
@@ -206,34 +193,6 @@ Lifting::ApproxLift Lifting::MakeApproxLift(const int32_t* f, const FaceFrame& f
   return out;
 }
 
-LiftedPoint Lifting::Lift(const SurfacePoint& p) const {
-  const int k = Heaviest(p);
-  if (p.w[k] >= 1.0) return VertexLift(view_.faces[3 * p.face + k]);  // at a vertex: exact record
-  const FaceLift& fl = face_lifts_[p.face];
-  if (fl.triangle < 0) return SlowLift(p, k);
-  const double px = p.w[1] * fl.l + p.w[2] * fl.cx, py = p.w[2] * fl.cy;
-  LiftedPoint out;
-  if (fl.approx < 0) {
-    out.triangle = fl.triangle;
-    for (int c = 0; c < 3; ++c) {
-      out.corner[c] = fl.corner[c];
-      out.distance[c] = Norm2(px - fl.src[c][0], py - fl.src[c][1]);
-    }
-    return out;
-  }
-  const ApproxLift& al = ApproxLiftOf(fl, k);
-  out.triangle = al.triangle;
-  for (int c = 0; c < 3; ++c) {
-    out.corner[c] = al.corner[c];
-    double best = kInf;
-    for (int i = 0; i < 3; ++i) {
-      const double dx = px - al.image[c][i][0], dy = py - al.image[c][i][1];
-      best = std::min(best, dx * dx + dy * dy);
-    }
-    out.distance[c] = std::sqrt(best);
-  }
-  return out;
-}
 
 void Lifting::PrefetchFace(const SurfacePoint& p) const {
   __builtin_prefetch(&view_.faces[3 * p.face]);

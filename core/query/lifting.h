@@ -24,7 +24,10 @@
 // Thread safety: immutable after construction; every method is const and
 // thread-safe.
 
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
+#include <limits>
 #include <span>
 #include <vector>
 
@@ -111,6 +114,59 @@ class Lifting {
   std::vector<FaceLift> face_lifts_;      // one per face
   std::vector<ApproxLift> approx_lifts_;  // of the approximate faces
 };
+
+// Inline: on the path of every query.
+
+namespace internal {
+
+// The face vertex of largest weight: the anchor of points of faces whose
+// vertices lie in three different triangles.
+inline int Heaviest(const SurfacePoint& p) {
+  int k = 0;
+  for (int i = 1; i < 3; ++i) {
+    if (p.w[i] > p.w[k]) k = i;
+  }
+  return k;
+}
+
+// sqrt(x^2 + y^2) without std::hypot's overflow care, which costs more than
+// the rest of a query.
+inline double Norm2(double x, double y) { return std::sqrt(x * x + y * y); }
+
+}  // namespace internal
+
+inline const Lifting::ApproxLift& Lifting::ApproxLiftOf(const FaceLift& fl, int heaviest) const {
+  return approx_lifts_[fl.approx + (fl.anchors == 3 ? heaviest : 0)];
+}
+
+inline LiftedPoint Lifting::Lift(const SurfacePoint& p) const {
+  const int k = internal::Heaviest(p);
+  if (p.w[k] >= 1.0) return VertexLift(view_.faces[3 * p.face + k]);  // at a vertex: exact record
+  const FaceLift& fl = face_lifts_[p.face];
+  if (fl.triangle < 0) return SlowLift(p, k);
+  const double px = p.w[1] * fl.l + p.w[2] * fl.cx, py = p.w[2] * fl.cy;
+  LiftedPoint out;
+  if (fl.approx < 0) {
+    out.triangle = fl.triangle;
+    for (int c = 0; c < 3; ++c) {
+      out.corner[c] = fl.corner[c];
+      out.distance[c] = internal::Norm2(px - fl.src[c][0], py - fl.src[c][1]);
+    }
+    return out;
+  }
+  const ApproxLift& al = ApproxLiftOf(fl, k);
+  out.triangle = al.triangle;
+  for (int c = 0; c < 3; ++c) {
+    out.corner[c] = al.corner[c];
+    double best = std::numeric_limits<double>::infinity();
+    for (int i = 0; i < 3; ++i) {
+      const double dx = px - al.image[c][i][0], dy = py - al.image[c][i][1];
+      best = std::min(best, dx * dx + dy * dy);
+    }
+    out.distance[c] = std::sqrt(best);
+  }
+  return out;
+}
 
 // The O(1) answer of §5 for valid points, as they are (not made canonical):
 // both lifted, then unfolded; for near pairs (Unfolding::AreNear) at least

@@ -8,35 +8,6 @@ namespace geodex::query {
 
 using mesh::SurfacePoint;
 
-SurfacePoint MeshView::Canonical(const SurfacePoint& p) const {
-  SurfacePoint c = p;
-  double sum = 0;
-  for (double& w : c.w) {
-    w = std::max(w, 0.0);
-    sum += w;
-  }
-  for (double& w : c.w) w /= sum;
-  // A point on an edge is expressed in the face of lower id, so that both
-  // descriptions of it give the same answers.
-  int zeros = 0, zero = 0;
-  for (int i = 0; i < 3; ++i) {
-    if (c.w[i] == 0) {
-      ++zeros;
-      zero = i;
-    }
-  }
-  if (zeros == 1) {
-    const int32_t h = 3 * c.face + (zero + 1) % 3;  // the edge opposite the zero weight
-    const int32_t g = twins[h];
-    if (g >= 0 && g / 3 < c.face) {
-      SurfacePoint t{g / 3, {0, 0, 0}};
-      t.w[g % 3] = c.w[(zero + 2) % 3];            // Origin(g) = Dest(h)
-      t.w[(g % 3 + 1) % 3] = c.w[(zero + 1) % 3];  // Dest(g) = Origin(h)
-      return t;
-    }
-  }
-  return c;
-}
 
 SurfacePoint MeshView::InLowestFaceIfVertex(const SurfacePoint& c) const {
   int corner = -1;

@@ -48,45 +48,7 @@ double Unfolding::ToSample(const LiftedPoint& p, int32_t s) const {
   return std::sqrt(TwoSideToOutside2(frames, PlaceInTriangle(frames, p.distance.data()), e));
 }
 
-double Unfolding::Distance(const LiftedPoint& p0, const LiftedPoint& q0) const {
-  if (p0.triangle == q0.triangle) {
-    // Case 3.1: both placed in the triangle (each on the side its distances
-    // say, which for points inside is the one-side unfolding).
-    const Frame<double>* frames = Frames(p0.triangle);
-    const Placed<double> p = PlaceInTriangle(frames, p0.distance.data());
-    const Placed<double> q = PlaceInTriangle(frames, q0.distance.data());
-    double best = kInf;
-    for (int i = 0; i < 3; ++i) {
-      const double dx = p.x[i] - q.x[i], dy = p.y[i] - q.y[i];
-      best = std::min(best, dx * dx + dy * dy);
-    }
-    return std::sqrt(best);
-  }
-  // Case 3.2, in a fixed order so that the result is symmetric.
-  const bool swap = p0.triangle > q0.triangle;
-  const LiftedPoint& p = swap ? q0 : p0;
-  const LiftedPoint& q = swap ? p0 : q0;
-  // Rows of q's corners: the entries Prefetch brings in.
-  if (!(Matrix(q.corner[0], p.corner[0]) < kInf)) return kInf;  // different components
-  return kernel::FarDistance(GatherFar(p, q));
-}
 
-kernel::FarPair Unfolding::GatherFar(const LiftedPoint& p, const LiftedPoint& q) const {
-  kernel::FarPair pair;
-  pair.p_frames = Frames(p.triangle);
-  pair.q_frames = Frames(q.triangle);
-  pair.p_distance = p.distance.data();
-  pair.q_distance = q.distance.data();
-  for (int j = 0; j < 3; ++j) {
-    const int32_t s = q.corner[j];
-    pair.shared[j] = -1;
-    for (int i = 0; i < 3; ++i) {
-      pair.e[j][i] = Matrix(s, p.corner[i]);
-      if (p.corner[i] == s) pair.shared[j] = p.distance[i];  // case 2.1
-    }
-  }
-  return pair;
-}
 
 void Unfolding::DistanceLanes(const LiftedPoint* a, const LiftedPoint* b, double* out) const {
   // Each lane in the order of Distance's case 3.2; the other cases (same
@@ -122,13 +84,6 @@ double Unfolding::Spread(const LiftedPoint& p, const LiftedPoint& q,
   return std::abs(canonical - kernel::FarDistance(GatherFar(hi, lo)));
 }
 
-bool Unfolding::AreNear(const LiftedPoint& a, const LiftedPoint& b) const {
-  if (a.triangle == b.triangle) return true;
-  for (int i = 0; i < 3; ++i) {
-    if (triangles_[a.triangle].neighbor[i] == b.triangle) return true;
-  }
-  return false;
-}
 
 void Unfolding::Prefetch(const LiftedPoint& p, const LiftedPoint& q) const {
   __builtin_prefetch(Frames(p.triangle));

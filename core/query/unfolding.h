@@ -17,7 +17,10 @@
 // Thread safety: immutable after construction; every method is const and
 // thread-safe.
 
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
+#include <limits>
 #include <optional>
 #include <span>
 #include <vector>
@@ -75,5 +78,55 @@ class Unfolding {
   bool vector_lanes_ = true;
   std::vector<kernel::Frame<double>> frames_;  // 3 per geodesic triangle
 };
+
+// Inline: on the path of every query.
+
+inline double Unfolding::Distance(const LiftedPoint& p0, const LiftedPoint& q0) const {
+  if (p0.triangle == q0.triangle) {
+    // Case 3.1: both placed in the triangle (each on the side its distances
+    // say, which for points inside is the one-side unfolding).
+    const kernel::Frame<double>* frames = Frames(p0.triangle);
+    const kernel::Placed<double> p = kernel::PlaceInTriangle(frames, p0.distance.data());
+    const kernel::Placed<double> q = kernel::PlaceInTriangle(frames, q0.distance.data());
+    double best = std::numeric_limits<double>::infinity();
+    for (int i = 0; i < 3; ++i) {
+      const double dx = p.x[i] - q.x[i], dy = p.y[i] - q.y[i];
+      best = std::min(best, dx * dx + dy * dy);
+    }
+    return std::sqrt(best);
+  }
+  // Case 3.2, in a fixed order so that the result is symmetric.
+  const bool swap = p0.triangle > q0.triangle;
+  const LiftedPoint& p = swap ? q0 : p0;
+  const LiftedPoint& q = swap ? p0 : q0;
+  // Rows of q's corners: the entries Prefetch brings in.
+  if (!(Matrix(q.corner[0], p.corner[0]) < std::numeric_limits<double>::infinity())) return std::numeric_limits<double>::infinity();  // different components
+  return kernel::FarDistance(GatherFar(p, q));
+}
+
+inline kernel::FarPair Unfolding::GatherFar(const LiftedPoint& p, const LiftedPoint& q) const {
+  kernel::FarPair pair;
+  pair.p_frames = Frames(p.triangle);
+  pair.q_frames = Frames(q.triangle);
+  pair.p_distance = p.distance.data();
+  pair.q_distance = q.distance.data();
+  for (int j = 0; j < 3; ++j) {
+    const int32_t s = q.corner[j];
+    pair.shared[j] = -1;
+    for (int i = 0; i < 3; ++i) {
+      pair.e[j][i] = Matrix(s, p.corner[i]);
+      if (p.corner[i] == s) pair.shared[j] = p.distance[i];  // case 2.1
+    }
+  }
+  return pair;
+}
+
+inline bool Unfolding::AreNear(const LiftedPoint& a, const LiftedPoint& b) const {
+  if (a.triangle == b.triangle) return true;
+  for (int i = 0; i < 3; ++i) {
+    if (triangles_[a.triangle].neighbor[i] == b.triangle) return true;
+  }
+  return false;
+}
 
 }  // namespace geodex::query
