@@ -1,0 +1,72 @@
+// `geodex bench`: a load generator of random pairs (RunBench,
+// client/cli/bench.h); prints throughput and latency percentiles.
+
+#include "client/cli/bench.h"
+
+#include <algorithm>
+#include <memory>
+
+#include "absl/status/status.h"
+#include "absl/status/statusor.h"
+#include "absl/time/time.h"
+#include "client/cli/commands/command.h"
+#include "client/cli/commands/command_util.h"
+#include "client/cli/text_io.h"
+#include "geodex/client/client.h"
+
+namespace geodex::client::cli {
+namespace {
+
+struct BenchFlags {
+  ConnectionFlags conn;
+  ModelFlags model;
+  BenchOptions options;
+  double duration_s = 10, warmup_s = 1;
+};
+
+absl::Status Bench(BenchFlags flags) {
+  absl::StatusOr<Client> client = MakeClient(flags.conn, std::max(4096, flags.options.batch));
+  if (!client.ok()) return client.status();
+  flags.options.model = flags.model.ref();
+  flags.options.duration = absl::Seconds(flags.duration_s);
+  flags.options.warmup = absl::Seconds(flags.warmup_s);
+  absl::StatusOr<BenchReport> report = RunBench(*client, flags.options);
+  if (!report.ok()) return report.status();
+  return WriteFileOrStdout("-", FormatBenchReport(flags.options, *report));
+}
+
+}  // namespace
+
+void AddBenchCommand(CLI::App* app, absl::Status* status) {
+  auto flags = std::make_shared<BenchFlags>();
+  CLI::App* bench = app->add_subcommand(
+      "bench", "Load generator: random pairs; prints throughput and latency percentiles");
+  AddConnectionFlags(bench, &flags->conn);
+  AddModelFlags(bench, &flags->model);
+  bench->add_option("-c,--concurrency", flags->options.concurrency, "Concurrent workers")
+      ->check(CLI::Range(1, 4096))
+      ->capture_default_str();
+  bench->add_option("-d,--duration", flags->duration_s, "Measured seconds")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  bench->add_option("--warmup", flags->warmup_s, "Seconds run before measuring")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  bench->add_option("-b,--batch", flags->options.batch, "Pairs per call")
+      ->check(CLI::Range(1, 1 << 20))
+      ->capture_default_str();
+  bench
+      ->add_option("--mode", flags->options.mode,
+                   "unary: one Distance call at a time per worker; stream: --window batches in "
+                   "flight per worker on a StreamDistances session")
+      ->check(CLI::IsMember({"unary", "stream"}))
+      ->capture_default_str();
+  bench->add_option("--window", flags->options.window, "Stream mode: batches in flight")
+      ->check(CLI::Range(1, 1024))
+      ->capture_default_str();
+  AddNearPairsFlags(bench, &flags->options.near_pairs);
+  bench->add_option("--seed", flags->options.seed, "Random pairs seed")->capture_default_str();
+  bench->callback([flags, status] { *status = Bench(*flags); });
+}
+
+}  // namespace geodex::client::cli
