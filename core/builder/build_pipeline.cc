@@ -2,9 +2,12 @@
 
 #include <chrono>
 #include <cstdio>
+#include <filesystem>
+#include <optional>
 
 #include "absl/strings/str_format.h"
 #include "core/builder/build_progress.h"
+#include "core/builder/build_rounds.h"
 #include "core/builder/mesh_arrays.h"
 #include "core/builder/workdir.h"
 #include "core/common/file_util.h"
@@ -12,7 +15,6 @@
 #include "core/index/index.h"
 #include "core/mesh/generators.h"
 #include "core/validation/calibration.h"
-#include "core/validation/target_error.h"
 
 namespace geodex::builder {
 namespace {
@@ -107,37 +109,132 @@ void Log(const PipelineOptions& options, const std::string& line) {
   if (options.log) options.log(line);
 }
 
+RoundsOptions RoundsOf(const PipelineOptions& options) {
+  RoundsOptions rounds;
+  rounds.build = options.build;
+  rounds.target = options.target_error;
+  rounds.max_samples = options.max_samples;
+  return rounds;
+}
+
 absl::StatusOr<BuildReport> BuildToTargetError(const mesh::RepairedMesh& repaired,
                                                const std::string& out,
                                                const PipelineOptions& options) {
-  validation::TargetErrorOptions target;
-  target.target_rms = options.target_error;
-  target.max_samples = options.max_samples;
-  target.round_done = [&](int32_t round, const validation::TargetErrorRound& r) {
-    Log(options, absl::StrFormat("[target-error] round %d: m = %d, relative RMS %.3f%% (95%% upper "
-                                 "limit %.3f%%, target %.3f%%), p99 beyond 10L %.3f%% (upper limit "
-                                 "%.3f%%, target %.3f%%)",
-                                 round + 1, r.samples, 100 * r.rms, 100 * r.rms_upper,
-                                 100 * options.target_error, 100 * r.far_p99, 100 * r.far_p99_upper,
-                                 400 * options.target_error));
-  };
-  GEODEX_ASSIGN_OR_RETURN(auto result,
-                          validation::BuildForTargetError(repaired.mesh, options.build, target,
-                                                          RecordRepair(repaired)));
-  result.data.report += absl::StrFormat(
-      "target_error = %.6g\ntarget_error_reached = %s\ntarget_error_rounds = %d\n",
-      options.target_error, result.reached ? "yes" : "no (sample cap)", result.rounds.size());
-  result.data.report +=
-      absl::StrFormat("target_error_rms_upper95 = %.6g\ntarget_error_far_p99_upper95 = %.6g\n",
-                      result.rounds.back().rms_upper, result.rounds.back().far_p99_upper);
-  result.data.report += validation::CalibrationText(result.data.accuracy[0]);
+  GEODEX_ASSIGN_OR_RETURN(TargetBuild result, BuildToTarget(repaired.mesh, RecordRepair(repaired),
+                                                            RoundsOf(options), options.log));
   if (!result.reached) {
     Log(options, absl::StrFormat("geodex-build: the target error was not reached at the cap of %d "
                                  "samples; writing the last round's index",
                                  result.rounds.back().samples));
   }
   BuildReport report;
+  GEODEX_RETURN_IF_ERROR(WriteEdges(result.mesh, result.plan, options.edges_obj, &report));
   GEODEX_RETURN_IF_ERROR(WriteAndReport(result.data, result.summary, out, &report));
+  return report;
+}
+
+// The first round of a distributed target-error build: the coarse mesh, the
+// round's plan in its round directory, and the state.
+absl::StatusOr<BuildReport> PlanTargetBuild(const mesh::RepairedMesh& repaired,
+                                            const std::string& workdir,
+                                            const PipelineOptions& options) {
+  const RoundsOptions rounds = RoundsOf(options);
+  const RepairRecord record = RecordRepair(repaired);
+  GEODEX_ASSIGN_OR_RETURN(const RoundPlan round, PlanFirstRound(repaired.mesh, record, rounds));
+  GEODEX_RETURN_IF_ERROR(SaveCoarseMesh(repaired.mesh, record, workdir));
+  const std::string dir = RoundDirectory(workdir, 0);
+  GEODEX_RETURN_IF_ERROR(SavePlan(round.prepared.mesh, round.plan, dir));
+  GEODEX_RETURN_IF_ERROR(SaveRepair(round.prepared.record, round.plan, dir));
+  GEODEX_RETURN_IF_ERROR(RemoveCarriedRows(dir));
+  GEODEX_RETURN_IF_ERROR(RemoveRows(dir));
+  TargetState state;
+  state.target = rounds.target;
+  state.cap = SampleCap(repaired.mesh, rounds);
+  state.validation_sources = rounds.validation_sources;
+  state.seed = rounds.build.seed;
+  state.refine = rounds.build.refine_long_edges;
+  GEODEX_RETURN_IF_ERROR(SaveTargetState(state, workdir));
+  BuildReport report;
+  report.num_samples = round.plan.num_samples();
+  report.text += absl::StrFormat(
+      "geodex-build plan: target error %g, round 1: %d samples (%s), %zu triangles, in %s\n",
+      rounds.target, round.plan.num_samples(), round.plan.repair.Summary(),
+      round.plan.triangles.size(), dir);
+  GEODEX_RETURN_IF_ERROR(WriteEdges(round.prepared.mesh, round.plan, options.edges_obj, &report));
+  return report;
+}
+
+// The directory of the current plan: the work directory of a fixed-m build,
+// the current round's directory of a target-error build (with its state).
+absl::StatusOr<std::string> CurrentPlanDirectory(const std::string& workdir,
+                                                 std::optional<TargetState>* state) {
+  absl::StatusOr<TargetState> loaded = LoadTargetState(workdir);
+  if (absl::IsNotFound(loaded.status())) return workdir;
+  GEODEX_RETURN_IF_ERROR(loaded.status());
+  *state = *std::move(loaded);
+  return RoundDirectory(workdir, (*state)->round);
+}
+
+// Merge of a target-error build's round: the index when the target is met
+// (or the cap reached), otherwise the next round's plan.
+absl::StatusOr<BuildReport> MergeTargetRound(const std::string& workdir, TargetState state,
+                                             const std::string& out,
+                                             const PipelineOptions& options) {
+  const std::string dir = RoundDirectory(workdir, state.round);
+  GEODEX_ASSIGN_OR_RETURN(auto loaded, LoadPlan(dir));
+  GEODEX_ASSIGN_OR_RETURN(RepairRecord record, LoadRepair(loaded.second, dir));
+  RoundPlan round{
+      PreparedMesh{std::move(loaded.first), std::move(record)}, std::move(loaded.second), {}};
+  GEODEX_ASSIGN_OR_RETURN(std::vector<SampleRow> rows, LoadAllRows(round.plan, dir));
+  RoundsOptions rounds;
+  rounds.build = options.build;
+  rounds.build.seed = state.seed;
+  rounds.build.refine_long_edges = state.refine;
+  rounds.target = state.target;
+  rounds.max_samples = state.cap;
+  rounds.validation_sources = state.validation_sources;
+  GEODEX_ASSIGN_OR_RETURN(RoundResult result, FinishRound(round, &rows, rounds));
+  state.rounds.push_back(result.figures);
+  Log(options, RoundLine(state.round, result.figures, state.target));
+  const NextStep next =
+      DecideNext(state.rounds, round.plan.requested_samples, state.cap, state.target);
+  BuildReport report;
+  if (next.done) {
+    result.data.report +=
+        TargetReport(state.rounds, next.reached, state.target, result.data.accuracy[0]);
+    if (!next.reached) {
+      Log(options, absl::StrFormat("geodex-build: the target error was not reached at the cap of "
+                                   "%d samples; writing the last round's index",
+                                   result.figures.samples));
+    }
+    GEODEX_RETURN_IF_ERROR(WriteAndReport(result.data, result.summary, out, &report));
+    return report;
+  }
+  GEODEX_ASSIGN_OR_RETURN(auto coarse, LoadCoarseMesh(workdir));
+  GEODEX_ASSIGN_OR_RETURN(
+      const RoundPlan following,
+      PlanNextRound(coarse.first, coarse.second, round, std::move(rows), next.num_samples, rounds));
+  // The next round's directory is complete before the state points at it:
+  // a merge killed before that point is run again, from this round.
+  const std::string next_dir = RoundDirectory(workdir, state.round + 1);
+  GEODEX_RETURN_IF_ERROR(SavePlan(following.prepared.mesh, following.plan, next_dir));
+  GEODEX_RETURN_IF_ERROR(SaveRepair(following.prepared.record, following.plan, next_dir));
+  GEODEX_RETURN_IF_ERROR(RemoveRows(next_dir));
+  if (following.carried.empty()) {
+    GEODEX_RETURN_IF_ERROR(RemoveCarriedRows(next_dir));
+  } else {
+    GEODEX_RETURN_IF_ERROR(SaveCarriedRows(following.plan, following.carried, next_dir));
+  }
+  ++state.round;
+  GEODEX_RETURN_IF_ERROR(SaveTargetState(state, workdir));
+  std::error_code ignored;  // the finished round is no longer needed
+  std::filesystem::remove_all(dir, ignored);
+  report.another_round = true;
+  report.num_samples = following.plan.num_samples();
+  report.text += absl::StrFormat(
+      "geodex-build merge: target not met; round %d planned with %d samples (%d carried) in %s: "
+      "run the rows shards and merge again\n",
+      state.round + 1, following.plan.num_samples(), following.carried.size(), next_dir);
   return report;
 }
 
@@ -182,6 +279,8 @@ absl::StatusOr<BuildReport> PlanBuild(const std::string& mesh_path, const std::s
                                       const PipelineOptions& options) {
   GEODEX_ASSIGN_OR_RETURN(const mesh::RepairedMesh repaired,
                           LoadBuildInput(mesh_path, options.repair));
+  if (options.target_error > 0) return PlanTargetBuild(repaired, workdir, options);
+  GEODEX_RETURN_IF_ERROR(RemoveTargetState(workdir));
   GEODEX_ASSIGN_OR_RETURN(const PreparedMesh prepared,
                           PrepareMesh(repaired.mesh, RecordRepair(repaired),
                                       options.build.num_samples, options.build.refine_long_edges));
@@ -221,11 +320,14 @@ absl::StatusOr<BuildReport> ComputeShardRows(const std::string& workdir, std::st
                                              const PipelineOptions& options) {
   GEODEX_ASSIGN_OR_RETURN(const auto parsed, ParseShard(shard));
   const auto [index, count] = parsed;
-  GEODEX_ASSIGN_OR_RETURN(auto loaded, LoadPlan(workdir));
+  std::optional<TargetState> state;
+  GEODEX_ASSIGN_OR_RETURN(const std::string dir, CurrentPlanDirectory(workdir, &state));
+  GEODEX_ASSIGN_OR_RETURN(auto loaded, LoadPlan(dir));
   const auto& [mesh, plan] = loaded;
+  GEODEX_ASSIGN_OR_RETURN(const std::vector<SampleRow> carried, LoadCarriedRows(plan, dir));
   const std::vector<int32_t> ids = ShardSamples(plan.num_samples(), index, count);
-  GEODEX_ASSIGN_OR_RETURN(auto rows, ComputeRows(mesh, plan, ids, options.build));
-  GEODEX_RETURN_IF_ERROR(SaveRows(plan, rows, index, count, workdir));
+  GEODEX_ASSIGN_OR_RETURN(auto rows, ComputeRows(mesh, plan, ids, options.build, carried));
+  GEODEX_RETURN_IF_ERROR(SaveRows(plan, rows, index, count, dir));
   BuildReport report;
   report.num_samples = plan.num_samples();
   report.text +=
@@ -235,6 +337,9 @@ absl::StatusOr<BuildReport> ComputeShardRows(const std::string& workdir, std::st
 
 absl::StatusOr<BuildReport> MergeBuild(const std::string& workdir, const std::string& out,
                                        const PipelineOptions& options) {
+  std::optional<TargetState> state;
+  GEODEX_ASSIGN_OR_RETURN(const std::string dir, CurrentPlanDirectory(workdir, &state));
+  if (state.has_value()) return MergeTargetRound(workdir, *std::move(state), out, options);
   GEODEX_ASSIGN_OR_RETURN(auto loaded, LoadPlan(workdir));
   const auto& [mesh, plan] = loaded;
   GEODEX_ASSIGN_OR_RETURN(auto rows, LoadAllRows(plan, workdir));

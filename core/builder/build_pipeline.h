@@ -61,6 +61,10 @@ struct BuildReport {
   std::string text;  // what geodex-build prints on stdout, line by line
   int32_t num_samples = 0;
   uint64_t index_bytes = 0;
+  // MergeBuild of a target-error build's round that did not meet the target:
+  // it planned the next round instead of writing the index; run the rows
+  // shards and MergeBuild again.
+  bool another_round = false;
 };
 
 // The mesh at `path` (.obj/.ply/.off, or builtin:NAME for a generated demo

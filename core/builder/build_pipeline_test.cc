@@ -4,6 +4,8 @@
 
 #include "core/common/file_util.h"
 #include "core/index/index.h"
+#include "core/mesh/generators.h"
+#include "core/mesh/mesh_io.h"
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
 
@@ -86,6 +88,54 @@ TEST(BuildPipelineTest, EveryRouteGivesTheSameIndex) {
                 .status()
                 .code(),
             absl::StatusCode::kInvalidArgument);
+  std::filesystem::remove_all(dir);
+}
+
+// A target-error build in one process and the same build distributed
+// (plan, then rows shards and merge until merge writes the index) give the
+// same index, after the same rounds.
+TEST(BuildPipelineTest, DistributedTargetErrorBuildIsTheOneProcessBuild) {
+  const std::string dir = TempDir("target");
+  const std::string mesh_path = dir + "/sphere.obj";
+  ASSERT_TRUE(mesh::WriteObj(mesh::gen::Sphere(3, 1.0), mesh_path).ok());
+  PipelineOptions options;
+  options.build.num_samples = 60;
+  options.build.threads = 2;
+  options.target_error = 0.011;
+  std::vector<std::string> one_log, distributed_log;
+  options.log = [&](const std::string& line) { one_log.push_back(line); };
+  absl::StatusOr<BuildReport> one = BuildIndexFile(mesh_path, dir + "/one.gdx", options);
+  ASSERT_TRUE(one.ok()) << one.status();
+  EXPECT_FALSE(one->another_round);
+  ASSERT_GE(one_log.size(), 2u);  // at least two rounds
+
+  options.build.threads = 1;
+  options.log = [&](const std::string& line) { distributed_log.push_back(line); };
+  ASSERT_TRUE(PlanBuild(mesh_path, dir + "/wd", options).ok());
+  int merges = 0;
+  for (bool more = true; more && merges < 10; ++merges) {
+    for (const char* shard : {"0/2", "1/2"}) {
+      absl::StatusOr<BuildReport> rows = ComputeShardRows(dir + "/wd", shard, options);
+      ASSERT_TRUE(rows.ok()) << rows.status();
+    }
+    absl::StatusOr<BuildReport> merged = MergeBuild(dir + "/wd", dir + "/merged.gdx", options);
+    ASSERT_TRUE(merged.ok()) << merged.status();
+    more = merged->another_round;
+    EXPECT_EQ(std::filesystem::exists(dir + "/merged.gdx"), !more);
+  }
+  EXPECT_EQ(merges, static_cast<int>(one_log.size()));
+  EXPECT_EQ(FileBytes(dir + "/merged.gdx"), FileBytes(dir + "/one.gdx"));
+  // The round lines agree but for the one process's timings.
+  ASSERT_EQ(distributed_log.size(), one_log.size());
+  for (size_t k = 0; k < one_log.size(); ++k) {
+    EXPECT_EQ(one_log[k].substr(0, distributed_log[k].size()), distributed_log[k]);
+  }
+  // A fixed-m plan in the same work directory is a fixed-m build again.
+  ASSERT_TRUE(PlanBuild(mesh_path, dir + "/wd", Fixed(40)).ok());
+  ASSERT_TRUE(ComputeShardRows(dir + "/wd", "0/1", Fixed(40)).ok());
+  absl::StatusOr<BuildReport> fixed = MergeBuild(dir + "/wd", dir + "/fixed.gdx", Fixed(40));
+  ASSERT_TRUE(fixed.ok()) << fixed.status();
+  EXPECT_EQ(fixed->num_samples, 40);
   std::filesystem::remove_all(dir);
 }
 

@@ -44,7 +44,9 @@ absl::Status SortAndCheckRows(int32_t num_samples, std::vector<SampleRow>* rows)
     if ((*rows)[a].sample != a) {
       return absl::InvalidArgumentError(absl::StrFormat("row of sample %d missing or repeated", a));
     }
-    if (static_cast<int32_t>((*rows)[a].to_samples.size()) != num_samples) {
+    // A carried row ends where its round's samples ended (SampleDistances).
+    const size_t size = (*rows)[a].to_samples.size();
+    if (size <= static_cast<size_t>(a) || size > static_cast<size_t>(num_samples)) {
       return absl::InvalidArgumentError(absl::StrFormat("row of sample %d has the wrong size", a));
     }
   }
@@ -53,13 +55,19 @@ absl::Status SortAndCheckRows(int32_t num_samples, std::vector<SampleRow>* rows)
 
 // d(a, b) between samples, from rows sorted by sample. The two propagations
 // agree to rounding; the shorter is kept (both are lengths of real paths), so
-// the matrix is symmetric.
+// the matrix is symmetric. A row carried from an earlier round of a
+// target-error build has no entries for the samples added after it: their
+// own rows have it (every row reaches its own sample, SortAndCheckRows).
 class SampleDistances {
  public:
   explicit SampleDistances(const std::vector<SampleRow>& rows) : rows_(&rows) {}
 
   double operator()(int32_t a, int32_t b) const {
-    return std::min((*rows_)[a].to_samples[b], (*rows_)[b].to_samples[a]);
+    const std::vector<double>& from_a = (*rows_)[a].to_samples;
+    const std::vector<double>& from_b = (*rows_)[b].to_samples;
+    if (static_cast<size_t>(b) >= from_a.size()) return from_b[a];
+    if (static_cast<size_t>(a) >= from_b.size()) return from_a[b];
+    return std::min(from_a[b], from_b[a]);
   }
 
   // The index's m x m matrix, row-major, 0 on the diagonal.
@@ -187,6 +195,78 @@ void Summarize(const Mesh& mesh, const Plan& plan, const SampleDistances& sample
   summary->bbox_diagonal = mesh.BoundingBoxDiagonal();
 }
 
+// How far a carried row's propagation must go to reach every vertex of its
+// sample's cell and of the neighbouring cells: d(a, c) + the radius of cell
+// c, the largest over c = a and its neighbours. d(a, c) comes from a's
+// carried row when it has it; otherwise (c came after it) the two cells
+// touch across a mesh edge, so d(a, c) <= radius(a) + that edge + radius(c).
+class CarriedCellReach {
+ public:
+  CarriedCellReach(const Mesh& mesh, const Plan& plan,
+                   const std::vector<std::vector<int32_t>>& neighbors,
+                   std::span<const SampleRow> carried)
+      : plan_(plan), neighbors_(neighbors), carried_(carried) {
+    if (carried.empty()) return;
+    for (int32_t h = 0; h < mesh.num_halfedges(); ++h) {
+      longest_edge_ = std::max(longest_edge_, mesh.Length(h));
+    }
+  }
+
+  // 0 when there is no bound (a plan without cell radii).
+  double Radius(int32_t a) const {
+    if (plan_.cell_radius.size() != static_cast<size_t>(plan_.num_samples())) return 0;
+    const std::vector<double>& row = carried_[a].to_samples;
+    const double own = plan_.cell_radius[a];
+    double reach = own;
+    for (int32_t c : neighbors_[a]) {
+      const double to_c =
+          static_cast<size_t>(c) < row.size() ? row[c] : own + longest_edge_ + plan_.cell_radius[c];
+      reach = std::max(reach, to_c + plan_.cell_radius[c]);
+    }
+    // A margin for rounding: the check after the propagation decides.
+    return reach * (1 + 1e-6) + 1e-9 * longest_edge_;
+  }
+
+ private:
+  const Plan& plan_;
+  const std::vector<std::vector<int32_t>>& neighbors_;
+  std::span<const SampleRow> carried_;
+  double longest_edge_ = 0;
+};
+
+// MakePlan's second half, shared with ExtendPlan: the repair of `set` into
+// a valid triangulation, and the plan made of both.
+absl::Status RepairIntoPlan(const Mesh& mesh, sampling::SampleSet set, const BuildOptions& options,
+                            Plan* plan) {
+  plan->mesh_hash = index::MeshHash(FlatPositions(mesh), FlatFaces(mesh));
+  plan->requested_samples = options.num_samples;
+  plan->seed = options.seed;
+  const auto start = std::chrono::steady_clock::now();
+  if (options.progress) options.progress({"repair", 0, 1});
+  triangulation::RepairOptions repair;
+  repair.max_rounds = options.max_repair_rounds;
+  repair.max_samples =
+      std::min<int32_t>(std::max<int32_t>(4 * options.num_samples + 64, 256), mesh.num_vertices());
+  repair.check_edges = options.check_edges;
+  repair.threads = ThreadCount(options);
+  GEODEX_ASSIGN_OR_RETURN(triangulation::DualComplex dual,
+                          triangulation::RepairTriangulation(mesh, &set, repair, &plan->repair));
+  plan->triangulation_seconds = SecondsSince(start);
+  if (options.progress) options.progress({"repair", 1, 1});
+  plan->cell_radius.assign(set.samples.size(), 0.0);
+  for (size_t v = 0; v < set.nearest.size(); ++v) {
+    const int32_t a = set.nearest[v];
+    if (a != kNone) plan->cell_radius[a] = std::max(plan->cell_radius[a], set.distance[v]);
+  }
+  plan->samples = std::move(set.samples);
+  plan->nearest = std::move(set.nearest);
+  plan->triangles = std::move(dual.triangles);
+  plan->neighbors = std::move(dual.neighbors);
+  plan->edges = std::move(dual.edges);
+  plan->edge_stats = triangulation::SummarizeEdges(plan->edges);
+  return absl::OkStatus();
+}
+
 }  // namespace
 
 std::string BuildSummary::ToText() const {
@@ -203,48 +283,86 @@ std::string BuildSummary::ToText() const {
 
 absl::StatusOr<Plan> MakePlan(const Mesh& mesh, const BuildOptions& options) {
   Plan plan;
-  plan.mesh_hash = index::MeshHash(FlatPositions(mesh), FlatFaces(mesh));
-  plan.requested_samples = options.num_samples;
-  plan.seed = options.seed;
-  auto start = std::chrono::steady_clock::now();
+  const auto start = std::chrono::steady_clock::now();
   if (options.progress) options.progress({"sampling", 0, options.num_samples});
   GEODEX_ASSIGN_OR_RETURN(sampling::SampleSet set,
                           sampling::FarthestPointSampling(mesh, options.num_samples, options.seed,
                                                           options.spacing_weight));
   plan.sampling_seconds = SecondsSince(start);
   if (options.progress) options.progress({"sampling", options.num_samples, options.num_samples});
+  GEODEX_RETURN_IF_ERROR(RepairIntoPlan(mesh, std::move(set), options, &plan));
+  return plan;
+}
 
-  start = std::chrono::steady_clock::now();
-  if (options.progress) options.progress({"repair", 0, 1});
-  triangulation::RepairOptions repair;
-  repair.max_rounds = options.max_repair_rounds;
-  repair.max_samples =
-      std::min<int32_t>(std::max<int32_t>(4 * options.num_samples + 64, 256), mesh.num_vertices());
-  repair.check_edges = options.check_edges;
-  repair.threads = ThreadCount(options);
-  GEODEX_ASSIGN_OR_RETURN(triangulation::DualComplex dual,
-                          triangulation::RepairTriangulation(mesh, &set, repair, &plan.repair));
-  plan.triangulation_seconds = SecondsSince(start);
-  if (options.progress) options.progress({"repair", 1, 1});
-  plan.samples = std::move(set.samples);
-  plan.nearest = std::move(set.nearest);
-  plan.triangles = std::move(dual.triangles);
-  plan.neighbors = std::move(dual.neighbors);
-  plan.edges = std::move(dual.edges);
-  plan.edge_stats = triangulation::SummarizeEdges(plan.edges);
+absl::StatusOr<Plan> ExtendPlan(const Mesh& mesh, std::span<const int32_t> previous,
+                                const BuildOptions& options) {
+  const int32_t nv = mesh.num_vertices();
+  if (previous.empty() || static_cast<int32_t>(previous.size()) > options.num_samples) {
+    return absl::InvalidArgumentError(
+        absl::StrFormat("cannot grow %d samples to %d", previous.size(), options.num_samples));
+  }
+  std::vector<uint8_t> taken(nv, 0);
+  for (int32_t v : previous) {
+    if (v < 0 || v >= nv || !mesh.IsReferenced(v) || taken[v]) {
+      return absl::InvalidArgumentError(
+          absl::StrFormat("vertex %d cannot be a carried sample of this mesh", v));
+    }
+    taken[v] = 1;
+  }
+  Plan plan;
+  const auto start = std::chrono::steady_clock::now();
+  if (options.progress) options.progress({"sampling", 0, options.num_samples});
+  // The Voronoi diagram of the carried samples on this mesh (one
+  // propagation from all of them), then farthest-point sampling goes on
+  // from there exactly as FarthestPointSampling would.
+  geodesic::VertexGeodesicSolver solver(mesh);
+  GEODEX_RETURN_IF_ERROR(solver.Propagate(previous));
+  sampling::SampleSet set;
+  set.samples.assign(previous.begin(), previous.end());
+  set.distance = solver.VertexDistances();
+  set.nearest.resize(nv);
+  for (int32_t v = 0; v < nv; ++v) set.nearest[v] = solver.NearestSource(v);
+  for (size_t k = 0; k < previous.size(); ++k) {
+    set.distance[previous[k]] = 0;
+    set.nearest[previous[k]] = static_cast<int32_t>(k);
+  }
+  if (!options.spacing_weight.empty() && options.spacing_weight.size() != static_cast<size_t>(nv)) {
+    return absl::InvalidArgumentError("spacing weights of the wrong size");
+  }
+  while (static_cast<int32_t>(set.samples.size()) < options.num_samples) {
+    const int32_t next = sampling::FarthestVertex(mesh, set, {}, options.spacing_weight);
+    if (next == kNone) break;  // every vertex is a sample
+    GEODEX_RETURN_IF_ERROR(sampling::AddSample(solver, next, &set));
+  }
+  plan.sampling_seconds = SecondsSince(start);
+  if (options.progress) options.progress({"sampling", options.num_samples, options.num_samples});
+  GEODEX_RETURN_IF_ERROR(RepairIntoPlan(mesh, std::move(set), options, &plan));
   return plan;
 }
 
 absl::StatusOr<std::vector<SampleRow>> ComputeRows(const Mesh& mesh, const Plan& plan,
                                                    std::span<const int32_t> sample_ids,
-                                                   const BuildOptions& options) {
+                                                   const BuildOptions& options,
+                                                   std::span<const SampleRow> carried) {
   const int32_t m = plan.num_samples();
   for (int32_t id : sample_ids) {
     if (id < 0 || id >= m) {
       return absl::InvalidArgumentError(absl::StrFormat("sample %d out of range [0, %d)", id, m));
     }
   }
+  if (static_cast<int32_t>(carried.size()) > m) {
+    return absl::InvalidArgumentError(
+        absl::StrFormat("%d carried rows for a plan of %d samples", carried.size(), m));
+  }
+  for (size_t a = 0; a < carried.size(); ++a) {
+    if (carried[a].to_samples.size() <= a ||
+        carried[a].to_samples.size() > static_cast<size_t>(m)) {
+      return absl::InvalidArgumentError(
+          absl::StrFormat("the carried row of sample %d has the wrong size", a));
+    }
+  }
   const std::vector<std::vector<int32_t>> neighbors = plan.SampleNeighbors();
+  const CarriedCellReach reach(mesh, plan, neighbors, carried);
   std::vector<SampleRow> rows(sample_ids.size());
   std::atomic<size_t> next{0};
   std::atomic<int64_t> done{0};
@@ -255,19 +373,47 @@ absl::StatusOr<std::vector<SampleRow>> ComputeRows(const Mesh& mesh, const Plan&
     // Rows need vertex distances only: the wavefront engine, whose memory
     // follows the front rather than the whole propagation.
     geodesic::VertexGeodesicSolver solver(mesh);
+    std::vector<double> cap;
     for (size_t k; (k = next.fetch_add(1)) < sample_ids.size();) {
       const int32_t a = sample_ids[k];
-      const absl::Status status = solver.Propagate({plan.samples[a]});
-      if (!status.ok()) {
-        errors[id] = status;
-        return;
-      }
       SampleRow& row = rows[k];
       row.sample = a;
-      row.to_samples.resize(m);
-      for (int32_t b = 0; b < m; ++b) row.to_samples[b] = solver.VertexDistance(plan.samples[b]);
-      for (int32_t v : CellVertices(plan, neighbors[a], a)) {
-        row.to_cell_vertices.push_back(solver.VertexDistance(v));
+      const std::vector<int32_t> cell_vertices = CellVertices(plan, neighbors[a], a);
+      if (a < static_cast<int32_t>(carried.size())) {
+        row.to_samples = carried[a].to_samples;
+        // Exact below the cap (vertices the propagation did not reach
+        // sooner keep it, NearestSource kNone); a full propagation when a
+        // cell vertex lies beyond it after all.
+        const double radius = reach.Radius(a);
+        if (radius > 0) {
+          cap.assign(mesh.num_vertices(), radius);
+          geodesic::VertexGeodesicOptions bounded;
+          bounded.initial_distance = cap;
+          if (absl::Status status = solver.Propagate({plan.samples[a]}, bounded); !status.ok()) {
+            errors[id] = status;
+            return;
+          }
+          bool reached = true;
+          for (int32_t v : cell_vertices) reached &= solver.NearestSource(v) == 0;
+          if (reached) {
+            for (int32_t v : cell_vertices)
+              row.to_cell_vertices.push_back(solver.VertexDistance(v));
+          }
+        }
+      }
+      if (row.to_samples.empty() || row.to_cell_vertices.size() != cell_vertices.size()) {
+        row.to_cell_vertices.clear();
+        if (absl::Status status = solver.Propagate({plan.samples[a]}); !status.ok()) {
+          errors[id] = status;
+          return;
+        }
+        if (row.to_samples.empty()) {
+          row.to_samples.resize(m);
+          for (int32_t b = 0; b < m; ++b) {
+            row.to_samples[b] = solver.VertexDistance(plan.samples[b]);
+          }
+        }
+        for (int32_t v : cell_vertices) row.to_cell_vertices.push_back(solver.VertexDistance(v));
       }
       const int64_t finished = ++done;
       if (options.progress) {
@@ -285,12 +431,18 @@ absl::StatusOr<std::vector<SampleRow>> ComputeRows(const Mesh& mesh, const Plan&
 
 absl::StatusOr<index::IndexData> Merge(const Mesh& mesh, const Plan& plan,
                                        std::vector<SampleRow> rows, BuildSummary* summary) {
+  return MergeKeepingRows(mesh, plan, &rows, summary);
+}
+
+absl::StatusOr<index::IndexData> MergeKeepingRows(const Mesh& mesh, const Plan& plan,
+                                                  std::vector<SampleRow>* rows,
+                                                  BuildSummary* summary) {
   const auto start = std::chrono::steady_clock::now();
-  GEODEX_RETURN_IF_ERROR(SortAndCheckRows(plan.num_samples(), &rows));
+  GEODEX_RETURN_IF_ERROR(SortAndCheckRows(plan.num_samples(), rows));
   const std::vector<std::vector<int32_t>> neighbors = plan.SampleNeighbors();
-  const SampleDistances sample_distance(rows);
+  const SampleDistances sample_distance(*rows);
   GEODEX_ASSIGN_OR_RETURN(const CellDistances vertex_distance,
-                          CellDistances::FromRows(plan, neighbors, rows));
+                          CellDistances::FromRows(plan, neighbors, *rows));
   index::IndexData data;
   data.sample_distances = sample_distance.Matrix();
   const AssignmentCounts counts =

@@ -111,26 +111,59 @@ struct BuildSummary {
 // Thread safety: reentrant; `mesh` is only read.
 absl::StatusOr<Plan> MakePlan(const mesh::Mesh& mesh, const BuildOptions& options);
 
+// Phase 1 of a round that grows an earlier plan (a target-error build,
+// core/builder/build_rounds.h): the plan of options.num_samples samples on
+// `mesh` whose first samples are `previous` (vertex ids of `mesh`, e.g. an
+// earlier plan's samples on a mesh the refinement only added vertices to),
+// the others added by farthest-point sampling from them and then by the
+// repair, as MakePlan adds them. So the earlier rows stay rows of this plan
+// (ComputeRows' `carried`). options.seed is recorded but not used.
+// Errors: InvalidArgument if `previous` is empty, holds a vertex that is not
+// a referenced vertex of `mesh` or a repeated one, or has more samples than
+// options.num_samples; otherwise MakePlan's.
+absl::StatusOr<Plan> ExtendPlan(const mesh::Mesh& mesh, std::span<const int32_t> previous,
+                                const BuildOptions& options);
+
 // Phase 2, the rows (paper §4.2's distances): one full exact propagation from
 // each sample of `sample_ids` (indices into plan.samples; any subset, e.g. a
 // shard), spread over options.threads threads. Returns the rows in the order
 // of `sample_ids`; a row does not depend on the thread count or on which
 // process computes it. Reports "rows" progress through options.progress from
 // the worker threads, one call at a time.
-// Errors: InvalidArgument for an id outside [0, plan.num_samples()); an error
-// of the exact propagation (then no rows are returned).
-// Thread safety: reentrant; `mesh` and `plan` are only read.
+//
+// `carried` (a target-error build's later rounds): rows an earlier round
+// computed for the first carried.size() samples of `plan` (ExtendPlan keeps
+// them first), of which only to_samples is read. Such a sample's row keeps
+// that to_samples (the distances to the samples after it come from their
+// rows, Merge reads either direction), and its cell distances come from a
+// propagation that stops past its and its neighbours' cells (Plan's
+// cell_radius bounds how far that is), a few percent of a full one; a full
+// propagation when that bound does not hold.
+// Errors: InvalidArgument for an id outside [0, plan.num_samples()), or a
+// carried row that does not reach its own sample or has more entries than
+// the plan has samples; an error of the exact propagation (then no rows are
+// returned).
+// Thread safety: reentrant; `mesh`, `plan` and `carried` are only read.
 absl::StatusOr<std::vector<SampleRow>> ComputeRows(const mesh::Mesh& mesh, const Plan& plan,
                                                    std::span<const int32_t> sample_ids,
-                                                   const BuildOptions& options);
+                                                   const BuildOptions& options,
+                                                   std::span<const SampleRow> carried = {});
 
 // Phase 3: assembles the index from the plan and the rows of every sample (any
 // order) and fills `summary` (vertex_assignment.h assigns the vertices).
+// d(a, b) is the shorter of row a's entry b and row b's entry a, or the one
+// there is: a row has an entry for every sample up to its own at least (a
+// carried row of ComputeRows ends where its round's samples ended).
 // Errors: InvalidArgument if rows are missing, repeated or of the wrong size;
 // Internal if a referenced vertex's cell has no geodesic triangle.
 // Thread safety: reentrant.
 absl::StatusOr<index::IndexData> Merge(const mesh::Mesh& mesh, const Plan& plan,
                                        std::vector<SampleRow> rows, BuildSummary* summary);
+// The same with the rows left in `rows`, sorted by sample (for the next round
+// of a target-error build to carry).
+absl::StatusOr<index::IndexData> MergeKeepingRows(const mesh::Mesh& mesh, const Plan& plan,
+                                                  std::vector<SampleRow>* rows,
+                                                  BuildSummary* summary);
 
 // All three phases in one process.
 absl::StatusOr<index::IndexData> BuildIndex(const mesh::Mesh& mesh, const BuildOptions& options,

@@ -208,5 +208,98 @@ TEST(BuilderTest, MergeRejectsMissingRows) {
   EXPECT_EQ(Merge(m, *plan, *rows, &summary).status().code(), absl::StatusCode::kInvalidArgument);
 }
 
+// The refinement for more samples only adds midpoints after the vertices of
+// the refinement for fewer: a target-error build's rounds carry their
+// samples (vertex ids) over.
+TEST(BuilderTest, RefinementForMoreSamplesKeepsTheVerticesOfFewer) {
+  const mesh::Mesh coarse = gen::Cube(2, 2.0);  // long edges: every m refines it
+  int32_t last_vertices = coarse.num_vertices();
+  absl::StatusOr<PreparedMesh> fewer = PrepareMesh(coarse, {}, 40, true);
+  ASSERT_TRUE(fewer.ok()) << fewer.status();
+  for (int32_t m : {60, 200, 800}) {
+    absl::StatusOr<PreparedMesh> more = PrepareMesh(coarse, {}, m, true);
+    ASSERT_TRUE(more.ok()) << more.status();
+    ASSERT_GT(more->mesh.num_vertices(), fewer->mesh.num_vertices()) << m;
+    for (int32_t v = 0; v < fewer->mesh.num_vertices(); ++v) {
+      ASSERT_EQ(more->mesh.position(v), fewer->mesh.position(v)) << "m " << m << " vertex " << v;
+    }
+    EXPECT_GT(more->mesh.num_vertices(), last_vertices);
+    last_vertices = more->mesh.num_vertices();
+    fewer = std::move(more);
+  }
+}
+
+// A plan grown from an earlier plan's samples keeps them first, and rows
+// carried from the earlier plan give the index that full rows give (to
+// rounding: the carried cell distances come from bounded propagations).
+TEST(BuilderTest, GrownPlanWithCarriedRowsGivesTheIndexOfFullRows) {
+  const mesh::Mesh m = gen::Torus(48, 24, 2.0, 0.7);
+  BuildOptions options;
+  options.num_samples = 40;
+  options.threads = 2;
+  absl::StatusOr<Plan> first = MakePlan(m, options);
+  ASSERT_TRUE(first.ok()) << first.status();
+  ASSERT_EQ(first->cell_radius.size(), first->samples.size());
+  std::vector<int32_t> all_first(first->num_samples());
+  for (int32_t a = 0; a < first->num_samples(); ++a) all_first[a] = a;
+  absl::StatusOr<std::vector<SampleRow>> first_rows = ComputeRows(m, *first, all_first, options);
+  ASSERT_TRUE(first_rows.ok());
+
+  options.num_samples = 90;
+  absl::StatusOr<Plan> grown = ExtendPlan(m, first->samples, options);
+  ASSERT_TRUE(grown.ok()) << grown.status();
+  ASSERT_GE(grown->num_samples(), 90);
+  for (int32_t a = 0; a < first->num_samples(); ++a)
+    EXPECT_EQ(grown->samples[a], first->samples[a]);
+  std::vector<SampleRow> carried = *first_rows;
+  for (SampleRow& row : carried) row.to_cell_vertices.clear();
+
+  std::vector<int32_t> all(grown->num_samples());
+  for (int32_t a = 0; a < grown->num_samples(); ++a) all[a] = a;
+  absl::StatusOr<std::vector<SampleRow>> full = ComputeRows(m, *grown, all, options);
+  absl::StatusOr<std::vector<SampleRow>> reused = ComputeRows(m, *grown, all, options, carried);
+  ASSERT_TRUE(full.ok() && reused.ok());
+  for (int32_t a = 0; a < grown->num_samples(); ++a) {
+    const SampleRow& x = (*full)[a];
+    const SampleRow& y = (*reused)[a];
+    ASSERT_EQ(x.to_cell_vertices.size(), y.to_cell_vertices.size()) << a;
+    for (size_t k = 0; k < x.to_cell_vertices.size(); ++k) {
+      EXPECT_NEAR(x.to_cell_vertices[k], y.to_cell_vertices[k], 1e-9) << a;
+    }
+    if (a < first->num_samples()) {
+      EXPECT_EQ(y.to_samples.size(), static_cast<size_t>(first->num_samples()));
+    } else {
+      EXPECT_EQ(y.to_samples, x.to_samples);
+    }
+  }
+  BuildSummary summary_full, summary_reused;
+  absl::StatusOr<index::IndexData> a = Merge(m, *grown, *full, &summary_full);
+  absl::StatusOr<index::IndexData> b = Merge(m, *grown, *reused, &summary_reused);
+  ASSERT_TRUE(a.ok() && b.ok()) << a.status() << b.status();
+  ASSERT_EQ(a->sample_distances.size(), b->sample_distances.size());
+  for (size_t k = 0; k < a->sample_distances.size(); ++k) {
+    EXPECT_NEAR(a->sample_distances[k], b->sample_distances[k], 1e-5) << k;
+  }
+  // The same triangles but where rounding breaks a tie between two (the
+  // torus is symmetric): a vertex lies as far inside either.
+  ASSERT_EQ(a->vertices.size(), b->vertices.size());
+  size_t other_triangle = 0;
+  for (size_t v = 0; v < a->vertices.size(); ++v) {
+    EXPECT_NE(b->vertices[v].triangle, mesh::kNone);
+    other_triangle += a->vertices[v].triangle != b->vertices[v].triangle;
+  }
+  EXPECT_LT(other_triangle, a->vertices.size() / 50);
+  EXPECT_EQ(summary_full.unassigned_vertices, summary_reused.unassigned_vertices);
+  EXPECT_NEAR(summary_full.share_outside, summary_reused.share_outside, 0.002);
+
+  // Carried rows that do not reach their own sample are refused.
+  carried[3].to_samples.resize(3);
+  EXPECT_EQ(ComputeRows(m, *grown, all, options, carried).status().code(),
+            absl::StatusCode::kInvalidArgument);
+  EXPECT_EQ(ExtendPlan(m, {}, options).status().code(), absl::StatusCode::kInvalidArgument);
+  std::vector<int32_t> repeated = {first->samples[0], first->samples[0]};
+  EXPECT_EQ(ExtendPlan(m, repeated, options).status().code(), absl::StatusCode::kInvalidArgument);
+}
+
 }  // namespace
 }  // namespace geodex::builder

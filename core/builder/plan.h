@@ -20,6 +20,10 @@ struct Plan {
   uint64_t seed = 0;
   std::vector<int32_t> samples;  // vertex of each sample
   std::vector<int32_t> nearest;  // Voronoi cell (sample) of each vertex, kNone if unreferenced
+  // Per sample: the largest distance from it to a vertex of its cell
+  // (bounds how far a carried row's propagation must go; builder.h
+  // ComputeRows). Empty in a plan read from an older work directory.
+  std::vector<double> cell_radius;
   std::vector<std::array<int32_t, 3>> triangles;
   std::vector<std::array<int32_t, 3>> neighbors;
   triangulation::RepairReport repair;

@@ -3,6 +3,7 @@
 #include <xxhash.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstring>
 #include <filesystem>
 #include <regex>
@@ -18,15 +19,22 @@ namespace {
 
 // The last byte of a magic is the format version. Plan versions: 1 initial;
 // 2 adds kEdgesCross to the repair report (9 counters), the crossings found
-// and the figures of the traced geodesic edges.
-constexpr char kPlanMagic[8] = {'G', 'D', 'X', 'P', 'L', 'A', 'N', '2'};
+// and the figures of the traced geodesic edges; 3 adds the cell radii (2 is
+// still read, without them).
+constexpr char kPlanMagic[8] = {'G', 'D', 'X', 'P', 'L', 'A', 'N', '3'};
+constexpr char kPlanMagicV2[8] = {'G', 'D', 'X', 'P', 'L', 'A', 'N', '2'};
 constexpr char kRowsMagic[8] = {'G', 'D', 'X', 'R', 'O', 'W', 'S', '1'};
 // 2 adds the flat refinement (coarse faces, pieces, midpoint count); 1 is
 // still read.
 constexpr char kRepairMagic[8] = {'G', 'D', 'X', 'R', 'E', 'P', 'R', '2'};
 constexpr char kRepairMagicV1[8] = {'G', 'D', 'X', 'R', 'E', 'P', 'R', '1'};
 
+constexpr char kCarriedMagic[8] = {'G', 'D', 'X', 'C', 'A', 'R', 'R', '1'};
+
 std::string PlanPath(const std::string& workdir) { return workdir + "/plan.bin"; }
+std::string CarriedPath(const std::string& workdir) { return workdir + "/carried.bin"; }
+std::string CoarseMeshPath(const std::string& workdir) { return workdir + "/coarse.ply"; }
+std::string CoarseRepairPath(const std::string& workdir) { return workdir + "/coarse-repair.bin"; }
 std::string RepairPath(const std::string& workdir) { return workdir + "/repair.bin"; }
 
 std::string RowsPath(const std::string& workdir, int32_t shard, int32_t num_shards) {
@@ -61,6 +69,21 @@ absl::StatusOr<std::string_view> Unseal(const std::string& bytes, const char (&m
                                         bytes.size() - sizeof(magic) - sizeof(stored));
 }
 
+// A mesh the work directory holds, as the builder repaired it: zero-area
+// faces are part of it.
+absl::StatusOr<mesh::Mesh> LoadWorkMesh(const std::string& path) {
+  GEODEX_ASSIGN_OR_RETURN(mesh::RawMesh raw, mesh::LoadRawMeshFile(path));
+  mesh::MeshOptions mesh_options;
+  mesh_options.allow_zero_area_faces = true;
+  return mesh::Mesh::Create(std::move(raw.positions), std::move(raw.triangles), raw.name,
+                            mesh_options);
+}
+
+absl::Status SaveRepairStamped(const RepairRecord& record, uint64_t mesh_hash,
+                               const std::string& path);
+absl::StatusOr<RepairRecord> LoadRepairStamped(uint64_t mesh_hash, const std::string& path,
+                                               const std::string& owner);
+
 }  // namespace
 
 std::string PlanMeshPath(const std::string& workdir) { return workdir + "/mesh.ply"; }
@@ -85,6 +108,7 @@ absl::Status SavePlan(const mesh::Mesh& mesh, const Plan& plan, const std::strin
   w.Put(plan.seed);
   w.PutVector(plan.samples);
   w.PutVector(plan.nearest);
+  w.PutVector(plan.cell_radius);
   w.PutVector(plan.triangles);
   w.PutVector(plan.neighbors);
   w.Put(plan.repair.rounds);
@@ -102,16 +126,13 @@ absl::Status SavePlan(const mesh::Mesh& mesh, const Plan& plan, const std::strin
 }
 
 absl::StatusOr<std::pair<mesh::Mesh, Plan>> LoadPlan(const std::string& workdir) {
-  // The mesh as the plan repaired it: zero-area faces are part of it.
-  GEODEX_ASSIGN_OR_RETURN(mesh::RawMesh raw, mesh::LoadRawMeshFile(PlanMeshPath(workdir)));
-  mesh::MeshOptions mesh_options;
-  mesh_options.allow_zero_area_faces = true;
-  GEODEX_ASSIGN_OR_RETURN(mesh::Mesh mesh,
-                          mesh::Mesh::Create(std::move(raw.positions), std::move(raw.triangles),
-                                             raw.name, mesh_options));
+  GEODEX_ASSIGN_OR_RETURN(mesh::Mesh mesh, LoadWorkMesh(PlanMeshPath(workdir)));
   const std::string path = PlanPath(workdir);
   GEODEX_ASSIGN_OR_RETURN(const std::string bytes, ReadWholeFile(path));
-  GEODEX_ASSIGN_OR_RETURN(const std::string_view payload, Unseal(bytes, kPlanMagic, path));
+  const bool v2 = bytes.size() >= sizeof(kPlanMagicV2) &&
+                  std::memcmp(bytes.data(), kPlanMagicV2, sizeof(kPlanMagicV2)) == 0;
+  GEODEX_ASSIGN_OR_RETURN(const std::string_view payload,
+                          Unseal(bytes, v2 ? kPlanMagicV2 : kPlanMagic, path));
   ByteReader r(payload, path);
   Plan plan;
   GEODEX_RETURN_IF_ERROR(r.Get(&plan.mesh_hash));
@@ -119,6 +140,7 @@ absl::StatusOr<std::pair<mesh::Mesh, Plan>> LoadPlan(const std::string& workdir)
   GEODEX_RETURN_IF_ERROR(r.Get(&plan.seed));
   GEODEX_RETURN_IF_ERROR(r.GetVector(&plan.samples));
   GEODEX_RETURN_IF_ERROR(r.GetVector(&plan.nearest));
+  if (!v2) GEODEX_RETURN_IF_ERROR(r.GetVector(&plan.cell_radius));
   GEODEX_RETURN_IF_ERROR(r.GetVector(&plan.triangles));
   GEODEX_RETURN_IF_ERROR(r.GetVector(&plan.neighbors));
   GEODEX_RETURN_IF_ERROR(r.Get(&plan.repair.rounds));
@@ -138,7 +160,9 @@ absl::StatusOr<std::pair<mesh::Mesh, Plan>> LoadPlan(const std::string& workdir)
   }
   const int32_t m = plan.num_samples();
   bool valid = static_cast<int32_t>(plan.nearest.size()) == mesh.num_vertices() &&
-               plan.neighbors.size() == plan.triangles.size();
+               plan.neighbors.size() == plan.triangles.size() &&
+               (plan.cell_radius.empty() || static_cast<int32_t>(plan.cell_radius.size()) == m);
+  for (double r : plan.cell_radius) valid &= r >= 0 && std::isfinite(r);
   for (int32_t v : plan.samples) valid &= v >= 0 && v < mesh.num_vertices();
   for (int32_t a : plan.nearest) valid &= a >= mesh::kNone && a < m;
   for (const auto& t : plan.triangles) {
@@ -243,9 +267,124 @@ absl::StatusOr<std::vector<SampleRow>> LoadAllRows(const Plan& plan, const std::
 }
 
 absl::Status SaveRepair(const RepairRecord& record, const Plan& plan, const std::string& workdir) {
+  return SaveRepairStamped(record, plan.mesh_hash, RepairPath(workdir));
+}
+
+absl::StatusOr<RepairRecord> LoadRepair(const Plan& plan, const std::string& workdir) {
+  return LoadRepairStamped(plan.mesh_hash, RepairPath(workdir), PlanPath(workdir));
+}
+
+absl::Status SaveCarriedRows(const Plan& plan, const std::vector<SampleRow>& carried,
+                             const std::string& workdir) {
+  ByteWriter w;
+  w.bytes().append(kCarriedMagic, sizeof(kCarriedMagic));
+  w.Put(plan.mesh_hash);
+  w.Put(plan.num_samples());
+  w.Put<uint64_t>(carried.size());
+  for (const SampleRow& row : carried) w.PutVector(row.to_samples);
+  Seal(w);
+  return AtomicWriteFile(CarriedPath(workdir), w.bytes());
+}
+
+absl::StatusOr<std::vector<SampleRow>> LoadCarriedRows(const Plan& plan,
+                                                       const std::string& workdir) {
+  const std::string path = CarriedPath(workdir);
+  absl::StatusOr<std::string> bytes = ReadWholeFile(path);
+  if (absl::IsNotFound(bytes.status())) return std::vector<SampleRow>{};
+  GEODEX_RETURN_IF_ERROR(bytes.status());
+  GEODEX_ASSIGN_OR_RETURN(const std::string_view payload, Unseal(*bytes, kCarriedMagic, path));
+  ByteReader r(payload, path);
+  uint64_t hash = 0, count = 0;
+  int32_t m = 0;
+  GEODEX_RETURN_IF_ERROR(r.Get(&hash));
+  GEODEX_RETURN_IF_ERROR(r.Get(&m));
+  GEODEX_RETURN_IF_ERROR(r.Get(&count));
+  if (hash != plan.mesh_hash || m != plan.num_samples()) {
+    return absl::FailedPreconditionError(absl::StrFormat("%s was carried into another plan", path));
+  }
+  if (count > static_cast<uint64_t>(m)) {
+    return absl::DataLossError(absl::StrFormat("%s holds %d rows for %d samples", path, count, m));
+  }
+  std::vector<SampleRow> carried(count);
+  for (uint64_t a = 0; a < count; ++a) {
+    carried[a].sample = static_cast<int32_t>(a);
+    GEODEX_RETURN_IF_ERROR(r.GetVector(&carried[a].to_samples));
+    if (carried[a].to_samples.size() <= a ||
+        carried[a].to_samples.size() > static_cast<size_t>(m)) {
+      return absl::DataLossError(absl::StrFormat("%s: row %d has the wrong size", path, a));
+    }
+  }
+  if (!r.AtEnd()) return absl::DataLossError(absl::StrFormat("%s has trailing bytes", path));
+  return carried;
+}
+
+absl::Status RemoveCarriedRows(const std::string& workdir) {
+  std::error_code error;
+  std::filesystem::remove(CarriedPath(workdir), error);
+  if (error) {
+    return absl::InternalError(
+        absl::StrFormat("cannot remove %s: %s", CarriedPath(workdir), error.message()));
+  }
+  return absl::OkStatus();
+}
+
+absl::Status RemoveRows(const std::string& workdir) {
+  const std::regex pattern(R"(rows-(\d{5})-of-(\d{5})\.bin)");
+  std::error_code error;
+  std::vector<std::filesystem::path> stale;
+  for (const auto& entry : std::filesystem::directory_iterator(workdir, error)) {
+    if (std::regex_match(entry.path().filename().string(), pattern)) stale.push_back(entry.path());
+  }
+  for (const auto& path : stale) std::filesystem::remove(path, error);
+  if (error) {
+    return absl::InternalError(
+        absl::StrFormat("cannot remove the rows of %s: %s", workdir, error.message()));
+  }
+  return absl::OkStatus();
+}
+
+absl::Status SaveCoarseMesh(const mesh::Mesh& mesh, const RepairRecord& record,
+                            const std::string& workdir) {
+  std::error_code error;
+  std::filesystem::create_directories(workdir, error);
+  if (error) {
+    return absl::InternalError(absl::StrFormat("cannot create %s: %s", workdir, error.message()));
+  }
+  GEODEX_RETURN_IF_ERROR(mesh::WritePly(mesh, CoarseMeshPath(workdir)));
+  return SaveRepairStamped(record, index::MeshHash(FlatPositions(mesh), FlatFaces(mesh)),
+                           CoarseRepairPath(workdir));
+}
+
+absl::StatusOr<std::pair<mesh::Mesh, RepairRecord>> LoadCoarseMesh(const std::string& workdir) {
+  GEODEX_ASSIGN_OR_RETURN(mesh::Mesh mesh, LoadWorkMesh(CoarseMeshPath(workdir)));
+  GEODEX_ASSIGN_OR_RETURN(RepairRecord record,
+                          LoadRepairStamped(index::MeshHash(FlatPositions(mesh), FlatFaces(mesh)),
+                                            CoarseRepairPath(workdir), CoarseMeshPath(workdir)));
+  return std::make_pair(std::move(mesh), std::move(record));
+}
+
+absl::Status SaveSealedFile(const std::string& path, const char (&magic)[8],
+                            const std::string& payload) {
+  ByteWriter w;
+  w.bytes().append(magic, sizeof(magic));
+  w.bytes().append(payload);
+  Seal(w);
+  return AtomicWriteFile(path, w.bytes());
+}
+
+absl::StatusOr<std::string> LoadSealedFile(const std::string& path, const char (&magic)[8]) {
+  GEODEX_ASSIGN_OR_RETURN(const std::string bytes, ReadWholeFile(path));
+  GEODEX_ASSIGN_OR_RETURN(const std::string_view payload, Unseal(bytes, magic, path));
+  return std::string(payload);
+}
+
+namespace {
+
+absl::Status SaveRepairStamped(const RepairRecord& record, uint64_t mesh_hash,
+                               const std::string& path) {
   ByteWriter w;
   w.bytes().append(kRepairMagic, sizeof(kRepairMagic));
-  w.Put(plan.mesh_hash);
+  w.Put(mesh_hash);
   w.PutVector(record.input_faces);
   w.PutVector(record.vertex_copies);
   w.PutVector(record.coarse_faces);
@@ -253,11 +392,12 @@ absl::Status SaveRepair(const RepairRecord& record, const Plan& plan, const std:
   w.Put(record.refinement_vertices);
   w.PutVector(std::vector<char>(record.report.begin(), record.report.end()));
   Seal(w);
-  return AtomicWriteFile(RepairPath(workdir), w.bytes());
+  return AtomicWriteFile(path, w.bytes());
 }
 
-absl::StatusOr<RepairRecord> LoadRepair(const Plan& plan, const std::string& workdir) {
-  const std::string path = RepairPath(workdir);
+// The record at `path`, stamped with `mesh_hash` (of the mesh at `owner`).
+absl::StatusOr<RepairRecord> LoadRepairStamped(uint64_t mesh_hash, const std::string& path,
+                                               const std::string& owner) {
   absl::StatusOr<std::string> bytes = ReadWholeFile(path);
   if (absl::IsNotFound(bytes.status())) return RepairRecord{};
   GEODEX_RETURN_IF_ERROR(bytes.status());
@@ -279,12 +419,13 @@ absl::StatusOr<RepairRecord> LoadRepair(const Plan& plan, const std::string& wor
   }
   GEODEX_RETURN_IF_ERROR(r.GetVector(&report));
   if (!r.AtEnd()) return absl::DataLossError(absl::StrFormat("%s has trailing bytes", path));
-  if (hash != plan.mesh_hash) {
-    return absl::FailedPreconditionError(
-        absl::StrFormat("%s does not belong to %s", path, PlanPath(workdir)));
+  if (hash != mesh_hash) {
+    return absl::FailedPreconditionError(absl::StrFormat("%s does not belong to %s", path, owner));
   }
   record.report.assign(report.begin(), report.end());
   return record;
 }
+
+}  // namespace
 
 }  // namespace geodex::builder

@@ -60,5 +60,45 @@ absl::Status SaveRows(const Plan& plan, const std::vector<SampleRow>& rows, int3
 // exactly once; DataLoss for corrupt files; FailedPrecondition for rows of
 // another plan.
 absl::StatusOr<std::vector<SampleRow>> LoadAllRows(const Plan& plan, const std::string& workdir);
+// Removes every rows file (a round of a target-error build that planned the
+// next one is done with them). Errors: Internal.
+absl::Status RemoveRows(const std::string& workdir);
+
+// A target-error build's work directory also holds, between its rounds:
+//
+//   coarse.ply, coarse-repair.bin   the repaired input before the flat
+//                                   refinement, refined again for each round
+//   carried.bin                     the rows the current plan carries from
+//                                   the round before (ComputeRows' carried)
+//   target.bin                      the target and the figures of the rounds
+//                                   so far (core/builder/build_rounds.h)
+
+// Writes the coarse mesh and its repair record (RecordRepair), atomically,
+// into `workdir` (created if missing). Errors: as SavePlan's.
+absl::Status SaveCoarseMesh(const mesh::Mesh& mesh, const RepairRecord& record,
+                            const std::string& workdir);
+// Reads them back. Errors: NotFound without them; DataLoss for a corrupt file;
+// FailedPrecondition for a record of another mesh.
+absl::StatusOr<std::pair<mesh::Mesh, RepairRecord>> LoadCoarseMesh(const std::string& workdir);
+
+// Writes the to_samples of `carried` (rows of the first carried.size()
+// samples of `plan`) atomically, stamped with the plan's mesh hash and
+// sample count. Errors: AtomicWriteFile's.
+absl::Status SaveCarriedRows(const Plan& plan, const std::vector<SampleRow>& carried,
+                             const std::string& workdir);
+// Reads them back: none when there is no carried.bin (the first round, or a
+// plan that carries nothing). Errors: DataLoss for a corrupt file;
+// FailedPrecondition for rows carried into another plan.
+absl::StatusOr<std::vector<SampleRow>> LoadCarriedRows(const Plan& plan,
+                                                       const std::string& workdir);
+absl::Status RemoveCarriedRows(const std::string& workdir);
+
+// A file of `payload` behind `magic` (its last byte the version) and a
+// checksum, written atomically; and read back (the payload). Errors:
+// AtomicWriteFile's; on reading NotFound, DataLoss for another kind of file
+// or a checksum mismatch, FailedPrecondition for another version.
+absl::Status SaveSealedFile(const std::string& path, const char (&magic)[8],
+                            const std::string& payload);
+absl::StatusOr<std::string> LoadSealedFile(const std::string& path, const char (&magic)[8]);
 
 }  // namespace geodex::builder

@@ -1,29 +1,33 @@
 // geodex-build: the offline builder job (mesh -> .gdx index); the pipeline is
 // core/builder/build_pipeline.h.
 //
+//   geodex-build MESH -o OUT.gdx [--target-error E] [--samples M0] [--max-samples CAP]
 //   geodex-build MESH -o OUT.gdx --samples M [--threads N] [--seed S] [--edges-obj FILE]
-//   geodex-build MESH -o OUT.gdx --target-error E [--samples M0] [--max-samples CAP]
-//   geodex-build plan MESH --samples M [--seed S] [--threads N] [--edges-obj FILE] -o WORKDIR
+//   geodex-build plan MESH [--target-error E | --samples M] [--seed S] -o WORKDIR
 //   geodex-build rows WORKDIR --shard I/N [--threads T]
 //   geodex-build merge WORKDIR -o OUT.gdx [--threads T]
 //   geodex-build calibrate MESH INDEX.gdx -o OUT.gdx [--threads T]
 //
-// MESH is a .obj/.ply/.off file, or builtin:NAME (torus, sphere, cube,
-// double-torus). Exit codes: 0 success, 2 bad input or usage, 1 any other
-// failure.
+// Without --samples the build is to an error target (E = 0.005 unless
+// --target-error says otherwise; core/validation/target_error.h), in rounds
+// from M0 = 500 samples; --samples alone builds exactly M. MESH is a
+// .obj/.ply/.off file, or builtin:NAME (torus, sphere, cube, double-torus).
+// Exit codes: 0 success, 2 bad input or usage, 1 any other failure, 3 merge
+// planned another round of a target-error build (run rows and merge again).
 
 #include <cstdio>
 
 #include "CLI/CLI.hpp"
 #include "core/builder/build_pipeline.h"
 #include "core/builder/build_progress.h"
+#include "core/builder/build_rounds.h"
 
 namespace {
 
 int ExitCode(const absl::StatusOr<geodex::builder::BuildReport>& report) {
   if (report.ok()) {
     std::fputs(report->text.c_str(), stdout);
-    return 0;
+    return report->another_round ? 3 : 0;
   }
   std::fprintf(stderr, "geodex-build: %s\n", report.status().ToString().c_str());
   switch (report.status().code()) {
@@ -41,7 +45,6 @@ int ExitCode(const absl::StatusOr<geodex::builder::BuildReport>& report) {
 int main(int argc, char** argv) {
   using namespace geodex::builder;
   PipelineOptions o;
-  o.build.num_samples = 1000;
   ProgressPrinter printer;
   o.build.progress = [&printer](const Progress& p) { printer(p); };
   o.log = [](const std::string& line) { std::fprintf(stderr, "%s\n", line.c_str()); };
@@ -64,10 +67,23 @@ int main(int argc, char** argv) {
                   "Refuse a mesh that needs repair (duplicate faces, non-manifold edges or "
                   "vertices, inconsistent orientation, zero-area faces) with the first reason, "
                   "instead of repairing it");
+    cmd->add_option("--weld", o.repair.read.weld_tolerance,
+                    "STL and glTF: weld corners closer than EPS times the bounding-box diagonal "
+                    "(default 0: exactly equal positions)")
+        ->check(CLI::Range(0.0, 1.0));
   };
   const auto sampling_flags = [&](CLI::App* cmd) {
     cmd->add_option("--samples", o.build.num_samples,
-                    "Number of samples m (with --target-error: the first round's)")
+                    "Build exactly m samples (with --target-error: the first round's m)")
+        ->check(CLI::PositiveNumber);
+    cmd->add_option("--target-error", o.target_error,
+                    "The error target (default 0.005 when --samples is not given): relative RMS "
+                    "over area-uniform pairs <= E, p99 <= 2E below 3L and <= 4E from 3L, vertex "
+                    "and interior pairs, by 95% upper limits on held-out sources")
+        ->check(CLI::PositiveNumber);
+    cmd->add_option("--max-samples", o.max_samples,
+                    "With an error target: the cap on m (default 8000; with --no-refinement, "
+                    "half the vertices)")
         ->check(CLI::PositiveNumber);
     cmd->add_option("--seed", o.build.seed, "Sampling seed");
     cmd->add_option("--edges-obj", o.edges_obj, "Also write the geodesic edges as OBJ polylines");
@@ -77,17 +93,9 @@ int main(int argc, char** argv) {
     mesh_flags(cmd);
     threads(cmd);
   };
-  app.add_option("mesh", mesh_path, "Mesh file (.obj/.ply/.off) or builtin:NAME");
+  app.add_option("mesh", mesh_path, "Mesh file (.obj/.ply/.off/.stl/.gltf/.glb) or builtin:NAME");
   app.add_option("-o,--output", out, "Output index file (.gdx)");
   sampling_flags(&app);
-  app.add_option("--target-error", o.target_error,
-                 "Build until the held-out relative RMS is at most this (e.g. 0.005) and the "
-                 "p99 beyond 10L at most 4x it, growing m by 1.5x per round")
-      ->check(CLI::PositiveNumber);
-  app.add_option("--max-samples", o.max_samples,
-                 "With --target-error: the cap on m (default 8000; with --no-refinement, half the "
-                 "vertices)")
-      ->check(CLI::PositiveNumber);
   plan_cmd->add_option("mesh", mesh_path, "Mesh file")->required();
   plan_cmd->add_option("-o,--output", workdir, "Work directory")->required();
   sampling_flags(plan_cmd);
@@ -109,6 +117,11 @@ int main(int argc, char** argv) {
   CLI11_PARSE(app, argc, argv);
   o.build.refine_long_edges = !no_refinement;
   o.calibrate = !no_calibration;
+  const CLI::App* sampled = *plan_cmd ? plan_cmd : &app;
+  if (sampled->count("--samples") == 0) {
+    o.build.num_samples = kDefaultFirstRoundSamples;
+    if (o.target_error == 0) o.target_error = geodex::validation::kDefaultTargetError;
+  }
 
   if (*plan_cmd) return ExitCode(PlanBuild(mesh_path, workdir, o));
   if (*rows_cmd) return ExitCode(ComputeShardRows(workdir, shard, o));

@@ -139,15 +139,16 @@ UniformConfidence UniformConfidenceOf(const std::vector<double>& errors,
     const double se = mse.size() > 1 ? std::sqrt(var / (n - 1) / n) : mean;
     c.rms_upper = std::sqrt(mean + kZ95 * se);
   }
-  if (!far.empty()) {
-    std::vector<double> sorted = far;
-    std::sort(sorted.begin(), sorted.end());
-    const double n = static_cast<double>(sorted.size());
-    const double rank = 0.99 * n + kZ95 * std::sqrt(n * 0.99 * 0.01);
-    const size_t k = std::min(sorted.size() - 1, static_cast<size_t>(std::ceil(rank)));
-    c.far_p99_upper = sorted[k];
-  }
+  c.far_p99_upper = P99UpperLimit(far);
   return c;
+}
+
+double P99UpperLimit(std::vector<double> x) {
+  if (x.empty()) return 0;
+  std::sort(x.begin(), x.end());
+  const double n = static_cast<double>(x.size());
+  const double rank = 0.99 * n + kZ95 * std::sqrt(n * 0.99 * 0.01);
+  return x[std::min(x.size() - 1, static_cast<size_t>(std::ceil(rank)))];
 }
 
 absl::StatusOr<Calibration> Calibrate(const mesh::Mesh& mesh,
@@ -167,6 +168,7 @@ absl::StatusOr<Calibration> Calibrate(const mesh::Mesh& mesh,
   std::vector<double> unfold[2][index::kAccuracyBins], trace[4][index::kAccuracyBins];
   std::vector<SpreadSample> spread[2][index::kAccuracyBins];
   std::vector<double> relative[kNumScaleBins], uniform, uniform_far;
+  std::vector<double> by_kind[2][kNumScaleBins];  // |relative error|, BinConfidence's kinds
   std::vector<int32_t> uniform_source;
   const query::DistanceOptions pure{.near_pairs = query::NearPairs::kUnfold};
   for (const ExactPair& pair : pairs) {
@@ -208,6 +210,8 @@ absl::StatusOr<Calibration> Calibrate(const mesh::Mesh& mesh,
     if (!d.ok()) continue;
     const double e = (*d - pair.exact) / pair.exact;
     relative[pair.bin].push_back(e);
+    by_kind[pair.vertices ? BinConfidence::kVertex : BinConfidence::kInterior][pair.bin].push_back(
+        std::abs(e));
     if (pair.uniform && !pair.vertices) {
       uniform.push_back(e);
       uniform_source.push_back(pair.source);
@@ -224,12 +228,20 @@ absl::StatusOr<Calibration> Calibrate(const mesh::Mesh& mesh,
   r.uniform_rms = static_cast<float>(Rms(uniform));
   r.uniform_far_p99 = uniform_far.empty() ? 0 : static_cast<float>(Quantile(uniform_far, 0.99));
   result.confidence = UniformConfidenceOf(uniform, uniform_source, uniform_far);
+  for (int k = 0; k < 2; ++k) {
+    for (int b = 0; b < kNumScaleBins; ++b) {
+      const std::vector<double>& x = by_kind[k][b];
+      result.bins.pairs[k][b] = static_cast<int32_t>(x.size());
+      result.bins.p99[k][b] = x.empty() ? 0 : Quantile(x, 0.99);
+      result.bins.p99_upper[k][b] = P99UpperLimit(x);
+    }
+  }
   result.record = r;
   return result;
 }
 
 absl::Status AddCalibration(const mesh::Mesh& mesh, index::IndexData& data,
-                            const CalibrationOptions& options, UniformConfidence* confidence) {
+                            const CalibrationOptions& options, Calibration* out) {
   data.accuracy.clear();
   data.spread_bounds.clear();
   GEODEX_ASSIGN_OR_RETURN(std::string bytes, index::SerializeIndex(data));
@@ -238,7 +250,7 @@ absl::Status AddCalibration(const mesh::Mesh& mesh, index::IndexData& data,
                           Calibrate(mesh, std::move(index), options));
   data.accuracy = {calibration.record};
   data.spread_bounds = {calibration.spread};
-  if (confidence != nullptr) *confidence = calibration.confidence;
+  if (out != nullptr) *out = calibration;
   return absl::OkStatus();
 }
 

@@ -51,6 +51,20 @@ struct UniformConfidence {
   double far_p99_upper = 0;
 };
 
+// The default answer's relative error in each scale bin, vertex and
+// interior pairs apart (pair_sampling.h: vertex pairs are mesh vertices of
+// the file, interior pairs points inside faces), with the 95% upper
+// confidence limit of each p99 (the order statistic of
+// UniformConfidence::far_p99_upper). What a target-error build judges every
+// bin by (target_error.h).
+struct BinConfidence {
+  static constexpr int kVertex = 0, kInterior = 1;
+  // [kind][bin]; a bin without pairs has 0 pairs and 0 figures.
+  double p99[2][kNumScaleBins] = {};
+  double p99_upper[2][kNumScaleBins] = {};
+  int32_t pairs[2][kNumScaleBins] = {};
+};
+
 // What a calibration measures: the record of the constant bounds and
 // figures, the per-pair bounds of O(1) answers fitted on the same pairs
 // (index::SpreadBoundRecord: per bin, epsilon from a fixed grid of powers
@@ -60,6 +74,7 @@ struct Calibration {
   index::AccuracyRecord record{};
   index::SpreadBoundRecord spread{};
   UniformConfidence confidence;
+  BinConfidence bins;
 };
 
 // Measures `index` (built from `mesh`) and returns its calibration.
@@ -70,11 +85,10 @@ absl::StatusOr<Calibration> Calibrate(const mesh::Mesh& mesh,
                                       const CalibrationOptions& options = {});
 
 // `data` with its calibration (the accuracy and spread-bound records) added,
-// replacing any, for writing; with `confidence`, the upper confidence limits
-// of its uniform figures.
+// replacing any, for writing; with `calibration`, all that it measured.
 absl::Status AddCalibration(const mesh::Mesh& mesh, index::IndexData& data,
                             const CalibrationOptions& options = {},
-                            UniformConfidence* confidence = nullptr);
+                            Calibration* calibration = nullptr);
 
 // The upper confidence limits of UniformConfidence for relative errors
 // `errors` drawn from sources `source` (parallel arrays), and for the
@@ -82,6 +96,11 @@ absl::Status AddCalibration(const mesh::Mesh& mesh, index::IndexData& data,
 UniformConfidence UniformConfidenceOf(const std::vector<double>& errors,
                                       const std::vector<int32_t>& source,
                                       const std::vector<double>& far);
+
+// The order statistic of `x` (absolute errors) that is at least their 99th
+// percentile with 95% confidence (binomial, normal approximation); 0 for
+// no errors. Exposed for tests.
+double P99UpperLimit(std::vector<double> x);
 
 // "key = value" lines of a calibration, for build reports.
 std::string CalibrationText(const index::AccuracyRecord& record);

@@ -6,7 +6,6 @@
 #include "core/builder/builder.h"
 #include "core/mesh/generators.h"
 #include "core/query/query_engine.h"
-#include "core/validation/target_error.h"
 #include "gtest/gtest.h"
 
 namespace geodex::validation {
@@ -166,35 +165,25 @@ TEST(CalibrationTest, RefusesAnIndexOfAnotherMesh) {
 namespace geodex::validation {
 namespace {
 
-TEST(TargetErrorTest, GrowsTheSamplesUntilTheTargetIsMet) {
-  // The default answer traces pairs that may be closer than 3L; start where
-  // 3L is well below the sphere's half circumference (with 20 samples every
-  // pair is traced and the first round already meets the target).
-  const mesh::Mesh m = mesh::gen::Sphere(3, 1.0);
-  builder::BuildOptions build;
-  build.num_samples = 60;
-  build.threads = 2;
-  TargetErrorOptions options;
-  options.target_rms = 0.011;
-  auto result = BuildForTargetError(m, build, options);
-  ASSERT_TRUE(result.ok()) << result.status();
-  ASSERT_TRUE(result->reached);
-  ASSERT_GE(result->rounds.size(), 2u);  // 60 samples are not enough
-  EXPECT_LE(result->rounds.back().rms, 0.011);
-  EXPECT_GT(result->rounds.front().rms, 0.011);
-  // The stop is judged by the upper confidence limits, which are never
-  // below the measured figures.
-  EXPECT_LE(result->rounds.back().rms_upper, 0.011);
-  EXPECT_LE(result->rounds.back().far_p99_upper, 4 * 0.011);
-  for (const TargetErrorRound& r : result->rounds) {
-    EXPECT_GE(r.rms_upper, r.rms);
-    EXPECT_GE(r.far_p99_upper, r.far_p99);
+// The figures a target-error build judges: every bin of both kinds has
+// pairs on a sphere of 200 samples (its half circumference is about 11.7L),
+// and each p99's upper confidence limit is at least the p99.
+TEST(CalibrationTest, BinFiguresOfBothKindsWithUpperLimits) {
+  const mesh::Mesh m = mesh::gen::Sphere(4, 1.0);
+  index::IndexData data = IndexDataOf(m, 200);
+  Calibration calibration;
+  ASSERT_TRUE(AddCalibration(m, data, {}, &calibration).ok());
+  for (int k = 0; k < 2; ++k) {
+    for (int b = 0; b < kNumScaleBins; ++b) {
+      EXPECT_GE(calibration.bins.pairs[k][b], 64 / 2 * 10) << k << " " << b;
+      EXPECT_GE(calibration.bins.p99_upper[k][b], calibration.bins.p99[k][b]) << k << " " << b;
+    }
+    // Far pairs err by something, near pairs (traced) much less.
+    EXPECT_GT(calibration.bins.p99[k][3], 0) << k;
+    EXPECT_LT(calibration.bins.p99[k][0], calibration.bins.p99[k][3]) << k;
   }
-  ASSERT_EQ(result->data.accuracy.size(), 1u);
-  EXPECT_EQ(result->data.samples.size(), static_cast<size_t>(result->rounds.back().samples));
-  for (size_t k = 1; k < result->rounds.size(); ++k) {
-    EXPECT_GT(result->rounds[k].samples, result->rounds[k - 1].samples);
-  }
+  EXPECT_NEAR(calibration.record.uniform_rms, data.accuracy[0].uniform_rms, 0);
+  EXPECT_GE(calibration.confidence.rms_upper, calibration.record.uniform_rms);
 }
 
 TEST(UniformConfidenceTest, SourcesThatAgreeLeaveNoMarginAndOneBadSourceWidensIt) {
@@ -232,20 +221,11 @@ TEST(UniformConfidenceTest, FarP99LimitIsAHigherOrderStatistic) {
   EXPECT_DOUBLE_EQ(UniformConfidenceOf({}, {}, {0.1, 0.3, 0.2}).far_p99_upper, 0.3);
 }
 
-TEST(TargetErrorTest, StopsAtTheCapAndSaysSo) {
-  const mesh::Mesh m = mesh::gen::Sphere(3, 1.0);
-  builder::BuildOptions build;
-  build.num_samples = 20;
-  TargetErrorOptions options;
-  options.target_rms = 1e-6;
-  options.max_samples = 30;
-  auto result = BuildForTargetError(m, build, options);
-  ASSERT_TRUE(result.ok()) << result.status();
-  EXPECT_FALSE(result->reached);
-  EXPECT_EQ(result->rounds.size(), 2u);  // 20, then 30
-  options.target_rms = -1;
-  EXPECT_EQ(BuildForTargetError(m, build, options).status().code(),
-            absl::StatusCode::kInvalidArgument);
+TEST(UniformConfidenceTest, P99UpperLimitIsTheOrderStatisticOfAnyErrors) {
+  std::vector<double> x;
+  for (int k = 1; k <= 1000; ++k) x.push_back(k / 1000.0);
+  EXPECT_DOUBLE_EQ(P99UpperLimit(x), 0.997);
+  EXPECT_EQ(P99UpperLimit({}), 0);
 }
 
 }  // namespace

@@ -4,59 +4,93 @@
 #include <cmath>
 
 #include "absl/strings/str_format.h"
-#include "core/common/status_macros.h"
-#include "core/validation/calibration.h"
 
 namespace geodex::validation {
+namespace {
 
-absl::StatusOr<TargetErrorResult> BuildForTargetError(const mesh::Mesh& mesh,
-                                                      builder::BuildOptions build,
-                                                      const TargetErrorOptions& options,
-                                                      const builder::RepairRecord& repair) {
-  if (!(options.target_rms > 0) || !(options.growth > 1)) {
-    return absl::InvalidArgumentError(
-        absl::StrFormat("the target error must be > 0 and the growth > 1 (got %g, %g)",
-                        options.target_rms, options.growth));
+constexpr double kRmsRate = 0.7;
+constexpr double kBinRate = 0.6;
+
+int KindOf(int check) { return (check - 1) / kNumScaleBins; }
+int BinOf(int check) { return (check - 1) % kNumScaleBins; }
+
+}  // namespace
+
+std::string TargetCheckName(int check) {
+  if (check == 0) return "uniform RMS";
+  return absl::StrFormat("%s %s p99",
+                         KindOf(check) == BinConfidence::kVertex ? "vertex" : "interior",
+                         ScaleBinName(BinOf(check)));
+}
+
+double TargetLimit(int check, double target) {
+  if (check == 0) return target;
+  return BinOf(check) < 2 ? 2 * target : 4 * target;
+}
+
+TargetFigures FiguresOf(const Calibration& calibration, int32_t samples) {
+  TargetFigures f;
+  f.samples = samples;
+  f.measured[0] = calibration.record.uniform_rms;
+  f.upper[0] = calibration.confidence.rms_upper;
+  f.pairs[0] = 1;  // a calibration always has uniform pairs
+  for (int k = 0; k < 2; ++k) {
+    for (int b = 0; b < kNumScaleBins; ++b) {
+      const int check = 1 + k * kNumScaleBins + b;
+      f.measured[check] = calibration.bins.p99[k][b];
+      f.upper[check] = calibration.bins.p99_upper[k][b];
+      f.pairs[check] = calibration.bins.pairs[k][b];
+    }
   }
-  int32_t referenced = 0;
-  for (int32_t v = 0; v < mesh.num_vertices(); ++v) referenced += mesh.IsReferenced(v);
-  // Samples are vertices: without the flat refinement the mesh's own
-  // vertices bound m (by default half of them); with it, midpoints make room
-  // for more.
-  const int32_t bound = build.refine_long_edges ? kDefaultMaxSamples : referenced;
-  const int32_t default_cap =
-      build.refine_long_edges ? kDefaultMaxSamples : std::max(3, referenced / 2);
-  const int32_t cap =
-      std::min(bound, options.max_samples > 0 ? options.max_samples
-                                              : std::min(default_cap, kDefaultMaxSamples));
-  build.num_samples = std::min(std::max(build.num_samples, 3), cap);
-  TargetErrorResult result;
-  for (int32_t round = 0;; ++round) {
-    builder::BuildSummary summary;
-    GEODEX_ASSIGN_OR_RETURN(
-        const builder::PreparedMesh prepared,
-        builder::PrepareMesh(mesh, repair, build.num_samples, build.refine_long_edges));
-    GEODEX_ASSIGN_OR_RETURN(index::IndexData data,
-                            builder::BuildPreparedIndex(prepared, build, &summary));
-    CalibrationOptions calibration;
-    calibration.pairs.threads = build.threads;
-    calibration.pairs.num_sources = options.validation_sources;
-    UniformConfidence confidence;
-    GEODEX_RETURN_IF_ERROR(AddCalibration(prepared.mesh, data, calibration, &confidence));
-    const index::AccuracyRecord& r = data.accuracy[0];
-    const TargetErrorRound done{static_cast<int32_t>(data.samples.size()), r.uniform_rms,
-                                r.uniform_far_p99, confidence.rms_upper, confidence.far_p99_upper};
-    result.rounds.push_back(done);
-    if (options.round_done) options.round_done(round, done);
-    result.data = std::move(data);
-    result.summary = summary;
-    result.reached =
-        done.rms_upper <= options.target_rms && done.far_p99_upper <= 4 * options.target_rms;
-    if (result.reached || build.num_samples >= cap) break;
-    build.num_samples =
-        std::min(cap, static_cast<int32_t>(std::ceil(build.num_samples * options.growth)));
+  return f;
+}
+
+bool TargetMet(const TargetFigures& f, double target) {
+  for (int c = 0; c < kNumTargetChecks; ++c) {
+    if (f.pairs[c] > 0 && !(f.upper[c] <= TargetLimit(c, target))) return false;
   }
-  return result;
+  return true;
+}
+
+int WorstCheck(const TargetFigures& f, double target) {
+  int worst = 0;
+  double worst_ratio = -1;
+  for (int c = 0; c < kNumTargetChecks; ++c) {
+    if (f.pairs[c] == 0) continue;
+    const double ratio = f.upper[c] / TargetLimit(c, target);
+    if (ratio > worst_ratio) worst = c, worst_ratio = ratio;
+  }
+  return worst;
+}
+
+std::string FiguresText(const TargetFigures& f, double target) {
+  std::string out = absl::StrFormat("m = %d:", f.samples);
+  for (int c = 0; c < kNumTargetChecks; ++c) {
+    if (f.pairs[c] == 0) {
+      out += absl::StrFormat(" %s no pairs;", TargetCheckName(c));
+      continue;
+    }
+    const double limit = TargetLimit(c, target);
+    out +=
+        absl::StrFormat(" %s %.3f%% (%.3f%%) / %.2f%%%s;", TargetCheckName(c), 100 * f.measured[c],
+                        100 * f.upper[c], 100 * limit, f.upper[c] <= limit ? "" : " MISSED");
+  }
+  out.pop_back();
+  return out;
+}
+
+int32_t PredictSamples(std::span<const TargetFigures> rounds, double target, int32_t cap,
+                       const PredictionOptions& options) {
+  const TargetFigures& last = rounds.back();
+  double want = last.samples * options.min_growth;
+  for (int c = 0; c < kNumTargetChecks; ++c) {
+    const double limit = TargetLimit(c, target);
+    if (last.pairs[c] == 0 || last.upper[c] <= limit) continue;
+    const double rate = c == 0 ? kRmsRate : kBinRate;
+    want = std::max(want, last.samples * std::pow(last.upper[c] / (options.aim * limit), 1 / rate));
+  }
+  want = std::min(want, last.samples * options.max_growth);
+  return static_cast<int32_t>(std::min<double>(cap, std::ceil(want)));
 }
 
 }  // namespace geodex::validation

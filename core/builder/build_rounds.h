@@ -1,0 +1,148 @@
+#pragma once
+
+// A build to a target error (core/validation/target_error.h says what a
+// target asks), in rounds that keep what the rounds before computed:
+//
+//   round k  mesh_k: the repaired input refined for m_k (PrepareMesh).
+//            Longest-edge bisection splits the longest edges first, so
+//            mesh_k is mesh_{k-1} with more midpoints after its vertices,
+//            which keep their ids.
+//            plan_k: plan_{k-1}'s samples grown to m_k by farthest points,
+//            then repaired (ExtendPlan).
+//            rows: a full exact propagation for each new sample only; a
+//            carried sample keeps its distances to the samples before it,
+//            and its cell distances come from a propagation bounded to its
+//            cells (ComputeRows' `carried`), a few percent of a full one.
+//            Then the merge, and the validation against held-out exact
+//            propagations (the index's calibration), judged as
+//            target_error.h says.
+//   next m   PredictSamples, from the figures of the rounds so far.
+//
+// A round whose refined mesh does not begin with the earlier round's
+// vertices (the refinement's vertex cap cut it off differently) starts
+// afresh at its m.
+//
+// The same functions run one process's rounds (BuildToTarget) and the steps
+// of a distributed build (build_pipeline.h: plan, then rows and merge again
+// until merge says the target is met), so both give the same index.
+//
+// Thread safety: reentrant.
+
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "absl/status/statusor.h"
+#include "core/builder/builder.h"
+#include "core/builder/mesh_arrays.h"
+#include "core/index/index.h"
+#include "core/mesh/mesh.h"
+#include "core/validation/target_error.h"
+
+namespace geodex::builder {
+
+// The first round's m of a build asked for no sample count.
+inline constexpr int32_t kDefaultFirstRoundSamples = 500;
+
+struct RoundsOptions {
+  // num_samples: the first round's m; seed, threads, refinement, progress.
+  BuildOptions build;
+  double target = validation::kDefaultTargetError;
+  // Cap on m; 0: validation::kDefaultMaxSamples, and without the flat
+  // refinement at most half the referenced vertices.
+  int32_t max_samples = 0;
+  // Held-out sources of each round's validation (and of the index's
+  // calibration). A source's pairs err together and sources differ a lot,
+  // so the figures vary with the draw: twice the calibration's default 64
+  // halves their variance.
+  int32_t validation_sources = 128;
+};
+
+// The cap on m for `coarse` (the repaired input).
+int32_t SampleCap(const mesh::Mesh& coarse, const RoundsOptions& options);
+
+// One round's mesh and plan, and the rows it carries from the round before
+// (empty in the first round, or when it could not carry).
+struct RoundPlan {
+  PreparedMesh prepared;
+  Plan plan;
+  std::vector<SampleRow> carried;
+};
+
+// Round 0: `coarse` refined for options.build.num_samples (at most the cap),
+// with `repair` (RecordRepair of the input), and its plan.
+absl::StatusOr<RoundPlan> PlanFirstRound(const mesh::Mesh& coarse, const RepairRecord& repair,
+                                         const RoundsOptions& options);
+
+// The round after `previous`, whose rows (all of them, any order) are `rows`:
+// `num_samples` samples, on `coarse` refined for them.
+absl::StatusOr<RoundPlan> PlanNextRound(const mesh::Mesh& coarse, const RepairRecord& repair,
+                                        const RoundPlan& previous, std::vector<SampleRow> rows,
+                                        int32_t num_samples, const RoundsOptions& options);
+
+struct RoundResult {
+  index::IndexData data;  // with the repair record and the calibration
+  BuildSummary summary;
+  validation::TargetFigures figures;
+  double validation_seconds = 0;
+};
+
+// Merges the round (its plan and all its rows, left sorted in `rows` for
+// the next round to carry) and validates the index.
+absl::StatusOr<RoundResult> FinishRound(const RoundPlan& round, std::vector<SampleRow>* rows,
+                                        const RoundsOptions& options);
+
+// What comes after a finished round.
+struct NextStep {
+  bool done = false;        // the target is met, or the round was at the cap
+  bool reached = false;     // the target is met
+  int32_t num_samples = 0;  // when not done: the next round's m
+};
+NextStep DecideNext(const std::vector<validation::TargetFigures>& rounds, int32_t requested_samples,
+                    int32_t cap, double target);
+
+// The report lines of a target-error build (the target, whether it was
+// reached, each round's figures, the calibration's), for the index's report.
+std::string TargetReport(const std::vector<validation::TargetFigures>& rounds, bool reached,
+                         double target, const index::AccuracyRecord& accuracy);
+// The line geodex-build logs after a round.
+std::string RoundLine(int32_t round, const validation::TargetFigures& figures, double target);
+
+// All rounds in one process.
+struct TargetBuild {
+  mesh::Mesh mesh;  // the last round's (refined) mesh and plan
+  Plan plan;
+  index::IndexData data;
+  BuildSummary summary;  // of the last round, its times summed over the rounds
+  std::vector<validation::TargetFigures> rounds;
+  bool reached = false;
+};
+absl::StatusOr<TargetBuild> BuildToTarget(const mesh::Mesh& coarse, const RepairRecord& repair,
+                                          const RoundsOptions& options,
+                                          const std::function<void(const std::string&)>& log);
+
+// A distributed target-error build's state between its steps, in its work
+// directory (target.bin): the options the rounds need and the figures of the
+// rounds so far. The current round's files are in RoundDirectory(workdir,
+// round).
+struct TargetState {
+  double target = 0;
+  int32_t cap = 0;
+  int32_t validation_sources = 0;
+  uint64_t seed = 0;
+  bool refine = true;
+  int32_t round = 0;                              // the current round
+  std::vector<validation::TargetFigures> rounds;  // the finished ones
+};
+std::string RoundDirectory(const std::string& workdir, int32_t round);
+// Writes target.bin atomically. Errors: AtomicWriteFile's.
+absl::Status SaveTargetState(const TargetState& state, const std::string& workdir);
+// NotFound when `workdir` holds a fixed-m build (no target.bin); DataLoss for
+// a corrupt file.
+absl::StatusOr<TargetState> LoadTargetState(const std::string& workdir);
+// Removes target.bin (a fixed-m plan made in a work directory that held a
+// target-error build). Errors: Internal.
+absl::Status RemoveTargetState(const std::string& workdir);
+
+}  // namespace geodex::builder

@@ -1,0 +1,137 @@
+#include "core/builder/build_rounds.h"
+
+#include <filesystem>
+
+#include "core/builder/workdir.h"
+#include "core/mesh/generators.h"
+#include "gtest/gtest.h"
+
+namespace geodex::builder {
+namespace {
+
+using validation::TargetFigures;
+
+RoundsOptions Options(int32_t first, double target) {
+  RoundsOptions options;
+  options.build.num_samples = first;
+  options.build.threads = 2;
+  options.target = target;
+  options.validation_sources = 64;
+  return options;
+}
+
+// 60 samples on a sphere are not enough for 1.1%: the build grows them,
+// judged by upper confidence limits (never below the measured figures), and
+// stops where the last round meets every check.
+TEST(BuildRoundsTest, GrowsTheSamplesUntilTheTargetIsMet) {
+  const mesh::Mesh m = mesh::gen::Sphere(3, 1.0);
+  std::vector<std::string> lines;
+  absl::StatusOr<TargetBuild> result =
+      BuildToTarget(m, {}, Options(60, 0.011), [&](const std::string& l) { lines.push_back(l); });
+  ASSERT_TRUE(result.ok()) << result.status();
+  ASSERT_TRUE(result->reached);
+  ASSERT_GE(result->rounds.size(), 2u);
+  EXPECT_EQ(lines.size(), result->rounds.size());
+  EXPECT_FALSE(validation::TargetMet(result->rounds.front(), 0.011));
+  EXPECT_TRUE(validation::TargetMet(result->rounds.back(), 0.011));
+  for (const TargetFigures& r : result->rounds) {
+    for (int c = 0; c < validation::kNumTargetChecks; ++c) EXPECT_GE(r.upper[c], r.measured[c]);
+  }
+  for (size_t k = 1; k < result->rounds.size(); ++k) {
+    EXPECT_GT(result->rounds[k].samples, result->rounds[k - 1].samples);
+  }
+  ASSERT_EQ(result->data.accuracy.size(), 1u);
+  EXPECT_EQ(result->data.samples.size(), static_cast<size_t>(result->rounds.back().samples));
+  EXPECT_EQ(result->plan.samples, result->data.samples);
+  EXPECT_NE(result->data.report.find("target_error_reached = yes\n"), std::string::npos);
+  EXPECT_NE(result->data.report.find("target_error_round_2 = m = "), std::string::npos);
+}
+
+TEST(BuildRoundsTest, StopsAtTheCapAndSaysSo) {
+  const mesh::Mesh m = mesh::gen::Sphere(3, 1.0);
+  RoundsOptions options = Options(20, 1e-6);
+  options.max_samples = 30;
+  absl::StatusOr<TargetBuild> result = BuildToTarget(m, {}, options, nullptr);
+  ASSERT_TRUE(result.ok()) << result.status();
+  EXPECT_FALSE(result->reached);
+  EXPECT_EQ(result->rounds.size(), 2u);  // 20, then the cap
+  EXPECT_NE(result->data.report.find("target_error_reached = no (sample cap)"), std::string::npos);
+  options.target = -1;
+  EXPECT_EQ(BuildToTarget(m, {}, options, nullptr).status().code(),
+            absl::StatusCode::kInvalidArgument);
+}
+
+// The next round carries the samples and rows of the one before.
+TEST(BuildRoundsTest, TheNextRoundCarriesTheSamplesAndRows) {
+  const mesh::Mesh coarse = mesh::gen::Cube(3, 2.0);  // refined again for more samples
+  const RoundsOptions options = Options(40, 0.01);
+  absl::StatusOr<RoundPlan> first = PlanFirstRound(coarse, {}, options);
+  ASSERT_TRUE(first.ok()) << first.status();
+  std::vector<int32_t> all(first->plan.num_samples());
+  for (int32_t a = 0; a < first->plan.num_samples(); ++a) all[a] = a;
+  absl::StatusOr<std::vector<SampleRow>> rows =
+      ComputeRows(first->prepared.mesh, first->plan, all, options.build);
+  ASSERT_TRUE(rows.ok());
+  absl::StatusOr<RoundPlan> next = PlanNextRound(coarse, {}, *first, *rows, 100, options);
+  ASSERT_TRUE(next.ok()) << next.status();
+  EXPECT_GT(next->prepared.mesh.num_vertices(), first->prepared.mesh.num_vertices());
+  ASSERT_EQ(next->carried.size(), first->plan.samples.size());
+  for (size_t a = 0; a < first->plan.samples.size(); ++a) {
+    EXPECT_EQ(next->plan.samples[a], first->plan.samples[a]);
+    EXPECT_EQ(next->carried[a].to_samples, (*rows)[a].to_samples);
+    EXPECT_TRUE(next->carried[a].to_cell_vertices.empty());
+  }
+  EXPECT_GE(next->plan.num_samples(), 100);
+}
+
+TEST(BuildRoundsTest, DecideNext) {
+  TargetFigures met;
+  met.samples = 500;
+  for (int c = 0; c < validation::kNumTargetChecks; ++c) met.pairs[c] = 10;
+  EXPECT_TRUE(DecideNext({met}, 500, 8000, 0.005).reached);
+  TargetFigures missed = met;
+  missed.upper[0] = 0.01;
+  NextStep next = DecideNext({missed}, 500, 8000, 0.005);
+  EXPECT_FALSE(next.done);
+  EXPECT_GT(next.num_samples, 500);
+  next = DecideNext({missed}, 8000, 8000, 0.005);
+  EXPECT_TRUE(next.done);
+  EXPECT_FALSE(next.reached);
+}
+
+TEST(BuildRoundsTest, TargetStateRoundTripsAndRefusesCorruption) {
+  const std::string dir =
+      (std::filesystem::temp_directory_path() / "geodex_build_rounds_test_state").string();
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  EXPECT_EQ(LoadTargetState(dir).status().code(), absl::StatusCode::kNotFound);
+  TargetState state;
+  state.target = 0.005;
+  state.cap = 8000;
+  state.validation_sources = 128;
+  state.seed = 7;
+  state.refine = false;
+  state.round = 1;
+  TargetFigures f;
+  f.samples = 512;
+  f.upper[3] = 0.25;
+  state.rounds = {f};
+  ASSERT_TRUE(SaveTargetState(state, dir).ok());
+  absl::StatusOr<TargetState> loaded = LoadTargetState(dir);
+  ASSERT_TRUE(loaded.ok()) << loaded.status();
+  EXPECT_EQ(loaded->target, 0.005);
+  EXPECT_EQ(loaded->seed, 7u);
+  EXPECT_FALSE(loaded->refine);
+  ASSERT_EQ(loaded->rounds.size(), 1u);
+  EXPECT_EQ(loaded->rounds[0].samples, 512);
+  EXPECT_EQ(loaded->rounds[0].upper[3], 0.25);
+  state.round = 2;  // a round without its figures
+  ASSERT_TRUE(SaveTargetState(state, dir).ok());
+  EXPECT_EQ(LoadTargetState(dir).status().code(), absl::StatusCode::kDataLoss);
+  ASSERT_TRUE(RemoveTargetState(dir).ok());
+  EXPECT_EQ(LoadTargetState(dir).status().code(), absl::StatusCode::kNotFound);
+  std::filesystem::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace geodex::builder
