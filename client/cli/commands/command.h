@@ -4,13 +4,14 @@
 // (models.cc, info.cc, distance.cc, ...; the usage of all of them heads
 // client/cli/geodex_main.cc).
 //
-// Add<Verb>Command adds the verb's subcommand to `app` with its flags: the
-// connection flags every verb has first, then the model's, then its own, in
-// the order `--help` lists them. When the user chooses that subcommand,
-// parsing runs the verb and stores its Status in *status; an input error
-// (IsInputError, client/cli/commands/command_util.h) maps to exit code 2,
-// any other error to 1. The flags' values are owned by the subcommand's
-// callback, so they live as long as `app`; `status` must outlive the parse.
+// Add<Verb>Command adds the verb's subcommand to `app` with its flags, in
+// the order `--help` lists them: the connection flags every verb has first,
+// then the model's (every verb but models and web), then its own. When the
+// user chooses that subcommand, parsing runs the verb and stores its Status
+// in *status; an input error (IsInputError, command_util.h) maps to exit
+// code 2, any other error to 1. The flags' values are owned by the
+// subcommand's callback, so they live as long as `app`; `status` must
+// outlive the parse.
 
 #include "CLI/CLI.hpp"
 #include "absl/status/status.h"

@@ -25,7 +25,7 @@ absl::Status InputError(absl::Status status);
 // Whether `status` was marked by InputError.
 bool IsInputError(const absl::Status& status);
 
-// Flags every subcommand has.
+// Flags every subcommand has: where the server is and how to reach it.
 struct ConnectionFlags {
   std::string server;
   std::string tls_ca, tls_cert, tls_key, tls_server_name;
@@ -43,7 +43,8 @@ void AddConnectionFlags(CLI::App* app, ConnectionFlags* flags);
 // --token-file, and whatever Connect rejects (it comes from the command line).
 absl::StatusOr<Client> MakeClient(const ConnectionFlags& flags, int batch_size = 0);
 
-// -m,--model and --model-version.
+// The model a verb asks about: -m,--model (required) and --model-version
+// (0: the newest), added by AddModelFlags.
 struct ModelFlags {
   std::string name;
   int64_t version = 0;
