@@ -521,9 +521,8 @@ absl::StatusOr<RepairedMesh> RepairMesh(RawMesh raw, const RepairOptions& option
 }
 
 absl::StatusOr<RepairedMesh> LoadAndRepairMesh(const std::string& path,
-                                               const RepairOptions& options,
-                                               const ReadOptions& read) {
-  GEODEX_ASSIGN_OR_RETURN(RawMesh raw, LoadRawMeshFile(path, read));
+                                               const RepairOptions& options) {
+  GEODEX_ASSIGN_OR_RETURN(RawMesh raw, LoadRawMeshFile(path, options.read));
   return RepairMesh(std::move(raw), options);
 }
 

@@ -60,6 +60,8 @@ namespace geodex::mesh {
 struct RepairOptions {
   // Refuse instead of repairing (geodex-build --strict).
   bool strict = false;
+  // How LoadAndRepairMesh reads the file (geodex-build --weld).
+  ReadOptions read;
 };
 
 // How many of each repair were made.
@@ -126,10 +128,9 @@ struct RepairedMesh {
 // the repair (it made a mesh Mesh::Create refuses), never of the input.
 absl::StatusOr<RepairedMesh> RepairMesh(RawMesh raw, const RepairOptions& options = {});
 
-// LoadRawMeshFile (read as `read` says), then RepairMesh.
+// LoadRawMeshFile (read as options.read says), then RepairMesh.
 absl::StatusOr<RepairedMesh> LoadAndRepairMesh(const std::string& path,
-                                               const RepairOptions& options = {},
-                                               const ReadOptions& read = {});
+                                               const RepairOptions& options = {});
 
 // A valid mesh as a repaired one with nothing repaired (identity maps), e.g.
 // a generated mesh.

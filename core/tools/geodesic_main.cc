@@ -1,7 +1,7 @@
 // geodex-geodesic: exact geodesic distances, with the engine the builder uses.
 //
-//   geodex-geodesic MESH --pairs FILE [--threads N]
-//   geodex-geodesic MESH --source-vertex V [--out FILE]
+//   geodex-geodesic MESH --pairs FILE [--threads N] [--weld EPS]
+//   geodex-geodesic MESH --source-vertex V [--out FILE] [--weld EPS]
 //
 // --pairs reads lines "fa a0 a1 a2 fb b0 b1 b2" (see core/mesh/pairs_io.h)
 // and prints one exact distance per pair in input order ("inf" when
@@ -44,8 +44,9 @@ struct Group {
   std::vector<int64_t> pairs;  // indices into the pair list
 };
 
-absl::Status Run(const std::string& mesh_path, const std::string& pairs_path, int threads) {
-  GEODEX_ASSIGN_OR_RETURN(const mesh::Mesh mesh, mesh::LoadMesh(mesh_path));
+absl::Status Run(const std::string& mesh_path, const mesh::ReadOptions& read,
+                 const std::string& pairs_path, int threads) {
+  GEODEX_ASSIGN_OR_RETURN(const mesh::Mesh mesh, mesh::LoadMesh(mesh_path, read));
   GEODEX_ASSIGN_OR_RETURN(const std::string text, mesh::ReadFileOrStdin(pairs_path));
   GEODEX_ASSIGN_OR_RETURN(const std::vector<mesh::PointPair> pairs, mesh::ParsePairs(text));
   GEODEX_RETURN_IF_ERROR(mesh::ValidatePairs(mesh, pairs));
@@ -92,9 +93,10 @@ absl::Status Run(const std::string& mesh_path, const std::string& pairs_path, in
   return absl::OkStatus();
 }
 
-absl::Status RunFromVertex(const std::string& mesh_path, int64_t source, const std::string& out,
-                           const std::string& engine, bool stats) {
-  GEODEX_ASSIGN_OR_RETURN(const mesh::Mesh mesh, mesh::LoadMesh(mesh_path));
+absl::Status RunFromVertex(const std::string& mesh_path, const mesh::ReadOptions& read,
+                           int64_t source, const std::string& out, const std::string& engine,
+                           bool stats) {
+  GEODEX_ASSIGN_OR_RETURN(const mesh::Mesh mesh, mesh::LoadMesh(mesh_path, read));
   if (source < 0 || source >= mesh.num_vertices()) {
     return absl::OutOfRangeError(absl::StrCat("--source-vertex ", source, " is not a vertex of ",
                                               mesh_path, " (it has ", mesh.num_vertices(),
@@ -148,7 +150,12 @@ int main(int argc, char** argv) {
   std::string mesh_path, pairs_path, out = "-";
   int64_t source_vertex = -1;
   int threads = geodex::common::ThreadCount(0);
-  app.add_option("mesh", mesh_path, "Mesh file (.obj, .ply, .off)")->required();
+  app.add_option("mesh", mesh_path, "Mesh file (.obj, .ply, .off, .stl, .gltf, .glb)")->required();
+  geodex::mesh::ReadOptions read;
+  app.add_option("--weld", read.weld_tolerance,
+                 "STL and glTF: weld corners closer than EPS times the bounding-box diagonal "
+                 "(default 0: exactly equal positions)")
+      ->check(CLI::Range(0.0, 1.0));
   auto* pairs = app.add_option("--pairs", pairs_path,
                                "File of lines 'fa a0 a1 a2 fb b0 b1 b2' ('-' for standard input)");
   auto* source = app.add_option("--source-vertex", source_vertex,
@@ -171,8 +178,9 @@ int main(int argc, char** argv) {
     return 2;
   }
   const absl::Status status =
-      pairs->count() > 0 ? geodex::Run(mesh_path, pairs_path, threads)
-                         : geodex::RunFromVertex(mesh_path, source_vertex, out, engine, stats);
+      pairs->count() > 0
+          ? geodex::Run(mesh_path, read, pairs_path, threads)
+          : geodex::RunFromVertex(mesh_path, read, source_vertex, out, engine, stats);
   if (!status.ok()) {
     std::fprintf(stderr, "geodex-geodesic: %s\n", status.ToString().c_str());
     return status.code() == absl::StatusCode::kInvalidArgument ||

@@ -5,11 +5,15 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <cstdio>
 #include <cstdlib>
+#include <string>
 #include <string_view>
 
 #include "absl/status/statusor.h"
 #include "core/mesh/mesh_io.h"
+#include "core/mesh/mesh_repair.h"
+#include "core/mesh/mesh_repair_testing.h"
 
 namespace geodex::fuzz {
 
@@ -38,6 +42,38 @@ void FuzzMeshParser(const uint8_t* data, size_t size, Parse parse) {
   if (!again.ok()) std::abort();
   volatile double sink = sum;
   (void)sink;
+}
+
+// Checks what a corner-welding reader returned (ids in range, finite
+// positions, one face per triangle in order) and what the repair makes of it
+// (mesh_repair_testing.h); aborts, saying why, on any broken promise.
+inline void CheckRawAndRepair(const mesh::RawMesh& raw) {
+  const size_t nv = raw.positions.size();
+  for (const mesh::Vec3& p : raw.positions) {
+    if (!p.allFinite()) {
+      std::fprintf(stderr, "reader returned a non-finite position\n");
+      std::abort();
+    }
+  }
+  if (raw.input_face.size() != raw.triangles.size()) std::abort();
+  for (size_t t = 0; t < raw.triangles.size(); ++t) {
+    if (raw.input_face[t] != static_cast<int32_t>(t)) std::abort();
+    const mesh::Triangle& tri = raw.triangles[t];
+    for (int32_t v : tri) {
+      if (v < 0 || static_cast<size_t>(v) >= nv) std::abort();
+    }
+    // Welding never gives one triangle the same vertex twice.
+    if (tri[0] == tri[1] || tri[1] == tri[2] || tri[0] == tri[2]) {
+      std::fprintf(stderr, "triangle %zu repeats a vertex after welding\n", t);
+      std::abort();
+    }
+  }
+  const absl::StatusOr<mesh::RepairedMesh> repaired = mesh::RepairMesh(raw);
+  const std::string problem = mesh::testing::CheckRepair(raw, repaired);
+  if (!problem.empty()) {
+    std::fprintf(stderr, "repair: %s\n", problem.c_str());
+    std::abort();
+  }
 }
 
 }  // namespace geodex::fuzz
