@@ -64,7 +64,8 @@ constexpr SectionSpec kSpecs[] = {
     {SectionId::kFaces, sizeof(int32_t), "faces", true},
     {SectionId::kTwins, sizeof(int32_t), "twins", true},
     {SectionId::kSamples, sizeof(int32_t), "samples", true},
-    {SectionId::kSampleDistances, sizeof(float), "sample distances", true},
+    // Required by version: the full matrix before 3.0, its lower triangle from 3.0.
+    {SectionId::kSampleDistances, sizeof(float), "sample distances", false},
     {SectionId::kVertexRecords, sizeof(VertexRecord), "vertex records", true},
     {SectionId::kTriangles, sizeof(GeodesicTriangle), "geodesic triangles", true},
     {SectionId::kFaceBvh, sizeof(BvhNode), "face BVH", false},
@@ -76,6 +77,7 @@ constexpr SectionSpec kSpecs[] = {
     {SectionId::kCoarseFaces, sizeof(int32_t), "coarse faces", false},
     {SectionId::kRefinedFaces, sizeof(RefinedFaceRecord), "refined faces", false},
     {SectionId::kSpreadBounds, sizeof(SpreadBoundRecord), "spread bounds", false},
+    {SectionId::kSampleDistancesLower, sizeof(float), "sample distances (lower triangle)", false},
 };
 constexpr size_t kNumSpecs = std::size(kSpecs);
 
@@ -108,6 +110,8 @@ std::optional<uint64_t> ExpectedCount(SectionId id, const Counts& c) {
       return c.num_samples;
     case SectionId::kSampleDistances:
       return c.num_samples * c.num_samples;
+    case SectionId::kSampleDistancesLower:
+      return c.num_samples * (c.num_samples - std::min<uint64_t>(c.num_samples, 1)) / 2;
     case SectionId::kVertexRecords:
       return c.num_vertices;
     case SectionId::kTriangles:
@@ -156,6 +160,7 @@ struct Contents {
   std::span<const int32_t> twins;
   std::span<const int32_t> samples;
   std::span<const float> sample_distances;
+  std::span<const float> sample_distances_lower;
   std::span<const VertexRecord> vertices;
   std::span<const GeodesicTriangle> triangles;
   std::span<const BvhNode> bvh_nodes;
@@ -254,6 +259,13 @@ absl::Status CheckContents(const Contents& c, absl::StatusCode code) {
     if (!NonNegative(c.sample_distances[i])) {
       return fail(absl::StrFormat("sample distance (%d, %d) is negative or NaN (%g)", i / m, i % m,
                                   c.sample_distances[i]));
+    }
+  }
+  for (size_t i = 0; i < c.sample_distances_lower.size(); ++i) {
+    if (!NonNegative(c.sample_distances_lower[i])) {
+      return fail(
+          absl::StrFormat("sample distance %d of the lower triangle is negative or NaN (%g)", i,
+                          c.sample_distances_lower[i]));
     }
   }
   for (size_t v = 0; v < c.vertices.size(); ++v) {
@@ -366,10 +378,11 @@ absl::StatusOr<FileHeader> ValidateHeader(const uint8_t* p, size_t n) {
     return absl::FailedPreconditionError(
         absl::StrFormat("bad byte order mark 0x%08x", h.byte_order_mark));
   }
-  if (h.format_major != kFormatMajor && h.format_major != kRefinedFormatMajor) {
+  if (h.format_major != kFormatMajor && h.format_major != kRefinedFormatMajor &&
+      h.format_major != kPackedFormatMajor) {
     return absl::FailedPreconditionError(absl::StrFormat(
         "index format version %d.%d is not supported by this reader (version %d.%d)",
-        h.format_major, h.format_minor, kRefinedFormatMajor, kRefinedFormatMinor));
+        h.format_major, h.format_minor, kPackedFormatMajor, kPackedFormatMinor));
   }
   if (h.header_size < kHeaderSize || h.header_size % 8 != 0) {
     return absl::DataLossError(absl::StrFormat("bad header size %d", h.header_size));
@@ -472,10 +485,21 @@ absl::Status FindSections(const uint8_t* p, size_t n, const FileHeader& h, const
     }
     found[spec] = e;
   }
+  // The matrix: in full before 3.0, its lower triangle from 3.0, never both.
+  const SectionId matrix = h.format_major >= kPackedFormatMajor ? SectionId::kSampleDistancesLower
+                                                                : SectionId::kSampleDistances;
+  const SectionId other = h.format_major >= kPackedFormatMajor ? SectionId::kSampleDistances
+                                                               : SectionId::kSampleDistancesLower;
   for (size_t s = 0; s < kNumSpecs; ++s) {
     const std::optional<uint64_t> count = ExpectedCount(kSpecs[s].id, counts);
-    if (!found[s].has_value() && (kSpecs[s].required || count.value_or(0) > 0)) {
+    if (!found[s].has_value() &&
+        (kSpecs[s].required || kSpecs[s].id == matrix || count.value_or(0) > 0) &&
+        kSpecs[s].id != other) {
       return absl::DataLossError(absl::StrFormat("missing section: %s", kSpecs[s].name));
+    }
+    if (found[s].has_value() && kSpecs[s].id == other) {
+      return absl::DataLossError(absl::StrFormat("a format %d.%d index with the section %s",
+                                                 h.format_major, h.format_minor, kSpecs[s].name));
     }
   }
   return absl::OkStatus();
@@ -538,6 +562,27 @@ absl::StatusOr<std::string> SerializeIndex(const IndexData& d) {
     return bad(absl::StrFormat("sample_distances: %d values, expected %d (num_samples^2)",
                                d.sample_distances.size(), counts.num_samples * counts.num_samples));
   }
+  // The matrix stored once (3.0): its lower triangle, checked symmetric.
+  std::vector<float> lower;
+  if (d.pack_sample_distances) {
+    const size_t m = counts.num_samples;
+    lower.reserve(m * (m - std::min<size_t>(m, 1)) / 2);
+    for (size_t a = 0; a < m; ++a) {
+      if (d.sample_distances[a * m + a] != 0) {
+        return bad(absl::StrFormat("sample_distances: (%d, %d) is not 0", a, a));
+      }
+      for (size_t b = 0; b < a; ++b) {
+        const float x = d.sample_distances[a * m + b];
+        if (!(x == d.sample_distances[b * m + a]) && !(std::isnan(x))) {
+          return bad(absl::StrFormat("sample_distances: (%d, %d) and (%d, %d) differ", a, b, b, a));
+        }
+        lower.push_back(x);
+      }
+    }
+  }
+  const std::span<const float> full_matrix = d.pack_sample_distances
+                                                 ? std::span<const float>()
+                                                 : std::span<const float>(d.sample_distances);
   if (d.vertices.size() != counts.num_vertices) {
     return bad(absl::StrFormat("vertices: %d records, expected %d (one per vertex)",
                                d.vertices.size(), counts.num_vertices));
@@ -557,8 +602,8 @@ absl::StatusOr<std::string> SerializeIndex(const IndexData& d) {
                                sizeof(FileHeader::builder_version), d.builder_version));
   }
   GEODEX_RETURN_IF_ERROR(CheckContents(
-      Contents{counts, d.positions, d.faces, d.twins, d.samples, d.sample_distances, d.vertices,
-               d.triangles, d.bvh_nodes, d.bvh_faces, d.input_faces, d.vertex_copies,
+      Contents{counts, d.positions, d.faces, d.twins, d.samples, d.sample_distances, lower,
+               d.vertices, d.triangles, d.bvh_nodes, d.bvh_faces, d.input_faces, d.vertex_copies,
                d.coarse_faces, d.refined_faces, d.params.refinement_vertices},
       absl::StatusCode::kInvalidArgument));
   GEODEX_RETURN_IF_ERROR(CheckAccuracy(d.accuracy, absl::StatusCode::kInvalidArgument));
@@ -576,7 +621,7 @@ absl::StatusOr<std::string> SerializeIndex(const IndexData& d) {
       {d.faces.data(), d.faces.size() * sizeof(int32_t)},
       {d.twins.data(), d.twins.size() * sizeof(int32_t)},
       {d.samples.data(), d.samples.size() * sizeof(int32_t)},
-      {d.sample_distances.data(), d.sample_distances.size() * sizeof(float)},
+      {full_matrix.data(), full_matrix.size() * sizeof(float)},
       {d.vertices.data(), d.vertices.size() * sizeof(VertexRecord)},
       {d.triangles.data(), d.triangles.size() * sizeof(GeodesicTriangle)},
       {d.bvh_nodes.data(), d.bvh_nodes.size() * sizeof(BvhNode)},
@@ -588,12 +633,17 @@ absl::StatusOr<std::string> SerializeIndex(const IndexData& d) {
       {d.coarse_faces.data(), d.coarse_faces.size() * sizeof(int32_t)},
       {d.refined_faces.data(), d.refined_faces.size() * sizeof(RefinedFaceRecord)},
       {d.spread_bounds.data(), d.spread_bounds.size() * sizeof(SpreadBoundRecord)},
+      {lower.data(), lower.size() * sizeof(float)},
   };
   // The input-id sections (1.2, 2.0) are written only when the mesh was
   // repaired or refined, so that the index of a mesh that needed neither
   // keeps the 1.1 layout.
-  auto written = [&pieces](size_t i) {
+  // The matrix section of the layout written, even when empty (no samples).
+  const bool packed = d.pack_sample_distances;
+  auto written = [&pieces, packed](size_t i) {
     const SectionId id = kSpecs[i].id;
+    if (id == SectionId::kSampleDistances) return !packed;
+    if (id == SectionId::kSampleDistancesLower) return packed;
     return pieces[i].size > 0 || (id != SectionId::kInputFaces && id != SectionId::kVertexCopies &&
                                   id != SectionId::kCoarseFaces && id != SectionId::kRefinedFaces &&
                                   id != SectionId::kSpreadBounds);
@@ -624,8 +674,8 @@ absl::StatusOr<std::string> SerializeIndex(const IndexData& d) {
   FileHeader h;
   std::memset(static_cast<void*>(&h), 0, sizeof(h));  // padding included
   std::memcpy(h.magic, kMagic, sizeof(kMagic));
-  h.format_major = refined ? kRefinedFormatMajor : kFormatMajor;
-  h.format_minor = refined ? kRefinedFormatMinor : kFormatMinor;
+  h.format_major = packed ? kPackedFormatMajor : refined ? kRefinedFormatMajor : kFormatMajor;
+  h.format_minor = packed ? kPackedFormatMinor : refined ? kRefinedFormatMinor : kFormatMinor;
   h.byte_order_mark = kByteOrderMark;
   h.header_size = sizeof(FileHeader);
   std::memcpy(h.builder_version, d.builder_version.data(), d.builder_version.size());
@@ -729,6 +779,8 @@ absl::Status Index::Validate() {
   twins_ = SectionView<int32_t>(p, entry(SectionId::kTwins));
   samples_ = SectionView<int32_t>(p, entry(SectionId::kSamples));
   sample_distances_ = SectionView<float>(p, entry(SectionId::kSampleDistances));
+  sample_distances_lower_ = SectionView<float>(p, entry(SectionId::kSampleDistancesLower));
+  packed_ = h.format_major >= kPackedFormatMajor;
   vertices_ = SectionView<VertexRecord>(p, entry(SectionId::kVertexRecords));
   triangles_ = SectionView<GeodesicTriangle>(p, entry(SectionId::kTriangles));
   bvh_nodes_ = SectionView<BvhNode>(p, entry(SectionId::kFaceBvh));
@@ -751,9 +803,9 @@ absl::Status Index::Validate() {
       CheckSpreadBounds(spread_bounds_, accuracy_.size(), absl::StatusCode::kDataLoss));
 
   return CheckContents(
-      Contents{counts, positions_, faces_, twins_, samples_, sample_distances_, vertices_,
-               triangles_, bvh_nodes_, bvh_faces_, input_faces_, vertex_copies_, coarse_faces_,
-               refined_faces_, h.params.refinement_vertices},
+      Contents{counts, positions_, faces_, twins_, samples_, sample_distances_,
+               sample_distances_lower_, vertices_, triangles_, bvh_nodes_, bvh_faces_, input_faces_,
+               vertex_copies_, coarse_faces_, refined_faces_, h.params.refinement_vertices},
       absl::StatusCode::kDataLoss);
 }
 
@@ -767,7 +819,18 @@ IndexData ToIndexData(const Index& index) {
   d.faces = copy(index.faces());
   d.twins = copy(index.twins());
   d.samples = copy(index.samples());
-  d.sample_distances = copy(index.sample_distances());
+  if (index.packed_sample_distances()) {
+    const int32_t m = index.num_samples();
+    d.sample_distances.resize(static_cast<size_t>(m) * m);
+    for (int32_t a = 0; a < m; ++a) {
+      for (int32_t b = 0; b < m; ++b) {
+        d.sample_distances[static_cast<size_t>(a) * m + b] = index.SampleDistance(a, b);
+      }
+    }
+    d.pack_sample_distances = true;
+  } else {
+    d.sample_distances = copy(index.sample_distances());
+  }
   d.vertices = copy(index.vertices());
   d.triangles = copy(index.triangles());
   d.bvh_nodes = copy(index.bvh_nodes());

@@ -10,6 +10,7 @@
 // Thread safety: Index is immutable after Open; every method is const and safe
 // from any number of threads. Share it as std::shared_ptr<const Index>.
 
+#include <algorithm>
 #include <cstdint>
 #include <memory>
 #include <span>
@@ -33,6 +34,9 @@ struct IndexData {
   std::vector<int32_t> twins;           // 3 per face
   std::vector<int32_t> samples;         // vertex of each sample
   std::vector<float> sample_distances;  // num_samples^2, row-major
+  // Write the matrix once (format 3.0, its lower triangle): then
+  // sample_distances must be symmetric with a zero diagonal.
+  bool pack_sample_distances = false;
   std::vector<VertexRecord> vertices;
   std::vector<GeodesicTriangle> triangles;
   std::vector<BvhNode> bvh_nodes;
@@ -106,7 +110,15 @@ class Index {
   std::span<const int32_t> faces() const { return faces_; }
   std::span<const int32_t> twins() const { return twins_; }
   std::span<const int32_t> samples() const { return samples_; }
+  // The full num_samples^2 matrix, row-major, of a 1.x / 2.x file; empty for
+  // a 3.x file, which stores only sample_distances_lower(). Prefer
+  // SampleDistance, which reads either.
   std::span<const float> sample_distances() const { return sample_distances_; }
+  // The strictly lower triangle of a 3.x file (d(a, b), a > b, at
+  // a (a - 1) / 2 + b); empty for an older file.
+  std::span<const float> sample_distances_lower() const { return sample_distances_lower_; }
+  // Whether the matrix is stored once (format 3.x).
+  bool packed_sample_distances() const { return packed_; }
   std::span<const VertexRecord> vertices() const { return vertices_; }
   std::span<const GeodesicTriangle> triangles() const { return triangles_; }
   std::span<const BvhNode> bvh_nodes() const { return bvh_nodes_; }
@@ -132,9 +144,13 @@ class Index {
     return static_cast<int32_t>(header_->params.refinement_vertices);
   }
 
-  // d(sample i, sample j) from the matrix.
+  // d(sample i, sample j) from the matrix, in either layout; i and j in
+  // [0, num_samples()).
   float SampleDistance(int32_t i, int32_t j) const {
-    return sample_distances_[static_cast<size_t>(i) * header_->num_samples + j];
+    if (!packed_) return sample_distances_[static_cast<size_t>(i) * header_->num_samples + j];
+    if (i == j) return 0.0f;
+    const size_t hi = static_cast<size_t>(std::max(i, j)), lo = static_cast<size_t>(std::min(i, j));
+    return sample_distances_lower_[hi * (hi - 1) / 2 + lo];
   }
   // Bytes of the file image (mapped or owned).
   size_t size_bytes() const { return size_; }
@@ -158,6 +174,8 @@ class Index {
   std::span<const int32_t> twins_;
   std::span<const int32_t> samples_;
   std::span<const float> sample_distances_;
+  std::span<const float> sample_distances_lower_;
+  bool packed_ = false;
   std::span<const VertexRecord> vertices_;
   std::span<const GeodesicTriangle> triangles_;
   std::span<const BvhNode> bvh_nodes_;

@@ -76,13 +76,32 @@ TEST(IndexTest, WrongMagicIsFailedPrecondition) {
 
 TEST(IndexTest, WrongMajorVersionIsFailedPrecondition) {
   Image image = Image::Parse(Serialize(MakeSphereIndex()));
-  image.header.format_major = kRefinedFormatMajor + 1;
+  image.header.format_major = kPackedFormatMajor + 1;
   image.header.format_minor = 3;
   const absl::Status status = Index::FromBytes(image.Layout()).status();
   EXPECT_EQ(status.code(), absl::StatusCode::kFailedPrecondition);
-  EXPECT_THAT(status.message(), HasSubstr(absl::StrCat(kRefinedFormatMajor + 1, ".3")));
+  EXPECT_THAT(status.message(), HasSubstr(absl::StrCat(kPackedFormatMajor + 1, ".3")));
   EXPECT_THAT(status.message(),
-              HasSubstr(absl::StrCat(kRefinedFormatMajor, ".", kRefinedFormatMinor)));
+              HasSubstr(absl::StrCat(kPackedFormatMajor, ".", kPackedFormatMinor)));
+}
+
+// A 3.x file has the lower triangle and not the full matrix; an older one
+// the full matrix and not the triangle.
+TEST(IndexTest, MatrixLayoutMustMatchTheVersion) {
+  IndexData d = MakeSphereIndex();
+  Image full = Image::Parse(Serialize(d));
+  full.header.format_major = kPackedFormatMajor;
+  full.header.format_minor = kPackedFormatMinor;
+  absl::Status status = Index::FromBytes(full.Layout()).status();
+  EXPECT_EQ(status.code(), absl::StatusCode::kDataLoss);
+  EXPECT_THAT(status.message(), HasSubstr("sample distances"));
+  d.pack_sample_distances = true;
+  Image packed = Image::Parse(Serialize(d));
+  packed.header.format_major = kFormatMajor;
+  packed.header.format_minor = kFormatMinor;
+  status = Index::FromBytes(packed.Layout()).status();
+  EXPECT_EQ(status.code(), absl::StatusCode::kDataLoss);
+  EXPECT_THAT(status.message(), HasSubstr("sample distances"));
 }
 
 TEST(IndexTest, SwappedByteOrderIsFailedPrecondition) {

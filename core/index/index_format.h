@@ -39,18 +39,28 @@
 //        calibrated with the AccuracyRecord. Optional, written only with a
 //        calibration; older readers ignore it and use the AccuracyRecord's
 //        bounds.
+//   3.0  the symmetric sample distance matrix stored once: its strictly
+//        lower triangle (SampleDistancesLower, d(a, b) for a > b at
+//        a (a - 1) / 2 + b; the diagonal is 0), half the bytes of the full
+//        matrix, which a 3.x file does not have, hence the major version.
+//        Otherwise as 2.1 (the refinement sections optional). Written when
+//        IndexData::pack_sample_distances asks; this reader reads 1.x, 2.x
+//        and 3.x (Index::SampleDistance reads either layout).
 
 #include <cstdint>
 
 namespace geodex::index {
 
 inline constexpr char kMagic[8] = {'G', 'E', 'O', 'D', 'E', 'X', 'I', 'X'};
-// The version written when the mesh was not refined, and the newest (when it
-// was); a reader takes both majors.
+// The version written when the mesh was not refined, and when it was; a
+// reader takes both majors, and kPackedFormatMajor.
 inline constexpr uint32_t kFormatMajor = 1;
 inline constexpr uint32_t kFormatMinor = 3;
 inline constexpr uint32_t kRefinedFormatMajor = 2;
 inline constexpr uint32_t kRefinedFormatMinor = 1;
+// The version of an index whose matrix is stored once (refined or not).
+inline constexpr uint32_t kPackedFormatMajor = 3;
+inline constexpr uint32_t kPackedFormatMinor = 0;
 inline constexpr uint32_t kByteOrderMark = 0x01020304;  // reads 0x04030201 when swapped
 inline constexpr uint64_t kAlignment = 64;
 
@@ -60,7 +70,7 @@ enum class SectionId : uint32_t {
   kFaces = 2,            // int32[num_faces][3]
   kTwins = 3,            // int32[num_faces * 3]: twin half-edge or -1
   kSamples = 4,          // int32[num_samples]: the vertex of each sample
-  kSampleDistances = 5,  // float[num_samples][num_samples], row-major, symmetric
+  kSampleDistances = 5,  // float[num_samples][num_samples], row-major, symmetric (1.x, 2.x)
   kVertexRecords = 6,    // VertexRecord[num_vertices]
   kTriangles = 7,        // GeodesicTriangle[num_triangles]
   kFaceBvh = 8,          // BvhNode[num_bvh_nodes]
@@ -72,6 +82,9 @@ enum class SectionId : uint32_t {
   kCoarseFaces = 14,     // int32[num_coarse_faces][3]: the faces before refinement (2.0)
   kRefinedFaces = 15,    // RefinedFaceRecord[num_faces] (2.0); absent: not refined
   kSpreadBounds = 16,    // SpreadBoundRecord[0 or 1] (1.3 / 2.1); absent: constant bounds
+  // float[num_samples (num_samples - 1) / 2]: the matrix's strictly lower
+  // triangle, row by row (3.x, instead of kSampleDistances).
+  kSampleDistancesLower = 17,
 };
 
 // Build parameters recorded in the header.

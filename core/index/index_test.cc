@@ -31,6 +31,45 @@ TEST(IndexTest, RoundTripFromBytes) {
   EXPECT_EQ((*index)->header().format_minor, kFormatMinor);
 }
 
+// Format 3.0: the matrix stored once. The same distances from
+// SampleDistance, half the matrix bytes, and a 3.x file copied through
+// ToIndexData is written packed again.
+TEST(IndexTest, MatrixStoredOnceRoundTrips) {
+  IndexData d = MakeSphereIndex();
+  const std::string full = Serialize(d);
+  d.pack_sample_distances = true;
+  const std::string packed = Serialize(d);
+  absl::StatusOr<std::shared_ptr<const Index>> index = Index::FromBytes(packed);
+  ASSERT_TRUE(index.ok()) << index.status();
+  EXPECT_EQ((*index)->header().format_major, kPackedFormatMajor);
+  EXPECT_EQ((*index)->header().format_minor, kPackedFormatMinor);
+  EXPECT_TRUE((*index)->packed_sample_distances());
+  EXPECT_TRUE((*index)->sample_distances().empty());
+  const int32_t m = (*index)->num_samples();
+  EXPECT_EQ((*index)->sample_distances_lower().size(), static_cast<size_t>(m * (m - 1) / 2));
+  for (int32_t i = 0; i < m; ++i) {
+    for (int32_t j = 0; j < m; ++j) {
+      EXPECT_EQ((*index)->SampleDistance(i, j), d.sample_distances[i * m + j]) << i << " " << j;
+    }
+  }
+  // The matrix's bytes: m^2 floats before, m (m - 1) / 2 now (to alignment).
+  const size_t saved = full.size() - packed.size();
+  EXPECT_GE(saved + 2 * kAlignment, sizeof(float) * (m * m - m * (m - 1) / 2));
+  EXPECT_EQ(Serialize(ToIndexData(**index)), packed);
+  // Older files still read, in their layout.
+  absl::StatusOr<std::shared_ptr<const Index>> old = Index::FromBytes(full);
+  ASSERT_TRUE(old.ok()) << old.status();
+  EXPECT_FALSE((*old)->packed_sample_distances());
+  EXPECT_EQ((*old)->SampleDistance(3, 7), (*index)->SampleDistance(3, 7));
+  // Only a symmetric matrix with a zero diagonal is stored once.
+  IndexData asymmetric = d;
+  asymmetric.sample_distances[1 * m + 2] += 0.5f;
+  EXPECT_EQ(SerializeIndex(asymmetric).status().code(), absl::StatusCode::kInvalidArgument);
+  IndexData diagonal = d;
+  diagonal.sample_distances[2 * m + 2] = 0.1f;
+  EXPECT_EQ(SerializeIndex(diagonal).status().code(), absl::StatusCode::kInvalidArgument);
+}
+
 AccuracyRecord SomeAccuracy() {
   AccuracyRecord r{};
   r.scale_length = 0.1f;
