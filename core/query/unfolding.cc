@@ -18,7 +18,9 @@ using kernel::TwoSideToOutside2;
 }  // namespace
 
 Unfolding::Unfolding(const index::Index& index, bool vector_lanes)
-    : matrix_(index.sample_distances()),
+    : matrix_(index.packed_sample_distances() ? index.sample_distances_lower()
+                                               : index.sample_distances()),
+      packed_(index.packed_sample_distances()),
       triangles_(index.triangles()),
       num_samples_(index.num_samples()),
       vector_lanes_(vector_lanes) {
@@ -93,8 +95,7 @@ void Unfolding::Prefetch(const LiftedPoint& p, const LiftedPoint& q) const {
   const LiftedPoint& lo = p.triangle > q.triangle ? q : p;
   const LiftedPoint& hi = p.triangle > q.triangle ? p : q;
   for (int r = 0; r < 3; ++r) {
-    const float* row = &matrix_[static_cast<size_t>(hi.corner[r]) * num_samples_];
-    for (int c = 0; c < 3; ++c) __builtin_prefetch(row + lo.corner[c]);
+    for (int c = 0; c < 3; ++c) __builtin_prefetch(Entry(hi.corner[r], lo.corner[c]));
   }
 }
 

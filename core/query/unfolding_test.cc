@@ -1,8 +1,10 @@
 #include "core/query/unfolding.h"
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 
+#include "core/builder/builder.h"
 #include "core/mesh/generators.h"
 #include "core/query/query_parts_testing.h"
 #include "gtest/gtest.h"
@@ -73,6 +75,45 @@ TEST(UnfoldingTest, ToSampleIsExactAtCornersAndNearTriangles) {
   EXPECT_TRUE(parts.unfolding.AreNear(a, b));
   EXPECT_EQ(parts.unfolding.Matrix(t.corner[0], t.corner[0]), 0);
   EXPECT_GT(parts.unfolding.Matrix(t.corner[0], t.corner[1]), 0);
+}
+
+TEST(UnfoldingTest, AMatrixStoredOnceGivesTheSameAnswers) {
+  // The same index with its (symmetrised) matrix written in full and once
+  // (format 3): every distance agrees to the bit.
+  const mesh::Mesh sphere = mesh::gen::Sphere(3, 1.0);
+  builder::BuildOptions options;
+  options.num_samples = 50;
+  builder::BuildSummary summary;
+  absl::StatusOr<index::IndexData> data = builder::BuildIndex(sphere, options, &summary);
+  ASSERT_TRUE(data.ok()) << data.status();
+  const int32_t m = static_cast<int32_t>(data->samples.size());
+  std::vector<float>& d = data->sample_distances;
+  for (int32_t a = 0; a < m; ++a) {
+    d[static_cast<size_t>(a) * m + a] = 0;
+    for (int32_t b = 0; b < a; ++b) {
+      const float x = std::min(d[static_cast<size_t>(a) * m + b], d[static_cast<size_t>(b) * m + a]);
+      d[static_cast<size_t>(a) * m + b] = d[static_cast<size_t>(b) * m + a] = x;
+    }
+  }
+  auto full = index::Index::FromBytes(*index::SerializeIndex(*data));
+  data->pack_sample_distances = true;
+  auto packed = index::Index::FromBytes(*index::SerializeIndex(*data));
+  ASSERT_TRUE(full.ok() && packed.ok());
+  ASSERT_TRUE((*packed)->packed_sample_distances());
+  ASSERT_LT((*packed)->size_bytes(), (*full)->size_bytes());
+  const MeshView view{(*full)->positions(), (*full)->faces(), (*full)->twins()};
+  const Unfolding u_full(**full, true), u_packed(**packed, true);
+  const Lifting l_full(view, (*full)->vertices(), u_full);
+  const Lifting l_packed(view, (*packed)->vertices(), u_packed);
+  const std::vector<SurfacePoint> points = Points(sphere, 200, 3);
+  for (size_t i = 0; i + 1 < points.size(); i += 2) {
+    const LiftedPoint a = l_full.Lift(points[i]), b = l_full.Lift(points[i + 1]);
+    EXPECT_EQ(u_full.Distance(a, b),
+              u_packed.Distance(l_packed.Lift(points[i]), l_packed.Lift(points[i + 1])));
+  }
+  for (int32_t a = 0; a < m; ++a) {
+    for (int32_t b = 0; b < m; ++b) EXPECT_EQ(u_full.Matrix(a, b), u_packed.Matrix(a, b));
+  }
 }
 
 }  // namespace

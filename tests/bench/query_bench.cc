@@ -102,7 +102,7 @@ struct PackedMatrix {
     const int64_t m = ix.num_samples();
     values.reserve(m * (m - 1) / 2);
     for (int64_t a = 1; a < m; ++a) {
-      for (int64_t b = 0; b < a; ++b) values.push_back(ix.sample_distances()[a * m + b]);
+      for (int64_t b = 0; b < a; ++b) values.push_back(ix.SampleDistance(a, b));
     }
   }
   double operator()(int32_t a, int32_t b) const {
