@@ -49,6 +49,12 @@ class SurfacePoints(NamedTuple):
     faces: np.ndarray
     weights: np.ndarray
 
+    def take(self, index: Any) -> "SurfacePoints":
+        """The points at ``index`` (a slice, an integer array or a mask):
+        ``points.take(slice(0, 10))``. (Indexing the tuple itself picks its
+        fields, as for any tuple.)"""
+        return SurfacePoints(self.faces[index], self.weights[index])
+
 
 class Located(NamedTuple):
     """The closest surface points of 3D positions (``locate``): usable

@@ -10,8 +10,10 @@ same ids (the mesh file's, also when the builder repaired the mesh).
 
 from __future__ import annotations
 
+import logging
 import os
 import sys
+import tempfile
 import time
 from typing import Any, Callable, Dict, List, NamedTuple, Optional, Sequence, Tuple, Union
 
@@ -41,6 +43,8 @@ else:
 __all__ = ["Index", "build", "BuildProgress", "has_in_process"]
 
 _NEAR_PAIRS = {None: 0, "path": 1, "unfold": 2, "exact": 3}
+# The builder's messages about the rounds of a target-error build.
+_log = logging.getLogger("geodex")
 
 
 def has_in_process() -> bool:
@@ -74,7 +78,7 @@ class Index:
     Parameters
     ----------
     path : str or os.PathLike
-        A .gdx file (geodex-build, or :func:`build`).
+        A .gdx file (geodex-build, or :func:`build`); kept as ``filename``.
     threads : int
         Threads for large batches (``distance``, ``matrix``); 0: one per
         core. The answers do not depend on it.
@@ -96,12 +100,12 @@ class Index:
         core = _require_core()
         if int(threads) < 0:
             raise InvalidArgument(f"threads must be >= 0, not {threads}")
-        self.path = os.fspath(path)
-        self._index = core.Index(self.path, int(threads))
+        self.filename = os.fspath(path)
+        self._index = core.Index(self.filename, int(threads))
 
     def __repr__(self) -> str:
         return (
-            f"geodex.Index({self.path!r}: {self.num_vertices} vertices, {self.num_faces} faces, "
+            f"geodex.Index({self.filename!r}: {self.num_vertices} vertices, {self.num_faces} faces, "
             f"{self.num_samples} samples)"
         )
 
@@ -324,7 +328,8 @@ def build(
         Default: the builder's (1000).
     target_error : float, optional
         Build until the held-out relative RMS error is at most this (e.g.
-        0.005), growing m round by round up to ``max_samples``.
+        0.005), growing m round by round up to ``max_samples``; each round
+        is logged to the "geodex" logger (logging.INFO).
     seed : int
         The sampling seed: the same mesh and options give the same bytes.
     threads : int
@@ -386,24 +391,49 @@ def build(
         assert callback is not None
         callback(BuildProgress(phase, done, total))
 
+    def run(mesh_path: str) -> None:
+        core.build(
+            mesh_path,
+            os.fsdecode(path),
+            0 if samples is None else int(samples),
+            0.0 if target_error is None else float(target_error),
+            0 if max_samples is None else int(max_samples),
+            int(seed),
+            int(threads),
+            bool(strict),
+            bool(refine),
+            bool(calibrate),
+            None if callback is None else report,
+            _log.info,
+        )
+
     if faces is None and is_pathlike(mesh):
-        vertices, face_array, mesh_path = None, None, os.fsdecode(mesh)
+        run(os.fsdecode(mesh))
     else:
+        # Arrays go to the builder as the file it reads (the same repair as
+        # for any mesh file): a binary PLY of doubles keeps every coordinate
+        # and the order of vertices and faces, so the ids are the arrays'.
         vertices, face_array = as_mesh(mesh, faces)
-        mesh_path = None
-    core.build(
-        vertices,
-        face_array,
-        mesh_path,
-        os.fsdecode(path),
-        0 if samples is None else int(samples),
-        0.0 if target_error is None else float(target_error),
-        0 if max_samples is None else int(max_samples),
-        int(seed),
-        int(threads),
-        bool(strict),
-        bool(refine),
-        bool(calibrate),
-        None if callback is None else report,
-    )
+        with tempfile.TemporaryDirectory(prefix="geodex-build-") as tmp:
+            ply = os.path.join(tmp, "mesh.ply")
+            _write_ply(ply, vertices, face_array)
+            run(ply)
     return Index(path, threads=threads)
+
+
+def _write_ply(path: str, vertices: np.ndarray, faces: np.ndarray) -> None:
+    """A binary little-endian PLY: double x, y, z; faces as uchar-counted int lists."""
+    header = (
+        "ply\nformat binary_little_endian 1.0\n"
+        f"element vertex {vertices.shape[0]}\n"
+        "property double x\nproperty double y\nproperty double z\n"
+        f"element face {faces.shape[0]}\n"
+        "property list uchar int vertex_indices\nend_header\n"
+    )
+    records = np.empty(faces.shape[0], dtype=[("n", "u1"), ("v", "<i4", (3,))])
+    records["n"] = 3
+    records["v"] = faces
+    with open(path, "wb") as f:
+        f.write(header.encode("ascii"))
+        f.write(np.ascontiguousarray(vertices, dtype="<f8").tobytes())
+        f.write(records.tobytes())

@@ -25,6 +25,13 @@ def test_points_accept_objects_with_faces_and_weights_and_one_point():
     assert one.faces.tolist() == [7] and one.weights.shape == (1, 3)
 
 
+def test_take_picks_points():
+    p = as_points((np.arange(5), np.full((5, 3), 1 / 3)), "a")
+    q = p.take(slice(1, 3))
+    assert q.faces.tolist() == [1, 2] and q.weights.shape == (2, 3)
+    assert p.take(np.array([4, 0])).faces.tolist() == [4, 0]
+
+
 def test_empty_points():
     p = as_points(([], np.zeros((0, 3))), "a")
     assert p.faces.shape == (0,) and p.weights.shape == (0, 3)

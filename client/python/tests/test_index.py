@@ -1,0 +1,183 @@
+"""The in-process index (geodex.Index, geodex.build) against the server on
+the same index file: the same engine in the same ids, so the same answers to
+the bit, and the same exceptions with the same messages."""
+
+import os
+from pathlib import Path
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+
+import geodex
+from support import build_index, query_distances, random_points, require_in_process, shared_mesh
+
+MODEL = "torus"
+
+
+@pytest.fixture(scope="module")
+def index(torus_index) -> "geodex.Index":
+    require_in_process()
+    return geodex.Index(torus_index)
+
+
+@pytest.fixture(scope="module")
+def num_faces(index) -> int:
+    return index.num_faces
+
+
+def test_what_the_index_holds(index, client):
+    model = client.model(MODEL)
+    assert (index.num_vertices, index.num_faces, index.num_samples) == (
+        model.num_vertices, model.num_faces, model.num_samples)
+    assert index.has_error_bounds
+    assert index.report == model.build_report
+    assert "torus" in repr(index) or "index.gdx" in repr(index)
+
+
+@pytest.mark.parametrize("options", [{}, {"bounds": True}, {"near_pairs": "unfold"},
+                                     {"near_pairs": "exact"}, {"tolerance": 0.005}])
+def test_distances_equal_the_servers_to_the_bit(index, client, num_faces, options):
+    # Under a tolerance, far pairs are refined exactly (milliseconds each);
+    # the exact mode propagates for every near pair.
+    n = 200 if "tolerance" in options else 2000 if options.get("near_pairs") == "exact" else 20000
+    a, b = random_points(num_faces, n, 41), random_points(num_faces, n, 42)
+    b.faces[::2] = a.faces[::2]  # near pairs too
+    ours, theirs = index.distance(a, b, **options), client.distance(MODEL, a, b, **options)
+    if options.get("bounds"):
+        assert np.array_equal(ours[0], theirs[0]) and np.array_equal(ours[1], theirs[1])
+    else:
+        assert np.array_equal(ours, theirs)
+
+
+def test_threads_do_not_change_the_answers(torus_index, num_faces):
+    a, b = random_points(num_faces, 50000, 43), random_points(num_faces, 50000, 44)
+    one = geodex.Index(torus_index, threads=1).distance(a, b)
+    assert np.array_equal(one, geodex.Index(torus_index, threads=3).distance(a, b))
+
+
+def test_every_other_method_equals_the_server(index, client, num_faces, torus_mesh):
+    s, t = random_points(num_faces, 6, 45), random_points(num_faces, 200, 46)
+    for ours, theirs in zip(index.matrix(s, t, bounds=True), client.matrix(MODEL, s, t, bounds=True)):
+        assert np.array_equal(ours, theirs)
+    for ours, theirs in zip(index.path(s, t.take(slice(6))), client.path(MODEL, s, t.take(slice(6)))):
+        assert np.array_equal(ours.positions, theirs.positions)
+        assert np.array_equal(ours.faces, theirs.faces)
+        assert np.array_equal(ours.weights, theirs.weights)
+        assert ours.length == theirs.length
+    for ours, theirs in zip(index.field(s, nearest=True), client.field(MODEL, s, nearest=True)):
+        assert np.array_equal(ours, theirs)
+    for ours, theirs in zip(index.expmap((5, (0.1, 0.1, 0.8)), 1.2, direction=(1, 2, 3)),
+                            client.expmap(MODEL, (5, (0.1, 0.1, 0.8)), 1.2, direction=(1, 2, 3))):
+        assert np.array_equal(ours, theirs)
+    xyz = np.random.default_rng(47).uniform(-3, 3, (300, 3))
+    for ours, theirs in zip(index.locate(xyz), client.locate(MODEL, xyz)):
+        assert np.array_equal(ours, theirs)
+    assert np.array_equal(index.distance(xyz[:10], xyz[10:20], xyz=True),
+                          client.distance(MODEL, xyz[:10], xyz[10:20], xyz=True))
+    for ours, theirs in zip(index.mesh(), torus_mesh):
+        assert np.array_equal(ours, theirs) and ours.dtype == theirs.dtype
+
+
+def test_the_same_exceptions_as_the_server(index, client, num_faces):
+    g = random_points(num_faces, 10, 48)
+    cases = [
+        ((np.array([0, num_faces], np.int32), np.eye(3)[:2]), geodex.OutOfRange),
+        ((g.faces[:2], np.array([[1, 0, 0], [0.5, 0.2, 0.2]])), geodex.InvalidArgument),
+    ]
+    for a, error in cases:
+        with pytest.raises(error) as ours:
+            index.distance(a, (g.faces[:2], g.weights[:2]))
+        with pytest.raises(error) as theirs:
+            client.distance(MODEL, a, (g.faces[:2], g.weights[:2]))
+        assert ours.value.message == theirs.value.message
+    with pytest.raises(geodex.InvalidArgument, match="a.faces\\[1\\] is -1"):
+        index.distance((np.array([0, -1]), np.eye(3)[:2]), (g.faces[:2], g.weights[:2]))
+    with pytest.raises(geodex.NotFound):
+        geodex.Index("/nonexistent/index.gdx")
+
+
+def test_an_uncalibrated_index_refuses_bounds(models_dir):
+    require_in_process()
+    cube = geodex.Index(models_dir / "cube" / "1" / "index.gdx")
+    p = random_points(cube.num_faces, 3, 49)
+    with pytest.raises(geodex.FailedPrecondition):
+        cube.distance(p, p, bounds=True)
+
+
+def test_build_from_arrays_gives_the_servers_index(torus_mesh, client, tmp_path, num_faces):
+    """The torus's arrays, built as geodex-build built builtin:torus: the
+    same mesh and options, so the same index and the same answers."""
+    vertices, faces = torus_mesh
+    seen = []
+    built = geodex.build(vertices, faces, tmp_path / "torus.gdx", samples=200,
+                         progress=lambda p: seen.append(p))
+    assert isinstance(built, geodex.Index) and Path(built.filename).is_file()
+    phases = {p.phase for p in seen}
+    assert {"sampling", "rows"} <= phases, phases
+    assert all(0 <= p.done <= p.total for p in seen if p.total > 0)
+    a, b = random_points(num_faces, 5000, 50), random_points(num_faces, 5000, 51)
+    assert np.array_equal(built.distance(a, b), client.distance(MODEL, a, b))
+
+
+def test_build_from_objects_and_files(tmp_path):
+    require_in_process()
+    # A flat 2 x 1 strip of four triangles: distances are Euclidean.
+    v = np.array([[0, 0, 0], [1, 0, 0], [2, 0, 0], [0, 1, 0], [1, 1, 0], [2, 1, 0]], float)
+    f = np.array([[0, 1, 4], [0, 4, 3], [1, 2, 5], [1, 5, 4]])
+    trimesh_like = SimpleNamespace(vertices=v, faces=f)
+    strip = geodex.build(trimesh_like, tmp_path / "strip.gdx", samples=4, calibrate=False)
+    d = strip.distance(([0], [[1, 0, 0]]), ([2], [[0, 1, 0]]))  # (0,0,0) to (2,0,0)
+    assert d == pytest.approx([2.0], rel=1e-9)
+    obj = tmp_path / "strip.obj"
+    obj.write_text("".join(f"v {x} {y} {z}\n" for x, y, z in v)
+                   + "".join(f"f {i + 1} {j + 1} {k + 1}\n" for i, j, k in f))
+    from_file = geodex.build(obj, tmp_path / "strip_file.gdx", samples=4, calibrate=False)
+    assert np.array_equal(from_file.mesh()[1], f)
+    assert from_file.distance(([0], [[1, 0, 0]]), ([2], [[0, 1, 0]])) == pytest.approx([2.0], rel=1e-9)
+
+
+def test_build_refuses_bad_input(tmp_path):
+    require_in_process()
+    v = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0]], float)
+    with pytest.raises(geodex.InvalidArgument, match=r"faces\[0\]"):
+        geodex.build(v, [[0, 1, 3]], tmp_path / "x.gdx")
+    with pytest.raises(geodex.InvalidArgument, match="output path"):
+        geodex.build(v, [[0, 1, 2]])
+    with pytest.raises(geodex.InvalidArgument, match="samples"):
+        geodex.build(v, [[0, 1, 2]], tmp_path / "x.gdx", samples=0)
+    with pytest.raises(geodex.NotFound):
+        geodex.build(tmp_path / "missing.obj", tmp_path / "x.gdx")
+    # Two triangles sharing an edge the same way round: inconsistent
+    # orientation, which strict refuses and the default repairs.
+    v4 = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [1, 1, 0]], float)
+    flipped = np.array([[0, 1, 2], [1, 2, 3]])
+    with pytest.raises(geodex.InvalidArgument):
+        geodex.build(v4, flipped, tmp_path / "strict.gdx", samples=3, strict=True, calibrate=False)
+    assert not (tmp_path / "strict.gdx").exists()
+
+
+def test_a_failing_progress_callback_is_raised_after_the_build(tmp_path):
+    require_in_process()
+    v = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [1, 1, 0]], float)
+
+    def progress(p):
+        raise KeyError("stop")
+
+    with pytest.raises(KeyError, match="stop"):
+        geodex.build(v, [[0, 1, 2], [1, 3, 2]], tmp_path / "p.gdx", samples=3, calibrate=False,
+                     progress=progress)
+
+
+def test_a_repaired_shared_mesh_answers_in_the_files_ids(tmp_path):
+    """cow_nonmanifold_3k needs repair (non-manifold): the index answers in
+    the file's ids, in process as with geodex-query."""
+    require_in_process()
+    mesh = shared_mesh("cow_nonmanifold_3k.obj")
+    path = build_index(str(mesh), tmp_path / "cow.gdx", "--samples", "200", "--no-calibration")
+    cow = geodex.Index(path)
+    a, b = random_points(cow.num_faces, 2000, 52), random_points(cow.num_faces, 2000, 53)
+    reference = query_distances(path, tmp_path, a, b)
+    d = cow.distance(a, b)
+    same = (d == reference) | (np.isinf(d) & np.isinf(reference))
+    assert np.all(same | (np.abs(d - reference) <= 1e-12 * np.abs(reference)))
