@@ -116,7 +116,7 @@ DRIVER_PID=""
 cat "$WORK/driver.out"
 if [ $DRIVER_RC -ne 0 ]; then
   cat "$WORK/driver.err" >&2
-  fail "the driver saw violations (exit $DRIVER_RC)"
+  fail "the driver failed (exit $DRIVER_RC): violations, or no call checked (above)"
 fi
 [ $STEP -eq 3 ] || fail "the run ended before all three swaps (step $STEP)"
 kill -0 "$SERVER_PID" 2> /dev/null || fail "the server died"

@@ -414,5 +414,16 @@ int main(int argc, char** argv) {
       "%lld violations\n",
       threads, seconds, static_cast<long long>(c.valid.load()),
       static_cast<long long>(c.invalid.load()), static_cast<long long>(c.violations.load()));
-  return c.violations.load() == 0 ? 0 : 1;
+  if (c.violations.load() != 0) return 1;
+  // A run that answered nothing checked nothing: a server that refused every
+  // call from the start, or clients that never ran, must not look like a
+  // clean soak.
+  if (c.valid.load() == 0 || c.invalid.load() == 0) {
+    std::fprintf(
+        stderr,
+        "soak_driver: FAILED: %lld valid and %lld invalid calls made: nothing was checked\n",
+        static_cast<long long>(c.valid.load()), static_cast<long long>(c.invalid.load()));
+    return 1;
+  }
+  return 0;
 }
