@@ -105,6 +105,23 @@ absl::Status WriteAndReport(const index::IndexData& data, BuildSummary& summary,
   return absl::OkStatus();
 }
 
+// The summary's line of a target-error build.
+std::string TargetSummary(const std::vector<validation::TargetFigures>& rounds, bool reached,
+                          double target) {
+  std::string samples;
+  for (const validation::TargetFigures& r : rounds) {
+    samples += absl::StrFormat("%s%d", samples.empty() ? "" : ", ", r.samples);
+  }
+  const validation::TargetFigures& last = rounds.back();
+  const int worst = validation::WorstCheck(last, target);
+  return absl::StrFormat(
+      "  error target     %g: %s in %d rounds (m = %s); closest check %s, 95%% upper limit "
+      "%.3f%% of %.3f%%\n",
+      target, reached ? "met" : "NOT met (sample cap)", rounds.size(), samples,
+      validation::TargetCheckName(worst), 100 * last.upper[worst],
+      100 * validation::TargetLimit(worst, target));
+}
+
 void Log(const PipelineOptions& options, const std::string& line) {
   if (options.log) options.log(line);
 }
@@ -130,6 +147,7 @@ absl::StatusOr<BuildReport> BuildToTargetError(const mesh::RepairedMesh& repaire
   BuildReport report;
   GEODEX_RETURN_IF_ERROR(WriteEdges(result.mesh, result.plan, options.edges_obj, &report));
   GEODEX_RETURN_IF_ERROR(WriteAndReport(result.data, result.summary, out, &report));
+  report.text += TargetSummary(result.rounds, result.reached, options.target_error);
   return report;
 }
 
@@ -208,6 +226,7 @@ absl::StatusOr<BuildReport> MergeTargetRound(const std::string& workdir, TargetS
                                    result.figures.samples));
     }
     GEODEX_RETURN_IF_ERROR(WriteAndReport(result.data, result.summary, out, &report));
+    report.text += TargetSummary(state.rounds, next.reached, state.target);
     return report;
   }
   GEODEX_ASSIGN_OR_RETURN(auto coarse, LoadCoarseMesh(workdir));
@@ -324,7 +343,7 @@ absl::StatusOr<BuildReport> ComputeShardRows(const std::string& workdir, std::st
   GEODEX_ASSIGN_OR_RETURN(const std::string dir, CurrentPlanDirectory(workdir, &state));
   GEODEX_ASSIGN_OR_RETURN(auto loaded, LoadPlan(dir));
   const auto& [mesh, plan] = loaded;
-  GEODEX_ASSIGN_OR_RETURN(const std::vector<SampleRow> carried, LoadCarriedRows(plan, dir));
+  GEODEX_ASSIGN_OR_RETURN(std::vector<SampleRow> carried, LoadCarriedRows(plan, dir));
   const std::vector<int32_t> ids = ShardSamples(plan.num_samples(), index, count);
   GEODEX_ASSIGN_OR_RETURN(auto rows, ComputeRows(mesh, plan, ids, options.build, carried));
   GEODEX_RETURN_IF_ERROR(SaveRows(plan, rows, index, count, dir));

@@ -112,7 +112,7 @@ absl::StatusOr<RoundPlan> PlanNextRound(const mesh::Mesh& coarse, const RepairRe
         for (int32_t a = 0; a < m; ++a) {
           // Cell distances are of the earlier cells: the carried rows' are redone.
           carried[a].sample = a;
-          carried[a].to_samples = rows[a].to_samples;
+          carried[a].to_samples = std::move(rows[a].to_samples);
         }
         return RoundPlan{std::move(prepared), std::move(plan), std::move(carried)};
       });

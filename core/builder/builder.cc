@@ -203,8 +203,7 @@ void Summarize(const Mesh& mesh, const Plan& plan, const SampleDistances& sample
 class CarriedCellReach {
  public:
   CarriedCellReach(const Mesh& mesh, const Plan& plan,
-                   const std::vector<std::vector<int32_t>>& neighbors,
-                   std::span<const SampleRow> carried)
+                   const std::vector<std::vector<int32_t>>& neighbors, std::span<SampleRow> carried)
       : plan_(plan), neighbors_(neighbors), carried_(carried) {
     if (carried.empty()) return;
     for (int32_t h = 0; h < mesh.num_halfedges(); ++h) {
@@ -230,7 +229,7 @@ class CarriedCellReach {
  private:
   const Plan& plan_;
   const std::vector<std::vector<int32_t>>& neighbors_;
-  std::span<const SampleRow> carried_;
+  std::span<SampleRow> carried_;
   double longest_edge_ = 0;
 };
 
@@ -343,7 +342,7 @@ absl::StatusOr<Plan> ExtendPlan(const Mesh& mesh, std::span<const int32_t> previ
 absl::StatusOr<std::vector<SampleRow>> ComputeRows(const Mesh& mesh, const Plan& plan,
                                                    std::span<const int32_t> sample_ids,
                                                    const BuildOptions& options,
-                                                   std::span<const SampleRow> carried) {
+                                                   std::span<SampleRow> carried) {
   const int32_t m = plan.num_samples();
   for (int32_t id : sample_ids) {
     if (id < 0 || id >= m) {
@@ -380,11 +379,11 @@ absl::StatusOr<std::vector<SampleRow>> ComputeRows(const Mesh& mesh, const Plan&
       row.sample = a;
       const std::vector<int32_t> cell_vertices = CellVertices(plan, neighbors[a], a);
       if (a < static_cast<int32_t>(carried.size())) {
-        row.to_samples = carried[a].to_samples;
         // Exact below the cap (vertices the propagation did not reach
         // sooner keep it, NearestSource kNone); a full propagation when a
         // cell vertex lies beyond it after all.
         const double radius = reach.Radius(a);
+        row.to_samples = std::move(carried[a].to_samples);
         if (radius > 0) {
           cap.assign(mesh.num_vertices(), radius);
           geodesic::VertexGeodesicOptions bounded;

@@ -133,9 +133,10 @@ absl::StatusOr<Plan> ExtendPlan(const mesh::Mesh& mesh, std::span<const int32_t>
 //
 // `carried` (a target-error build's later rounds): rows an earlier round
 // computed for the first carried.size() samples of `plan` (ExtendPlan keeps
-// them first), of which only to_samples is read. Such a sample's row keeps
-// that to_samples (the distances to the samples after it come from their
-// rows, Merge reads either direction), and its cell distances come from a
+// them first), of which only to_samples is read. Such a sample's row takes
+// over that to_samples (moved: the carried rows are left empty; the
+// distances to the samples after it come from their rows, Merge reads
+// either direction), and its cell distances come from a
 // propagation that stops past its and its neighbours' cells (Plan's
 // cell_radius bounds how far that is), a few percent of a full one; a full
 // propagation when that bound does not hold.
@@ -143,11 +144,11 @@ absl::StatusOr<Plan> ExtendPlan(const mesh::Mesh& mesh, std::span<const int32_t>
 // carried row that does not reach its own sample or has more entries than
 // the plan has samples; an error of the exact propagation (then no rows are
 // returned).
-// Thread safety: reentrant; `mesh`, `plan` and `carried` are only read.
+// Thread safety: reentrant; `mesh` and `plan` are only read.
 absl::StatusOr<std::vector<SampleRow>> ComputeRows(const mesh::Mesh& mesh, const Plan& plan,
                                                    std::span<const int32_t> sample_ids,
                                                    const BuildOptions& options,
-                                                   std::span<const SampleRow> carried = {});
+                                                   std::span<SampleRow> carried = {});
 
 // Phase 3: assembles the index from the plan and the rows of every sample (any
 // order) and fills `summary` (vertex_assignment.h assigns the vertices).

@@ -293,6 +293,7 @@ TEST(BuilderTest, GrownPlanWithCarriedRowsGivesTheIndexOfFullRows) {
   EXPECT_NEAR(summary_full.share_outside, summary_reused.share_outside, 0.002);
 
   // Carried rows that do not reach their own sample are refused.
+  carried = *first_rows;  // moved from by the call above
   carried[3].to_samples.resize(3);
   EXPECT_EQ(ComputeRows(m, *grown, all, options, carried).status().code(),
             absl::StatusCode::kInvalidArgument);
