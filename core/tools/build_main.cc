@@ -55,7 +55,10 @@ int main(int argc, char** argv) {
   app.require_subcommand(0, 1);
   CLI::App* plan_cmd = app.add_subcommand("plan", "Distributed build, step 1: sampling");
   CLI::App* rows_cmd = app.add_subcommand("rows", "Distributed build, step 2: one shard of rows");
-  CLI::App* merge_cmd = app.add_subcommand("merge", "Distributed build, step 3: the index");
+  CLI::App* merge_cmd = app.add_subcommand(
+      "merge",
+      "Distributed build, step 3: the index (exit 3: a target-error build planned "
+      "another round; run the rows and merge again)");
   CLI::App* calibrate_cmd = app.add_subcommand(
       "calibrate", "Adds the accuracy calibration (error bounds) to an index built without it");
   const auto threads = [&o](CLI::App* cmd) {
