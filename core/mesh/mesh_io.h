@@ -20,8 +20,9 @@
 // first (each node, then its children, in the file's order), each node's mesh
 // primitives in order, each primitive's triangles in index order, positions
 // transformed by the node's world matrix. A file without scenes gives every
-// mesh once, untransformed, in mesh order. Primitives of points and lines,
-// strips and fans, and compressed or quantized positions are refused.
+// mesh once, untransformed, in mesh order. Morph targets and skins are not
+// applied. Primitives of points and lines, strips and fans, and compressed
+// or quantized positions are refused.
 //
 // Errors: InvalidArgument for a malformed, truncated or garbage file (naming
 // file and line or element) and for anything Mesh::Create rejects; reading a

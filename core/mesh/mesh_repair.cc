@@ -387,7 +387,7 @@ std::string RepairReport::ToText() const {
       duplicate_faces, reoriented_faces, unreferenced_vertices, zero_area_faces, sliver_faces);
   if (weld.welded) {
     absl::StrAppendFormat(&out,
-                          "mesh_welded_corners = %d\nmesh_weld_tolerance = %.17g\n"
+                          "mesh_welded_corners = %d\nmesh_weld_tolerance = %.9g\n"
                           "mesh_degenerate_corners_unwelded = %d\n",
                           weld.welded_corners, weld.tolerance, weld.degenerate_corners);
   }
