@@ -32,10 +32,18 @@ absl::Status CheckPairedUp(const v1::SurfacePoints& a, const v1::SurfacePoints& 
       absl::StrFormat("a has %d points but b has %d; they must pair up", na, nb));
 }
 
-mesh::SurfacePoint InputPointAt(const v1::SurfacePoints& points, int64_t i) {
-  const int k = static_cast<int>(i);
-  return {points.faces(k),
-          {points.weights(3 * k), points.weights(3 * k + 1), points.weights(3 * k + 2)}};
+absl::StatusOr<mesh::SurfacePoint> OnePointFromProto(const v1::SurfacePoints& points,
+                                                     std::string_view name,
+                                                     const query::InputQueries& queries,
+                                                     query::EnginePoints* out) {
+  if (PointCount(points) != 1) {
+    return absl::InvalidArgumentError(absl::StrFormat("%s: give exactly one point, got %d",
+                                                      std::string(name), PointCount(points)));
+  }
+  const absl::Status status = PointsFromProto(points, name, queries, out);
+  if (!status.ok()) return status;
+  return mesh::SurfacePoint{points.faces(0),
+                            {points.weights(0), points.weights(1), points.weights(2)}};
 }
 
 absl::Status PositionsFromProto(const v1::Positions& positions, std::string_view name,
@@ -97,12 +105,14 @@ void AppendLocated(const query::LocatedPoint& located, v1::LocateResponse* respo
 }
 
 void MatrixBlockToProto(int64_t row_offset, int64_t rows, int64_t num_targets,
-                        std::span<const double> values, int64_t version, v1::MatrixBlock* block) {
+                        std::span<const double> values, std::span<const double> bounds,
+                        int64_t version, v1::MatrixBlock* block) {
   block->set_row_offset(row_offset);
   block->set_rows(rows);
   block->set_num_targets(num_targets);
   block->set_version(version);
   block->mutable_values()->Assign(values.begin(), values.end());
+  block->mutable_bounds()->Assign(bounds.begin(), bounds.end());
 }
 
 void FieldChunkToProto(const query::DistanceField& field, int64_t offset, int64_t count,

@@ -22,6 +22,7 @@
 #include <vector>
 
 #include "absl/status/status.h"
+#include "absl/status/statusor.h"
 #include "core/index/index.h"
 #include "core/mesh/mesh.h"
 #include "core/query/exp_map.h"
@@ -48,10 +49,15 @@ inline int64_t PointCount(const v1::SurfacePoints& points) { return points.faces
 // InvalidArgument ("a has 3 points but b has 2; they must pair up").
 absl::Status CheckPairedUp(const v1::SurfacePoints& a, const v1::SurfacePoints& b);
 
-// Point `i` of `points` as the request gives it (input ids), for calls that
-// take input points (InputQueries::ExpMap). `points` must have passed
+// Reads `points` that must hold exactly one point (named `name`): into
+// `out` as PointsFromProto does, and returned as the request gives it, in
+// input ids (for InputQueries::ExpMap's centre). Errors: InvalidArgument for
+// another count ("center: give exactly one point, got 2"), and those of
 // PointsFromProto.
-mesh::SurfacePoint InputPointAt(const v1::SurfacePoints& points, int64_t i);
+absl::StatusOr<mesh::SurfacePoint> OnePointFromProto(const v1::SurfacePoints& points,
+                                                     std::string_view name,
+                                                     const query::InputQueries& queries,
+                                                     query::EnginePoints* out);
 
 // Reads packed 3D positions. Errors: InvalidArgument if xyz is not a multiple
 // of 3 long or a coordinate is not finite ("positions[4]: y is nan").
@@ -75,9 +81,11 @@ void UnreachablePathToProto(v1::Polyline* polyline);
 // LocateResponse.
 void AppendLocated(const query::LocatedPoint& located, v1::LocateResponse* response);
 
-// Rows [row_offset, row_offset + rows) of a matrix, `values` row-major.
+// Rows [row_offset, row_offset + rows) of a matrix, `values` row-major, and
+// their error bounds alike (empty when the request asked for none).
 void MatrixBlockToProto(int64_t row_offset, int64_t rows, int64_t num_targets,
-                        std::span<const double> values, int64_t version, v1::MatrixBlock* block);
+                        std::span<const double> values, std::span<const double> bounds,
+                        int64_t version, v1::MatrixBlock* block);
 
 // Vertices [offset, offset + count) of a distance field (per input vertex:
 // InputQueries::Field).

@@ -1,5 +1,6 @@
 #include "server/convert.h"
 
+#include <array>
 #include <cmath>
 #include <limits>
 
@@ -82,6 +83,52 @@ TEST_F(ConvertTest, WeightsMustBeThreePerFace) {
 
 TEST_F(ConvertTest, WeightsWithinToleranceAreAccepted) {
   EXPECT_TRUE(Read(Points({0}, {1 + 5e-7, -5e-7, 0})).ok());
+}
+
+TEST(ConvertPairsTest, PointsMustPairUp) {
+  v1::SurfacePoints a, b;
+  for (int32_t f : {0, 1, 2}) a.add_faces(f);
+  for (int32_t f : {0, 1}) b.add_faces(f);
+  const absl::Status s = CheckPairedUp(a, b);
+  EXPECT_EQ(s.code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_EQ(std::string(s.message()), "a has 3 points but b has 2; they must pair up");
+  b.add_faces(2);
+  EXPECT_TRUE(CheckPairedUp(a, b).ok());
+}
+
+TEST_F(ConvertTest, OnePointIsReadAndReturnedAsGiven) {
+  absl::StatusOr<mesh::SurfacePoint> p =
+      OnePointFromProto(Points({5}, {0.25, 0.25, 0.5}), "center", *queries_, &out_);
+  ASSERT_TRUE(p.ok()) << p.status();
+  EXPECT_EQ(p->face, 5);
+  EXPECT_EQ(p->w, (std::array<double, 3>{0.25, 0.25, 0.5}));
+  EXPECT_EQ(out_.size(), 1u);
+  for (const v1::SurfacePoints& points : {Points({}, {}), Points({0, 1}, {1, 0, 0, 1, 0, 0})}) {
+    p = OnePointFromProto(points, "center", *queries_, &out_);
+    EXPECT_EQ(p.status().code(), absl::StatusCode::kInvalidArgument);
+    EXPECT_EQ(std::string(p.status().message()),
+              absl::StrFormat("center: give exactly one point, got %d", points.faces_size()));
+  }
+  p = OnePointFromProto(Points({99999}, {1, 0, 0}), "center", *queries_, &out_);
+  EXPECT_EQ(p.status().code(), absl::StatusCode::kOutOfRange);
+  EXPECT_THAT(std::string(p.status().message()), StartsWith("center[0]: face id 99999"));
+}
+
+TEST(ConvertMatrixTest, BlockCarriesValuesAndBoundsRowMajor) {
+  const std::vector<double> values = {1, 2, 3, 4, 5, 6};
+  const std::vector<double> bounds = {0.1, 0.2, 0.3, 0.4, 0.5, 0.6};
+  v1::MatrixBlock block;
+  MatrixBlockToProto(4, 2, 3, values, bounds, 7, &block);
+  EXPECT_EQ(block.row_offset(), 4);
+  EXPECT_EQ(block.rows(), 2);
+  EXPECT_EQ(block.num_targets(), 3);
+  EXPECT_EQ(block.version(), 7);
+  EXPECT_THAT(block.values(), ::testing::ElementsAreArray(values));
+  EXPECT_THAT(block.bounds(), ::testing::ElementsAreArray(bounds));
+  // A reused block without bounds has none left from the last one.
+  MatrixBlockToProto(6, 1, 3, std::span<const double>(values).first(3), {}, 7, &block);
+  EXPECT_EQ(block.values_size(), 3);
+  EXPECT_EQ(block.bounds_size(), 0);
 }
 
 TEST(ConvertPositionsTest, ChecksShapeAndFiniteness) {

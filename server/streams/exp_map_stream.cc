@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <vector>
 
-#include "absl/strings/str_format.h"
 #include "core/common/status_macros.h"
 #include "server/convert.h"
 #include "server/convert_options.h"
@@ -23,18 +22,14 @@ class ExpMapStream final : public ChunkedWriteStream<v1::ExpMapChunk> {
   absl::Status ComputeNext(WorkerContext& worker) override {
     GEODEX_RETURN_IF_ERROR(CheckAlive(*context_));
     GEODEX_ASSIGN_OR_RETURN(model_, resources_->Resolve(request_->model(), call_));
-    if (PointCount(request_->center()) != 1) {
-      return absl::InvalidArgumentError(absl::StrFormat("center: give exactly one point, got %d",
-                                                        PointCount(request_->center())));
-    }
     const query::InputQueries& queries = model_.version->queries();
-    GEODEX_RETURN_IF_ERROR(PointsFromProto(request_->center(), "center", queries, &worker.a));
+    // The centre as the request gives it: the map's θ runs round that input
+    // face's normal (InputQueries::ExpMap).
+    GEODEX_ASSIGN_OR_RETURN(const mesh::SurfacePoint centre,
+                            OnePointFromProto(request_->center(), "center", queries, &worker.a));
     GEODEX_ASSIGN_OR_RETURN(const query::ExpMapOptions options,
                             ExpMapOptionsFor(model_.model->config, *request_));
-    // The centre as the request gives it (validated above): the map's θ runs
-    // round that input face's normal (InputQueries::ExpMap).
-    GEODEX_ASSIGN_OR_RETURN(
-        map_, queries.ExpMap(InputPointAt(request_->center(), 0), options, &worker.scratch));
+    GEODEX_ASSIGN_OR_RETURN(map_, queries.ExpMap(centre, options, &worker.scratch));
     call_.pairs = static_cast<int64_t>(map_.size());
     return absl::OkStatus();
   }

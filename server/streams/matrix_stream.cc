@@ -63,8 +63,7 @@ class MatrixStream final : public ChunkedWriteStream<v1::MatrixBlock> {
           &worker.scratch,
           bounds ? std::span<double>(bounds_.data() + r * t, t) : std::span<double>()));
     }
-    MatrixBlockToProto(next_row_, rows_, t, values_, model_.version->version(), &block_);
-    block_.mutable_bounds()->Assign(bounds_.begin(), bounds_.end());
+    MatrixBlockToProto(next_row_, rows_, t, values_, bounds_, model_.version->version(), &block_);
     return absl::OkStatus();
   }
 
