@@ -1,0 +1,207 @@
+// The index file writer: IndexData -> the bytes of a file the reader
+// (index.cc) accepts, with the same checks of the arrays.
+
+#include <algorithm>
+#include <cstring>
+#include <string>
+
+#include "absl/strings/str_format.h"
+#include "core/common/file_util.h"
+#include "core/common/status_macros.h"
+#include "core/index/index.h"
+#include "core/index/index_sections.h"
+#include "core/index/input_id_checks.h"
+
+namespace geodex::index {
+
+using internal::AlignUp;
+using internal::CheckAccuracy;
+using internal::CheckContents;
+using internal::CheckSpreadBounds;
+using internal::Checksum;
+using internal::Contents;
+using internal::Counts;
+using internal::ExpectedCount;
+using internal::HeaderChecksum;
+using internal::kInt32Max;
+using internal::kNumSpecs;
+using internal::kSpecs;
+using internal::SpecIndex;
+
+absl::StatusOr<std::string> SerializeIndex(const IndexData& d) {
+  auto bad = [](std::string message) { return absl::InvalidArgumentError(message); };
+  if (d.positions.size() % 3 != 0) {
+    return bad(absl::StrFormat("positions: %d values, not a multiple of 3", d.positions.size()));
+  }
+  if (d.faces.size() % 3 != 0) {
+    return bad(absl::StrFormat("faces: %d values, not a multiple of 3", d.faces.size()));
+  }
+  Counts counts;
+  counts.num_vertices = d.positions.size() / 3;
+  counts.num_faces = d.faces.size() / 3;
+  counts.num_samples = d.samples.size();
+  counts.num_triangles = d.triangles.size();
+  counts.num_bvh_nodes = d.bvh_nodes.size();
+  if (counts.num_vertices > kInt32Max || 3 * counts.num_faces > kInt32Max ||
+      counts.num_samples > kInt32Max || counts.num_triangles > kInt32Max ||
+      counts.num_bvh_nodes > kInt32Max) {
+    return bad("too many vertices, faces, samples, triangles or BVH nodes for int32 ids");
+  }
+  if (d.twins.size() != d.faces.size()) {
+    return bad(absl::StrFormat("twins: %d values, expected %d (3 per face)", d.twins.size(),
+                               d.faces.size()));
+  }
+  if (d.sample_distances.size() != counts.num_samples * counts.num_samples) {
+    return bad(absl::StrFormat("sample_distances: %d values, expected %d (num_samples^2)",
+                               d.sample_distances.size(), counts.num_samples * counts.num_samples));
+  }
+  // The matrix stored once (3.0): its lower triangle, checked symmetric.
+  std::vector<float> lower;
+  if (d.pack_sample_distances) {
+    const size_t m = counts.num_samples;
+    lower.reserve(m * (m - std::min<size_t>(m, 1)) / 2);
+    for (size_t a = 0; a < m; ++a) {
+      if (d.sample_distances[a * m + a] != 0) {
+        return bad(absl::StrFormat("sample_distances: (%d, %d) is not 0", a, a));
+      }
+      for (size_t b = 0; b < a; ++b) {
+        const float x = d.sample_distances[a * m + b];
+        if (!(x == d.sample_distances[b * m + a]) && !(std::isnan(x))) {
+          return bad(absl::StrFormat("sample_distances: (%d, %d) and (%d, %d) differ", a, b, b, a));
+        }
+        lower.push_back(x);
+      }
+    }
+  }
+  const std::span<const float> full_matrix = d.pack_sample_distances
+                                                 ? std::span<const float>()
+                                                 : std::span<const float>(d.sample_distances);
+  if (d.vertices.size() != counts.num_vertices) {
+    return bad(absl::StrFormat("vertices: %d records, expected %d (one per vertex)",
+                               d.vertices.size(), counts.num_vertices));
+  }
+  const uint64_t expected_bvh_faces = counts.num_bvh_nodes > 0 ? counts.num_faces : 0;
+  if (d.bvh_faces.size() != expected_bvh_faces) {
+    return bad(absl::StrFormat("bvh_faces: %d values, expected %d", d.bvh_faces.size(),
+                               expected_bvh_faces));
+  }
+  if (d.params.num_samples != counts.num_samples) {
+    return bad(absl::StrFormat("params.num_samples is %d but there are %d samples",
+                               d.params.num_samples, counts.num_samples));
+  }
+  if (d.builder_version.size() >= sizeof(FileHeader::builder_version) ||
+      d.builder_version.find('\0') != std::string::npos) {
+    return bad(absl::StrFormat("builder_version must be under %d bytes without NULs: \"%s\"",
+                               sizeof(FileHeader::builder_version), d.builder_version));
+  }
+  GEODEX_RETURN_IF_ERROR(CheckContents(
+      Contents{counts, d.positions, d.faces, d.twins, d.samples, d.sample_distances, lower,
+               d.vertices, d.triangles, d.bvh_nodes, d.bvh_faces, d.input_faces, d.vertex_copies,
+               d.coarse_faces, d.refined_faces, d.params.refinement_vertices},
+      absl::StatusCode::kInvalidArgument));
+  GEODEX_RETURN_IF_ERROR(CheckAccuracy(d.accuracy, absl::StatusCode::kInvalidArgument));
+  GEODEX_RETURN_IF_ERROR(
+      CheckSpreadBounds(d.spread_bounds, d.accuracy.size(), absl::StatusCode::kInvalidArgument));
+
+  // Every section is written, empty ones with size 0, in kSpecs order (but the
+  // input-id sections, below).
+  struct Piece {
+    const void* data;
+    uint64_t size;
+  };
+  const Piece pieces[kNumSpecs] = {
+      {d.positions.data(), d.positions.size() * sizeof(double)},
+      {d.faces.data(), d.faces.size() * sizeof(int32_t)},
+      {d.twins.data(), d.twins.size() * sizeof(int32_t)},
+      {d.samples.data(), d.samples.size() * sizeof(int32_t)},
+      {full_matrix.data(), full_matrix.size() * sizeof(float)},
+      {d.vertices.data(), d.vertices.size() * sizeof(VertexRecord)},
+      {d.triangles.data(), d.triangles.size() * sizeof(GeodesicTriangle)},
+      {d.bvh_nodes.data(), d.bvh_nodes.size() * sizeof(BvhNode)},
+      {d.bvh_faces.data(), d.bvh_faces.size() * sizeof(int32_t)},
+      {d.report.data(), d.report.size()},
+      {d.accuracy.data(), d.accuracy.size() * sizeof(AccuracyRecord)},
+      {d.input_faces.data(), d.input_faces.size() * sizeof(InputFaceRecord)},
+      {d.vertex_copies.data(), d.vertex_copies.size() * sizeof(int32_t)},
+      {d.coarse_faces.data(), d.coarse_faces.size() * sizeof(int32_t)},
+      {d.refined_faces.data(), d.refined_faces.size() * sizeof(RefinedFaceRecord)},
+      {d.spread_bounds.data(), d.spread_bounds.size() * sizeof(SpreadBoundRecord)},
+      {lower.data(), lower.size() * sizeof(float)},
+  };
+  // The input-id sections (1.2, 2.0) are written only when the mesh was
+  // repaired or refined, so that the index of a mesh that needed neither
+  // keeps the 1.1 layout.
+  // The matrix section of the layout written, even when empty (no samples).
+  const bool packed = d.pack_sample_distances;
+  auto written = [&pieces, packed](size_t i) {
+    const SectionId id = kSpecs[i].id;
+    if (id == SectionId::kSampleDistances) return !packed;
+    if (id == SectionId::kSampleDistancesLower) return packed;
+    return pieces[i].size > 0 || (id != SectionId::kInputFaces && id != SectionId::kVertexCopies &&
+                                  id != SectionId::kCoarseFaces && id != SectionId::kRefinedFaces &&
+                                  id != SectionId::kSpreadBounds);
+  };
+  const bool refined = !d.refined_faces.empty();
+  size_t num_sections = 0;
+  for (size_t i = 0; i < kNumSpecs; ++i) num_sections += written(i) ? 1 : 0;
+  SectionEntry entries[kNumSpecs];
+  std::memset(entries, 0, sizeof(entries));
+  const uint64_t table_offset = sizeof(FileHeader);
+  const uint64_t table_bytes = num_sections * sizeof(SectionEntry);
+  uint64_t cursor = table_offset + table_bytes;
+  size_t piece_of[kNumSpecs];
+  for (size_t i = 0, e = 0; i < kNumSpecs; ++i) {
+    if (!written(i)) continue;
+    cursor = AlignUp(cursor);
+    piece_of[e] = i;
+    entries[e].id = static_cast<uint32_t>(kSpecs[i].id);
+    entries[e].element_size = kSpecs[i].element_size;
+    entries[e].offset = cursor;
+    entries[e].size = pieces[i].size;
+    entries[e].checksum = Checksum(pieces[i].data, pieces[i].size);
+    cursor += pieces[i].size;
+    ++e;
+  }
+  const uint64_t file_size = cursor;
+
+  FileHeader h;
+  std::memset(static_cast<void*>(&h), 0, sizeof(h));  // padding included
+  std::memcpy(h.magic, kMagic, sizeof(kMagic));
+  h.format_major = packed ? kPackedFormatMajor : refined ? kRefinedFormatMajor : kFormatMajor;
+  h.format_minor = packed ? kPackedFormatMinor : refined ? kRefinedFormatMinor : kFormatMinor;
+  h.byte_order_mark = kByteOrderMark;
+  h.header_size = sizeof(FileHeader);
+  std::memcpy(h.builder_version, d.builder_version.data(), d.builder_version.size());
+  h.mesh_hash = d.mesh_hash;
+  h.params = d.params;
+  h.num_vertices = static_cast<uint32_t>(counts.num_vertices);
+  h.num_faces = static_cast<uint32_t>(counts.num_faces);
+  h.num_samples = static_cast<uint32_t>(counts.num_samples);
+  h.num_triangles = static_cast<uint32_t>(counts.num_triangles);
+  h.num_bvh_nodes = static_cast<uint32_t>(counts.num_bvh_nodes);
+  h.num_sections = static_cast<uint32_t>(num_sections);
+  h.section_table_offset = table_offset;
+  h.file_size = file_size;
+  h.table_checksum = Checksum(entries, table_bytes);
+  h.header_checksum = 0;
+  h.header_checksum = HeaderChecksum(reinterpret_cast<const uint8_t*>(&h), sizeof(h));
+
+  std::string out(file_size, '\0');  // zero padding everywhere
+  std::memcpy(out.data(), &h, sizeof(h));
+  std::memcpy(out.data() + table_offset, entries, table_bytes);
+  for (size_t e = 0; e < num_sections; ++e) {
+    const Piece& piece = pieces[piece_of[e]];
+    if (piece.size > 0) std::memcpy(out.data() + entries[e].offset, piece.data, piece.size);
+  }
+  return out;
+}
+
+absl::Status WriteIndexFile(const IndexData& data, const std::string& path) {
+  GEODEX_ASSIGN_OR_RETURN(const std::string bytes, SerializeIndex(data));
+  return AtomicWriteFile(path, bytes);
+}
+
+// The file must not shrink while mapped (SIGBUS): writers replace files by
+// rename (WriteIndexFile), which leaves this mapping on the old inode.
+
+}  // namespace geodex::index
