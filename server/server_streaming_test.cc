@@ -6,6 +6,7 @@
 #include <atomic>
 #include <chrono>
 #include <cstdio>
+#include <string>
 #include <thread>
 #include <vector>
 
@@ -315,6 +316,20 @@ TEST(ServerTest, TooManyConcurrentStreamsAreResourceExhausted) {
   }
 }
 
+// The value of the first sample of `metric` whose labels contain `label` in
+// the Prometheus text `text`, or -1.
+double MetricValue(const std::string& text, const std::string& metric, const std::string& label) {
+  size_t at = 0;
+  while ((at = text.find(metric + "{", at)) != std::string::npos) {
+    const size_t end = text.find('\n', at);
+    const std::string line = text.substr(at, end - at);
+    at = end;
+    if (line.find(label) == std::string::npos) continue;
+    return std::stod(line.substr(line.rfind(' ') + 1));
+  }
+  return -1;
+}
+
 TEST(ServerTest, CancelledMatrixStopsComputing) {
   TestServer ts([](ServerOptions& o) { o.workers = 1; });
   auto stub = v1::Geodex::NewStub(ts.TcpChannel());
@@ -338,9 +353,14 @@ TEST(ServerTest, CancelledMatrixStopsComputing) {
     std::this_thread::sleep_for(std::chrono::milliseconds(5));
   }
   EXPECT_EQ(ts.server().service().active_streams(), 0);
-  // Far fewer than the 2000 rows were computed.
   const std::string text = ts.server().metrics().Text();
   EXPECT_THAT(text, HasSubstr("geodex_requests_total{code=\"CANCELLED\",method=\"Matrix\""));
+  // The rows stopped: the call's cells (rows computed and handed to gRPC x
+  // 2000 targets) are the two rows read and the few in flight at the cancel,
+  // far fewer than the 2000 rows asked for.
+  const double cells = MetricValue(text, "geodex_pairs_total", "method=\"Matrix\"");
+  EXPECT_GE(cells, 2 * 2000);
+  EXPECT_LE(cells, 50 * 2000) << "the server kept computing rows of a cancelled Matrix";
 }
 
 TEST(ServerTest, GetMeshOfALargeMeshComesInSeveralChunks) {
