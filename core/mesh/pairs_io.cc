@@ -31,10 +31,11 @@ std::vector<std::string_view> Fields(std::string_view line) {
   return fields;
 }
 
-}  // namespace
-
-absl::StatusOr<std::vector<PointPair>> ParsePairs(std::string_view contents) {
-  std::vector<PointPair> pairs;
+// The fields of each line of `contents` that is neither blank nor a '#'
+// comment, with its 1-based line number, to `fn`, which returns a Status;
+// the first error ends the walk.
+template <typename Fn>
+absl::Status ForEachLine(std::string_view contents, Fn fn) {
   int64_t line_number = 0;
   size_t begin = 0;
   while (begin < contents.size()) {
@@ -45,6 +46,17 @@ absl::StatusOr<std::vector<PointPair>> ParsePairs(std::string_view contents) {
     ++line_number;
     const std::vector<std::string_view> fields = Fields(line);
     if (fields.empty() || fields[0][0] == '#') continue;
+    GEODEX_RETURN_IF_ERROR(fn(line_number, fields));
+  }
+  return absl::OkStatus();
+}
+
+}  // namespace
+
+absl::StatusOr<std::vector<PointPair>> ParsePairs(std::string_view contents) {
+  std::vector<PointPair> pairs;
+  GEODEX_RETURN_IF_ERROR(ForEachLine(contents, [&](int64_t line_number,
+                                                   const std::vector<std::string_view>& fields) {
     if (fields.size() != 8) {
       return absl::InvalidArgumentError(
           absl::StrFormat("line %d: expected 8 fields 'fa a0 a1 a2 fb b0 b1 b2', found %d",
@@ -76,23 +88,16 @@ absl::StatusOr<std::vector<PointPair>> ParsePairs(std::string_view contents) {
       }
     }
     pairs.push_back(pair);
-  }
+    return absl::OkStatus();
+  }));
   return pairs;
 }
 
 absl::StatusOr<std::vector<NumberLine>> ParseNumberLines(std::string_view contents,
                                                          size_t width) {
   std::vector<NumberLine> lines;
-  int64_t line_number = 0;
-  size_t begin = 0;
-  while (begin < contents.size()) {
-    size_t end = contents.find('\n', begin);
-    if (end == std::string_view::npos) end = contents.size();
-    const std::string_view line = contents.substr(begin, end - begin);
-    begin = end + 1;
-    ++line_number;
-    const std::vector<std::string_view> fields = Fields(line);
-    if (fields.empty() || fields[0][0] == '#') continue;
+  GEODEX_RETURN_IF_ERROR(ForEachLine(contents, [&](int64_t line_number,
+                                                   const std::vector<std::string_view>& fields) {
     NumberLine out;
     out.line = line_number;
     for (const std::string_view text : fields) {
@@ -112,7 +117,8 @@ absl::StatusOr<std::vector<NumberLine>> ParseNumberLines(std::string_view conten
       }
     }
     lines.push_back(std::move(out));
-  }
+    return absl::OkStatus();
+  }));
   return lines;
 }
 
