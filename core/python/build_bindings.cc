@@ -71,8 +71,8 @@ class Callbacks {
 // returns geodex-build's report. samples 0: the builder's default; target
 // error 0: none; max_samples 0: the default cap.
 std::string Build(const std::string& mesh_path, const std::string& out, int32_t samples,
-                  double target_error, int32_t max_samples, uint64_t seed, int threads,
-                  bool strict, bool refine, bool calibrate, py::object progress, py::object log) {
+                  double target_error, int32_t max_samples, uint64_t seed, int threads, bool strict,
+                  bool refine, bool calibrate, py::object progress, py::object log) {
   auto callbacks = std::make_shared<Callbacks>(std::move(progress), std::move(log));
   builder::PipelineOptions options;
   if (samples > 0) options.build.num_samples = samples;

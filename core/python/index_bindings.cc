@@ -43,6 +43,9 @@ using Weights = py::array_t<double, py::array::c_style | py::array::forcecast>;
 
 // Work below this many items a thread stays on one thread.
 constexpr int64_t kMinItemsPerThread = 4096;
+// Pairs per DistanceBatch call: the translated points of one block at a time
+// per thread, not of the whole input.
+constexpr int64_t kBlockPairs = 8192;
 
 // Calls fn(begin, end, part) for `parts` consecutive ranges covering [0, n),
 // each on its own thread (the first on the caller's).
@@ -116,11 +119,12 @@ class Index {
 
   // (distances, bounds or None) of pairs (a[i], b[i]).
   py::tuple Distance(const Faces& a_faces, const Weights& a_weights, const Faces& b_faces,
-                     const Weights& b_weights, int near_pairs, double tolerance, bool bounds) const {
+                     const Weights& b_weights, int near_pairs, double tolerance,
+                     bool bounds) const {
     const int64_t n = a_faces.size();
     if (b_faces.size() != n) {
-      throw StatusError(absl::InvalidArgumentError(absl::StrFormat(
-          "a has %d points but b has %d; they must pair up", n, b_faces.size())));
+      throw StatusError(absl::InvalidArgumentError(
+          absl::StrFormat("a has %d points but b has %d; they must pair up", n, b_faces.size())));
     }
     py::array_t<double> out(n);
     std::optional<py::array_t<double>> out_bounds;
@@ -130,26 +134,31 @@ class Index {
     const query::DistanceOptions options = DistanceOptionsOf(near_pairs, tolerance);
     {
       py::gil_scoped_release release;
-      const int parts = Parts(n);
-      std::vector<query::EnginePoints> a(parts), b(parts);
-      std::vector<absl::Status> a_status(parts), b_status(parts), status(parts);
-      // All of a is checked before any of b, as the server does.
-      ForRanges(n, parts, [&](int64_t begin, int64_t end, int p) {
-        a_status[p] = queries_->Read(SpanOf(a_faces).subspan(begin, end - begin),
-                                     SpanOf(a_weights).subspan(3 * begin, 3 * (end - begin)),
-                                     NamedFrom("a", begin), &a[p]);
-        b_status[p] = queries_->Read(SpanOf(b_faces).subspan(begin, end - begin),
-                                     SpanOf(b_weights).subspan(3 * begin, 3 * (end - begin)),
-                                     NamedFrom("b", begin), &b[p]);
+      // Blocks of kBlockPairs pairs, each read (checked and translated) and
+      // answered in turn; the threads take consecutive runs of blocks.
+      const int64_t blocks = (n + kBlockPairs - 1) / kBlockPairs;
+      std::vector<absl::Status> a_status(blocks), b_status(blocks), status(blocks);
+      const int parts = static_cast<int>(std::min<int64_t>(Parts(n), std::max<int64_t>(blocks, 1)));
+      ForRanges(blocks, parts, [&](int64_t first, int64_t last, int) {
+        query::QueryScratch scratch;
+        query::EnginePoints a, b;
+        for (int64_t k = first; k < last; ++k) {
+          const int64_t begin = k * kBlockPairs, size = std::min(n - begin, kBlockPairs);
+          a_status[k] = queries_->Read(SpanOf(a_faces).subspan(begin, size),
+                                       SpanOf(a_weights).subspan(3 * begin, 3 * size),
+                                       NamedFrom("a", begin), &a);
+          b_status[k] = queries_->Read(SpanOf(b_faces).subspan(begin, size),
+                                       SpanOf(b_weights).subspan(3 * begin, 3 * size),
+                                       NamedFrom("b", begin), &b);
+          if (!a_status[k].ok() || !b_status[k].ok()) continue;
+          status[k] = queries_->DistanceBatch(
+              a, b, std::span<double>(d + begin, size), options, &scratch,
+              bnd ? std::span<double>(bnd + begin, size) : std::span<double>());
+        }
       });
+      // All of a is checked before any of b, as the server does.
       ThrowIfError(FirstError(a_status));
       ThrowIfError(FirstError(b_status));
-      ForRanges(n, parts, [&](int64_t begin, int64_t end, int p) {
-        query::QueryScratch scratch;
-        status[p] = queries_->DistanceBatch(
-            a[p], b[p], std::span<double>(d + begin, end - begin), options, &scratch,
-            bnd ? std::span<double>(bnd + begin, end - begin) : std::span<double>());
-      });
       ThrowIfError(FirstError(status));
     }
     return py::make_tuple(out, bounds ? py::object(*out_bounds) : py::object(py::none()));
@@ -169,10 +178,10 @@ class Index {
     {
       py::gil_scoped_release release;
       query::EnginePoints sources, targets;
-      ThrowIfError(queries_->Read(SpanOf(s_faces), SpanOf(s_weights), query::Named("sources"),
-                                  &sources));
-      ThrowIfError(queries_->Read(SpanOf(t_faces), SpanOf(t_weights), query::Named("targets"),
-                                  &targets));
+      ThrowIfError(
+          queries_->Read(SpanOf(s_faces), SpanOf(s_weights), query::Named("sources"), &sources));
+      ThrowIfError(
+          queries_->Read(SpanOf(t_faces), SpanOf(t_weights), query::Named("targets"), &targets));
       const int parts = static_cast<int>(std::min<int64_t>(Parts(s * t), std::max<int64_t>(s, 1)));
       std::vector<absl::Status> status(parts);
       ForRanges(s, parts, [&](int64_t begin, int64_t end, int p) {
@@ -196,8 +205,8 @@ class Index {
                 const Weights& b_weights, int exact_corridor) const {
     const int64_t n = a_faces.size();
     if (b_faces.size() != n) {
-      throw StatusError(absl::InvalidArgumentError(absl::StrFormat(
-          "a has %d points but b has %d; they must pair up", n, b_faces.size())));
+      throw StatusError(absl::InvalidArgumentError(
+          absl::StrFormat("a has %d points but b has %d; they must pair up", n, b_faces.size())));
     }
     std::vector<std::vector<query::PathPoint>> paths(n);
     std::vector<char> reachable(n, 1);
@@ -255,8 +264,8 @@ class Index {
     {
       py::gil_scoped_release release;
       query::EnginePoints sources;
-      ThrowIfError(queries_->Read(SpanOf(faces), SpanOf(weights), query::Named("sources"),
-                                  &sources));
+      ThrowIfError(
+          queries_->Read(SpanOf(faces), SpanOf(weights), query::Named("sources"), &sources));
       field = ValueOrThrow(queries_->Field(sources));
     }
     py::array_t<double> distances(static_cast<int64_t>(field.distance.size()));
@@ -321,8 +330,9 @@ class Index {
           absl::StatusOr<query::LocatedPoint> located =
               queries_->Locate(mesh::Vec3(x[3 * i], x[3 * i + 1], x[3 * i + 2]));
           if (!located.ok()) {
-            status[p] = absl::Status(located.status().code(),
-                                     absl::StrFormat("positions[%d]: %s", i, located.status().message()));
+            status[p] =
+                absl::Status(located.status().code(),
+                             absl::StrFormat("positions[%d]: %s", i, located.status().message()));
             continue;
           }
           f[i] = located->point.face;

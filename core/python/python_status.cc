@@ -14,8 +14,8 @@ void RegisterStatusTranslator(py::module_& m) {
       if (p) std::rethrow_exception(p);
     } catch (const StatusError& e) {
       py::object factory = py::module_::import("geodex.errors").attr("error_for_code");
-      py::object error = factory(static_cast<int>(e.status().code()),
-                                 std::string(e.status().message()));
+      py::object error =
+          factory(static_cast<int>(e.status().code()), std::string(e.status().message()));
       PyErr_SetObject(reinterpret_cast<PyObject*>(Py_TYPE(error.ptr())), error.ptr());
     }
   });
