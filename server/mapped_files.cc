@@ -52,7 +52,7 @@ void OnSigbus(int signal, siginfo_t* info, void*) {
     WriteText(" at byte ");
     WriteNumber(address - slot.begin);
     WriteText(": the file shrank or was rewritten in place while mapped. Publish indexes by "
-              "writing them elsewhere and renaming them into place (README, \"Faults\"); the "
+              "writing them elsewhere and renaming them into place (tests/README.md, \"Faults\"); the "
               "restarted server refuses the damaged file and serves the rest.\n");
     named = true;
     break;
