@@ -3,7 +3,10 @@
 # as a test that fails loudly on any violation:
 #
 #   1. distributed build of a built-in mesh: geodex-build plan, N
-#      `geodex-build rows --shard i/N` in parallel, geodex-build merge;
+#      `geodex-build rows --shard i/N` in parallel, geodex-build merge, the
+#      rows and merge again while merge plans another round (v1 is built to
+#      an error target, in rounds, and must be the index a one-process build
+#      to that target makes; v2 has a fixed sample count);
 #   2. atomic publication: the version directory is assembled outside the
 #      repository (same filesystem) and renamed to <repo>/<model>/<version>,
 #      so a polling server never sees a version without its complete index;
@@ -34,10 +37,12 @@ SHARDS=3
 MESH="builtin:torus"
 MODEL="torus"
 KEEP=0
-# Two sample counts, so that the two versions answer differently and a
-# replica still answering from version 1 cannot pass the version 2 checks.
-SAMPLES_V1=120
-SAMPLES_V2=180
+# Two builds that answer differently, so that a replica still answering
+# from version 1 cannot pass the version 2 checks: v1 to an error target
+# (from a small m with a low cap, so that it takes two small rounds), v2
+# with a fixed m.
+FLAGS_V1="--target-error 0.01 --samples 120 --max-samples 360"
+FLAGS_V2="--samples 180"
 
 usage() { sed -n '/^#   deploy/,/^# 2 bad usage/p' "$0" | sed 's/^# \{0,1\}//' >&2; exit 2; }
 die() { echo "local-cluster: FAILED: $*" >&2; exit 1; }
@@ -108,16 +113,10 @@ cd "$WORK"
 SECONDS=0
 
 # --- 1 + 2: distributed build, atomic publication ------------------------------
-# build_version VERSION SAMPLES: plan, SHARDS row jobs in parallel, merge into
-# the staging area, then one rename into the repository.
-build_version() {
-  local version="$1" samples="$2"
-  local workdir="$WORK/build-v$version"
-  log "v$version: geodex-build plan $MESH --samples $samples"
-  "$BUILD_BIN" plan "$MESH" --samples "$samples" --threads 1 -o "$workdir" \
-    > "plan-v$version.log" 2>&1 || { cat "plan-v$version.log" >&2; die "plan of v$version"; }
-
-  log "v$version: $SHARDS x geodex-build rows --shard i/$SHARDS, in parallel"
+# run_shards VERSION WORKDIR ROUND: SHARDS row jobs in parallel, one thread each.
+run_shards() {
+  local version="$1" workdir="$2" round="$3"
+  log "v$version round $round: $SHARDS x geodex-build rows --shard i/$SHARDS, in parallel"
   local pids=() i
   for ((i = 0; i < SHARDS; i++)); do
     # One thread each: the shards, not the threads, are the parallelism here,
@@ -129,19 +128,39 @@ build_version() {
   for ((i = 0; i < SHARDS; i++)); do
     if ! wait "${pids[$i]}"; then
       cat "rows-v$version-$i.log" >&2
-      die "rows shard $i/$SHARDS of v$version"
+      die "rows shard $i/$SHARDS of v$version, round $round"
     fi
   done
-  local shard_files
-  shard_files="$(find "$workdir" -maxdepth 1 -name "rows-*-of-*.bin" | wc -l)"
-  [ "$shard_files" -eq "$SHARDS" ] || die "v$version: $shard_files row files in $workdir, expected $SHARDS"
+}
+
+# build_version VERSION FLAGS: plan, then the rows shards and merge into the
+# staging area, again while merge exits 3 (it planned another round of a
+# target-error build), then one rename into the repository.
+build_version() {
+  local version="$1" flags="$2"
+  local workdir="$WORK/build-v$version"
+  log "v$version: geodex-build plan $MESH $flags"
+  # shellcheck disable=SC2086  # flags is a list of flags
+  "$BUILD_BIN" plan "$MESH" $flags --threads 1 -o "$workdir" \
+    > "plan-v$version.log" 2>&1 || { cat "plan-v$version.log" >&2; die "plan of v$version"; }
 
   local stage
   stage="$(mktemp -d "$STAGING/$MODEL-v$version.XXXXXX")"
-  log "v$version: geodex-build merge -> staging, then rename to $MODEL/$version"
-  "$BUILD_BIN" merge "$workdir" -o "$stage/index.gdx" > "merge-v$version.log" 2>&1 ||
-    { cat "merge-v$version.log" >&2; die "merge of v$version"; }
+  local round=1 status
+  while :; do
+    run_shards "$version" "$workdir" "$round"
+    log "v$version round $round: geodex-build merge"
+    status=0
+    "$BUILD_BIN" merge "$workdir" -o "$stage/index.gdx" > "merge-v$version-$round.log" 2>&1 ||
+      status=$?
+    [ "$status" -eq 0 ] && break
+    [ "$status" -eq 3 ] || { cat "merge-v$version-$round.log" >&2; die "merge of v$version"; }
+    [ ! -e "$stage/index.gdx" ] || die "merge of v$version wrote an index and planned a round"
+    round=$((round + 1))
+    [ "$round" -le 10 ] || die "v$version: no index after 10 rounds"
+  done
   [ -s "$stage/index.gdx" ] || die "merge of v$version wrote no index"
+  ROUNDS_V[$version]="$round"
   # mktemp -d makes 0700 directories; a server under another uid must read it.
   chmod 0755 "$stage"
   if [ "$(stat -c %d "$stage")" != "$(stat -c %d "$REPO")" ]; then
@@ -213,7 +232,16 @@ metric() {
 }
 
 # --- pairs and offline answers ---------------------------------------------------
-build_version 1 "$SAMPLES_V1"
+declare -A ROUNDS_V
+build_version 1 "$FLAGS_V1"
+[ "${ROUNDS_V[1]}" -ge 2 ] || die "v1 met its target in one round: the rounds were not exercised"
+# The same target in one process: the same index, byte for byte.
+# shellcheck disable=SC2086  # FLAGS_V1 is a list of flags
+"$BUILD_BIN" "$MESH" $FLAGS_V1 --threads 2 -o "$WORK/one-process-v1.gdx" > one-process-v1.log 2>&1 ||
+  { cat one-process-v1.log >&2; die "one-process build of v1"; }
+cmp -s "$WORK/one-process-v1.gdx" "$REPO/$MODEL/1/index.gdx" ||
+  die "the distributed target-error build differs from the one-process build"
+log "v1: ${ROUNDS_V[1]} rounds, the same bytes as the one-process build"
 FACES="$("$QUERY_BIN" "$REPO/$MODEL/1/index.gdx" --info | sed -n 's/^faces = \([0-9]*\)$/\1/p')" ||
   die "geodex-query --info on v1"
 if ! [[ "$FACES" =~ ^[1-9][0-9]*$ ]]; then die "cannot tell the mesh's face count"; fi
@@ -291,7 +319,7 @@ fi
 log "no failed call: bench ${BASH_REMATCH[1]} calls, loop $LOOP_CALLS calls ($LOOP_BEFORE_KILL before the kill), all answers equal to geodex-query's"
 
 # --- 4: a new version, picked up by the survivor and by a restarted replica -----
-build_version 2 "$SAMPLES_V2"
+build_version 2 "$FLAGS_V2"
 wait_version B "$REPLICA_ADDR_B" 2 30
 log "replica B picked up v2 by polling"
 # The restarted replica takes its old port, as a pod behind the same address.
@@ -331,4 +359,4 @@ if grep -i 'fail' "$WORK"/server-*.log >&2; then
   die "a replica logged a failure (above)"
 fi
 
-log "PASSED in ${SECONDS} s: $SHARDS-shard builds of v1 ($SAMPLES_V1 samples) and v2 ($SAMPLES_V2), atomic publication, no failed call across a SIGKILL, v2 picked up by the survivor and the restarted replica, answers equal to geodex-query's"
+log "PASSED in ${SECONDS} s: $SHARDS-shard builds of v1 (${ROUNDS_V[1]} rounds to an error target, as one process builds it) and v2 (fixed m), atomic publication, no failed call across a SIGKILL, v2 picked up by the survivor and the restarted replica, answers equal to geodex-query's"
