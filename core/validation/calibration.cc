@@ -25,13 +25,33 @@ double Quantile(std::vector<double> x, double q) {
   return x[std::min(x.size() - 1, static_cast<size_t>(q * x.size()))];
 }
 
-// Quantiles by bin; a bin without errors takes the larger bound of its
-// nearest measured neighbours (bounds are not meant to be exact there, only
-// not vacuous).
+// An answer is no more precise than the float32 distances the index stores
+// and the arithmetic on them: on a surface where the refined answers are
+// exact (a sphere's traces), the held-out errors are rounding, up to a few
+// 1e-6 of the distance, and a quantile of them is no bound for other
+// points. So no bound is below this share of the largest distance of its
+// bin (0.001%: far below any error target).
+constexpr double kRelativePrecision = 1e-5;
+
+// The largest distance of answer bin `b` for scale length L: its upper edge,
+// or for the last, open bin the largest answer measured in it.
+double BinReach(int b, double scale_length, double largest_in_last) {
+  return b + 1 < index::kAccuracyBins ? index::kAccuracyBinUpper[b] * scale_length
+                                      : largest_in_last;
+}
+
+// Quantiles by bin, at least the precision floor; a bin without errors takes
+// the larger bound of its nearest measured neighbours (bounds are not meant
+// to be exact there, only not vacuous).
 void FillBounds(const std::vector<double> (&errors)[index::kAccuracyBins], double quantile,
-                float* out) {
+                double scale_length, double largest_in_last, float* out) {
   double q[index::kAccuracyBins];
-  for (int b = 0; b < index::kAccuracyBins; ++b) q[b] = Quantile(errors[b], quantile);
+  for (int b = 0; b < index::kAccuracyBins; ++b) {
+    q[b] = Quantile(errors[b], quantile);
+    if (!std::isnan(q[b])) {
+      q[b] = std::max(q[b], kRelativePrecision * BinReach(b, scale_length, largest_in_last));
+    }
+  }
   for (int b = 0; b < index::kAccuracyBins; ++b) {
     if (!std::isnan(q[b])) {
       out[b] = static_cast<float>(q[b]);
@@ -171,11 +191,14 @@ absl::StatusOr<Calibration> Calibrate(const mesh::Mesh& mesh,
   std::vector<double> by_kind[2][kNumScaleBins];  // |relative error|, BinConfidence's kinds
   std::vector<int32_t> uniform_source;
   const query::DistanceOptions pure{.near_pairs = query::NearPairs::kUnfold};
+  double largest_answer = 0;  // of the last, open answer bin
   for (const ExactPair& pair : pairs) {
     const absl::StatusOr<double> u = engine->Distance(pair.p, pair.q, pure);
     bool wraps = false;
     const absl::StatusOr<double> t = engine->TracedDistance(pair.p, pair.q, &wraps);
     if (!u.ok()) continue;
+    if (std::isfinite(*u)) largest_answer = std::max(largest_answer, *u);
+    if (t.ok() && std::isfinite(*t)) largest_answer = std::max(largest_answer, *t);
     const int bin = AccuracyBinOf(*u, scale);
     unfold[pair.vertices ? 0 : 1][bin].push_back(std::abs(*u - pair.exact));
     spread[pair.vertices ? 0 : 1][bin].push_back(
@@ -190,9 +213,11 @@ absl::StatusOr<Calibration> Calibrate(const mesh::Mesh& mesh,
   r.num_sources = options.pairs.num_sources;
   r.num_pairs = static_cast<uint32_t>(pairs.size());
   r.bound_quantile_permille = static_cast<uint32_t>(std::lround(1000 * options.quantile));
-  FillBounds(unfold[0], options.quantile, r.unfold_bound[0]);
-  FillBounds(unfold[1], options.quantile, r.unfold_bound[1]);
-  for (int k = 0; k < 4; ++k) FillBounds(trace[k], options.quantile, r.trace_bound[k]);
+  FillBounds(unfold[0], options.quantile, scale, largest_answer, r.unfold_bound[0]);
+  FillBounds(unfold[1], options.quantile, scale, largest_answer, r.unfold_bound[1]);
+  for (int k = 0; k < 4; ++k) {
+    FillBounds(trace[k], options.quantile, scale, largest_answer, r.trace_bound[k]);
+  }
   Calibration result;
   for (int k = 0; k < 2; ++k) {
     FitSpreadBounds(spread[k], options.quantile, result.spread.epsilon[k], result.spread.factor[k]);
