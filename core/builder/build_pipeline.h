@@ -43,10 +43,13 @@ struct PipelineOptions {
   // How the input mesh is repaired (strict: refused instead).
   mesh::RepairOptions repair;
   // Measure the index against held-out exact propagations and store its
-  // error bounds (core/validation/calibration.h).
+  // error bounds (core/validation/calibration.h). A target-error build is
+  // always calibrated: its validation is the calibration.
   bool calibrate = true;
-  // > 0: build until the held-out error meets this target
-  // (core/validation/target_error.h); 0: build build.num_samples samples.
+  // > 0: build until the held-out error meets this target, in rounds from
+  // build.num_samples (build_rounds.h; geodex-build's default is
+  // validation::kDefaultTargetError from kDefaultFirstRoundSamples); 0: build
+  // exactly build.num_samples samples.
   double target_error = 0;
   // With a target error: the cap on m (0: the default cap).
   int32_t max_samples = 0;
@@ -67,8 +70,9 @@ struct BuildReport {
   bool another_round = false;
 };
 
-// The mesh at `path` (.obj/.ply/.off, or builtin:NAME for a generated demo
-// mesh: torus, sphere, cube, double-torus), repaired as `options` says.
+// The mesh at `path` (a mesh file core/mesh/mesh_io.h reads, or builtin:NAME
+// for a generated demo mesh: torus, sphere, cube, double-torus), read and
+// repaired as `options` says.
 absl::StatusOr<mesh::RepairedMesh> LoadBuildInput(const std::string& path,
                                                   const mesh::RepairOptions& options);
 
