@@ -47,10 +47,12 @@ def area_uniform(vertices: np.ndarray, faces: np.ndarray, n: int, seed: int):
 
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--index", type=Path, help="index file (.gdx); default: builtin:torus, m = 200")
+    parser.add_argument("--index", type=Path,
+                        help="index file (.gdx); default: builtin:torus, m = 200")
     parser.add_argument("--build-dir", type=Path, default=REPO / "build")
     parser.add_argument("--pairs", type=int, default=1_000_000)
-    parser.add_argument("--repeat", type=int, default=3, help="timed runs of each (best and median)")
+    parser.add_argument("--repeat", type=int, default=3,
+                        help="timed runs of each (best and median)")
     parser.add_argument("--batch-size", type=int, default=32768, help="pairs per stream batch")
     parser.add_argument("--workers", type=int, default=0, help="server workers (0: one per core)")
     parser.add_argument("--near-pairs", choices=["path", "unfold", "exact"], default=None,
@@ -62,8 +64,9 @@ def main() -> int:
     index = args.index
     if index is None:
         index = work / "torus.gdx"
-        subprocess.run([str(args.build_dir / "core/geodex-build"), "builtin:torus", "--samples", "200",
-                        "-o", str(index)], check=True, stdout=subprocess.DEVNULL)
+        subprocess.run([str(args.build_dir / "core/geodex-build"), "builtin:torus",
+                        "--samples", "200", "-o", str(index)],
+                       check=True, stdout=subprocess.DEVNULL)
     model_dir = work / "models" / "bench" / "1"
     model_dir.mkdir(parents=True)
     (model_dir / "index.gdx").symlink_to(index.resolve())
@@ -104,8 +107,9 @@ def main() -> int:
         d_client = client.distance("bench", a, b, near_pairs=args.near_pairs)
         d_local = in_process.distance(a, b, near_pairs=args.near_pairs)
         same = bool(np.array_equal(d_client, d_local))
-        client_best, client_median = timed(lambda: client.distance("bench", a, b, near_pairs=args.near_pairs))
-        local_best, local_median = timed(lambda: in_process.distance(a, b, near_pairs=args.near_pairs))
+        mode = args.near_pairs
+        client_best, client_median = timed(lambda: client.distance("bench", a, b, near_pairs=mode))
+        local_best, local_median = timed(lambda: in_process.distance(a, b, near_pairs=mode))
         n = args.pairs
         model = client.model("bench")
         print(f"index {index} ({model.num_vertices} vertices, m = {model.num_samples}), "
@@ -117,7 +121,8 @@ def main() -> int:
               f"{n / client_best / 1e6:.3f}M |")
         print(f"| Index.distance in process | {local_best:.3f} s | {local_median:.3f} s | "
               f"{n / local_best / 1e6:.3f}M |")
-        print(f"client / in process: {local_best / client_best:.2f}; answers equal to the bit: {same}")
+        print(f"client / in process: {local_best / client_best:.2f}; "
+              f"answers equal to the bit: {same}")
         return 0 if same else 1
     finally:
         server.terminate()

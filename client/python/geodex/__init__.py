@@ -15,8 +15,25 @@ the barycentric weights of that face's three vertices: points are
 (:class:`InvalidArgument`, :class:`NotFound`, ...).
 """
 
-from .errors import *  # noqa: F401,F403  (the exception classes)
-from .errors import __all__ as _errors_all
+from .errors import (
+    Aborted,
+    AlreadyExists,
+    Cancelled,
+    DataLoss,
+    DeadlineExceeded,
+    Error,
+    FailedPrecondition,
+    Internal,
+    InvalidArgument,
+    NotFound,
+    OutOfRange,
+    PermissionDenied,
+    ResourceExhausted,
+    Unauthenticated,
+    Unavailable,
+    Unimplemented,
+    Unknown,
+)
 from ._arrays import Located, Path, SurfacePoints
 from .client import Client, Model, Tls, Triangulation, connect
 from ._inprocess import BuildProgress, Index, build, has_in_process
@@ -36,5 +53,21 @@ __all__ = [
     "SurfacePoints",
     "Located",
     "Path",
-    *[name for name in _errors_all if name != "error_for_code"],
+    "Error",
+    "Cancelled",
+    "Unknown",
+    "InvalidArgument",
+    "DeadlineExceeded",
+    "NotFound",
+    "AlreadyExists",
+    "PermissionDenied",
+    "ResourceExhausted",
+    "FailedPrecondition",
+    "Aborted",
+    "OutOfRange",
+    "Unimplemented",
+    "Internal",
+    "Unavailable",
+    "DataLoss",
+    "Unauthenticated",
 ]

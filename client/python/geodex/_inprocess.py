@@ -105,8 +105,8 @@ class Index:
 
     def __repr__(self) -> str:
         return (
-            f"geodex.Index({self.filename!r}: {self.num_vertices} vertices, {self.num_faces} faces, "
-            f"{self.num_samples} samples)"
+            f"geodex.Index({self.filename!r}: {self.num_vertices} vertices, "
+            f"{self.num_faces} faces, {self.num_samples} samples)"
         )
 
     # --- what the index holds -----------------------------------------------
@@ -216,7 +216,7 @@ class Index:
                 f"a has {pa.faces.shape[0]} points but b has {pb.faces.shape[0]}; they must pair up"
             )
         raw = self._index.path(pa.faces, pa.weights, pb.faces, pb.weights, int(exact_corridor))
-        return [Path(positions, faces, weights, length) for positions, faces, weights, length in raw]
+        return [Path(*path) for path in raw]  # (positions, faces, weights, length)
 
     def field(
         self, sources: Any, *, nearest: bool = False, xyz: bool = False

@@ -114,7 +114,9 @@ def connect(
             "backoffMultiplier": 2,
             "retryableStatusCodes": ["UNAVAILABLE"],
         }
-        config = {"methodConfig": [{"name": [{"service": "geodex.v1.Geodex"}], "retryPolicy": policy}]}
+        config = {
+            "methodConfig": [{"name": [{"service": "geodex.v1.Geodex"}], "retryPolicy": policy}]
+        }
         options.append(("grpc.service_config", json.dumps(config)))
     if tls is None or tls is False:
         channel = grpc.insecure_channel(address, options=options)
@@ -271,7 +273,9 @@ class Client:
         pa, pb_, version = self._points_pair(model, a, b, xyz, version)
         n = pa.faces.shape[0]
         if pb_.faces.shape[0] != n:
-            raise InvalidArgument(f"a has {n} points but b has {pb_.faces.shape[0]}; they must pair up")
+            raise InvalidArgument(
+                f"a has {n} points but b has {pb_.faces.shape[0]}; they must pair up"
+            )
         ref = _model_ref(model, version)
         if n <= self._batch_size:
             head = pb.DistanceRequest(
@@ -325,8 +329,12 @@ class Client:
                     head.model.CopyFrom(ref)
                 yield (
                     head.SerializeToString()
-                    + _wire.length_delimited(3, _wire.surface_points(a.faces[lo:hi], a.weights[lo:hi]))
-                    + _wire.length_delimited(4, _wire.surface_points(b.faces[lo:hi], b.weights[lo:hi]))
+                    + _wire.length_delimited(
+                        3, _wire.surface_points(a.faces[lo:hi], a.weights[lo:hi])
+                    )
+                    + _wire.length_delimited(
+                        4, _wire.surface_points(b.faces[lo:hi], b.weights[lo:hi])
+                    )
                 )
 
         call = self._stream_distances(batches(), metadata=self._metadata)
@@ -339,14 +347,17 @@ class Client:
                 fields = _wire.read_fields(data)
                 if _wire.scalar(fields, 1) != k:
                     raise DataLoss(
-                        f"the server answered batch {_wire.scalar(fields, 1)} when batch {k} was due"
+                        f"the server answered batch {_wire.scalar(fields, 1)} "
+                        f"when batch {k} was due"
                     )
                 code = _wire.scalar(fields, 3)
                 if code != 0:
                     raise _in_pairs(error_for_code(code, _wire.string(fields, 4)), lo, hi)
                 out[lo:hi] = self._sized(_wire.packed_doubles(fields, 2), hi - lo, "distances")
                 if out_bounds is not None:
-                    out_bounds[lo:hi] = self._sized(_wire.packed_doubles(fields, 6), hi - lo, "bounds")
+                    out_bounds[lo:hi] = self._sized(
+                        _wire.packed_doubles(fields, 6), hi - lo, "bounds"
+                    )
                 k += 1
         except grpc.RpcError as e:
             raise _rpc_error(e) from None
@@ -379,7 +390,9 @@ class Client:
         """
         check_tolerance(tolerance)
         as_near_pairs(near_pairs)
-        src, tgt, version = self._points_pair(model, sources, targets, xyz, version, ("sources", "targets"))
+        src, tgt, version = self._points_pair(
+            model, sources, targets, xyz, version, ("sources", "targets")
+        )
         s, t = src.faces.shape[0], tgt.faces.shape[0]
         out = np.empty((s, t), dtype=np.float64)
         out_bounds = np.empty((s, t), dtype=np.float64) if bounds else None
@@ -414,8 +427,11 @@ class Client:
                     block = self._sized(_wire.packed_doubles(fields, 4), count * t, "matrix values")
                     out[start + offset : start + offset + count] = block.reshape(count, t)
                     if out_bounds is not None:
-                        block = self._sized(_wire.packed_doubles(fields, 6), count * t, "matrix bounds")
-                        out_bounds[start + offset : start + offset + count] = block.reshape(count, t)
+                        block = self._sized(
+                            _wire.packed_doubles(fields, 6), count * t, "matrix bounds"
+                        )
+                        rows_at = slice(start + offset, start + offset + count)
+                        out_bounds[rows_at] = block.reshape(count, t)
                     rows += count
                     if version == 0:  # the rest from the version that answered
                         version = _wire.scalar(fields, 5)
@@ -464,7 +480,9 @@ class Client:
         pa, pb_, version = self._points_pair(model, a, b, xyz, version)
         n = pa.faces.shape[0]
         if pb_.faces.shape[0] != n:
-            raise InvalidArgument(f"a has {n} points but b has {pb_.faces.shape[0]}; they must pair up")
+            raise InvalidArgument(
+                f"a has {n} points but b has {pb_.faces.shape[0]}; they must pair up"
+            )
         paths: List[Path] = []
         for lo in range(0, max(n, 1), max(1, int(batch_size))):
             hi = min(n, lo + max(1, int(batch_size)))
@@ -472,8 +490,12 @@ class Client:
                 pb.PathRequest(
                     model=_model_ref(model, version), exact_corridor=int(exact_corridor)
                 ).SerializeToString()
-                + _wire.length_delimited(2, _wire.surface_points(pa.faces[lo:hi], pa.weights[lo:hi]))
-                + _wire.length_delimited(3, _wire.surface_points(pb_.faces[lo:hi], pb_.weights[lo:hi]))
+                + _wire.length_delimited(
+                    2, _wire.surface_points(pa.faces[lo:hi], pa.weights[lo:hi])
+                )
+                + _wire.length_delimited(
+                    3, _wire.surface_points(pb_.faces[lo:hi], pb_.weights[lo:hi])
+                )
             )
             try:
                 data = self._path(request, timeout=self._timeout, metadata=self._metadata)
@@ -526,7 +548,9 @@ class Client:
                 offset = _wire.scalar(fields, 1)
                 values = _wire.packed_doubles(fields, 2)
                 if total != out.shape[0] or offset != filled or offset + values.shape[0] > total:
-                    raise DataLoss(f"field chunk at {offset} ({values.shape[0]} of {total}) after {filled}")
+                    raise DataLoss(
+                        f"field chunk at {offset} ({values.shape[0]} of {total}) after {filled}"
+                    )
                 out[offset : offset + values.shape[0]] = values
                 if near is not None:
                     near[offset : offset + values.shape[0]] = self._sized(
@@ -586,7 +610,8 @@ class Client:
             tolerance=float(tolerance),
         )
         if direction is not None:
-            request.reference_direction.xyz.extend(as_positions(direction, "direction").ravel().tolist())
+            xyz = as_positions(direction, "direction").ravel()
+            request.reference_direction.xyz.extend(xyz.tolist())
         data = request.SerializeToString() + _wire.length_delimited(
             2, _wire.surface_points(c.faces, c.weights)
         )

@@ -41,7 +41,8 @@ def test_empty_points():
     "faces, weights, error, words",
     [
         ([0, -4], [[1, 0, 0]] * 2, geodex.InvalidArgument, "a.faces[1] is -4"),
-        ([0, 1, 2], [[1, 0, 0]] * 2, geodex.InvalidArgument, "a.weights has shape (2, 3), want (3, 3)"),
+        ([0, 1, 2], [[1, 0, 0]] * 2, geodex.InvalidArgument,
+         "a.weights has shape (2, 3), want (3, 3)"),
         ([[0, 1]], [[1, 0, 0]] * 2, geodex.InvalidArgument, "a.faces has shape (1, 2)"),
         ([0, 1], [[1, 0]] * 2, geodex.InvalidArgument, "want (2, 3)"),
         ([0.0, 1.5], [[1, 0, 0]] * 2, geodex.InvalidArgument, "integer array, not float64"),

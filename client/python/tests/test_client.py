@@ -3,13 +3,18 @@ geodex-query on the same index file as the reference: the same engine, so
 the answers agree to the last bit (asserted: relative difference <= 1e-12)."""
 
 import json
-from pathlib import Path
 
 import numpy as np
 import pytest
 
 import geodex
-from support import area_uniform_points, query_distances, query_points_lines, random_points, run_query
+from support import (
+    area_uniform_points,
+    query_distances,
+    query_points_lines,
+    random_points,
+    run_query,
+)
 
 MODEL = "torus"
 
@@ -24,6 +29,11 @@ def max_relative_difference(x: np.ndarray, y: np.ndarray) -> float:
 @pytest.fixture(scope="module")
 def num_faces(client) -> int:
     return client.model(MODEL).num_faces
+
+
+def pair_lines(a: geodex.SurfacePoints, b: geodex.SurfacePoints):
+    """geodex-query's pair lines "fa a0 a1 a2 fb b0 b1 b2"."""
+    return [f"{x} {y}" for x, y in zip(query_points_lines(a), query_points_lines(b))]
 
 
 def near_pairs(num_faces: int, n: int, seed: int):
@@ -69,8 +79,7 @@ def test_near_pair_modes_equal_geodex_query(client, torus_index, tmp_path, num_f
 def test_bounds_and_tolerance_equal_geodex_query(client, torus_index, tmp_path, num_faces):
     a, b = near_pairs(num_faces, 300, 5)
     lines = run_query(torus_index, tmp_path, "--error-bounds",
-                      stdin_lines=[f"{x} {y}" for x, y in zip(query_points_lines(a), query_points_lines(b))],
-                      file_flag="--pairs")
+                      stdin_lines=pair_lines(a, b), file_flag="--pairs")
     reference = np.array([[float(v) for v in line.split()] for line in lines.splitlines()])
     d, bounds = client.distance(MODEL, a, b, bounds=True)
     assert max_relative_difference(d, reference[:, 0]) <= 1e-12
@@ -89,15 +98,15 @@ def test_matrix_rows_are_distances(client, num_faces):
                                    np.repeat(sources.weights[s:s + 1], 300, axis=0))
         d, b = client.distance(MODEL, row, targets, bounds=True)
         assert np.array_equal(m[s], d) and np.array_equal(bounds[s], b)
-    empty = client.matrix(MODEL, geodex.SurfacePoints(np.zeros(0, np.int32), np.zeros((0, 3))), targets)
+    no_sources = geodex.SurfacePoints(np.zeros(0, np.int32), np.zeros((0, 3)))
+    empty = client.matrix(MODEL, no_sources, targets)
     assert empty.shape == (0, 300)
 
 
 def test_paths_equal_geodex_query(client, torus_index, tmp_path, num_faces, torus_mesh):
     a, b = random_points(num_faces, 20, 13), random_points(num_faces, 20, 14)
     out = run_query(torus_index, tmp_path, "--format", "json",
-                    stdin_lines=[f"{x} {y}" for x, y in zip(query_points_lines(a), query_points_lines(b))],
-                    file_flag="--paths")
+                    stdin_lines=pair_lines(a, b), file_flag="--paths")
     reference = json.loads(out)
     paths = client.path(MODEL, a, b, batch_size=6)
     assert len(paths) == 20

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 import geodex
-from support import Server, build_index, random_points
+from support import Server, random_points
 
 MODEL = "torus"
 ONE = np.array([[1.0, 0.0, 0.0]])

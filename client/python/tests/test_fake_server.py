@@ -59,7 +59,8 @@ def test_field_matrix_path_locate(fake):
     sources = geodex.SurfacePoints(np.array([10, 40], np.int32), np.eye(3)[:2])
     with geodex.connect(fake.address) as client:
         d, nearest = client.field("fake", sources, nearest=True)
-        expected = np.minimum(np.abs(np.arange(NUM_VERTICES) - 10), np.abs(np.arange(NUM_VERTICES) - 40))
+        v = np.arange(NUM_VERTICES)
+        expected = np.minimum(np.abs(v - 10), np.abs(v - 40))
         assert np.array_equal(d, expected)
         assert nearest.dtype == np.int32 and nearest.shape == (NUM_VERTICES,)
         a, b = random_points(NUM_FACES, 5, 5), random_points(NUM_FACES, 7, 6)
@@ -79,7 +80,8 @@ def test_failures_are_exceptions_of_their_code(fake):
         with pytest.raises(geodex.NotFound):
             client.model("nope")
         with pytest.raises(geodex.Unavailable):  # "loading" is always UNAVAILABLE
-            client.distance("loading", random_points(NUM_FACES, 3, 1), random_points(NUM_FACES, 3, 2))
+            p = random_points(NUM_FACES, 3, 1)
+            client.distance("loading", p, p)
         assert client.model("fake").state == "SERVING"
 
 
