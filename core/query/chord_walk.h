@@ -3,8 +3,10 @@
 // The length of a surface path between near points (closer than a few
 // geodesic-triangle edges), which is how the default mode refines them
 // (§6.5): first the corridor of the chord, walked face to face from either
-// end and straightened; the gradient trace (gradient_path.h) only when both
-// walks fail, wrap round a vertex, or are longer than is plausible. Every
+// end, unfolded into the plane and straightened by the funnel algorithm,
+// moved off the vertices it bends round short of a straight angle on their
+// other side; the gradient trace (gradient_path.h) only when both walks
+// fail, bend at several saddles, or are longer than is plausible. Every
 // candidate is a surface path, never shorter than the geodesic, so the
 // shortest is kept.
 //
@@ -21,7 +23,9 @@ namespace geodex::query {
 
 // A near pair's path length; `wraps` when the path bends round a mesh
 // vertex (else it is a straight line through the faces it crosses: a local
-// geodesic, practically always the shortest path between near points).
+// geodesic, practically always the shortest path between near points; so
+// is one bending at a single saddle vertex by no more than its angle
+// excess).
 struct NearPath {
   double length;
   bool wraps;

@@ -1,6 +1,8 @@
 #include "core/query/chord_walk.h"
 
+#include <algorithm>
 #include <cmath>
+#include <vector>
 
 #include "core/mesh/generators.h"
 #include "core/query/query_parts_testing.h"
@@ -29,6 +31,56 @@ TEST(ChordWalkTest, NearPairsAcrossAFoldAreTheUnfoldedSegment) {
     }
   }
   EXPECT_GT(straight, 0);
+}
+
+// A saddle: eight equilateral triangles round a vertex c (480 degrees),
+// split twice. A geodesic between points whose angle round c is at least
+// pi on both sides passes through c (length r_p + r_q); else it is the
+// straight segment in the unfolding of the shorter side.
+TEST(ChordWalkTest, NearPairsRoundASaddleVertexAreExact) {
+  constexpr int kSectors = 8;
+  const double r = std::sqrt(3 / (4 - 4 * std::pow(std::sin(M_PI / kSectors), 2))),
+               z = std::sqrt(1 - r * r);
+  std::vector<mesh::Vec3> positions = {{0, 0, 0}};
+  std::vector<mesh::Triangle> faces;
+  for (int i = 0; i < kSectors; ++i) {
+    const double t = 2 * M_PI * i / kSectors;
+    positions.push_back({r * std::cos(t), r * std::sin(t), i % 2 ? z : -z});
+    faces.push_back({0, 1 + i, 1 + (i + 1) % kSectors});
+  }
+  const absl::StatusOr<mesh::Mesh> fan = mesh::Mesh::Create(positions, faces, "saddle");
+  ASSERT_TRUE(fan.ok()) << fan.status();
+  const mesh::Mesh saddle = mesh::gen::SplitFacesInFour(*fan, 3);
+  const testing::QueryParts parts(saddle, 12);
+  const double total = kSectors * M_PI / 3;
+  // A point's distance from c and its angle round c from the first edge.
+  auto polar = [&](const mesh::Vec3& x, double* radius) {
+    *radius = x.norm();
+    const double t = std::atan2(x.y(), x.x());
+    const int sector = static_cast<int>(std::floor((t < 0 ? t + 2 * M_PI : t) / (M_PI / 4)));
+    const mesh::Vec3 edge = positions[1 + sector % kSectors];
+    return sector * M_PI / 3 + std::acos(std::clamp(x.dot(edge) / (*radius * edge.norm()), -1.0, 1.0));
+  };
+  int through_c = 0, checked = 0;
+  for (int32_t f = 0; f < saddle.num_faces(); f += 7) {
+    for (int32_t g = f + 3; g < saddle.num_faces(); g += 11) {
+      const SurfacePoint a{f, {0.2, 0.3, 0.5}}, b{g, {0.5, 0.25, 0.25}};
+      double ra, rb;
+      const double ta = polar(mesh::PositionOf(saddle, a), &ra);
+      const double tb = polar(mesh::PositionOf(saddle, b), &rb);
+      // Within 0.4 of c segments in the unfolding stay off the rim.
+      if (ra > 0.4 || rb > 0.4) continue;
+      const double side = std::min(std::abs(ta - tb), total - std::abs(ta - tb));
+      const double want = side >= M_PI ? ra + rb : std::sqrt(ra * ra + rb * rb - 2 * ra * rb * std::cos(side));
+      const std::optional<NearPath> path = NearPathLength(parts.view, parts.paths, a, b, true);
+      ASSERT_TRUE(path.has_value());
+      EXPECT_NEAR(path->length, want, 1e-9 * want) << "faces " << f << " " << g;
+      through_c += side >= M_PI;
+      ++checked;
+    }
+  }
+  EXPECT_GT(checked, 50);
+  EXPECT_GT(through_c, 10);
 }
 
 TEST(ChordWalkTest, ADoubtedWalkGivesWayToAShorterTrace) {
