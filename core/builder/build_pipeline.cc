@@ -106,8 +106,8 @@ absl::Status WriteAndReport(const index::IndexData& data, BuildSummary& summary,
 }
 
 // The summary's line of a target-error build.
-std::string TargetSummary(const std::vector<validation::TargetFigures>& rounds, bool reached,
-                          double target) {
+std::string TargetSummary(const std::vector<validation::TargetFigures>& rounds,
+                          const NextStep& end, double target) {
   std::string samples;
   for (const validation::TargetFigures& r : rounds) {
     samples += absl::StrFormat("%s%d", samples.empty() ? "" : ", ", r.samples);
@@ -117,7 +117,8 @@ std::string TargetSummary(const std::vector<validation::TargetFigures>& rounds, 
   return absl::StrFormat(
       "  error target     %g: %s in %d rounds (m = %s); closest check %s, 95%% upper limit "
       "%.3f%% of %.3f%%\n",
-      target, reached ? "met" : "NOT met (sample cap)", rounds.size(), samples,
+      target, end.reached ? "met" : absl::StrFormat("NOT met (m stopped at %s)", end.stop),
+      rounds.size(), samples,
       validation::TargetCheckName(worst), 100 * last.upper[worst],
       100 * validation::TargetLimit(worst, target));
 }
@@ -139,15 +140,15 @@ absl::StatusOr<BuildReport> BuildToTargetError(const mesh::RepairedMesh& repaire
                                                const PipelineOptions& options) {
   GEODEX_ASSIGN_OR_RETURN(TargetBuild result, BuildToTarget(repaired.mesh, RecordRepair(repaired),
                                                             RoundsOf(options), options.log));
-  if (!result.reached) {
-    Log(options, absl::StrFormat("geodex-build: the target error was not reached at the cap of %d "
-                                 "samples; writing the last round's index",
-                                 result.rounds.back().samples));
+  if (!result.last.reached) {
+    Log(options, absl::StrFormat("geodex-build: the target error was not reached at m = %d (%s); "
+                                 "writing the last round's index",
+                                 result.rounds.back().samples, result.last.stop));
   }
   BuildReport report;
   GEODEX_RETURN_IF_ERROR(WriteEdges(result.mesh, result.plan, options.edges_obj, &report));
   GEODEX_RETURN_IF_ERROR(WriteAndReport(result.data, result.summary, out, &report));
-  report.text += TargetSummary(result.rounds, result.reached, options.target_error);
+  report.text += TargetSummary(result.rounds, result.last, options.target_error);
   return report;
 }
 
@@ -214,19 +215,19 @@ absl::StatusOr<BuildReport> MergeTargetRound(const std::string& workdir, TargetS
   GEODEX_ASSIGN_OR_RETURN(RoundResult result, FinishRound(round, &rows, rounds));
   state.rounds.push_back(result.figures);
   Log(options, RoundLine(state.round, result.figures, state.target));
-  const NextStep next =
-      DecideNext(state.rounds, round.plan.requested_samples, state.cap, state.target);
+  GEODEX_ASSIGN_OR_RETURN(const std::string bytes, index::SerializeIndex(result.data));
+  const NextStep next = DecideNext(state.rounds, round.plan.requested_samples, state.cap,
+                                   state.target, static_cast<int64_t>(bytes.size()));
   BuildReport report;
   if (next.done) {
-    result.data.report +=
-        TargetReport(state.rounds, next.reached, state.target, result.data.accuracy[0]);
+    result.data.report += TargetReport(state.rounds, next, state.target, result.data.accuracy[0]);
     if (!next.reached) {
-      Log(options, absl::StrFormat("geodex-build: the target error was not reached at the cap of "
-                                   "%d samples; writing the last round's index",
-                                   result.figures.samples));
+      Log(options, absl::StrFormat("geodex-build: the target error was not reached at m = %d "
+                                   "(%s); writing the last round's index",
+                                   result.figures.samples, next.stop));
     }
     GEODEX_RETURN_IF_ERROR(WriteAndReport(result.data, result.summary, out, &report));
-    report.text += TargetSummary(state.rounds, next.reached, state.target);
+    report.text += TargetSummary(state.rounds, next, state.target);
     return report;
   }
   GEODEX_ASSIGN_OR_RETURN(auto coarse, LoadCoarseMesh(workdir));

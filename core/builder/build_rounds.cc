@@ -137,15 +137,24 @@ absl::StatusOr<RoundResult> FinishRound(const RoundPlan& round, std::vector<Samp
 }
 
 NextStep DecideNext(const std::vector<TargetFigures>& rounds, int32_t requested_samples,
-                    int32_t cap, double target) {
+                    int32_t cap, double target, int64_t index_bytes) {
   NextStep next;
   if (validation::TargetMet(rounds.back(), target)) {
     next.done = next.reached = true;
     return next;
   }
-  next.num_samples = validation::PredictSamples(rounds, target, cap);
+  const int32_t samples = rounds.back().samples;
+  const int32_t fits =
+      validation::SamplesWithinBytes(validation::kMaxIndexBytes, samples, index_bytes);
+  next.num_samples = validation::PredictSamples(rounds, target, std::min(cap, fits));
   // At the cap (the repair may have added samples beyond it): nothing more to try.
-  next.done = requested_samples >= cap || next.num_samples <= rounds.back().samples;
+  next.done = requested_samples >= cap || next.num_samples <= samples;
+  if (next.done) {
+    next.stop = fits < cap && next.num_samples <= samples
+                    ? absl::StrFormat("the index size budget of %d MiB",
+                                      validation::kMaxIndexBytes >> 20)
+                    : absl::StrFormat("the cap of %d samples", cap);
+  }
   return next;
 }
 
@@ -157,12 +166,12 @@ std::string RoundLine(int32_t round, const TargetFigures& figures, double target
                          figures.upper[worst] / validation::TargetLimit(worst, target));
 }
 
-std::string TargetReport(const std::vector<TargetFigures>& rounds, bool reached, double target,
-                         const index::AccuracyRecord& accuracy) {
+std::string TargetReport(const std::vector<TargetFigures>& rounds, const NextStep& next,
+                         double target, const index::AccuracyRecord& accuracy) {
   const TargetFigures& last = rounds.back();
-  std::string out =
-      absl::StrFormat("target_error = %.6g\ntarget_error_reached = %s\ntarget_error_rounds = %d\n",
-                      target, reached ? "yes" : "no (sample cap)", rounds.size());
+  std::string out = absl::StrFormat(
+      "target_error = %.6g\ntarget_error_reached = %s\ntarget_error_rounds = %d\n", target,
+      next.reached ? "yes" : absl::StrFormat("no (%s)", next.stop), rounds.size());
   for (size_t k = 0; k < rounds.size(); ++k) {
     out += absl::StrFormat("target_error_round_%d = %s\n", k + 1,
                            validation::FiguresText(rounds[k], target));
@@ -205,20 +214,22 @@ absl::StatusOr<TargetBuild> BuildToTarget(const mesh::Mesh& coarse, const Repair
           absl::StrFormat(" (rows %.1fs, validation %.1fs)", rows_seconds,
                           result.validation_seconds));
     }
-    const NextStep next = DecideNext(figures, round.plan.requested_samples, cap, options.target);
+    GEODEX_ASSIGN_OR_RETURN(const std::string bytes, index::SerializeIndex(result.data));
+    const NextStep next = DecideNext(figures, round.plan.requested_samples, cap, options.target,
+                                     static_cast<int64_t>(bytes.size()));
     if (next.done) {
       TargetBuild build{std::move(round.prepared.mesh),
                         std::move(round.plan),
                         std::move(result.data),
                         result.summary,
                         std::move(figures),
-                        next.reached};
+                        next};
       build.summary.sampling_seconds = totals.sampling_seconds;
       build.summary.triangulation_seconds = totals.triangulation_seconds;
       build.summary.rows_seconds = totals.rows_seconds;
       build.summary.merge_seconds = totals.merge_seconds;
       build.data.report +=
-          TargetReport(build.rounds, build.reached, options.target, build.data.accuracy[0]);
+          TargetReport(build.rounds, build.last, options.target, build.data.accuracy[0]);
       return build;
     }
     GEODEX_ASSIGN_OR_RETURN(

@@ -95,17 +95,23 @@ absl::StatusOr<RoundResult> FinishRound(const RoundPlan& round, std::vector<Samp
 
 // What comes after a finished round.
 struct NextStep {
-  bool done = false;        // the target is met, or the round was at the cap
+  bool done = false;        // the target is met, or m can grow no more
   bool reached = false;     // the target is met
   int32_t num_samples = 0;  // when not done: the next round's m
+  // When done and not reached: why m stops ("the cap of 8000 samples", "the
+  // index size budget of 64 MiB").
+  std::string stop;
 };
+// `index_bytes`: the size of the last round's index; m grows no further than
+// validation::kMaxIndexBytes allows.
 NextStep DecideNext(const std::vector<validation::TargetFigures>& rounds, int32_t requested_samples,
-                    int32_t cap, double target);
+                    int32_t cap, double target, int64_t index_bytes);
 
 // The report lines of a target-error build (the target, whether it was
 // reached, each round's figures, the calibration's), for the index's report.
-std::string TargetReport(const std::vector<validation::TargetFigures>& rounds, bool reached,
-                         double target, const index::AccuracyRecord& accuracy);
+std::string TargetReport(const std::vector<validation::TargetFigures>& rounds,
+                         const NextStep& last, double target,
+                         const index::AccuracyRecord& accuracy);
 // The line geodex-build logs after a round.
 std::string RoundLine(int32_t round, const validation::TargetFigures& figures, double target);
 
@@ -116,7 +122,7 @@ struct TargetBuild {
   index::IndexData data;
   BuildSummary summary;  // of the last round, its times summed over the rounds
   std::vector<validation::TargetFigures> rounds;
-  bool reached = false;
+  NextStep last;  // done: whether the target was reached, else why m stopped
 };
 absl::StatusOr<TargetBuild> BuildToTarget(const mesh::Mesh& coarse, const RepairRecord& repair,
                                           const RoundsOptions& options,

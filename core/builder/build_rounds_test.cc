@@ -29,7 +29,7 @@ TEST(BuildRoundsTest, GrowsTheSamplesUntilTheTargetIsMet) {
   absl::StatusOr<TargetBuild> result =
       BuildToTarget(m, {}, Options(60, 0.011), [&](const std::string& l) { lines.push_back(l); });
   ASSERT_TRUE(result.ok()) << result.status();
-  ASSERT_TRUE(result->reached);
+  ASSERT_TRUE(result->last.reached);
   ASSERT_GE(result->rounds.size(), 2u);
   EXPECT_EQ(lines.size(), result->rounds.size());
   EXPECT_FALSE(validation::TargetMet(result->rounds.front(), 0.011));
@@ -53,9 +53,9 @@ TEST(BuildRoundsTest, StopsAtTheCapAndSaysSo) {
   options.max_samples = 30;
   absl::StatusOr<TargetBuild> result = BuildToTarget(m, {}, options, nullptr);
   ASSERT_TRUE(result.ok()) << result.status();
-  EXPECT_FALSE(result->reached);
+  EXPECT_FALSE(result->last.reached);
   EXPECT_EQ(result->rounds.size(), 2u);  // 20, then the cap
-  EXPECT_NE(result->data.report.find("target_error_reached = no (sample cap)"), std::string::npos);
+  EXPECT_NE(result->data.report.find("target_error_reached = no (the cap of "), std::string::npos);
   options.target = -1;
   EXPECT_EQ(BuildToTarget(m, {}, options, nullptr).status().code(),
             absl::StatusCode::kInvalidArgument);
@@ -88,15 +88,28 @@ TEST(BuildRoundsTest, DecideNext) {
   TargetFigures met;
   met.samples = 500;
   for (int c = 0; c < validation::kNumTargetChecks; ++c) met.pairs[c] = 10;
-  EXPECT_TRUE(DecideNext({met}, 500, 8000, 0.005).reached);
+  constexpr int64_t kSmall = 1 << 20;  // an index of 1 MiB
+  EXPECT_TRUE(DecideNext({met}, 500, 8000, 0.005, kSmall).reached);
   TargetFigures missed = met;
   missed.upper[0] = 0.01;
-  NextStep next = DecideNext({missed}, 500, 8000, 0.005);
+  NextStep next = DecideNext({missed}, 500, 8000, 0.005, kSmall);
   EXPECT_FALSE(next.done);
   EXPECT_GT(next.num_samples, 500);
-  next = DecideNext({missed}, 8000, 8000, 0.005);
+  next = DecideNext({missed}, 8000, 8000, 0.005, kSmall);
   EXPECT_TRUE(next.done);
   EXPECT_FALSE(next.reached);
+  EXPECT_EQ(next.stop, "the cap of 8000 samples");
+  // An index already at the size budget stops m where it is.
+  missed.samples = 5000;
+  next = DecideNext({missed}, 5000, 8000, 0.005, validation::kMaxIndexBytes);
+  EXPECT_TRUE(next.done);
+  EXPECT_FALSE(next.reached);
+  EXPECT_EQ(next.stop, "the index size budget of 64 MiB");
+  // Below it, m grows at most to what fits.
+  next = DecideNext({missed}, 5000, 8000, 0.005, 2 * int64_t{5000} * 4999);
+  EXPECT_FALSE(next.done);
+  EXPECT_EQ(next.num_samples,
+            validation::SamplesWithinBytes(validation::kMaxIndexBytes, 5000, 2 * int64_t{5000} * 4999));
 }
 
 TEST(BuildRoundsTest, TargetStateRoundTripsAndRefusesCorruption) {

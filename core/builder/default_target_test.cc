@@ -51,7 +51,7 @@ void ExpectDefaultTargetMet(const mesh::Mesh& coarse) {
   options.build.threads = 2;
   absl::StatusOr<TargetBuild> build = BuildToTarget(coarse, {}, options, nullptr);
   ASSERT_TRUE(build.ok()) << build.status();
-  ASSERT_TRUE(build->reached) << build->data.report;
+  ASSERT_TRUE(build->last.reached) << build->data.report;
   absl::StatusOr<std::string> bytes = index::SerializeIndex(build->data);
   ASSERT_TRUE(bytes.ok());
   absl::StatusOr<std::shared_ptr<const index::Index>> index =

@@ -93,4 +93,14 @@ int32_t PredictSamples(std::span<const TargetFigures> rounds, double target, int
   return static_cast<int32_t>(std::min<double>(cap, std::ceil(want)));
 }
 
+int32_t SamplesWithinBytes(int64_t budget, int32_t samples, int64_t bytes) {
+  // The packed matrix: m (m - 1) / 2 floats.
+  auto matrix = [](double m) { return 2 * m * (m - 1); };
+  const double per_sample = std::max(0.0, bytes - matrix(samples)) / std::max(samples, 1);
+  // The positive root of 2 m^2 + (per_sample - 2) m - budget = 0.
+  const double b = per_sample - 2;
+  const double m = (-b + std::sqrt(b * b + 8.0 * static_cast<double>(budget))) / 4;
+  return static_cast<int32_t>(std::clamp(std::floor(m), 3.0, 2e9));
+}
+
 }  // namespace geodex::validation

@@ -40,6 +40,16 @@ namespace geodex::validation {
 inline constexpr double kDefaultTargetError = 0.005;
 // The default cap on m: its m x m float matrix is 256 MB.
 inline constexpr int32_t kDefaultMaxSamples = 8000;
+// The most bytes a target-error build's index may take. A server holds many
+// models, so m stops growing where the next index would not fit; the
+// sample matrix (m (m - 1) / 2 floats) alone is 64 MiB near m = 5,800.
+inline constexpr int64_t kMaxIndexBytes = int64_t{64} << 20;
+
+// The largest m whose index fits in `budget` bytes, predicted from an index
+// of `samples` samples that takes `bytes`: the sample matrix grows as m^2,
+// the rest (the refined mesh, vertex records, calibration) at most in
+// proportion to m.
+int32_t SamplesWithinBytes(int64_t budget, int32_t samples, int64_t bytes);
 
 // The checks: 0 the uniform RMS, then 1 + kind * kNumScaleBins + bin
 // (BinConfidence's kinds and bins).

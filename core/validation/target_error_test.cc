@@ -80,5 +80,19 @@ TEST(TargetErrorTest, PredictionFromTheRatesTheFiguresFallAt) {
   EXPECT_EQ(PredictSamples(rounds, kE, 2500), 2500);
 }
 
+TEST(TargetErrorTest, SamplesWithinBytesCountsTheMatrixAndThePerSampleRest) {
+  // An index of exactly its packed matrix: m^2 - m = budget / 2.
+  const int64_t budget = kMaxIndexBytes;
+  const int32_t m = SamplesWithinBytes(budget, 1000, 2 * int64_t{1000} * 999);
+  EXPECT_LE(2 * int64_t{m} * (m - 1), budget);
+  EXPECT_GT(2 * int64_t{m + 1} * m, budget);
+  EXPECT_NEAR(m, 5793, 1);
+  // 4 kB a sample beside the matrix leaves room for fewer.
+  const int32_t fewer = SamplesWithinBytes(budget, 1000, 2 * int64_t{1000} * 999 + 4000 * 1000);
+  EXPECT_LE(2 * int64_t{fewer} * (fewer - 1) + int64_t{4000} * fewer, budget);
+  EXPECT_GT(2 * int64_t{fewer + 1} * fewer + int64_t{4000} * (fewer + 1), budget);
+  EXPECT_LT(fewer, m);
+}
+
 }  // namespace
 }  // namespace geodex::validation
