@@ -230,14 +230,12 @@ class Corridor {
 // A corridor from `from` to `to` found without the distance field: from
 // face to face, each step heading for `to` along the chord projected into
 // the face (past a ridge, where that points back, straight on across the
-// edge), until a face holds `to`. The faces go to *faces, and the
-// crossings, with the ends, to *path (consecutive points share a face, as
-// StraightenPath needs). False when the walk reaches a vertex, the boundary
-// or a dead end, crosses more than `max_steps` faces or walks more than
-// twice the chord; then the caller traces instead.
+// edge), until a face holds `to`. The faces go to *faces. False when the
+// walk reaches a vertex, the boundary or a dead end, crosses more than
+// `max_steps` faces or walks more than twice the chord; then the caller
+// traces instead.
 bool WalkCorridor(const MeshView& view, const PathPoint& from, const PathPoint& to, int max_steps,
-                  std::vector<PathPoint>* path, std::vector<int32_t>* faces) {
-  path->assign({from});
+                  std::vector<int32_t>* faces) {
   // The face to start in: from's face, or, for a vertex or edge point, the
   // face round it that the chord enters.
   absl::InlinedVector<int32_t, 16> starts;
@@ -261,7 +259,6 @@ bool WalkCorridor(const MeshView& view, const PathPoint& from, const PathPoint& 
       if (c >= 0) b[c] = from.point.w[i];  // FaceHolds: the others weigh ~0
     }
     if (FaceHolds(view, g, to.point)) {
-      path->push_back(to);
       faces->assign({g});
       return true;
     }
@@ -284,10 +281,7 @@ bool WalkCorridor(const MeshView& view, const PathPoint& from, const PathPoint& 
   Vec3 heading = Vec3::Zero();  // the last step, and the edge it crossed
   std::array<int32_t, 2> heading_edge = {-1, -1};
   for (int step = 0; step < max_steps && length <= max_length; ++step) {
-    if (FaceHolds(view, f, to.point)) {
-      path->push_back(to);
-      return true;
-    }
+    if (FaceHolds(view, f, to.point)) return true;
     std::array<double, 3> beta = Velocity(view, f, to.position - x);
     double t;
     int exit = DescentExit(beta, w, &t);
@@ -307,7 +301,6 @@ bool WalkCorridor(const MeshView& view, const PathPoint& from, const PathPoint& 
     x = w[0] * view.Position(view.Vertex(f, 0)) + w[1] * view.Position(view.Vertex(f, 1)) +
         w[2] * view.Position(view.Vertex(f, 2));
     length += (x - last).norm();
-    path->push_back({SurfacePoint{f, w}, x});
     const int32_t g = view.twins[3 * f + (exit + 1) % 3];  // the edge opposite `exit`
     if (g < 0) return false;
     heading = x - last;
@@ -370,25 +363,18 @@ std::optional<NearPath> NearPathLength(const MeshView& view, const GradientPaths
   const PathPoint ends[2] = {{from, view.PositionOf(from)}, {to, view.PositionOf(to)}};
   std::optional<double> doubted;
   auto doubt = [&](double length) { doubted = std::min(length, doubted.value_or(length)); };
-  // Walks whose corridor could not be unfolded or released, for the
-  // straightener.
-  std::vector<PathPoint> walks[2];
   Corridor corridor;
   Corridor::Bends bends;
   for (int start = 0; start < (walk_chord ? 2 : 0); ++start) {
-    std::vector<PathPoint>& walk = walks[start];
     const SurfacePoint& a = ends[start].point;
     const SurfacePoint& b = ends[1 - start].point;
-    if (!WalkCorridor(view, ends[start], ends[1 - start], kMaxWalkSteps, &walk,
-                      &corridor.faces())) {
-      walk.clear();
+    if (!WalkCorridor(view, ends[start], ends[1 - start], kMaxWalkSteps, &corridor.faces()) ||
+        !corridor.Unfold(view, a, b)) {
       continue;
     }
-    if (!corridor.Unfold(view, a, b)) continue;
     if (const std::optional<double> length = corridor.StraightLength()) {
       if (*length <= plausible) return NearPath{*length, false};
       doubt(*length);
-      walk.clear();
       continue;
     }
     for (int release = 0; release <= kMaxReleases; ++release) {
@@ -410,18 +396,10 @@ std::optional<NearPath> NearPathLength(const MeshView& view, const GradientPaths
       if (shortcut == nullptr) {
         if (length <= plausible && bends.size() <= 1) return NearPath{length, !bends.empty()};
         doubt(length);
-        walk.clear();
         break;
       }
       if (!corridor.Release(view, *shortcut) || !corridor.Unfold(view, a, b)) break;
     }
-  }
-  for (std::vector<PathPoint>& walk : walks) {
-    if (walk.empty()) continue;
-    walk = StraightenPath(view, std::move(walk));
-    const double length = PathLength(walk);
-    if (!WrapsRoundAVertex(walk) && length <= plausible) return NearPath{length, false};
-    doubt(length);
   }
   // Without Path's restarts, which double the cost of a near pair for a
   // small gain (tests/bench/README.md).
