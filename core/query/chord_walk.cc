@@ -363,6 +363,7 @@ std::optional<NearPath> NearPathLength(const MeshView& view, const GradientPaths
   const PathPoint ends[2] = {{from, view.PositionOf(from)}, {to, view.PositionOf(to)}};
   std::optional<double> doubted;
   auto doubt = [&](double length) { doubted = std::min(length, doubted.value_or(length)); };
+  std::optional<NearPath> found;
   Corridor corridor;
   Corridor::Bends bends;
   for (int start = 0; start < (walk_chord ? 2 : 0); ++start) {
@@ -394,12 +395,24 @@ std::optional<NearPath> NearPathLength(const MeshView& view, const GradientPaths
       }
       if (!judged) break;
       if (shortcut == nullptr) {
-        if (length <= plausible && bends.size() <= 1) return NearPath{length, !bends.empty()};
-        doubt(length);
+        if (length <= plausible && bends.size() <= 1) {
+          // Straight in the walk's own corridor: as sure as a straight walk.
+          if (release == 0 && bends.empty()) return NearPath{length, false};
+          // Else a local geodesic in a corridor the walk did not find by
+          // itself: kept, but the other walk may find a shorter one.
+          if (!found || length < found->length) found = NearPath{length, !bends.empty()};
+        } else {
+          doubt(length);
+        }
         break;
       }
       if (!corridor.Release(view, *shortcut) || !corridor.Unfold(view, a, b)) break;
     }
+  }
+  // Every candidate is a surface path: the shortest is the closest.
+  if (found) {
+    if (doubted && *doubted < found->length) return NearPath{*doubted, true};
+    return found;
   }
   // Without Path's restarts, which double the cost of a near pair for a
   // small gain (tests/bench/README.md).
