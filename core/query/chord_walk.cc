@@ -122,7 +122,6 @@ class Corridor {
     Vec2 apex = start_, side_at[2] = {end_of(0, 0), end_of(0, 1)};
     size_t index[2] = {0, 0};
     for (size_t i = 1; i <= n; ++i) {
-      bool bent = false;
       // Side 1 (right) narrows when the new end is left of the apex's ray
       // to it, side 0 (left) when it is right; crossing the other side's
       // ray, the path bends round that side's end.
@@ -147,10 +146,8 @@ class Corridor {
         bends->push_back({v, other, first, last, 0});
         side_at[0] = side_at[1] = apex;
         index[0] = index[1] = i = at;
-        bent = true;
         break;
       }
-      (void)bent;
     }
     apexes.push_back(end_);
     double length = 0;
