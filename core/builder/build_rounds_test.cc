@@ -105,11 +105,18 @@ TEST(BuildRoundsTest, DecideNext) {
   EXPECT_TRUE(next.done);
   EXPECT_FALSE(next.reached);
   EXPECT_EQ(next.stop, "the index size budget of 64 MiB");
-  // Below it, m grows at most to what fits.
-  next = DecideNext({missed}, 5000, 8000, 0.005, 2 * int64_t{5000} * 4999);
+  // Below it, m grows at most to what fits, with 3% of the budget spare.
+  missed.samples = 3000;
+  const int64_t bytes = 2 * int64_t{3000} * 2999;
+  next = DecideNext({missed}, 3000, 8000, 0.005, bytes);
   EXPECT_FALSE(next.done);
   EXPECT_EQ(next.num_samples,
-            validation::SamplesWithinBytes(validation::kMaxIndexBytes, 5000, 2 * int64_t{5000} * 4999));
+            validation::SamplesWithinBytes(validation::kMaxIndexBytes * 97 / 100, 3000, bytes));
+  // Room for less than the least growth of a round (1.2x): stop there.
+  missed.samples = 4800;
+  next = DecideNext({missed}, 4800, 8000, 0.005, 2 * int64_t{4800} * 4799);
+  EXPECT_TRUE(next.done);
+  EXPECT_EQ(next.stop, "the index size budget of 64 MiB");
 }
 
 TEST(BuildRoundsTest, TargetStateRoundTripsAndRefusesCorruption) {
