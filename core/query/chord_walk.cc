@@ -59,12 +59,11 @@ bool FaceHolds(const MeshView& view, int32_t f, const SurfacePoint& p) {
 class Corridor {
  public:
   using Vec2 = Eigen::Vector2d;
-  // Where the funnel's path bends: the vertex, the side of the corridor it
-  // is on (0 left, 1 right), the run of portals [first, last] that end at
-  // it on that side, and the angle the path turns by.
+  // Where the funnel's path bends: the vertex, the run of portals
+  // [first, last] that end at it on the side it is on, and the angle the
+  // path turns by.
   struct Bend {
     int32_t vertex;
-    int side;
     size_t first, last;
     double turn;
   };
@@ -143,7 +142,7 @@ class Corridor {
         size_t first = at, last = at;
         while (first > 0 && ids_[first - 1][other] == v) --first;
         while (last + 1 < n && ids_[last + 1][other] == v) ++last;
-        bends->push_back({v, other, first, last, 0});
+        bends->push_back({v, first, last, 0});
         side_at[0] = side_at[1] = apex;
         index[0] = index[1] = i = at;
         break;
