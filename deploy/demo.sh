@@ -2,7 +2,8 @@
 # The README's first command. On a fresh Debian 12 machine: installs the
 # dependencies, builds geodex, builds an index of the built-in torus with the
 # builder's default accuracy target, starts geodex-server on loopback, asks
-# it for distances (with their error bounds), a path and a distance field
+# it for distances (within a tolerance of 0.5%, with their error bounds), a
+# path and a distance field
 # (as text and as the torus colored by distance, field.ply, for MeshLab) with
 # the `geodex` CLI, and checks every distance against the exact one that
 # geodex-geodesic computes on the same mesh: the demo fails if an answer is
@@ -125,13 +126,20 @@ FAR_POINT="$(awk -v v="$FAR" '
 [ -n "$FAR_POINT" ] || die "vertex $FAR is on no face of field.ply"
 echo "$(cat sources.txt) $FAR_POINT" >> pairs.txt
 
-"$GEODEX" distance --model torus --pairs pairs.txt --error-bounds > distances.txt
+# With a relative tolerance of 0.5%: the server refines every answer whose
+# bound exceeds it. A bound is a calibrated statistic (99.5% of held-out
+# pairs), and these pairs are special: (1.3,0,0) and (-2.7,0,0) are each
+# joined to (2.7,0,0) by two geodesics (over and under the tube, or round
+# either side of the hole), where the O(1) answer errs most, by 1-2.4%
+# at this m, beyond its bound.
+"$GEODEX" distance --model torus --pairs pairs.txt --error-bounds --tolerance 0.005 > distances.txt
 "$EXACT_BIN" field.ply --pairs pairs.txt > exact.txt
 { [ "$(wc -l < distances.txt)" -eq 4 ] && [ "$(wc -l < exact.txt)" -eq 4 ]; } ||
   die "expected 4 answers from geodex and from geodex-geodesic"
 
-echo "-- distances: geodex's answer and its error bound, the exact distance on the same mesh"
-echo "   (geodex-geodesic), and the error; an answer farther from exact than its bound fails"
+echo "-- distances within a tolerance of 0.5%: geodex's answer and its error bound, the exact"
+echo "   distance on the same mesh (geodex-geodesic), and the error; an answer farther from exact"
+echo "   than its bound fails"
 printf "   %-34s %10s %10s %10s %9s\n" pair geodex bound exact error
 paste <(grep -v '^#' pairs_xyz.txt; echo "farthest vertex $FAR of the field") \
   distances.txt exact.txt | awk -F'\t' '
