@@ -21,12 +21,10 @@ using internal::CheckSpreadBounds;
 using internal::Checksum;
 using internal::Contents;
 using internal::Counts;
-using internal::ExpectedCount;
 using internal::HeaderChecksum;
 using internal::kInt32Max;
 using internal::kNumSpecs;
 using internal::kSpecs;
-using internal::SpecIndex;
 
 absl::StatusOr<std::string> SerializeIndex(const IndexData& d) {
   auto bad = [](std::string message) { return absl::InvalidArgumentError(message); };

@@ -27,7 +27,8 @@ std::array<double, 3> Velocity(const MeshView& view, int32_t f, const Vec3& dir)
 // Direction `d`, in the plane of the face across edge (a, b) from face f,
 // turned about that edge into f's plane: a straight line across the edge
 // in the unfolding of the two faces.
-Vec3 Unfold(const MeshView& view, int32_t f, const std::array<int32_t, 2>& edge, const Vec3& d) {
+Vec3 UnfoldHeading(const MeshView& view, int32_t f, const std::array<int32_t, 2>& edge,
+                   const Vec3& d) {
   const Vec3 a = view.Position(edge[0]);
   const Vec3 e = (view.Position(edge[1]) - a).normalized();
   Vec3 into = Vec3::Zero();  // in f's plane, perpendicular to the edge, into f
@@ -284,7 +285,7 @@ bool WalkCorridor(const MeshView& view, const PathPoint& from, const PathPoint& 
     if ((exit < 0 || !(t > 1e-14)) && heading.squaredNorm() > 0) {
       // Past a ridge the chord points back: go on straight, the heading of
       // the face before unfolded into this one.
-      beta = Velocity(view, f, Unfold(view, f, heading_edge, heading));
+      beta = Velocity(view, f, UnfoldHeading(view, f, heading_edge, heading));
       exit = DescentExit(beta, w, &t);
     }
     if (exit < 0 || !(t > 1e-14)) return false;

@@ -34,6 +34,7 @@ from .errors import (
     Unimplemented,
     Unknown,
 )
+from . import errors as _errors
 from ._arrays import Located, Path, SurfacePoints
 from .client import Client, Model, Tls, Triangulation, connect
 from ._inprocess import BuildProgress, Index, build, has_in_process
@@ -53,21 +54,6 @@ __all__ = [
     "SurfacePoints",
     "Located",
     "Path",
-    "Error",
-    "Cancelled",
-    "Unknown",
-    "InvalidArgument",
-    "DeadlineExceeded",
-    "NotFound",
-    "AlreadyExists",
-    "PermissionDenied",
-    "ResourceExhausted",
-    "FailedPrecondition",
-    "Aborted",
-    "OutOfRange",
-    "Unimplemented",
-    "Internal",
-    "Unavailable",
-    "DataLoss",
-    "Unauthenticated",
+    # the exception classes, one per status code
+    *(name for name in _errors.__all__ if name != "error_for_code"),
 ]
