@@ -32,18 +32,13 @@ absl::Status CheckPairedUp(const v1::SurfacePoints& a, const v1::SurfacePoints& 
       absl::StrFormat("a has %d points but b has %d; they must pair up", na, nb));
 }
 
-absl::StatusOr<mesh::SurfacePoint> OnePointFromProto(const v1::SurfacePoints& points,
-                                                     std::string_view name,
-                                                     const query::InputQueries& queries,
-                                                     query::EnginePoints* out) {
+absl::Status OnePointFromProto(const v1::SurfacePoints& points, std::string_view name,
+                               const query::InputQueries& queries, query::EnginePoints* out) {
   if (PointCount(points) != 1) {
     return absl::InvalidArgumentError(absl::StrFormat("%s: give exactly one point, got %d",
                                                       std::string(name), PointCount(points)));
   }
-  const absl::Status status = PointsFromProto(points, name, queries, out);
-  if (!status.ok()) return status;
-  return mesh::SurfacePoint{points.faces(0),
-                            {points.weights(0), points.weights(1), points.weights(2)}};
+  return PointsFromProto(points, name, queries, out);
 }
 
 absl::Status PositionsFromProto(const v1::Positions& positions, std::string_view name,

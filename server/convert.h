@@ -9,7 +9,7 @@
 //
 // Ids. Requests and answers use the ids of the mesh file a model was built
 // from; when the builder repaired that mesh they differ from the index's
-// (core/query/input_ids.h). Points are read into the index's ids here
+// (core/query/internal/input_ids.h). Points are read into the index's ids here
 // (PointsFromProto), and every answer that names faces or vertices is written
 // back in input ids here too (paths, located points, fields, exponential maps,
 // the mesh, the triangulation, the model's counts).
@@ -25,9 +25,8 @@
 #include "absl/status/statusor.h"
 #include "core/index/index.h"
 #include "core/mesh/mesh.h"
-#include "core/query/exp_map.h"
 #include "core/query/input_queries.h"
-#include "core/query/query_engine.h"
+#include "core/query/query_types.h"
 #include "geodex/v1/geodex.pb.h"
 #include "server/model_registry.h"
 
@@ -49,15 +48,12 @@ inline int64_t PointCount(const v1::SurfacePoints& points) { return points.faces
 // InvalidArgument ("a has 3 points but b has 2; they must pair up").
 absl::Status CheckPairedUp(const v1::SurfacePoints& a, const v1::SurfacePoints& b);
 
-// Reads `points` that must hold exactly one point (named `name`): into
-// `out` as PointsFromProto does, and returned as the request gives it, in
-// input ids (for InputQueries::ExpMap's centre). Errors: InvalidArgument for
-// another count ("center: give exactly one point, got 2"), and those of
-// PointsFromProto.
-absl::StatusOr<mesh::SurfacePoint> OnePointFromProto(const v1::SurfacePoints& points,
-                                                     std::string_view name,
-                                                     const query::InputQueries& queries,
-                                                     query::EnginePoints* out);
+// Reads `points` that must hold exactly one point (named `name`) into `out`
+// as PointsFromProto does (an exponential map's centre). Errors:
+// InvalidArgument for another count ("center: give exactly one point, got
+// 2"), and those of PointsFromProto.
+absl::Status OnePointFromProto(const v1::SurfacePoints& points, std::string_view name,
+                               const query::InputQueries& queries, query::EnginePoints* out);
 
 // Reads packed 3D positions. Errors: InvalidArgument if xyz is not a multiple
 // of 3 long or a coordinate is not finite ("positions[4]: y is nan").

@@ -13,7 +13,6 @@
 #include <cstdint>
 
 #include "absl/status/statusor.h"
-#include "core/query/exp_map.h"
 #include "core/query/query_types.h"
 #include "geodex/v1/geodex.pb.h"
 #include "server/model_config.pb.h"

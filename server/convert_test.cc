@@ -42,9 +42,12 @@ class ConvertTest : public ::testing::Test {
 TEST_F(ConvertTest, ReadsValidPoints) {
   ASSERT_TRUE(Read(Points({0, 5}, {1, 0, 0, 0.25, 0.25, 0.5})).ok());
   ASSERT_EQ(out_.size(), 2u);
-  // The sphere needed no repair: the points are the engine's as given.
-  const absl::StatusOr<double> want =
-      queries_->engine().Distance({0, {1, 0, 0}}, {5, {0.25, 0.25, 0.5}});
+  // Read point by point, the same points answer the same.
+  query::EnginePoints p, q;
+  const std::vector<query::SurfacePoint> input = {{0, {1, 0, 0}}, {5, {0.25, 0.25, 0.5}}};
+  ASSERT_TRUE(queries_->Read(std::span(input).first(1), query::Named("p"), &p).ok());
+  ASSERT_TRUE(queries_->Read(std::span(input).last(1), query::Named("q"), &q).ok());
+  const absl::StatusOr<double> want = queries_->Distance(p, 0, q, 0);
   ASSERT_TRUE(want.ok()) << want.status();
   EXPECT_EQ(*queries_->Distance(out_, 0, out_, 1), *want);
 }
@@ -96,22 +99,20 @@ TEST(ConvertPairsTest, PointsMustPairUp) {
   EXPECT_TRUE(CheckPairedUp(a, b).ok());
 }
 
-TEST_F(ConvertTest, OnePointIsReadAndReturnedAsGiven) {
-  absl::StatusOr<mesh::SurfacePoint> p =
+TEST_F(ConvertTest, OnePointIsRead) {
+  absl::Status status =
       OnePointFromProto(Points({5}, {0.25, 0.25, 0.5}), "center", *queries_, &out_);
-  ASSERT_TRUE(p.ok()) << p.status();
-  EXPECT_EQ(p->face, 5);
-  EXPECT_EQ(p->w, (std::array<double, 3>{0.25, 0.25, 0.5}));
+  ASSERT_TRUE(status.ok()) << status;
   EXPECT_EQ(out_.size(), 1u);
   for (const v1::SurfacePoints& points : {Points({}, {}), Points({0, 1}, {1, 0, 0, 1, 0, 0})}) {
-    p = OnePointFromProto(points, "center", *queries_, &out_);
-    EXPECT_EQ(p.status().code(), absl::StatusCode::kInvalidArgument);
-    EXPECT_EQ(std::string(p.status().message()),
+    status = OnePointFromProto(points, "center", *queries_, &out_);
+    EXPECT_EQ(status.code(), absl::StatusCode::kInvalidArgument);
+    EXPECT_EQ(std::string(status.message()),
               absl::StrFormat("center: give exactly one point, got %d", points.faces_size()));
   }
-  p = OnePointFromProto(Points({99999}, {1, 0, 0}), "center", *queries_, &out_);
-  EXPECT_EQ(p.status().code(), absl::StatusCode::kOutOfRange);
-  EXPECT_THAT(std::string(p.status().message()), StartsWith("center[0]: face id 99999"));
+  status = OnePointFromProto(Points({99999}, {1, 0, 0}), "center", *queries_, &out_);
+  EXPECT_EQ(status.code(), absl::StatusCode::kOutOfRange);
+  EXPECT_THAT(std::string(status.message()), StartsWith("center[0]: face id 99999"));
 }
 
 TEST(ConvertMatrixTest, BlockCarriesValuesAndBoundsRowMajor) {

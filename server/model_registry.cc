@@ -58,9 +58,7 @@ absl::StatusOr<std::shared_ptr<const ServedVersion>> ServedVersion::Load(int64_t
                                                                          FileId file_id) {
   auto index = index::Index::Open(path);
   if (!index.ok()) return index.status();
-  auto engine = query::QueryEngine::Create(*index, {});
-  if (!engine.ok()) return engine.status();
-  auto queries = query::InputQueries::Create(*std::move(engine));
+  auto queries = query::InputQueries::Create(*index);
   if (!queries.ok()) return queries.status();
   std::shared_ptr<ServedVersion> served(new ServedVersion());
   served->version_ = version;

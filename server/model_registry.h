@@ -19,7 +19,7 @@
 // model it serves the newest `keep_versions` versions (config; default 1) that
 // are not known to be broken. A version is loaded with index::Index::Open
 // (read-only MAP_SHARED mapping: every server process on the host shares the
-// page cache) and query::QueryEngine::Create, in the background; the new set
+// page cache) and query::InputQueries::Create, in the background; the new set
 // of served versions is then published as one immutable RegistrySnapshot
 // through one shared_ptr. Requests resolve a model against the snapshot
 // of the moment and keep it alive until they finish, so a swap never blocks a
@@ -81,7 +81,7 @@ struct FileId {
 class ServedVersion {
  public:
   // Opens and validates `path` and builds its engine. Errors: those of
-  // index::Index::Open and query::QueryEngine::Create.
+  // index::Index::Open and query::InputQueries::Create.
   static absl::StatusOr<std::shared_ptr<const ServedVersion>> Load(int64_t version,
                                                                    const std::string& path,
                                                                    FileId file_id);
@@ -95,7 +95,6 @@ class ServedVersion {
   // The queries in the mesh file's ids (what every call answers with); each
   // call chooses how its pairs are refined (query::DistanceOptions).
   const query::InputQueries& queries() const { return *queries_; }
-  const query::QueryEngine& engine() const { return queries_->engine(); }
 
  private:
   ServedVersion() = default;

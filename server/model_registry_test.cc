@@ -109,7 +109,7 @@ TEST_F(ModelRegistryTest, AddsReplacesAndRemovesWhileRequestsHoldTheOldVersion) 
   Start();
   auto held = registry_->Resolve("a", 0);
   ASSERT_TRUE(held.ok());
-  const query::QueryEngine& old_engine = held->version->engine();
+  const query::InputQueries& old_queries = held->version->queries();
 
   Write("a", 2, OtherSphereBytes());
   Write("b", 1, testing::TorusIndexBytes());
@@ -118,13 +118,15 @@ TEST_F(ModelRegistryTest, AddsReplacesAndRemovesWhileRequestsHoldTheOldVersion) 
   EXPECT_EQ(Model("b")->state, LoadState::kServing);
   // The request that resolved version 1 still runs on it.
   EXPECT_EQ(held->version->version(), 1);
-  mesh::SurfacePoint p{0, {1, 0, 0}}, q{10, {0, 1, 0}};
-  EXPECT_TRUE(old_engine.Distance(p, q).ok());
+  const std::vector<mesh::SurfacePoint> input = {{0, {1, 0, 0}}, {10, {0, 1, 0}}};
+  query::EnginePoints points;
+  ASSERT_TRUE(old_queries.Read(input, query::Named("p"), &points).ok());
+  EXPECT_TRUE(old_queries.Distance(points, 0, points, 1).ok());
 
   testing::RemoveModel(dir_.path(), "a");
   registry_->RescanNow();
   EXPECT_EQ(registry_->Resolve("a", 0).status().code(), absl::StatusCode::kNotFound);
-  EXPECT_TRUE(old_engine.Distance(p, q).ok());  // still mapped while held
+  EXPECT_TRUE(old_queries.Distance(points, 0, points, 1).ok());  // still mapped while held
 }
 
 TEST_F(ModelRegistryTest, ReloadsAVersionWhoseFileChanged) {
@@ -291,11 +293,13 @@ TEST_F(ModelRegistryTest, OneEngineAnswersEveryNearPairMode) {
   Start();
   auto resolved = registry_->Resolve("a", 0);
   ASSERT_TRUE(resolved.ok());
-  const query::QueryEngine& engine = resolved->version->engine();
+  const query::InputQueries& queries = resolved->version->queries();
   // A point and another of the same face: a near pair, answered by each mode.
-  const mesh::SurfacePoint p{0, {0.6, 0.2, 0.2}}, q{0, {0.1, 0.1, 0.8}};
+  const std::vector<mesh::SurfacePoint> input = {{0, {0.6, 0.2, 0.2}}, {0, {0.1, 0.1, 0.8}}};
+  query::EnginePoints points;
+  ASSERT_TRUE(queries.Read(input, query::Named("p"), &points).ok());
   for (auto mode : {query::NearPairs::kPath, query::NearPairs::kUnfold, query::NearPairs::kExact}) {
-    EXPECT_TRUE(engine.Distance(p, q, {.near_pairs = mode}).ok());
+    EXPECT_TRUE(queries.Distance(points, 0, points, 1, {.near_pairs = mode}).ok());
   }
 }
 

@@ -45,7 +45,7 @@ std::string RepairedIndexBytes(const mesh::RawMesh& raw, bool refine) {
   absl::StatusOr<builder::PreparedMesh> prepared =
       builder::PrepareMesh(repaired->mesh, builder::RecordRepair(*repaired), samples, refine);
   EXPECT_TRUE(prepared.ok()) << prepared.status();
-  EXPECT_EQ(prepared->record.refinement_vertices > 0, refine);
+  EXPECT_EQ(prepared->record.split_vertices > 0, refine);
   builder::BuildOptions options;
   options.num_samples = samples;
   options.threads = 2;

@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "core/mesh/generators.h"
-#include "core/query/exp_map.h"
+#include "core/query/query_types.h"
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
 #include "server/server_test_util.h"

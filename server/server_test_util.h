@@ -13,7 +13,7 @@
 #include <string>
 #include <utility>
 
-#include "core/query/query_engine.h"
+#include "core/query/internal/query_engine.h"
 #include "geodex/v1/geodex.grpc.pb.h"
 #include "grpcpp/channel.h"
 #include "grpcpp/client_context.h"

@@ -21,7 +21,6 @@
 
 #include "core/mesh/mesh.h"
 #include "core/query/input_queries.h"
-#include "core/query/query_engine.h"
 
 namespace geodex::server {
 

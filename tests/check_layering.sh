@@ -5,7 +5,11 @@
 #   core/builder  nothing built from core/query sources (the query engine, the
 #                 point locator); the face BVH it stores is in core/index;
 #   client/       nothing from core/ or server/;
-#   server/       not the client library.
+#   server/       not the client library;
+#   the parts of core/query (core/query/internal/) only from core/ and from
+#                 tests and benchmarks: the server, the offline tools and the
+#                 Python bindings use the public headers (input_queries.h,
+#                 query_types.h, query_scratch.h).
 # The Python package keeps the same direction: client/python/geodex imports
 # core only through the optional in-process module geodex._core, in
 # _inprocess.py alone and inside a try (the client works without it), and
@@ -26,6 +30,14 @@ if grep -rnE '#include\s*[<"](grpc|grpcpp|google/protobuf)/|#include\s*[<"][^">]
 fi
 if [ -d "$root/client" ] && grep -rnE '#include\s*[<"](core|server)/' "$root/client" 2>/dev/null; then
   echo "layering: client/ must depend on proto/ only" >&2
+  status=1
+fi
+
+# Production code outside core's libraries: server/ (but its tests), the tools'
+# mains and the Python bindings.
+if grep -rnE '#include\s*[<"]core/query/internal/' "$root/server" "$root/core/tools" "$root/core/python" \
+    2>/dev/null | grep -vE '_test\.cc:|/server_test_util\.(h|cc):'; then
+  echo "layering: only core/ and tests include core/query/internal/ (use core/query/input_queries.h)" >&2
   status=1
 fi
 

@@ -106,8 +106,8 @@ absl::Status WriteAndReport(const index::IndexData& data, BuildSummary& summary,
 }
 
 // The summary's line of a target-error build.
-std::string TargetSummary(const std::vector<validation::TargetFigures>& rounds,
-                          const NextStep& end, double target) {
+std::string TargetSummary(const std::vector<validation::TargetFigures>& rounds, const NextStep& end,
+                          double target) {
   std::string samples;
   for (const validation::TargetFigures& r : rounds) {
     samples += absl::StrFormat("%s%d", samples.empty() ? "" : ", ", r.samples);
@@ -118,8 +118,7 @@ std::string TargetSummary(const std::vector<validation::TargetFigures>& rounds,
       "  error target     %g: %s in %d rounds (m = %s); closest check %s, 95%% upper limit "
       "%.3f%% of %.3f%%\n",
       target, end.reached ? "met" : absl::StrFormat("NOT met (m stopped at %s)", end.stop),
-      rounds.size(), samples,
-      validation::TargetCheckName(worst), 100 * last.upper[worst],
+      rounds.size(), samples, validation::TargetCheckName(worst), 100 * last.upper[worst],
       100 * validation::TargetLimit(worst, target));
 }
 
@@ -312,8 +311,8 @@ absl::StatusOr<BuildReport> PlanBuild(const std::string& mesh_path, const std::s
   report.num_samples = plan.num_samples();
   report.text +=
       absl::StrFormat("geodex-build plan: mesh repairs: %s\n", repaired.report.Summary());
-  report.text += absl::StrFormat("geodex-build plan: %d midpoints added by the flat refinement\n",
-                                 prepared.record.refinement_vertices);
+  report.text += absl::StrFormat("geodex-build plan: %d midpoints added by the long-edge split\n",
+                                 prepared.record.split_vertices);
   report.text +=
       absl::StrFormat("geodex-build plan: %d samples (%s), %zu triangles, edges %s, in %s\n",
                       plan.num_samples(), plan.repair.Summary(), plan.triangles.size(),
@@ -387,7 +386,7 @@ absl::StatusOr<BuildReport> CalibrateIndexFile(const std::string& mesh_path,
   GEODEX_ASSIGN_OR_RETURN(
       const PreparedMesh prepared,
       PrepareMesh(repaired.mesh, {}, static_cast<int32_t>(index->header().params.requested_samples),
-                  index->refinement_vertices() > 0));
+                  index->split_vertices() > 0));
   const mesh::Mesh& mesh = prepared.mesh;
   if (index->header().mesh_hash != index::MeshHash(FlatPositions(mesh), FlatFaces(mesh))) {
     return absl::InvalidArgumentError(

@@ -3,7 +3,7 @@
 // The geodex-build job as library calls; core/tools/build_main.cc is only
 // their command line.
 //
-//   BuildIndexFile      mesh -> repair -> flat refinement -> plan -> rows ->
+//   BuildIndexFile      mesh -> repair -> long-edge split -> plan -> rows ->
 //                       merge -> calibration -> index file; to a fixed sample
 //                       count, or to a target error in rounds
 //   PlanBuild           the distributed build's step 1 (work directory, workdir.h)

@@ -59,7 +59,7 @@ absl::StatusOr<RoundPlan> WithRetries(
 int32_t SampleCap(const mesh::Mesh& coarse, const RoundsOptions& options) {
   int32_t referenced = 0;
   for (int32_t v = 0; v < coarse.num_vertices(); ++v) referenced += coarse.IsReferenced(v);
-  // Samples are vertices: without the flat refinement the mesh's own
+  // Samples are vertices: without the long-edge split the mesh's own
   // vertices bound m (by default half of them); with it, midpoints make room
   // for more.
   const bool refine = options.build.refine_long_edges;
@@ -147,8 +147,8 @@ NextStep DecideNext(const std::vector<TargetFigures>& rounds, int32_t requested_
   // 3% of the budget spare: the refined mesh, and with it the bytes beside
   // the matrix, grow a little faster than m (bunny_closed_30k: an index
   // predicted to fit came out 1% over).
-  const int32_t fits = validation::SamplesWithinBytes(validation::kMaxIndexBytes * 97 / 100,
-                                                      samples, index_bytes);
+  const int32_t fits =
+      validation::SamplesWithinBytes(validation::kMaxIndexBytes * 97 / 100, samples, index_bytes);
   const validation::PredictionOptions prediction;
   next.num_samples = validation::PredictSamples(rounds, target, std::min(cap, fits), prediction);
   // A round that cannot grow m by the least growth a prediction asks is not

@@ -19,7 +19,7 @@
 //   next m   PredictSamples, from the figures of the rounds so far.
 //
 // A round whose refined mesh does not begin with the earlier round's
-// vertices (the refinement's vertex cap cut it off differently) starts
+// vertices (the split's vertex cap cut it off differently) starts
 // afresh at its m.
 //
 // The same functions run one process's rounds (BuildToTarget) and the steps
@@ -109,9 +109,8 @@ NextStep DecideNext(const std::vector<validation::TargetFigures>& rounds, int32_
 
 // The report lines of a target-error build (the target, whether it was
 // reached, each round's figures, the calibration's), for the index's report.
-std::string TargetReport(const std::vector<validation::TargetFigures>& rounds,
-                         const NextStep& last, double target,
-                         const index::AccuracyRecord& accuracy);
+std::string TargetReport(const std::vector<validation::TargetFigures>& rounds, const NextStep& last,
+                         double target, const index::AccuracyRecord& accuracy);
 // The line geodex-build logs after a round.
 std::string RoundLine(int32_t round, const validation::TargetFigures& figures, double target);
 

@@ -114,7 +114,7 @@ absl::StatusOr<Plan> MakePlan(const mesh::Mesh& mesh, const BuildOptions& option
 // Phase 1 of a round that grows an earlier plan (a target-error build,
 // core/builder/build_rounds.h): the plan of options.num_samples samples on
 // `mesh` whose first samples are `previous` (vertex ids of `mesh`, e.g. an
-// earlier plan's samples on a mesh the refinement only added vertices to),
+// earlier plan's samples on a mesh the split only added vertices to),
 // the others added by farthest-point sampling from them and then by the
 // repair, as MakePlan adds them. So the earlier rows stay rows of this plan
 // (ComputeRows' `carried`). options.seed is recorded but not used.

@@ -209,7 +209,7 @@ TEST(BuilderTest, MergeRejectsMissingRows) {
 }
 
 // The refinement for more samples only adds midpoints after the vertices of
-// the refinement for fewer: a target-error build's rounds carry their
+// the split for fewer: a target-error build's rounds carry their
 // samples (vertex ids) over.
 TEST(BuilderTest, RefinementForMoreSamplesKeepsTheVerticesOfFewer) {
   const mesh::Mesh coarse = gen::Cube(2, 2.0);  // long edges: every m refines it

@@ -13,7 +13,7 @@
 
 #include "core/builder/build_rounds.h"
 #include "core/mesh/generators.h"
-#include "core/query/query_engine.h"
+#include "core/query/internal/query_engine.h"
 #include "core/validation/pair_sampling.h"
 #include "core/validation/target_error.h"
 #include "gtest/gtest.h"
@@ -62,7 +62,7 @@ void ExpectDefaultTargetMet(const mesh::Mesh& coarse) {
   ASSERT_TRUE(engine.ok()) << engine.status();
 
   // Another seed than the calibration's, and vertex pairs among the
-  // generated mesh's vertices (not the refinement's midpoints).
+  // generated mesh's vertices (not the split's midpoints).
   validation::PairOptions pair_options;
   pair_options.num_sources = 40;
   pair_options.uniform_points = 100;

@@ -43,48 +43,48 @@ void AddRepair(const RepairRecord& record, index::IndexData* data) {
   data->input_faces = record.input_faces;
   data->vertex_copies = record.vertex_copies;
   data->coarse_faces = record.coarse_faces;
-  data->refined_faces = record.refined_faces;
-  data->params.refinement_vertices = static_cast<uint32_t>(record.refinement_vertices);
+  data->split_faces = record.split_faces;
+  data->params.split_vertices = static_cast<uint32_t>(record.split_vertices);
   data->report = record.report + data->report;
 }
 
-absl::StatusOr<mesh::FlatRefinement> RefineForSamples(const mesh::Mesh& mesh, int32_t num_samples) {
+absl::StatusOr<mesh::LongEdgeSplit> SplitForSamples(const mesh::Mesh& mesh, int32_t num_samples) {
   const double scale_length =
       std::sqrt(2 * mesh.TotalArea() / (std::sqrt(3.0) * std::max(num_samples, 1)));
   const int64_t cap = 4 * int64_t{mesh.num_vertices()} + 16 * int64_t{std::max(num_samples, 0)};
   double max_edge = kMaxEdgeOverScaleLength * scale_length;
   // A surface of zero area has no scale: leave it as it is.
   if (!(max_edge > 0) || !std::isfinite(max_edge)) max_edge = std::numeric_limits<double>::max();
-  return mesh::RefineLongEdges(mesh, max_edge,
-                               static_cast<int32_t>(std::min<int64_t>(cap, 1 << 30)));
+  return mesh::SplitLongEdges(mesh, max_edge,
+                              static_cast<int32_t>(std::min<int64_t>(cap, 1 << 30)));
 }
 
-void AddRefinement(const mesh::Mesh& coarse, const mesh::FlatRefinement& refinement,
+void AddSplitFaces(const mesh::Mesh& coarse, const mesh::LongEdgeSplit& split,
                    RepairRecord* record) {
-  if (refinement.new_vertices == 0) return;
+  if (split.new_vertices == 0) return;
   record->coarse_faces = FlatFaces(coarse);
-  record->refined_faces.resize(refinement.parent.size());
-  for (size_t f = 0; f < refinement.parent.size(); ++f) {
-    index::RefinedFaceRecord& r = record->refined_faces[f];
-    r.coarse_face = refinement.parent[f];
+  record->split_faces.resize(split.parent.size());
+  for (size_t f = 0; f < split.parent.size(); ++f) {
+    index::SplitFaceRecord& r = record->split_faces[f];
+    r.coarse_face = split.parent[f];
     for (int i = 0; i < 3; ++i) {
-      for (int j = 0; j < 3; ++j) r.weight[i][j] = static_cast<float>(refinement.weights[f][i][j]);
+      for (int j = 0; j < 3; ++j) r.weight[i][j] = static_cast<float>(split.weights[f][i][j]);
     }
   }
-  record->refinement_vertices = refinement.new_vertices;
+  record->split_vertices = split.new_vertices;
   record->report += absl::StrFormat(
       "mesh_refinement = %d midpoints added, %d faces became %d (long edges split flat)\n",
-      refinement.new_vertices, coarse.num_faces(), refinement.mesh.num_faces());
+      split.new_vertices, coarse.num_faces(), split.mesh.num_faces());
 }
 
 absl::StatusOr<PreparedMesh> PrepareMesh(const mesh::Mesh& coarse, RepairRecord repair,
                                          int32_t num_samples, bool refine) {
   if (!refine) return PreparedMesh{coarse, std::move(repair)};
-  absl::StatusOr<mesh::FlatRefinement> refinement = RefineForSamples(coarse, num_samples);
-  if (!refinement.ok()) return refinement.status();
-  if (refinement->new_vertices == 0) return PreparedMesh{coarse, std::move(repair)};
-  AddRefinement(coarse, *refinement, &repair);
-  return PreparedMesh{std::move(refinement->mesh), std::move(repair)};
+  absl::StatusOr<mesh::LongEdgeSplit> split = SplitForSamples(coarse, num_samples);
+  if (!split.ok()) return split.status();
+  if (split->new_vertices == 0) return PreparedMesh{coarse, std::move(repair)};
+  AddSplitFaces(coarse, *split, &repair);
+  return PreparedMesh{std::move(split->mesh), std::move(repair)};
 }
 
 }  // namespace geodex::builder

@@ -10,7 +10,7 @@
 
 #include "absl/status/statusor.h"
 #include "core/index/index.h"
-#include "core/mesh/flat_refinement.h"
+#include "core/mesh/long_edge_split.h"
 #include "core/mesh/mesh.h"
 #include "core/mesh/mesh_repair.h"
 
@@ -20,7 +20,7 @@ std::vector<double> FlatPositions(const mesh::Mesh& mesh);
 std::vector<int32_t> FlatFaces(const mesh::Mesh& mesh);
 
 // What the repair of an index's mesh did (core/mesh/mesh_repair.h), and the
-// flat refinement after it, as the index records them: its input-id sections
+// long-edge split after it, as the index records them: its input-id sections
 // (format 1.2: input faces and vertex copies, empty for identity maps; 2.0:
 // the coarse faces and the pieces, empty without refinement) and the
 // report's mesh_* lines.
@@ -28,8 +28,8 @@ struct RepairRecord {
   std::vector<index::InputFaceRecord> input_faces;
   std::vector<int32_t> vertex_copies;
   std::vector<int32_t> coarse_faces;
-  std::vector<index::RefinedFaceRecord> refined_faces;
-  int32_t refinement_vertices = 0;
+  std::vector<index::SplitFaceRecord> split_faces;
+  int32_t split_vertices = 0;
   std::string report;
 };
 RepairRecord RecordRepair(const mesh::RepairedMesh& repaired);
@@ -41,26 +41,26 @@ void AddRepair(const RepairRecord& record, index::IndexData* data);
 // Samples are mesh vertices, so a geodesic triangle is no smaller than the
 // mesh edges it spans: on a coarse mesh the error stops falling with m once
 // the sample spacing L(m) = sqrt(2 A / (sqrt(3) m)) reaches the long edges.
-// The builder splits flat (core/mesh/flat_refinement.h) every edge longer
+// The builder splits flat (core/mesh/long_edge_split.h) every edge longer
 // than this share of L(m), so that a vertex lies within about L/4 of every
 // point and farthest-point sampling can place samples L apart anywhere.
 inline constexpr double kMaxEdgeOverScaleLength = 0.5;
 
 // The refinement the builder applies before sampling `num_samples` samples:
-// RefineLongEdges at kMaxEdgeOverScaleLength * L(num_samples), adding at most
+// SplitLongEdges at kMaxEdgeOverScaleLength * L(num_samples), adding at most
 // 4 vertices per input vertex plus 16 per sample. A mesh with no longer edge
-// comes back unchanged (new_vertices == 0). Errors: RefineLongEdges's.
-absl::StatusOr<mesh::FlatRefinement> RefineForSamples(const mesh::Mesh& mesh, int32_t num_samples);
+// comes back unchanged (new_vertices == 0). Errors: SplitLongEdges's.
+absl::StatusOr<mesh::LongEdgeSplit> SplitForSamples(const mesh::Mesh& mesh, int32_t num_samples);
 
 // Records `refinement` of `coarse` (the mesh RecordRepair's record is of)
 // into `record`: the sections and a mesh_refinement report line. Nothing for
 // a refinement that added no vertex.
-void AddRefinement(const mesh::Mesh& coarse, const mesh::FlatRefinement& refinement,
+void AddSplitFaces(const mesh::Mesh& coarse, const mesh::LongEdgeSplit& refinement,
                    RepairRecord* record);
 
 // The mesh the builder samples for `num_samples` samples and the record of
 // how it came from the input: `coarse` (the repaired input, whose repair is
-// `repair`), refined by RefineForSamples when `refine`. The index built from
+// `repair`), refined by SplitForSamples when `refine`. The index built from
 // `mesh` takes AddRepair(record).
 struct PreparedMesh {
   mesh::Mesh mesh;

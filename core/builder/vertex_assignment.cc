@@ -4,7 +4,7 @@
 #include <array>
 
 #include "core/geodesic/exact_geodesic.h"
-#include "core/geometry/unfolding.h"
+#include "core/geometry/planar_unfolding.h"
 
 namespace geodex::builder {
 

@@ -6,7 +6,7 @@
 //
 // Which triangle contains v is decided here: a vertex of the Voronoi cell of
 // sample a goes to the geodesic triangle around a in which its unfolded
-// barycentric coordinates (§5.1, core/geometry/unfolding.h) are most inside,
+// barycentric coordinates (§5.1, core/geometry/planar_unfolding.h) are most inside,
 // the triangle whose smallest coordinate is largest. Geodesic triangles are
 // curved, so a vertex may lie slightly outside every one; it still gets the
 // best and is counted (AssignmentCounts::outside).

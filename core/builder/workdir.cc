@@ -24,7 +24,7 @@ namespace {
 constexpr char kPlanMagic[8] = {'G', 'D', 'X', 'P', 'L', 'A', 'N', '3'};
 constexpr char kPlanMagicV2[8] = {'G', 'D', 'X', 'P', 'L', 'A', 'N', '2'};
 constexpr char kRowsMagic[8] = {'G', 'D', 'X', 'R', 'O', 'W', 'S', '1'};
-// 2 adds the flat refinement (coarse faces, pieces, midpoint count); 1 is
+// 2 adds the long-edge split (coarse faces, pieces, midpoint count); 1 is
 // still read.
 constexpr char kRepairMagic[8] = {'G', 'D', 'X', 'R', 'E', 'P', 'R', '2'};
 constexpr char kRepairMagicV1[8] = {'G', 'D', 'X', 'R', 'E', 'P', 'R', '1'};
@@ -388,8 +388,8 @@ absl::Status SaveRepairStamped(const RepairRecord& record, uint64_t mesh_hash,
   w.PutVector(record.input_faces);
   w.PutVector(record.vertex_copies);
   w.PutVector(record.coarse_faces);
-  w.PutVector(record.refined_faces);
-  w.Put(record.refinement_vertices);
+  w.PutVector(record.split_faces);
+  w.Put(record.split_vertices);
   w.PutVector(std::vector<char>(record.report.begin(), record.report.end()));
   Seal(w);
   return AtomicWriteFile(path, w.bytes());
@@ -414,8 +414,8 @@ absl::StatusOr<RepairRecord> LoadRepairStamped(uint64_t mesh_hash, const std::st
   GEODEX_RETURN_IF_ERROR(r.GetVector(&record.vertex_copies));
   if (!v1) {
     GEODEX_RETURN_IF_ERROR(r.GetVector(&record.coarse_faces));
-    GEODEX_RETURN_IF_ERROR(r.GetVector(&record.refined_faces));
-    GEODEX_RETURN_IF_ERROR(r.Get(&record.refinement_vertices));
+    GEODEX_RETURN_IF_ERROR(r.GetVector(&record.split_faces));
+    GEODEX_RETURN_IF_ERROR(r.Get(&record.split_vertices));
   }
   GEODEX_RETURN_IF_ERROR(r.GetVector(&report));
   if (!r.AtEnd()) return absl::DataLossError(absl::StrFormat("%s has trailing bytes", path));

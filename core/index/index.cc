@@ -103,7 +103,7 @@ absl::StatusOr<FileHeader> ValidateHeader(const uint8_t* p, size_t n) {
     return absl::FailedPreconditionError(
         absl::StrFormat("bad byte order mark 0x%08x", h.byte_order_mark));
   }
-  if (h.format_major != kFormatMajor && h.format_major != kRefinedFormatMajor &&
+  if (h.format_major != kFormatMajor && h.format_major != kSplitFormatMajor &&
       h.format_major != kPackedFormatMajor) {
     return absl::FailedPreconditionError(absl::StrFormat(
         "index format version %d.%d is not supported by this reader (version %d.%d)",
@@ -341,10 +341,10 @@ absl::Status Index::Validate() {
   input_faces_ = SectionView<InputFaceRecord>(p, entry(SectionId::kInputFaces));
   vertex_copies_ = SectionView<int32_t>(p, entry(SectionId::kVertexCopies));
   coarse_faces_ = SectionView<int32_t>(p, entry(SectionId::kCoarseFaces));
-  refined_faces_ = SectionView<RefinedFaceRecord>(p, entry(SectionId::kRefinedFaces));
+  split_faces_ = SectionView<SplitFaceRecord>(p, entry(SectionId::kSplitFaces));
   spread_bounds_ = SectionView<SpreadBoundRecord>(p, entry(SectionId::kSpreadBounds));
-  if (h.format_major < kRefinedFormatMajor &&
-      (!refined_faces_.empty() || !coarse_faces_.empty() || h.params.refinement_vertices != 0)) {
+  if (h.format_major < kSplitFormatMajor &&
+      (!split_faces_.empty() || !coarse_faces_.empty() || h.params.split_vertices != 0)) {
     return absl::DataLossError(absl::StrFormat("a format %d.%d index with refinement sections",
                                                h.format_major, h.format_minor));
   }
@@ -355,7 +355,7 @@ absl::Status Index::Validate() {
   return CheckContents(
       Contents{counts, positions_, faces_, twins_, samples_, sample_distances_,
                sample_distances_lower_, vertices_, triangles_, bvh_nodes_, bvh_faces_, input_faces_,
-               vertex_copies_, coarse_faces_, refined_faces_, h.params.refinement_vertices},
+               vertex_copies_, coarse_faces_, split_faces_, h.params.split_vertices},
       absl::StatusCode::kDataLoss);
 }
 
@@ -391,7 +391,7 @@ IndexData ToIndexData(const Index& index) {
   d.input_faces = copy(index.input_faces());
   d.vertex_copies = copy(index.vertex_copies());
   d.coarse_faces = copy(index.coarse_faces());
-  d.refined_faces = copy(index.refined_faces());
+  d.split_faces = copy(index.split_faces());
   return d;
 }
 

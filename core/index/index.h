@@ -52,10 +52,10 @@ struct IndexData {
   std::vector<int32_t> vertex_copies;
   // A refined mesh's pieces (format 2.0; see index_format.h): the faces
   // before refinement (3 vertex ids each) and, per face, where it lies in
-  // them; both empty when the mesh was not refined. params.refinement_vertices
+  // them; both empty when the mesh was not refined. params.split_vertices
   // counts the midpoints.
   std::vector<int32_t> coarse_faces;
-  std::vector<RefinedFaceRecord> refined_faces;
+  std::vector<SplitFaceRecord> split_faces;
 };
 
 // XXH64 of the positions and faces: identifies the source mesh.
@@ -137,12 +137,10 @@ class Index {
   // of a mesh that needed no repair, or one older than 1.2.
   std::span<const InputFaceRecord> input_faces() const { return input_faces_; }
   std::span<const int32_t> vertex_copies() const { return vertex_copies_; }
-  // The flat refinement (format 2.0); empty for an index of an unrefined mesh.
+  // The long-edge split (format 2.0); empty for an index of an unrefined mesh.
   std::span<const int32_t> coarse_faces() const { return coarse_faces_; }
-  std::span<const RefinedFaceRecord> refined_faces() const { return refined_faces_; }
-  int32_t refinement_vertices() const {
-    return static_cast<int32_t>(header_->params.refinement_vertices);
-  }
+  std::span<const SplitFaceRecord> split_faces() const { return split_faces_; }
+  int32_t split_vertices() const { return static_cast<int32_t>(header_->params.split_vertices); }
 
   // d(sample i, sample j) from the matrix, in either layout; i and j in
   // [0, num_samples()).
@@ -186,7 +184,7 @@ class Index {
   std::span<const InputFaceRecord> input_faces_;
   std::span<const int32_t> vertex_copies_;
   std::span<const int32_t> coarse_faces_;
-  std::span<const RefinedFaceRecord> refined_faces_;
+  std::span<const SplitFaceRecord> split_faces_;
 };
 
 }  // namespace geodex::index

@@ -279,12 +279,12 @@ IndexData MakeRefinedSphereIndex() {
   IndexData d = MakeSphereIndex();
   d.coarse_faces = d.faces;
   for (size_t f = 0; f < d.faces.size() / 3; ++f) {
-    RefinedFaceRecord r{};
+    SplitFaceRecord r{};
     r.coarse_face = static_cast<int32_t>(f);
     for (int i = 0; i < 3; ++i) r.weight[i][i] = 1;
-    d.refined_faces.push_back(r);
+    d.split_faces.push_back(r);
   }
-  d.params.refinement_vertices = 1;
+  d.params.split_vertices = 1;
   return d;
 }
 
@@ -292,9 +292,9 @@ TEST(IndexTest, RefinedIndexIsWrittenAsVersion2AndReadBack) {
   absl::StatusOr<std::shared_ptr<const Index>> index =
       Index::FromBytes(Serialize(MakeRefinedSphereIndex()));
   ASSERT_TRUE(index.ok()) << index.status();
-  EXPECT_EQ((*index)->header().format_major, kRefinedFormatMajor);
-  EXPECT_EQ((*index)->refinement_vertices(), 1);
-  EXPECT_EQ((*index)->refined_faces().size(), 80u);
+  EXPECT_EQ((*index)->header().format_major, kSplitFormatMajor);
+  EXPECT_EQ((*index)->split_vertices(), 1);
+  EXPECT_EQ((*index)->split_faces().size(), 80u);
   EXPECT_EQ((*index)->coarse_faces().size(), 240u);
   // Written again, the same bytes.
   EXPECT_EQ(Serialize(ToIndexData(**index)), Serialize(MakeRefinedSphereIndex()));
@@ -312,28 +312,28 @@ TEST(IndexTest, RefinementCorruptionWithValidChecksumsIsDataLoss) {
   auto weight = [](int32_t face, int corner, int k) { return 10 * face + 1 + 3 * corner + k; };
   const std::vector<Case> cases = {
       {"piece of a coarse face out of range",
-       [&](Image& i) { i.Set<int32_t>(SectionId::kRefinedFaces, 10 * 3, 80); }, "refined face 3"},
+       [&](Image& i) { i.Set<int32_t>(SectionId::kSplitFaces, 10 * 3, 80); }, "refined face 3"},
       {"NaN weight",
        [&](Image& i) {
-         i.Set<float>(SectionId::kRefinedFaces, weight(4, 1, 1),
+         i.Set<float>(SectionId::kSplitFaces, weight(4, 1, 1),
                       std::numeric_limits<float>::quiet_NaN());
        },
        "refined face 4"},
       {"weights not summing to 1",
-       [&](Image& i) { i.Set<float>(SectionId::kRefinedFaces, weight(5, 2, 0), 0.5f); },
+       [&](Image& i) { i.Set<float>(SectionId::kSplitFaces, weight(5, 2, 0), 0.5f); },
        "refined face 5"},
       {"negative weight",
        [&](Image& i) {
-         i.Set<float>(SectionId::kRefinedFaces, weight(6, 0, 0), 1.5f);
-         i.Set<float>(SectionId::kRefinedFaces, weight(6, 0, 1), -0.5f);
+         i.Set<float>(SectionId::kSplitFaces, weight(6, 0, 0), 1.5f);
+         i.Set<float>(SectionId::kSplitFaces, weight(6, 0, 1), -0.5f);
        },
        "refined face 6"},
       {"coarse face without a piece",
-       [&](Image& i) { i.Set<int32_t>(SectionId::kRefinedFaces, 0, 1); }, "coarse face 0 has no"},
+       [&](Image& i) { i.Set<int32_t>(SectionId::kSplitFaces, 0, 1); }, "coarse face 0 has no"},
       {"coarse face on a midpoint",
        [&](Image& i) { i.Set<int32_t>(SectionId::kCoarseFaces, 7, nv - 1); }, "coarse face 2"},
-      {"more midpoints than vertices",
-       [&](Image& i) { i.header.params.refinement_vertices = nv + 1; }, "midpoints"},
+      {"more midpoints than vertices", [&](Image& i) { i.header.params.split_vertices = nv + 1; },
+       "midpoints"},
       {"refinement sections in a 1.x file", [&](Image& i) { i.header.format_major = kFormatMajor; },
        "refinement sections"},
   };

@@ -27,11 +27,11 @@
 //        vertex copies. Optional, written only when the mesh was repaired;
 //        absent means identity maps. A 1.0/1.1 reader loads a repaired
 //        index but answers in its internal ids.
-//   2.0  flat refinement (core/mesh/flat_refinement.h): the builder split
+//   2.0  long-edge split (core/mesh/long_edge_split.h): the builder split
 //        long input edges at their midpoints, so the index's faces are pieces
 //        of the (repaired) input's faces. CoarseFaces holds the faces before
-//        the split, RefinedFaceRecord says which of them each face lies in,
-//        and params.refinement_vertices counts the midpoints (the last
+//        the split, SplitFaceRecord says which of them each face lies in,
+//        and params.split_vertices counts the midpoints (the last
 //        vertices). A 1.x reader must refuse such a file (its face ids are
 //        not the input's), hence the major version; an index without
 //        refinement is still written as 1.2, so older readers keep reading it.
@@ -56,7 +56,7 @@ inline constexpr char kMagic[8] = {'G', 'E', 'O', 'D', 'E', 'X', 'I', 'X'};
 // reader takes both majors, and kPackedFormatMajor.
 inline constexpr uint32_t kFormatMajor = 1;
 inline constexpr uint32_t kFormatMinor = 3;
-inline constexpr uint32_t kRefinedFormatMajor = 2;
+inline constexpr uint32_t kSplitFormatMajor = 2;
 inline constexpr uint32_t kRefinedFormatMinor = 1;
 // The version of an index whose matrix is stored once (refined or not).
 inline constexpr uint32_t kPackedFormatMajor = 3;
@@ -80,7 +80,7 @@ enum class SectionId : uint32_t {
   kInputFaces = 12,      // InputFaceRecord[num_input_faces] (1.2); absent: identity
   kVertexCopies = 13,    // int32[k]: input vertex of the i-th copy (1.2; see InputFaceRecord)
   kCoarseFaces = 14,     // int32[num_coarse_faces][3]: the faces before refinement (2.0)
-  kRefinedFaces = 15,    // RefinedFaceRecord[num_faces] (2.0); absent: not refined
+  kSplitFaces = 15,      // SplitFaceRecord[num_faces] (2.0); absent: not refined
   kSpreadBounds = 16,    // SpreadBoundRecord[0 or 1] (1.3 / 2.1); absent: constant bounds
   // float[num_samples (num_samples - 1) / 2]: the matrix's strictly lower
   // triangle, row by row (3.x, instead of kSampleDistances).
@@ -93,8 +93,8 @@ struct BuildParams {
   uint32_t num_samples = 0;  // after repair insertions
   uint64_t seed = 0;
   uint32_t samples_added_by_repair = 0;
-  // Midpoints the flat refinement added (2.0): the last vertices; 0 in 1.x.
-  uint32_t refinement_vertices = 0;
+  // Midpoints the long-edge split added (2.0): the last vertices; 0 in 1.x.
+  uint32_t split_vertices = 0;
 };
 
 struct FileHeader {
@@ -157,19 +157,19 @@ static_assert(sizeof(InputFaceRecord) == 8);
 inline constexpr uint8_t kInputFaceDropped = 1;     // a duplicate, answered by its twin
 inline constexpr uint8_t kInputFaceReoriented = 2;  // its corners 1 and 2 swapped
 // Vertex ids: the input's vertices, then the repair's copies (kVertexCopies),
-// then the refinement's midpoints (params.refinement_vertices). Without
+// then the split's midpoints (params.split_vertices). Without
 // refinement InputFaceRecord::face is a face of the index; with it, a coarse
-// face (kCoarseFaces), whose pieces are the faces whose RefinedFaceRecord
+// face (kCoarseFaces), whose pieces are the faces whose SplitFaceRecord
 // names it.
 
 // Where a face of a refined index lies (2.0): in coarse face `coarse_face`,
 // its corner i at barycentric weights weight[i] of that face's corners.
 // Midpoint weights are dyadic fractions, exact in float.
-struct RefinedFaceRecord {
+struct SplitFaceRecord {
   int32_t coarse_face;
   float weight[3][3];
 };
-static_assert(sizeof(RefinedFaceRecord) == 40);
+static_assert(sizeof(SplitFaceRecord) == 40);
 
 // Axis-aligned bounding-box hierarchy over the mesh faces. A leaf has
 // count > 0 and covers bvh_faces[first, first+count); an inner node has

@@ -56,7 +56,7 @@ std::optional<uint64_t> ExpectedCount(SectionId id, const Counts& c) {
     case SectionId::kInputFaces:
     case SectionId::kVertexCopies:
     case SectionId::kCoarseFaces:
-    case SectionId::kRefinedFaces:
+    case SectionId::kSplitFaces:
     case SectionId::kSpreadBounds:
       return std::nullopt;
   }
@@ -226,9 +226,9 @@ absl::Status CheckContents(const Contents& c, absl::StatusCode code) {
                           i, b.first, b.count, nb, nf));
     }
   }
-  GEODEX_RETURN_IF_ERROR(CheckInputIds({nv, nf, c.input_faces, c.vertex_copies, c.coarse_faces,
-                                        c.refined_faces, c.refinement_vertices},
-                                       code));
+  GEODEX_RETURN_IF_ERROR(CheckInputIds(
+      {nv, nf, c.input_faces, c.vertex_copies, c.coarse_faces, c.split_faces, c.split_vertices},
+      code));
   if (!c.bvh_faces.empty()) {
     std::vector<bool> seen(nf, false);
     for (size_t i = 0; i < c.bvh_faces.size(); ++i) {

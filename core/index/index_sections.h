@@ -46,7 +46,7 @@ constexpr SectionSpec kSpecs[] = {
     {SectionId::kInputFaces, sizeof(InputFaceRecord), "input faces", false},
     {SectionId::kVertexCopies, sizeof(int32_t), "vertex copies", false},
     {SectionId::kCoarseFaces, sizeof(int32_t), "coarse faces", false},
-    {SectionId::kRefinedFaces, sizeof(RefinedFaceRecord), "refined faces", false},
+    {SectionId::kSplitFaces, sizeof(SplitFaceRecord), "refined faces", false},
     {SectionId::kSpreadBounds, sizeof(SpreadBoundRecord), "spread bounds", false},
     {SectionId::kSampleDistancesLower, sizeof(float), "sample distances (lower triangle)", false},
 };
@@ -93,8 +93,8 @@ struct Contents {
   std::span<const InputFaceRecord> input_faces;
   std::span<const int32_t> vertex_copies;
   std::span<const int32_t> coarse_faces;
-  std::span<const RefinedFaceRecord> refined_faces;
-  uint64_t refinement_vertices = 0;
+  std::span<const SplitFaceRecord> split_faces;
+  uint64_t split_vertices = 0;
 };
 // The accuracy records (at most one, finite, non-negative); errors with `code`.
 absl::Status CheckAccuracy(std::span<const AccuracyRecord> records, absl::StatusCode code);

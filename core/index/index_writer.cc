@@ -95,7 +95,7 @@ absl::StatusOr<std::string> SerializeIndex(const IndexData& d) {
   GEODEX_RETURN_IF_ERROR(CheckContents(
       Contents{counts, d.positions, d.faces, d.twins, d.samples, d.sample_distances, lower,
                d.vertices, d.triangles, d.bvh_nodes, d.bvh_faces, d.input_faces, d.vertex_copies,
-               d.coarse_faces, d.refined_faces, d.params.refinement_vertices},
+               d.coarse_faces, d.split_faces, d.params.split_vertices},
       absl::StatusCode::kInvalidArgument));
   GEODEX_RETURN_IF_ERROR(CheckAccuracy(d.accuracy, absl::StatusCode::kInvalidArgument));
   GEODEX_RETURN_IF_ERROR(
@@ -122,7 +122,7 @@ absl::StatusOr<std::string> SerializeIndex(const IndexData& d) {
       {d.input_faces.data(), d.input_faces.size() * sizeof(InputFaceRecord)},
       {d.vertex_copies.data(), d.vertex_copies.size() * sizeof(int32_t)},
       {d.coarse_faces.data(), d.coarse_faces.size() * sizeof(int32_t)},
-      {d.refined_faces.data(), d.refined_faces.size() * sizeof(RefinedFaceRecord)},
+      {d.split_faces.data(), d.split_faces.size() * sizeof(SplitFaceRecord)},
       {d.spread_bounds.data(), d.spread_bounds.size() * sizeof(SpreadBoundRecord)},
       {lower.data(), lower.size() * sizeof(float)},
   };
@@ -136,10 +136,10 @@ absl::StatusOr<std::string> SerializeIndex(const IndexData& d) {
     if (id == SectionId::kSampleDistances) return !packed;
     if (id == SectionId::kSampleDistancesLower) return packed;
     return pieces[i].size > 0 || (id != SectionId::kInputFaces && id != SectionId::kVertexCopies &&
-                                  id != SectionId::kCoarseFaces && id != SectionId::kRefinedFaces &&
+                                  id != SectionId::kCoarseFaces && id != SectionId::kSplitFaces &&
                                   id != SectionId::kSpreadBounds);
   };
-  const bool refined = !d.refined_faces.empty();
+  const bool refined = !d.split_faces.empty();
   size_t num_sections = 0;
   for (size_t i = 0; i < kNumSpecs; ++i) num_sections += written(i) ? 1 : 0;
   SectionEntry entries[kNumSpecs];
@@ -165,7 +165,7 @@ absl::StatusOr<std::string> SerializeIndex(const IndexData& d) {
   FileHeader h;
   std::memset(static_cast<void*>(&h), 0, sizeof(h));  // padding included
   std::memcpy(h.magic, kMagic, sizeof(kMagic));
-  h.format_major = packed ? kPackedFormatMajor : refined ? kRefinedFormatMajor : kFormatMajor;
+  h.format_major = packed ? kPackedFormatMajor : refined ? kSplitFormatMajor : kFormatMajor;
   h.format_minor = packed ? kPackedFormatMinor : refined ? kRefinedFormatMinor : kFormatMinor;
   h.byte_order_mark = kByteOrderMark;
   h.header_size = sizeof(FileHeader);

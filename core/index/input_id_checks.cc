@@ -20,12 +20,12 @@ absl::Status CheckInputIds(const InputIdSections& c, absl::StatusCode code) {
   const int64_t nf = c.num_faces;
   // Vertices: the input's, the copies, the midpoints. Copies copy an input
   // vertex; coarse faces use no midpoint.
-  const int64_t num_coarse_vertices = nv - static_cast<int64_t>(c.refinement_vertices);
+  const int64_t num_coarse_vertices = nv - static_cast<int64_t>(c.split_vertices);
   const int64_t num_input_vertices =
       num_coarse_vertices - static_cast<int64_t>(c.vertex_copies.size());
   if (num_input_vertices < 0) {
     return fail(absl::StrFormat("%d vertex copies and %d midpoints but %d vertices",
-                                c.vertex_copies.size(), c.refinement_vertices, nv));
+                                c.vertex_copies.size(), c.split_vertices, nv));
   }
   for (size_t i = 0; i < c.vertex_copies.size(); ++i) {
     if (!InRange(c.vertex_copies[i], 0, num_input_vertices)) {
@@ -35,13 +35,13 @@ absl::Status CheckInputIds(const InputIdSections& c, absl::StatusCode code) {
   }
   // A refined index: every face is a piece of one coarse face, given by
   // weights in it, and every coarse face has a piece.
-  const bool refined = !c.refined_faces.empty();
-  if (refined != !c.coarse_faces.empty() || (c.refinement_vertices > 0 && !refined) ||
-      (refined && static_cast<int64_t>(c.refined_faces.size()) != nf) ||
+  const bool refined = !c.split_faces.empty();
+  if (refined != !c.coarse_faces.empty() || (c.split_vertices > 0 && !refined) ||
+      (refined && static_cast<int64_t>(c.split_faces.size()) != nf) ||
       c.coarse_faces.size() % 3 != 0) {
     return fail(absl::StrFormat(
         "refinement: %d refined face records for %d faces, %d coarse face ids, %d midpoints",
-        c.refined_faces.size(), nf, c.coarse_faces.size(), c.refinement_vertices));
+        c.split_faces.size(), nf, c.coarse_faces.size(), c.split_vertices));
   }
   const int64_t num_coarse_faces = refined ? static_cast<int64_t>(c.coarse_faces.size() / 3) : nf;
   for (size_t i = 0; i < c.coarse_faces.size(); ++i) {
@@ -52,8 +52,8 @@ absl::Status CheckInputIds(const InputIdSections& c, absl::StatusCode code) {
   }
   if (refined) {
     std::vector<uint8_t> has_piece(num_coarse_faces, 0);
-    for (size_t f = 0; f < c.refined_faces.size(); ++f) {
-      const RefinedFaceRecord& r = c.refined_faces[f];
+    for (size_t f = 0; f < c.split_faces.size(); ++f) {
+      const SplitFaceRecord& r = c.split_faces[f];
       bool ok = InRange(r.coarse_face, 0, num_coarse_faces);
       for (int i = 0; i < 3 && ok; ++i) {
         const float* w = r.weight[i];

@@ -1,7 +1,7 @@
 #pragma once
 
 // The checks of an index's input-id sections (format 1.2: input faces and
-// vertex copies; 2.0: the flat refinement's coarse faces and pieces), shared
+// vertex copies; 2.0: the long-edge split's coarse faces and pieces), shared
 // by the writer (InvalidArgument) and the reader (DataLoss) through
 // index.cc's CheckContents.
 
@@ -19,8 +19,8 @@ struct InputIdSections {
   std::span<const InputFaceRecord> input_faces;
   std::span<const int32_t> vertex_copies;
   std::span<const int32_t> coarse_faces;
-  std::span<const RefinedFaceRecord> refined_faces;
-  uint64_t refinement_vertices = 0;
+  std::span<const SplitFaceRecord> split_faces;
+  uint64_t split_vertices = 0;
 };
 
 // OK, or `code` with a message naming the first bad element.

@@ -35,7 +35,7 @@
 #include "core/mesh/mesh_io.h"
 #include "core/mesh/mesh_repair.h"
 #include "core/query/input_queries.h"
-#include "core/query/query_engine.h"
+#include "core/query/internal/query_engine.h"
 #include "gtest/gtest.h"
 
 namespace geodex {

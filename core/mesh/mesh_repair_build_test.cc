@@ -19,7 +19,7 @@
 #include "core/mesh/broken_meshes_testing.h"
 #include "core/mesh/mesh_repair.h"
 #include "core/query/input_queries.h"
-#include "core/query/query_engine.h"
+#include "core/query/internal/query_engine.h"
 #include "gtest/gtest.h"
 
 namespace geodex {

@@ -26,7 +26,6 @@
 #include "absl/strings/str_format.h"
 #include "core/python/bindings.h"
 #include "core/python/python_status.h"
-#include "core/query/exp_map.h"
 #include "core/query/input_queries.h"
 #include "core/query/query_types.h"
 #include "pybind11/numpy.h"
@@ -114,7 +113,7 @@ class Index {
   int32_t num_vertices() const { return queries_->num_vertices(); }
   int32_t num_faces() const { return queries_->num_faces(); }
   int32_t num_samples() const { return queries_->index().num_samples(); }
-  bool has_error_bounds() const { return queries_->engine().has_error_bounds(); }
+  bool has_error_bounds() const { return queries_->has_error_bounds(); }
   std::string report() const { return std::string(queries_->index().report()); }
 
   // (distances, bounds or None) of pairs (a[i], b[i]).
@@ -298,7 +297,7 @@ class Index {
       ThrowIfError(queries_->Read(std::span<const query::SurfacePoint>(&centre, 1),
                                   query::Named("center"), &checked));
       query::QueryScratch scratch;
-      map = ValueOrThrow(queries_->ExpMap(centre, options, &scratch));
+      map = ValueOrThrow(queries_->ExpMap(checked, 0, options, &scratch));
     }
     const int64_t k = static_cast<int64_t>(map.size());
     py::array_t<int32_t> vertices(k);

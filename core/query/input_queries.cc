@@ -8,6 +8,7 @@
 
 #include "absl/strings/str_format.h"
 #include "core/common/status_macros.h"
+#include "core/query/internal/query_engine.h"
 
 namespace geodex::query {
 
@@ -18,6 +19,11 @@ PointName Named(std::string_view name) {
 absl::StatusOr<std::shared_ptr<const InputQueries>> InputQueries::Open(const std::string& path,
                                                                        QueryOptions options) {
   GEODEX_ASSIGN_OR_RETURN(std::shared_ptr<const index::Index> index, index::Index::Open(path));
+  return Create(std::move(index), options);
+}
+
+absl::StatusOr<std::shared_ptr<const InputQueries>> InputQueries::Create(
+    std::shared_ptr<const index::Index> index, QueryOptions options) {
   GEODEX_ASSIGN_OR_RETURN(std::shared_ptr<const QueryEngine> engine,
                           QueryEngine::Create(std::move(index), options));
   return Create(std::move(engine));
@@ -31,6 +37,11 @@ absl::StatusOr<std::shared_ptr<const InputQueries>> InputQueries::Create(
 
 InputQueries::InputQueries(std::shared_ptr<const QueryEngine> engine)
     : engine_(std::move(engine)), ids_(engine_->index()) {}
+
+const index::Index& InputQueries::index() const { return engine_->index(); }
+const QueryOptions& InputQueries::options() const { return engine_->options(); }
+bool InputQueries::has_error_bounds() const { return engine_->has_error_bounds(); }
+double InputQueries::scale_length() const { return engine_->scale_length(); }
 
 namespace {
 
@@ -46,11 +57,13 @@ absl::Status Prefixed(const absl::Status& status, const PointName& name, size_t 
 absl::Status InputQueries::Read(std::span<const SurfacePoint> input, const PointName& name,
                                 EnginePoints* out) const {
   out->points_.resize(input.size());
+  out->input_faces_.resize(input.size());
   const double tolerance = engine_->options().weight_tolerance;
   for (size_t i = 0; i < input.size(); ++i) {
     absl::StatusOr<SurfacePoint> internal = ids_.ToInternal(input[i], tolerance);
     if (!internal.ok()) return Prefixed(internal.status(), name, i);
     out->points_[i] = *internal;
+    out->input_faces_[i] = input[i].face;
   }
   return absl::OkStatus();
 }
@@ -58,11 +71,11 @@ absl::Status InputQueries::Read(std::span<const SurfacePoint> input, const Point
 absl::Status InputQueries::Read(std::span<const int32_t> faces, std::span<const double> weights,
                                 const PointName& name, EnginePoints* out) const {
   if (weights.size() != 3 * faces.size()) {
-    return absl::InvalidArgumentError(
-        absl::StrFormat("%d points but %d weights (want %d)", faces.size(), weights.size(),
-                        3 * faces.size()));
+    return absl::InvalidArgumentError(absl::StrFormat(
+        "%d points but %d weights (want %d)", faces.size(), weights.size(), 3 * faces.size()));
   }
   out->points_.resize(faces.size());
+  out->input_faces_.assign(faces.begin(), faces.end());
   const double tolerance = engine_->options().weight_tolerance;
   for (size_t i = 0; i < faces.size(); ++i) {
     absl::StatusOr<SurfacePoint> internal = ids_.ToInternal(
@@ -81,9 +94,14 @@ absl::Status InputQueries::DistanceBatch(const EnginePoints& a, const EnginePoin
 
 absl::StatusOr<double> InputQueries::Distance(const EnginePoints& a, size_t i,
                                               const EnginePoints& b, size_t j,
-                                              const DistanceOptions& options,
-                                              QueryScratch* scratch, double* bound) const {
+                                              const DistanceOptions& options, QueryScratch* scratch,
+                                              double* bound) const {
   return engine_->Distance(a.points_.at(i), b.points_.at(j), options, scratch, bound);
+}
+
+double InputQueries::LinearInterpolationDistance(const EnginePoints& a, size_t i,
+                                                 const EnginePoints& b, size_t j) const {
+  return engine_->LinearInterpolationDistance(a.points_.at(i), b.points_.at(j));
 }
 
 absl::StatusOr<double> InputQueries::TracedDistance(const EnginePoints& a, size_t i,
@@ -105,28 +123,27 @@ absl::StatusOr<DistanceField> InputQueries::Field(const EnginePoints& sources) c
   return ids_.FieldToInput(std::move(field));
 }
 
-absl::StatusOr<std::vector<ExpMapVertex>> InputQueries::ExpMap(const SurfacePoint& centre,
-                                                               ExpMapOptions options,
+absl::StatusOr<std::vector<ExpMapVertex>> InputQueries::ExpMap(const EnginePoints& centres,
+                                                               size_t i, ExpMapOptions options,
                                                                QueryScratch* scratch) const {
-  GEODEX_ASSIGN_OR_RETURN(const SurfacePoint internal,
-                          ids_.ToInternal(centre, engine_->options().weight_tolerance));
+  const SurfacePoint& internal = centres.points_.at(i);
+  const int32_t input_face = centres.input_faces_.at(i);
   // A re-oriented face's normal is the input face's reversed, and its first
   // edge another edge: give the input's first edge, and mirror θ. A piece of
-  // a refined face has other edges too.
-  const bool mirrored = ids_.Reoriented(centre.face);
-  if ((mirrored || ids_.refined()) && !options.reference_direction.has_value()) {
-    const mesh::Triangle t = ids_.InputFace(centre.face);
+  // a split face has other edges too.
+  const bool mirrored = ids_.Reoriented(input_face);
+  if ((mirrored || ids_.split()) && !options.reference_direction.has_value()) {
+    const mesh::Triangle t = ids_.InputFace(input_face);
     const std::span<const double> p = index().positions();
     options.reference_direction = mesh::Vec3(p[3 * t[1]], p[3 * t[1] + 1], p[3 * t[1] + 2]) -
                                   mesh::Vec3(p[3 * t[0]], p[3 * t[0] + 1], p[3 * t[0] + 2]);
   }
   GEODEX_ASSIGN_OR_RETURN(std::vector<ExpMapVertex> map,
-                          query::ExpMap(*engine_, internal, options, scratch));
+                          engine_->ExpMap(internal, options, scratch));
   if (ids_.identity()) return map;
   // Midpoints of a refinement are no input vertices.
-  std::erase_if(map, [this](const ExpMapVertex& e) {
-    return ids_.InputVertex(e.vertex) == mesh::kNone;
-  });
+  std::erase_if(
+      map, [this](const ExpMapVertex& e) { return ids_.InputVertex(e.vertex) == mesh::kNone; });
   for (ExpMapVertex& e : map) {
     e.vertex = ids_.InputVertex(e.vertex);
     if (mirrored) {

@@ -1,13 +1,16 @@
 #pragma once
 
-// The queries of one index in the ids of the mesh file it was built from.
+// The queries of one index, in the ids of the mesh file it was built from:
+// the public face of core/query, with its value types (query_types.h) and
+// scratch space (query_scratch.h). Everything under core/query/internal/ is
+// a part behind it.
 //
-// QueryEngine answers on the index's internal mesh, whose ids differ from the
-// file's when the builder repaired or refined it (input_ids.h says how).
-// InputQueries is the one layer that speaks the file's ids: every caller that
-// takes points from a user or gives answers back (the server, geodex-query,
-// the accuracy harness, the Python bindings) goes through it, and nothing
-// else translates ids.
+// The index's internal mesh differs from the file's when the builder
+// repaired it or split its long edges (internal/input_ids.h says how);
+// InputQueries is the one layer that speaks the file's ids: every caller
+// that takes points from a user or gives answers back (the server,
+// geodex-query, the accuracy harness, the Python bindings) goes through it,
+// and nothing else translates ids.
 //
 // Points enter once: Read validates a span of points in input ids and keeps
 // them, translated, in an EnginePoints, which the queries take. Answers that
@@ -35,13 +38,13 @@
 #include "absl/status/statusor.h"
 #include "core/index/index.h"
 #include "core/mesh/mesh.h"
-#include "core/query/exp_map.h"
-#include "core/query/input_ids.h"
-#include "core/query/point_locator.h"
-#include "core/query/query_engine.h"
+#include "core/query/internal/input_ids.h"
+#include "core/query/query_scratch.h"
 #include "core/query/query_types.h"
 
 namespace geodex::query {
+
+class QueryEngine;
 
 // Points read by InputQueries::Read: validated, in the engine's ids. Only
 // InputQueries looks inside; callers keep them between calls (reusing one
@@ -53,11 +56,13 @@ class EnginePoints {
   // n copies of from's point i (a matrix row's source against its targets).
   void AssignRepeated(const EnginePoints& from, size_t i, size_t n) {
     points_.assign(n, from.points_.at(i));
+    input_faces_.assign(n, from.input_faces_.at(i));
   }
 
  private:
   friend class InputQueries;
-  std::vector<SurfacePoint> points_;
+  std::vector<SurfacePoint> points_;  // in the engine's ids
+  std::vector<int32_t> input_faces_;  // each point's face as the caller gave it
 };
 
 // How Read names the i-th point in an error message ("a[17]", "line 5").
@@ -67,16 +72,28 @@ PointName Named(std::string_view name);
 
 class InputQueries {
  public:
-  // Opens the index file at `path` and makes its engine. Errors: those of
-  // index::Index::Open and QueryEngine::Create.
+  // Opens the index file at `path` and makes its queries. Errors: those of
+  // index::Index::Open; InvalidArgument for a null index; FailedPrecondition
+  // for an index without geodesic triangles or samples.
   static absl::StatusOr<std::shared_ptr<const InputQueries>> Open(const std::string& path,
                                                                   QueryOptions options = {});
-  // Over an engine, sharing it. Errors: InvalidArgument for a null engine.
+  // Over a loaded index, sharing it. Errors: those of Open but the file's.
+  static absl::StatusOr<std::shared_ptr<const InputQueries>> Create(
+      std::shared_ptr<const index::Index> index, QueryOptions options = {});
+  // Over an engine (internal/query_engine.h), sharing it: for an engine made
+  // with test switches (internal/query_knobs.h). Errors: InvalidArgument for
+  // a null engine.
   static absl::StatusOr<std::shared_ptr<const InputQueries>> Create(
       std::shared_ptr<const QueryEngine> engine);
 
-  const QueryEngine& engine() const { return *engine_; }
-  const index::Index& index() const { return engine_->index(); }
+  const index::Index& index() const;
+  const QueryOptions& options() const;
+  // True when the index carries its accuracy calibration (error bounds, and
+  // so tolerances).
+  bool has_error_bounds() const;
+  // L = sqrt(2 A / (sqrt(3) m)): the edge of an equilateral geodesic
+  // triangle when the index's m samples tile the surface's area A.
+  double scale_length() const;
 
   // The input mesh's counts: what face and vertex ids are checked against.
   int32_t num_vertices() const { return ids_.num_input_vertices(); }
@@ -110,10 +127,9 @@ class InputQueries {
                                   QueryScratch* scratch = nullptr, double* bound = nullptr) const;
   // The paper's linear-interpolation baseline (§6.3) for a[i] and b[j].
   double LinearInterpolationDistance(const EnginePoints& a, size_t i, const EnginePoints& b,
-                                     size_t j) const {
-    return engine_->LinearInterpolationDistance(a.points_.at(i), b.points_.at(j));
-  }
-  // QueryEngine::TracedDistance of a[i] and b[j].
+                                     size_t j) const;
+  // The length of a near pair's surface path as the default refinement
+  // finds it (QueryEngine::TracedDistance) for a[i] and b[j].
   absl::StatusOr<double> TracedDistance(const EnginePoints& a, size_t i, const EnginePoints& b,
                                         size_t j) const;
 
@@ -128,12 +144,14 @@ class InputQueries {
   // copy's nearest source.
   absl::StatusOr<DistanceField> Field(const EnginePoints& sources) const;
 
-  // The exponential map round `centre` (in input ids; validated): vertices
-  // are input vertices, ascending (a split vertex: its copy of smallest r); θ
-  // counter-clockwise about the normal of the centre's input face, θ = 0 by
-  // default along that face's first input edge. Errors: those of Read and
-  // query::ExpMap.
-  absl::StatusOr<std::vector<ExpMapVertex>> ExpMap(const SurfacePoint& centre,
+  // The exponential map round centres[i] (§6.4, internal/exp_map.h):
+  // vertices are input vertices, ascending (a split vertex: its copy of
+  // smallest r); θ counter-clockwise about the normal of the centre's input
+  // face, θ = 0 by default along that face's first input edge. Errors:
+  // InvalidArgument for a radius that is not finite and > 0, and for a
+  // reference direction that is not finite or is perpendicular to the
+  // centre's face.
+  absl::StatusOr<std::vector<ExpMapVertex>> ExpMap(const EnginePoints& centres, size_t i,
                                                    ExpMapOptions options,
                                                    QueryScratch* scratch = nullptr) const;
 

@@ -1,13 +1,15 @@
 #pragma once
 
-// The value types of geodex's queries (core/query): how a distance is asked
-// for (DistanceOptions, NearPairs), how an engine is set up (QueryOptions),
-// and what comes back (PathPoint, DistanceField). Plain data, shared by the
-// engine (query_engine.h), its layer in input ids (input_queries.h) and the
-// id maps (input_ids.h), so that none of them needs another's header.
+// The value types of geodex's queries: how a distance is asked for
+// (DistanceOptions, NearPairs), how the queries of an index are set up
+// (QueryOptions), an exponential map's options, and what comes back
+// (PathPoint, DistanceField, ExpMapVertex, LocatedPoint). Plain data: the
+// public face of core/query with input_queries.h and query_scratch.h.
 
 #include <array>
 #include <cstdint>
+#include <limits>
+#include <optional>
 #include <vector>
 
 #include "core/mesh/mesh.h"
@@ -15,6 +17,9 @@
 namespace geodex::query {
 
 using mesh::SurfacePoint;
+
+// The distance between points of different components.
+inline constexpr double kInf = std::numeric_limits<double>::infinity();
 
 // How Distance and DistanceBatch answer the pairs they refine by default:
 // near pairs (points in the same or adjacent geodesic triangles) and pairs
@@ -63,13 +68,6 @@ struct QueryOptions {
   double weight_tolerance = 1e-6;
 };
 
-// A point lifted into a geodesic triangle (see the header comment).
-struct LiftedPoint {
-  int32_t triangle = -1;
-  std::array<int32_t, 3> corner = {-1, -1, -1};
-  std::array<double, 3> distance = {0, 0, 0};
-};
-
 struct PathPoint {
   SurfacePoint point;
   mesh::Vec3 position;
@@ -78,6 +76,32 @@ struct PathPoint {
 struct DistanceField {
   std::vector<double> distance;  // per vertex; +inf when unreachable or unreferenced
   std::vector<int32_t> nearest;  // per vertex: index of the nearest source (-1 if none)
+};
+
+struct LocatedPoint {
+  SurfacePoint point;   // face + barycentric weights (>= 0, sum 1)
+  double distance = 0;  // Euclidean distance from the query to the surface
+};
+
+struct ExpMapOptions {
+  // Vertices whose distance from the centre exceeds this are left out.
+  double radius = 0;
+  // θ = 0 along this direction, projected into the plane of the centre's
+  // face; without it, along that face's first edge (corner 0 to corner 1).
+  std::optional<mesh::Vec3> reference_direction;
+  // How r is computed.
+  DistanceOptions distance;
+};
+
+// One vertex of an exponential map: polar (r, theta), theta in (-pi, pi],
+// counter-clockwise about the centre face's normal, and
+// (u, v) = r (cos, sin) theta.
+struct ExpMapVertex {
+  int32_t vertex = -1;
+  double r = 0;
+  double theta = 0;
+  double u = 0;
+  double v = 0;
 };
 
 }  // namespace geodex::query

@@ -11,9 +11,9 @@
 // FILE holds lines "fa a0 a1 a2 fb b0 b1 b2" (core/mesh/pairs_io.h); SOURCES
 // lines "f w0 w1 w2"; POINTS lines "x y z". "-" reads standard input.
 // --expmap prints "vertex u v" for every vertex within R of the centre (the
-// exponential map, core/query/exp_map.h), ascending by vertex id. Face and
+// exponential map, core/query/internal/exp_map.h), ascending by vertex id. Face and
 // vertex ids, in and out, are those of the mesh file the index was built
-// from, also when the builder repaired it (core/query/input_ids.h). Output
+// from, also when the builder repaired it (core/query/internal/input_ids.h). Output
 // goes to standard output in input order; on a bad line nothing is printed and
 // the error names the line. Exit codes: 0 ok, 2 bad input, 1 other errors.
 
@@ -134,8 +134,7 @@ absl::StatusOr<std::string> Paths(const query::InputQueries& queries, const Args
       continue;
     }
     for (const query::PathPoint& p : *path) {
-      out += absl::StrFormat("%.17g %.17g %.17g\n", p.position.x(), p.position.y(),
-                             p.position.z());
+      out += absl::StrFormat("%.17g %.17g %.17g\n", p.position.x(), p.position.y(), p.position.z());
     }
     out += "\n";
   }
@@ -193,10 +192,11 @@ absl::StatusOr<std::string> ExpMap(const query::InputQueries& queries, const Arg
     map_options.reference_direction =
         mesh::Vec3(args.direction[0], args.direction[1], args.direction[2]);
   }
+  const query::SurfacePoint input = {static_cast<int32_t>(c[0]), {c[1], c[2], c[3]}};
+  query::EnginePoints read;
+  GEODEX_RETURN_IF_ERROR(queries.Read(std::span(&input, 1), query::PointName(), &read));
   query::QueryScratch scratch;
-  GEODEX_ASSIGN_OR_RETURN(
-      const auto map,
-      queries.ExpMap({static_cast<int32_t>(c[0]), {c[1], c[2], c[3]}}, map_options, &scratch));
+  GEODEX_ASSIGN_OR_RETURN(const auto map, queries.ExpMap(read, 0, map_options, &scratch));
   std::string out;
   for (const query::ExpMapVertex& e : map) {
     out += absl::StrFormat("%d %.17g %.17g\n", e.vertex, e.u, e.v);

@@ -7,7 +7,7 @@
 
 #include "absl/strings/str_format.h"
 #include "core/common/status_macros.h"
-#include "core/query/query_engine.h"
+#include "core/query/internal/query_engine.h"
 
 namespace geodex::validation {
 namespace {
@@ -183,7 +183,7 @@ absl::StatusOr<Calibration> Calibrate(const mesh::Mesh& mesh,
   // those are flat points, and bounds fitted on them would be too tight for
   // the corners callers ask about.
   PairOptions pair_options = options.pairs;
-  pair_options.vertex_limit = index->num_vertices() - index->refinement_vertices();
+  pair_options.vertex_limit = index->num_vertices() - index->split_vertices();
   const std::vector<ExactPair> pairs = DrawPairs(mesh, index->num_samples(), pair_options);
   std::vector<double> unfold[2][index::kAccuracyBins], trace[4][index::kAccuracyBins];
   std::vector<SpreadSample> spread[2][index::kAccuracyBins];

@@ -5,7 +5,7 @@
 
 #include "core/builder/builder.h"
 #include "core/mesh/generators.h"
-#include "core/query/query_engine.h"
+#include "core/query/internal/query_engine.h"
 #include "gtest/gtest.h"
 
 namespace geodex::validation {

@@ -9,7 +9,7 @@
 #include "core/common/status_macros.h"
 #include "core/common/threads.h"
 #include "core/geodesic/vertex_geodesic.h"
-#include "core/query/query_engine.h"
+#include "core/query/internal/query_engine.h"
 #include "core/validation/pair_sampling.h"
 
 namespace geodex::validation {
@@ -57,7 +57,7 @@ absl::StatusOr<std::vector<double>> VertexErrorMap(const mesh::Mesh& mesh,
       for (int32_t v = 0; v < n; ++v) {
         const double exact = solver.VertexDistance(v);
         if (!mesh.IsReferenced(v) || !(exact >= near) || !std::isfinite(exact)) continue;
-        const double e = (engine->DistanceUnchecked(sources[s], at_vertex[v]) - exact) / exact;
+        const double e = (engine->O1Distance(sources[s], at_vertex[v]) - exact) / exact;
         out[v] = static_cast<float>(e * e);
       }
     }

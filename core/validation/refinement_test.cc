@@ -1,4 +1,4 @@
-// The flat refinement on a coarse mesh, measured as users see it: pairs in
+// The long-edge split on a coarse mesh, measured as users see it: pairs in
 // the input's ids, the O(1) answer against exact distances. Samples are
 // vertices, so without refinement a coarse mesh caps m at its vertex count
 // and its geodesic triangles at its edge lengths; with it, the error keeps
@@ -10,8 +10,8 @@
 #include "core/builder/builder.h"
 #include "core/builder/mesh_arrays.h"
 #include "core/mesh/generators.h"
-#include "core/query/input_ids.h"
-#include "core/query/query_engine.h"
+#include "core/query/internal/input_ids.h"
+#include "core/query/internal/query_engine.h"
 #include "core/validation/pair_sampling.h"
 #include "gtest/gtest.h"
 
@@ -52,7 +52,7 @@ Measured Measure(const mesh::Mesh& coarse, int32_t m, bool refine,
     sum += e * e;
     ++count;
   }
-  return {(*index)->num_samples(), (*index)->refinement_vertices(), std::sqrt(sum / count)};
+  return {(*index)->num_samples(), (*index)->split_vertices(), std::sqrt(sum / count)};
 }
 
 TEST(RefinementTest, ErrorFallsWithSamplesPastTheVertexCountOfACoarseMesh) {

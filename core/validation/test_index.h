@@ -10,7 +10,7 @@
 
 #include "absl/status/statusor.h"
 #include "core/mesh/mesh.h"
-#include "core/query/query_engine.h"
+#include "core/query/internal/query_engine.h"
 
 namespace geodex::testing {
 

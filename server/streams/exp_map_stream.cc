@@ -23,13 +23,10 @@ class ExpMapStream final : public ChunkedWriteStream<v1::ExpMapChunk> {
     GEODEX_RETURN_IF_ERROR(CheckAlive(*context_));
     GEODEX_ASSIGN_OR_RETURN(model_, resources_->Resolve(request_->model(), call_));
     const query::InputQueries& queries = model_.version->queries();
-    // The centre as the request gives it: the map's θ runs round that input
-    // face's normal (InputQueries::ExpMap).
-    GEODEX_ASSIGN_OR_RETURN(const mesh::SurfacePoint centre,
-                            OnePointFromProto(request_->center(), "center", queries, &worker.a));
+    GEODEX_RETURN_IF_ERROR(OnePointFromProto(request_->center(), "center", queries, &worker.a));
     GEODEX_ASSIGN_OR_RETURN(const query::ExpMapOptions options,
                             ExpMapOptionsFor(model_.model->config, *request_));
-    GEODEX_ASSIGN_OR_RETURN(map_, queries.ExpMap(centre, options, &worker.scratch));
+    GEODEX_ASSIGN_OR_RETURN(map_, queries.ExpMap(worker.a, 0, options, &worker.scratch));
     call_.pairs = static_cast<int64_t>(map_.size());
     return absl::OkStatus();
   }

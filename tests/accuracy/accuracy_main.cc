@@ -21,7 +21,7 @@
 #include "core/mesh/generators.h"
 #include "core/mesh/mesh_io.h"
 #include "core/query/input_queries.h"
-#include "core/query/query_knobs.h"
+#include "core/query/internal/query_knobs.h"
 #include "core/validation/calibration.h"
 #include "core/validation/error_map.h"
 #include "tests/accuracy/accuracy.h"
@@ -79,7 +79,7 @@ absl::StatusOr<std::shared_ptr<const index::Index>> IndexFor(
     GEODEX_ASSIGN_OR_RETURN(
         const builder::PreparedMesh prepared,
         builder::PrepareMesh(m, {}, static_cast<int32_t>(index->header().params.requested_samples),
-                             index->refinement_vertices() > 0));
+                             index->split_vertices() > 0));
     GEODEX_ASSIGN_OR_RETURN(const validation::Calibration calibration,
                             validation::Calibrate(prepared.mesh, index));
     std::fprintf(stderr, "calibrated %s in memory\n", file.c_str());
@@ -139,9 +139,9 @@ absl::Status Measure(const Flags& flags, const std::string& label,
       absl::StatusOr<double> d = absl::InternalError("no internal point");
       if (queries->Read({&input_p, 1}, nullptr, &p).ok() &&
           queries->Read({&input_q, 1}, nullptr, &q).ok()) {
-        d = mode == "trace" ? queries->TracedDistance(p, 0, q, 0)
-                            : queries->Distance(p, 0, q, 0, options, &scratch,
-                                                bounds ? &a.bound : nullptr);
+        d = mode == "trace"
+                ? queries->TracedDistance(p, 0, q, 0)
+                : queries->Distance(p, 0, q, 0, options, &scratch, bounds ? &a.bound : nullptr);
       }
       if (!d.ok()) ++failed;
       a.distance = d.value_or(std::numeric_limits<double>::quiet_NaN());

@@ -6,7 +6,7 @@
 //
 // The batch runs in the default mode (near and close pairs by path length)
 // and in the pure O(1) mode; the share of random pairs that are near is printed with it.
-// Vertex and interior pairs/s are single DistanceUnchecked calls (O(1)). The
+// Vertex and interior pairs/s are single O1Distance calls (O(1)). The
 // cost of one near pair in the path and exact modes is measured apart, on
 // near pairs drawn on purpose. So is the time of one Path between random
 // interior points, traced (O(k)) and with an exact corridor of 8 steps.
@@ -17,7 +17,7 @@
 // default mode, the pure O(1) mode, the default with error bounds and with
 // a tolerance of 0.005, on uniform pairs and on pairs at each scale.
 //
-// Then the exponential map (core/query/exp_map.h): the time of one map round
+// Then the exponential map (core/query/internal/exp_map.h): the time of one map round
 // an interior point for radii of 3 L, 10 L and the whole mesh, in the default
 // mode and with r from the pure O(1) distance.
 //
@@ -33,10 +33,10 @@
 #include "absl/strings/str_format.h"
 #include "core/builder/builder.h"
 #include "core/mesh/generators.h"
-#include "core/query/exp_map.h"
-#include "core/query/query_engine.h"
-#include "core/query/query_knobs.h"
-#include "core/query/unfold_kernel.h"
+#include "core/query/internal/exp_map.h"
+#include "core/query/internal/query_engine.h"
+#include "core/query/internal/query_knobs.h"
+#include "core/query/internal/unfold_kernel.h"
 
 namespace geodex {
 namespace {
@@ -215,7 +215,7 @@ void BenchRefinement(const std::string& label, std::shared_ptr<const index::Inde
       other.face = static_cast<int32_t>(
           (p[i].face + q[i].face % (2 * spread + 1) + ix->num_faces() - spread) % ix->num_faces());
     }
-    const double d = engine->DistanceUnchecked(p[i], other) / scale;
+    const double d = engine->O1Distance(p[i], other) / scale;
     int bin = 0;
     while (bin < 3 && d >= kEdges[bin + 1]) ++bin;
     if (bin_a[bin].size() < per_bin) {
@@ -251,11 +251,11 @@ void Bench(const std::string& label, std::shared_ptr<const index::Index> ix, int
   std::vector<double> out(n);
   volatile double sink = 0;
   const double vertex_rate = Rate(n, [&] {
-    for (int i = 0; i < n; ++i) out[i] = engine->DistanceUnchecked(va[i], vb[i]);
+    for (int i = 0; i < n; ++i) out[i] = engine->O1Distance(va[i], vb[i]);
     sink = sink + out[n - 1];
   });
   const double interior_rate = Rate(n, [&] {
-    for (int i = 0; i < n; ++i) out[i] = engine->DistanceUnchecked(a[i], b[i]);
+    for (int i = 0; i < n; ++i) out[i] = engine->O1Distance(a[i], b[i]);
     sink = sink + out[n - 1];
   });
   const double batch_rate = Rate(n, [&] {

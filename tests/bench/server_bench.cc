@@ -40,7 +40,7 @@
 #include "core/index/face_bvh.h"
 #include "core/index/index.h"
 #include "core/mesh/generators.h"
-#include "core/query/query_engine.h"
+#include "core/query/internal/query_engine.h"
 #include "geodex/v1/geodex.grpc.pb.h"
 #include "grpcpp/create_channel.h"
 #include "server/server.h"

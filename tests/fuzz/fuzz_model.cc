@@ -45,9 +45,7 @@ const query::InputQueries& FuzzQueries() {
   static const std::shared_ptr<const query::InputQueries>* const queries = [] {
     auto index = index::Index::FromBytes(FuzzIndexBytes());
     if (!index.ok()) Die(index.status());
-    auto engine = query::QueryEngine::Create(*std::move(index));
-    if (!engine.ok()) Die(engine.status());
-    auto created = query::InputQueries::Create(*std::move(engine));
+    auto created = query::InputQueries::Create(*std::move(index));
     if (!created.ok()) Die(created.status());
     return new std::shared_ptr<const query::InputQueries>(*std::move(created));
   }();

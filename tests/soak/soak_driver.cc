@@ -30,8 +30,8 @@
 #include "CLI/CLI.hpp"
 #include "absl/strings/str_format.h"
 #include "core/index/index.h"
-#include "core/query/exp_map.h"
-#include "core/query/query_engine.h"
+#include "core/query/internal/exp_map.h"
+#include "core/query/internal/query_engine.h"
 #include "geodex/v1/geodex.grpc.pb.h"
 #include "grpcpp/create_channel.h"
 

@@ -1,0 +1,456 @@
+// Queries over indexes of repaired meshes, in the input's ids: a generated
+// broken mesh of each kind is repaired, built and answered.
+
+#include "core/query/input_queries.h"
+
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <memory>
+#include <string>
+
+#include "core/builder/builder.h"
+#include "core/builder/mesh_arrays.h"
+#include "core/geodesic/exact_geodesic.h"
+#include "core/index/index.h"
+#include "core/mesh/broken_meshes_testing.h"
+#include "core/mesh/generators.h"
+#include "core/mesh/mesh_repair.h"
+#include "core/query/internal/exp_map.h"
+#include "core/query/internal/input_ids.h"
+#include "core/query/internal/query_engine.h"
+#include "gmock/gmock.h"
+#include "gtest/gtest.h"
+
+namespace geodex::query {
+namespace {
+
+using mesh::RawMesh;
+using mesh::RepairedMesh;
+using mesh::SurfacePoint;
+using mesh::testing::AddTriangle;
+using mesh::testing::RawOf;
+
+struct Built {
+  RepairedMesh repaired;
+  std::shared_ptr<const QueryEngine> engine;
+};
+
+// Repairs, builds (as geodex-build does, with the long-edge split when
+// `refine`) and loads an index of `raw`.
+Built Build(const RawMesh& raw, int32_t samples, bool refine = false) {
+  absl::StatusOr<RepairedMesh> repaired = mesh::RepairMesh(raw);
+  if (!repaired.ok()) throw std::runtime_error(repaired.status().ToString());
+  absl::StatusOr<builder::PreparedMesh> prepared =
+      builder::PrepareMesh(repaired->mesh, builder::RecordRepair(*repaired), samples, refine);
+  if (!prepared.ok()) throw std::runtime_error(prepared.status().ToString());
+  builder::BuildOptions options;
+  options.num_samples = samples;
+  options.threads = 2;
+  builder::BuildSummary summary;
+  absl::StatusOr<index::IndexData> data = builder::BuildPreparedIndex(*prepared, options, &summary);
+  if (!data.ok()) throw std::runtime_error(data.status().ToString());
+  absl::StatusOr<std::string> bytes = index::SerializeIndex(*data);
+  if (!bytes.ok()) throw std::runtime_error(bytes.status().ToString());
+  auto index = index::Index::FromBytes(*std::move(bytes));
+  if (!index.ok()) throw std::runtime_error(index.status().ToString());
+  auto engine = QueryEngine::Create(*index);
+  if (!engine.ok()) throw std::runtime_error(engine.status().ToString());
+  return {*std::move(repaired), *std::move(engine)};
+}
+
+// The exponential map of `e` round an input point (InputQueries::ExpMap).
+absl::StatusOr<std::vector<ExpMapVertex>> ExpMapOfInput(const QueryEngine& e,
+                                                        const SurfacePoint& centre,
+                                                        const ExpMapOptions& options) {
+  // The engine outlives the call: a non-owning pointer.
+  auto queries =
+      InputQueries::Create(std::shared_ptr<const QueryEngine>(&e, [](const QueryEngine*) {}));
+  if (!queries.ok()) return queries.status();
+  EnginePoints read;
+  const absl::Status status = (*queries)->Read(std::span(&centre, 1), Named("centre"), &read);
+  if (!status.ok()) return status;
+  return (*queries)->ExpMap(read, 0, options);
+}
+
+double InputDistance(const QueryEngine& engine, const SurfacePoint& a, const SurfacePoint& b,
+                     NearPairs near = NearPairs::kPath) {
+  absl::StatusOr<SurfacePoint> p = InputIds(engine.index()).ToInternal(a);
+  absl::StatusOr<SurfacePoint> q = InputIds(engine.index()).ToInternal(b);
+  if (!p.ok() || !q.ok()) throw std::runtime_error("bad point");
+  DistanceOptions options;
+  options.near_pairs = near;
+  absl::StatusOr<double> d = engine.Distance(*p, *q, options);
+  if (!d.ok()) throw std::runtime_error(d.status().ToString());
+  return *d;
+}
+
+TEST(InputIdsTest, IndexWithoutRepairHasIdentityMaps) {
+  Built b = Build(RawOf(mesh::gen::Sphere(2, 1.0), "sphere"), 40);
+  const InputIds ids(b.engine->index());
+  EXPECT_TRUE(ids.identity());
+  EXPECT_TRUE(b.engine->index().input_faces().empty());
+  EXPECT_EQ(ids.num_input_faces(), 320);
+  const SurfacePoint p{17, {0.2, 0.3, 0.5}};
+  absl::StatusOr<SurfacePoint> q = ids.ToInternal(p);
+  ASSERT_TRUE(q.ok());
+  EXPECT_EQ(q->face, 17);
+  EXPECT_EQ(ids.ToInput(p).w, p.w);
+  EXPECT_EQ(ids.ToInternal({320, {1, 0, 0}}).status().code(), absl::StatusCode::kOutOfRange);
+}
+
+TEST(InputIdsTest, DroppedDuplicateAnswersAsItsTwin) {
+  const mesh::Mesh sphere = mesh::gen::Sphere(2, 1.0);
+  RawMesh raw = RawOf(sphere, "sphere");
+  const mesh::Triangle t = raw.triangles[7];
+  AddTriangle(&raw, {t[1], t[2], t[0]});  // input face 320
+  AddTriangle(&raw, {t[0], t[2], t[1]});  // input face 321
+  Built b = Build(raw, 40);
+  const QueryEngine& e = *b.engine;
+  // The input's face count, so face 321 is valid and 322 is not.
+  EXPECT_EQ(InputIds(e.index()).num_input_faces(), 322);
+  EXPECT_EQ(e.index().num_faces(), 320);
+  EXPECT_EQ(InputIds(e.index()).ToInternal({322, {1, 0, 0}}).status().code(),
+            absl::StatusCode::kOutOfRange);
+  const SurfacePoint far{150, {0.3, 0.3, 0.4}};
+  // The same point of space: weights follow each description's corners.
+  const SurfacePoint on_twin{7, {0.2, 0.3, 0.5}};
+  const SurfacePoint on_rotated{320, {0.3, 0.5, 0.2}};
+  const SurfacePoint on_reversed{321, {0.2, 0.5, 0.3}};
+  const double d = InputDistance(e, on_twin, far);
+  EXPECT_GT(d, 0);
+  EXPECT_EQ(InputDistance(e, on_rotated, far), d);
+  EXPECT_EQ(InputDistance(e, on_reversed, far), d);
+  // Answers name the kept face.
+  absl::StatusOr<SurfacePoint> internal = InputIds(e.index()).ToInternal(on_reversed);
+  ASSERT_TRUE(internal.ok());
+  const SurfacePoint back = InputIds(e.index()).ToInput(*internal);
+  EXPECT_EQ(back.face, 7);
+  EXPECT_EQ(back.w, on_twin.w);
+}
+
+TEST(InputIdsTest, ReorientedFacesKeepTheirInputWeights) {
+  const mesh::Mesh sphere = mesh::gen::Sphere(2, 1.0);
+  RawMesh raw = RawOf(sphere, "sphere");
+  for (int32_t f : {0, 5, 17, 200}) std::swap(raw.triangles[f][1], raw.triangles[f][2]);
+  Built b = Build(raw, 40);
+  const QueryEngine& e = *b.engine;
+  // Input face 5 is (a, c, b) of the sphere's (a, b, c): weights (x, y, z) on
+  // it are (x, z, y) on the sphere's face 5.
+  const SurfacePoint far{150, {0.3, 0.3, 0.4}};
+  Built reference = Build(RawOf(sphere, "sphere"), 40);
+  EXPECT_EQ(InputDistance(e, {5, {0.1, 0.2, 0.7}}, far),
+            InputDistance(*reference.engine, {5, {0.1, 0.7, 0.2}}, far));
+  // A path from a re-oriented face starts there, in its input weights.
+  absl::StatusOr<SurfacePoint> from = InputIds(e.index()).ToInternal({5, {0.1, 0.2, 0.7}});
+  absl::StatusOr<SurfacePoint> to = InputIds(e.index()).ToInternal(far);
+  ASSERT_TRUE(from.ok() && to.ok());
+  absl::StatusOr<std::vector<PathPoint>> path = e.Path(*from, *to);
+  ASSERT_TRUE(path.ok()) << path.status();
+  InputIds(e.index()).PathToInput(*path);
+  EXPECT_EQ(path->front().point.face, 5);
+  EXPECT_NEAR(path->front().point.w[1], 0.2, 1e-12);
+  EXPECT_NEAR(path->front().point.w[2], 0.7, 1e-12);
+  EXPECT_EQ(path->back().point.face, 150);
+  // The exponential map's θ runs round the input face's normal: mirrored
+  // against the internal face's.
+  ExpMapOptions map_options;
+  map_options.radius = 0.5;
+  absl::StatusOr<std::vector<ExpMapVertex>> mirrored =
+      ExpMapOfInput(e, {5, {0.1, 0.2, 0.7}}, map_options);
+  absl::StatusOr<std::vector<ExpMapVertex>> plain =
+      ExpMapOfInput(*reference.engine, {5, {0.1, 0.7, 0.2}}, map_options);
+  ASSERT_TRUE(mirrored.ok() && plain.ok());
+  ASSERT_EQ(mirrored->size(), plain->size());
+  ASSERT_FALSE(plain->empty());
+  for (size_t i = 0; i < plain->size(); ++i) {
+    EXPECT_EQ((*mirrored)[i].vertex, (*plain)[i].vertex);
+    EXPECT_NEAR((*mirrored)[i].r, (*plain)[i].r, 1e-9);
+  }
+}
+
+TEST(InputIdsTest, SplitVertexFieldTakesTheSmallestCopy) {
+  const RawMesh raw = mesh::testing::TwoPyramidsApexToApex();
+  Built b = Build(raw, 10);
+  const QueryEngine& e = *b.engine;
+  ASSERT_EQ(e.index().vertex_copies().size(), 1u);
+  EXPECT_EQ(InputIds(e.index()).num_input_vertices(), 9);
+  // A source on the first pyramid: its copy of the apex is reached, the
+  // other pyramid is another component.
+  absl::StatusOr<SurfacePoint> source = InputIds(e.index()).ToInternal({0, {0.2, 0.3, 0.5}});
+  ASSERT_TRUE(source.ok());
+  absl::StatusOr<DistanceField> field = e.Field(std::vector<SurfacePoint>{*source});
+  ASSERT_TRUE(field.ok());
+  ASSERT_EQ(field->distance.size(), 10u);
+  const double apex_copy = field->distance[9];
+  const DistanceField input = InputIds(e.index()).FieldToInput(*field);
+  ASSERT_EQ(input.distance.size(), 9u);
+  EXPECT_EQ(input.distance[0], std::min(field->distance[0], apex_copy));
+  EXPECT_TRUE(std::isfinite(input.distance[0]));
+  EXPECT_EQ(InputIds(e.index()).InputVertex(9), 0);
+}
+
+TEST(InputIdsTest, CubesSharingAnEdgeBuildAndAnswer) {
+  Built b = Build(mesh::testing::TwoCubesSharingAnEdge(), 16);
+  const QueryEngine& e = *b.engine;
+  // Across one face of the first cube: a straight line.
+  const double d = InputDistance(e, {0, {1.0 / 3, 1.0 / 3, 1.0 / 3}},
+                                 {1, {1.0 / 3, 1.0 / 3, 1.0 / 3}}, NearPairs::kExact);
+  EXPECT_TRUE(std::isfinite(d));
+  // The two cubes are separate surfaces once the edge is cut.
+  EXPECT_EQ(InputDistance(e, {0, {1, 0, 0}}, {12, {0.2, 0.3, 0.5}}),
+            std::numeric_limits<double>::infinity());
+}
+
+TEST(InputIdsTest, ZeroAreaFaceBuildsAndAnswersFiniteDistances) {
+  RawMesh raw = RawOf(mesh::gen::Grid(8, 8, 1, 1), "grid");
+  const int32_t degenerate = mesh::testing::AddZeroAreaFace(&raw, 60);
+  Built b = Build(raw, 30);
+  const QueryEngine& e = *b.engine;
+  ASSERT_EQ(b.repaired.report.zero_area_faces, 1);
+  // Points on the zero-area face, and across it: the grid is flat and
+  // convex, so distances are Euclidean.
+  const std::vector<SurfacePoint> points = {
+      {degenerate, {0.2, 0.3, 0.5}}, {degenerate, {1, 0, 0}},  {60, {0.3, 0.3, 0.4}},
+      {0, {0.2, 0.2, 0.6}},          {127, {0.5, 0.25, 0.25}}, {degenerate - 1, {0.6, 0.2, 0.2}}};
+  const mesh::Mesh& m = b.repaired.mesh;
+  for (const SurfacePoint& p : points) {
+    for (const SurfacePoint& q : points) {
+      for (NearPairs near : {NearPairs::kPath, NearPairs::kUnfold, NearPairs::kExact}) {
+        const double d = InputDistance(e, p, q, near);
+        const double euclid = (mesh::PositionOf(m, p) - mesh::PositionOf(m, q)).norm();
+        EXPECT_TRUE(std::isfinite(d)) << p.face << " " << q.face;
+        EXPECT_NEAR(d, euclid, 0.05) << p.face << " " << q.face << " mode " << int(near);
+      }
+      absl::StatusOr<std::vector<PathPoint>> path = e.Path(p, q);
+      ASSERT_TRUE(path.ok()) << path.status();
+      for (const PathPoint& x : *path) EXPECT_TRUE(x.position.allFinite());
+    }
+  }
+  absl::StatusOr<DistanceField> field = e.Field(std::vector<SurfacePoint>{points[0]});
+  ASSERT_TRUE(field.ok());
+  for (double d : field->distance) EXPECT_TRUE(std::isfinite(d));
+  absl::StatusOr<LocatedPoint> located = e.Locate(mesh::PositionOf(m, points[0]));
+  ASSERT_TRUE(located.ok());
+  EXPECT_NEAR(located->distance, 0, 1e-12);
+}
+
+// The development meshes, when present: cow_nonmanifold_3k (one non-manifold
+// vertex) builds once repaired and answers.
+TEST(InputIdsTest, CowNonmanifoldBuildsAndAnswers) {
+  const char* env = std::getenv("GEODEX_SHARED_MESHES");
+  const std::string dir = env != nullptr && *env != '\0'
+                              ? std::string(env)
+                              : std::string(GEODEX_SOURCE_DIR) + "/../shared/meshes";
+  const std::string path = dir + "/cow_nonmanifold_3k.obj";
+  if (!std::filesystem::exists(path)) {
+    GTEST_SKIP() << "no " << path
+                 << " (set GEODEX_SHARED_MESHES, or place the meshes in <source>/../shared/meshes)";
+  }
+  absl::StatusOr<RawMesh> raw = mesh::LoadRawMeshFile(path);
+  ASSERT_TRUE(raw.ok()) << raw.status();
+  Built b = Build(*raw, 100);
+  EXPECT_EQ(b.repaired.report.nonmanifold_vertices, 1);
+  EXPECT_THAT(std::string(b.engine->index().report()),
+              ::testing::HasSubstr("mesh_repairs = 1 non-manifold vertex split (2 copies)"));
+  const double d = InputDistance(*b.engine, {0, {0.2, 0.3, 0.5}}, {1000, {0.3, 0.3, 0.4}});
+  EXPECT_TRUE(std::isfinite(d));
+  EXPECT_GT(d, 0);
+  mesh::RepairOptions strict;
+  strict.strict = true;
+  const absl::StatusOr<RepairedMesh> refused = mesh::RepairMesh(*raw, strict);
+  ASSERT_FALSE(refused.ok());
+  EXPECT_THAT(refused.status().message(), ::testing::HasSubstr("non-manifold vertex"));
+}
+
+// The point of space a surface point of `faces`/`positions` names.
+mesh::Vec3 PointOf(std::span<const double> positions, const mesh::Triangle& t,
+                   const SurfacePoint& p) {
+  mesh::Vec3 x(0, 0, 0);
+  for (int i = 0; i < 3; ++i) {
+    x += p.w[i] * mesh::Vec3(positions[3 * t[i]], positions[3 * t[i] + 1], positions[3 * t[i] + 2]);
+  }
+  return x;
+}
+
+// A coarse sphere (42 vertices, edges about 0.6) sampled more finely than it
+// has vertices: only the long-edge split makes room for the samples, and
+// every answer still speaks of the input's faces and vertices.
+TEST(InputIdsTest, SplitIndexAnswersInTheInputIds) {
+  const mesh::Mesh coarse = mesh::gen::Sphere(1, 1.0);
+  ASSERT_EQ(coarse.num_vertices(), 42);
+  Built b = Build(RawOf(coarse, "sphere"), 120, /*refine=*/true);
+  const QueryEngine& e = *b.engine;
+  const InputIds ids(e.index());
+  EXPECT_EQ(e.index().header().format_major, index::kSplitFormatMajor);
+  EXPECT_GT(e.index().split_vertices(), 0);
+  EXPECT_GE(e.index().num_samples(), 120);
+  EXPECT_TRUE(ids.split());
+  EXPECT_FALSE(ids.identity());
+  EXPECT_EQ(ids.num_input_faces(), 80);
+  EXPECT_EQ(ids.num_input_vertices(), 42);
+  EXPECT_EQ(ids.ToInternal({80, {1, 0, 0}}).status().code(), absl::StatusCode::kOutOfRange);
+  EXPECT_THAT(std::string(e.index().report()), ::testing::HasSubstr("mesh_refinement = "));
+
+  const std::span<const double> x = e.index().positions();
+  const std::span<const int32_t> faces = e.index().faces();
+  auto internal_face = [&](int32_t f) {
+    return mesh::Triangle{faces[3 * f], faces[3 * f + 1], faces[3 * f + 2]};
+  };
+  std::vector<SurfacePoint> points;
+  for (int32_t f = 0; f < 80; ++f) {
+    EXPECT_EQ(ids.InputFace(f), coarse.face(f));
+    for (const mesh::Vec3& w : {mesh::Vec3(0.2, 0.3, 0.5), mesh::Vec3(1, 0, 0),
+                                mesh::Vec3(0.5, 0.5, 0), mesh::Vec3(0.05, 0.05, 0.9)}) {
+      const SurfacePoint p{f, {w.x(), w.y(), w.z()}};
+      absl::StatusOr<SurfacePoint> in = ids.ToInternal(p);
+      ASSERT_TRUE(in.ok()) << in.status();
+      // The same point of space, and back to the same input description.
+      EXPECT_LT((PointOf(x, internal_face(in->face), *in) - PointOf(x, coarse.face(f), p)).norm(),
+                1e-9);
+      const SurfacePoint back = ids.ToInput(*in);
+      EXPECT_EQ(back.face, f);
+      for (int i = 0; i < 3; ++i) EXPECT_NEAR(back.w[i], p.w[i], 1e-6);
+      points.push_back(p);
+    }
+  }
+  // The surface is the same: exact distances from an input point, on the
+  // refined mesh, equal those on the coarse one at every input vertex; the
+  // O(1) answers are close to them.
+  geodesic::ExactGeodesicSolver exact(coarse);
+  QueryScratch scratch;
+  int checked = 0;
+  for (size_t i = 0; i < points.size(); i += 37) {
+    ASSERT_TRUE(exact.Propagate({points[i]}).ok());
+    absl::StatusOr<SurfacePoint> internal = ids.ToInternal(points[i]);
+    ASSERT_TRUE(internal.ok());
+    absl::StatusOr<std::span<const double>> local = e.LocalExactDistances(*internal, 10, scratch);
+    ASSERT_TRUE(local.ok()) << local.status();
+    for (int32_t v = 0; v < 42; ++v) EXPECT_NEAR((*local)[v], exact.VertexDistance(v), 1e-9);
+    for (size_t j = 5; j < points.size(); j += 23) {
+      const double truth = exact.DistanceAt(points[j]);
+      if (truth < 0.3) continue;
+      EXPECT_NEAR(InputDistance(e, points[i], points[j], NearPairs::kUnfold), truth, 0.06 * truth)
+          << i << " " << j;
+      ++checked;
+    }
+  }
+  EXPECT_GT(checked, 20);
+  // Per-vertex answers cover the input's vertices only; midpoints have no
+  // input vertex.
+  EXPECT_EQ(ids.InputVertex(41), 41);
+  EXPECT_EQ(ids.InputVertex(42), mesh::kNone);
+  absl::StatusOr<SurfacePoint> source = ids.ToInternal(points[3]);
+  ASSERT_TRUE(source.ok());
+  absl::StatusOr<DistanceField> field = e.Field(std::vector<SurfacePoint>{*source});
+  ASSERT_TRUE(field.ok());
+  EXPECT_EQ(field->distance.size(), static_cast<size_t>(e.index().num_vertices()));
+  const DistanceField input = ids.FieldToInput(*field);
+  ASSERT_EQ(input.distance.size(), 42u);
+  ASSERT_TRUE(exact.Propagate({points[3]}).ok());
+  for (int32_t v = 0; v < 42; ++v) {
+    EXPECT_NEAR(input.distance[v], exact.VertexDistance(v), 0.03 * exact.VertexDistance(v) + 0.02);
+  }
+  ExpMapOptions map_options;
+  map_options.radius = 1.0;
+  absl::StatusOr<std::vector<ExpMapVertex>> map = ExpMapOfInput(e, points[3], map_options);
+  ASSERT_TRUE(map.ok()) << map.status();
+  ASSERT_FALSE(map->empty());
+  for (const ExpMapVertex& v : *map) EXPECT_LT(v.vertex, 42);
+  // A path comes back in input faces, from the first point to the second.
+  absl::StatusOr<SurfacePoint> to = ids.ToInternal(points[200]);
+  ASSERT_TRUE(to.ok());
+  absl::StatusOr<std::vector<PathPoint>> path = e.Path(*source, *to);
+  ASSERT_TRUE(path.ok()) << path.status();
+  ids.PathToInput(*path);
+  for (const PathPoint& p : *path) EXPECT_LT(p.point.face, 80);
+  EXPECT_LT((PointOf(x, coarse.face(path->front().point.face), path->front().point) -
+             PointOf(x, coarse.face(points[3].face), points[3]))
+                .norm(),
+            1e-9);
+}
+
+// Repair and refinement compose: a re-oriented, duplicated coarse mesh.
+TEST(InputIdsTest, RepairedAndSplitIndexAnswersInTheInputIds) {
+  const mesh::Mesh coarse = mesh::gen::Sphere(1, 1.0);
+  RawMesh raw = RawOf(coarse, "sphere");
+  for (int32_t f : {0, 5, 17}) std::swap(raw.triangles[f][1], raw.triangles[f][2]);
+  const mesh::Triangle t = raw.triangles[7];
+  AddTriangle(&raw, {t[1], t[2], t[0]});  // input face 80, a duplicate of 7
+  Built b = Build(raw, 120, /*refine=*/true);
+  Built reference = Build(RawOf(coarse, "sphere"), 120, /*refine=*/true);
+  const InputIds ids(b.engine->index());
+  EXPECT_TRUE(ids.split());
+  EXPECT_EQ(ids.num_input_faces(), 81);
+  EXPECT_EQ(ids.num_input_vertices(), 42);
+  const SurfacePoint far{40, {0.3, 0.3, 0.4}};
+  // Re-oriented face 5: (x, y, z) on the input is (x, z, y) on the sphere.
+  EXPECT_NEAR(InputDistance(*b.engine, {5, {0.1, 0.2, 0.7}}, far, NearPairs::kUnfold),
+              InputDistance(*reference.engine, {5, {0.1, 0.7, 0.2}}, far, NearPairs::kUnfold),
+              1e-9);
+  // The duplicate answers as its twin, and goes back to it.
+  const SurfacePoint on_twin{7, {0.2, 0.3, 0.5}};
+  const SurfacePoint on_rotated{80, {0.3, 0.5, 0.2}};
+  EXPECT_EQ(InputDistance(*b.engine, on_rotated, far), InputDistance(*b.engine, on_twin, far));
+  absl::StatusOr<SurfacePoint> internal = ids.ToInternal(on_rotated);
+  ASSERT_TRUE(internal.ok());
+  const SurfacePoint back = ids.ToInput(*internal);
+  EXPECT_EQ(back.face, 7);
+  for (int i = 0; i < 3; ++i) EXPECT_NEAR(back.w[i], on_twin.w[i], 1e-6);
+  EXPECT_EQ(ids.InputFace(5),
+            (mesh::Triangle{coarse.face(5)[0], coarse.face(5)[2], coarse.face(5)[1]}));
+}
+
+// Points are checked once, where they enter: every error of a bad point
+// comes from Read, named by the caller, and the queries after it take the
+// read points as they are.
+TEST(InputQueriesTest, PointsAreCheckedWhereTheyEnter) {
+  const mesh::Mesh sphere = mesh::gen::Sphere(2, 1.0);
+  Built b = Build(RawOf(sphere, "sphere"), 40);
+  auto queries = InputQueries::Create(b.engine);
+  ASSERT_TRUE(queries.ok()) << queries.status();
+  const int32_t faces = (*queries)->num_faces();
+  std::vector<SurfacePoint> points(50, SurfacePoint{3, {0.2, 0.3, 0.5}});
+  EnginePoints read;
+  points[42] = {faces, {1, 0, 0}};
+  absl::Status status = (*queries)->Read(points, Named("b"), &read);
+  EXPECT_EQ(status.code(), absl::StatusCode::kOutOfRange);
+  EXPECT_THAT(std::string(status.message()), ::testing::StartsWith("b[42]: face id"));
+  points[42] = {0, {NAN, 0.5, 0.5}};
+  EXPECT_EQ((*queries)->Read(points, Named("b"), &read).code(), absl::StatusCode::kInvalidArgument);
+  points[42] = {0, {-0.5, 1.0, 0.5}};
+  EXPECT_THAT((*queries)->Read(points, Named("b"), &read).message(),
+              ::testing::HasSubstr("negative"));
+  points[42] = {0, {0.5, 0.5, 0.5}};
+  EXPECT_THAT((*queries)->Read(points, Named("b"), &read).message(), ::testing::HasSubstr("sum"));
+  points[42] = {-1, {1, 0, 0}};
+  EXPECT_EQ((*queries)->Read(points, Named("b"), &read).code(), absl::StatusCode::kOutOfRange);
+  const std::vector<int32_t> face_ids = {0, 1};
+  const std::vector<double> weights = {1, 0, 0};
+  EXPECT_EQ((*queries)->Read(face_ids, weights, Named("c"), &read).code(),
+            absl::StatusCode::kInvalidArgument);
+
+  // The exponential map's centre is read like any point; its answers are
+  // the engine's round the same point (this mesh needed no repair).
+  const SurfacePoint centre{5, {0.2, 0.3, 0.5}};
+  ASSERT_TRUE((*queries)->Read(std::span(&centre, 1), Named("centre"), &read).ok());
+  ExpMapOptions options;
+  options.radius = 0.8;
+  absl::StatusOr<std::vector<ExpMapVertex>> facade = (*queries)->ExpMap(read, 0, options);
+  absl::StatusOr<std::vector<ExpMapVertex>> engine = ExpMap(*b.engine, centre, options);
+  ASSERT_TRUE(facade.ok() && engine.ok());
+  ASSERT_EQ(facade->size(), engine->size());
+  for (size_t i = 0; i < facade->size(); ++i) {
+    EXPECT_EQ((*facade)[i].vertex, (*engine)[i].vertex);
+    EXPECT_EQ((*facade)[i].r, (*engine)[i].r);
+    EXPECT_EQ((*facade)[i].theta, (*engine)[i].theta);
+  }
+  options.radius = 0;
+  EXPECT_EQ((*queries)->ExpMap(read, 0, options).status().code(),
+            absl::StatusCode::kInvalidArgument);
+  EnginePoints none;
+  EXPECT_EQ((*queries)->Field(none).status().code(), absl::StatusCode::kInvalidArgument);
+}
+
+}  // namespace
+}  // namespace geodex::query

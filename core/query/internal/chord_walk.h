@@ -1,0 +1,44 @@
+#pragma once
+
+// The length of a surface path between near points (closer than a few
+// geodesic-triangle edges), which is how the default mode refines them
+// (§6.5): first the corridor of the chord, walked face to face from either
+// end, unfolded into the plane and straightened by the funnel algorithm,
+// moved off the vertices it bends round short of a straight angle on their
+// other side; the gradient trace (gradient_path.h) only when both walks
+// fail, bend at several saddles, or are longer than is plausible. Every
+// candidate is a surface path, never shorter than the geodesic, so the
+// shortest is kept.
+//
+// Thread safety: a pure function of immutable data.
+
+#include <limits>
+#include <optional>
+
+#include "core/query/internal/gradient_path.h"
+#include "core/query/internal/mesh_view.h"
+#include "core/query/query_types.h"
+
+namespace geodex::query {
+
+// A near pair's path length; `wraps` when the path bends round a mesh
+// vertex (else it is a straight line through the faces it crosses: a local
+// geodesic, practically always the shortest path between near points; so
+// is one bending at a single saddle vertex by no more than its angle
+// excess).
+struct NearPath {
+  double length;
+  bool wraps;
+};
+
+// The shortest path found between valid canonical points `from` and `to`
+// (from the smaller point, for symmetry); nullopt when neither a walk nor a
+// trace reaches. `walk_chord`: try the chord's corridors first (off: the trace
+// only, for benchmarks). A straight walk longer than `plausible` is doubted
+// (it may run in a wrong corridor) and kept only if nothing shorter is found.
+std::optional<NearPath> NearPathLength(const MeshView& view, const GradientPaths& paths,
+                                       const SurfacePoint& from, const SurfacePoint& to,
+                                       bool walk_chord,
+                                       double plausible = std::numeric_limits<double>::infinity());
+
+}  // namespace geodex::query

@@ -1,0 +1,44 @@
+#pragma once
+
+// Straightening of a surface path within the faces it crosses.
+//
+// A path traced down an approximate distance field wiggles: each step
+// follows the local gradient, whose direction is only as good as the field.
+// Between two points pinned at mesh vertices (or the path's ends) the path
+// crosses a strip of faces; unfolded into the plane, the shortest path
+// through that strip is found exactly by the funnel algorithm (Lee &
+// Preparata 1984). It is a geodesic of the strip, so it is never longer than
+// the input and, when the input runs in the right corridor, it is the exact
+// geodesic. Points where the funnel wraps around a strip vertex are pinned at
+// that vertex.
+//
+// Thread safety: reentrant.
+
+#include <cstdint>
+#include <optional>
+#include <span>
+#include <vector>
+
+#include "core/query/internal/mesh_view.h"
+#include "core/query/query_types.h"
+
+namespace geodex::query {
+
+// Returns the straightened path; the endpoints are kept exactly. Consecutive
+// input points must share a face (as QueryEngine::Path produces); runs that
+// do not are returned unchanged.
+// True when a point strictly inside the path is a mesh vertex: there the
+// funnel of StraightenPath wrapped round the vertex.
+bool WrapsRoundAVertex(const std::vector<PathPoint>& path);
+
+// The sum of the path's 3D segments.
+double PathLength(const std::vector<PathPoint>& path);
+
+std::vector<PathPoint> StraightenPath(const MeshView& mesh, std::vector<PathPoint> path);
+
+// The length StraightenPath gives when the straightened path is one straight
+// segment through the strip (it wraps round no vertex), without building
+// it; nullopt otherwise (then StraightenPath may still shorten the path).
+std::optional<double> StraightLength(const MeshView& mesh, const std::vector<PathPoint>& path);
+
+}  // namespace geodex::query

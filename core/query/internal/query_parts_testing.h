@@ -1,0 +1,47 @@
+#pragma once
+
+// Test-only: the parts of a query engine (lifting, unfolding, paths, exact
+// refinement) made directly over the index of a generated mesh, so that each
+// part's tests exercise it without the facade.
+
+#include <memory>
+#include <stdexcept>
+
+#include "core/index/index.h"
+#include "core/mesh/mesh.h"
+#include "core/query/internal/gradient_path.h"
+#include "core/query/internal/lifted_unfolding.h"
+#include "core/query/internal/lifting.h"
+#include "core/query/internal/local_exact.h"
+#include "core/query/internal/mesh_view.h"
+#include "core/validation/test_index.h"
+
+namespace geodex::query::testing {
+
+struct QueryParts {
+  explicit QueryParts(const mesh::Mesh& mesh, int32_t samples)
+      : index(Open(mesh, samples)),
+        view{index->positions(), index->faces(), index->twins()},
+        unfolding(*index, /*vector_lanes=*/true),
+        lifting(view, index->vertices(), unfolding),
+        paths(view, lifting, unfolding, /*straighten=*/true),
+        exact(*index, view) {}
+  QueryParts(const QueryParts&) = delete;
+
+  static std::shared_ptr<const index::Index> Open(const mesh::Mesh& mesh, int32_t samples) {
+    absl::StatusOr<std::string> bytes = geodex::testing::BuildTestIndex(mesh, samples);
+    if (!bytes.ok()) throw std::runtime_error(bytes.status().ToString());
+    absl::StatusOr<std::shared_ptr<const index::Index>> ix = index::Index::FromBytes(*bytes);
+    if (!ix.ok()) throw std::runtime_error(ix.status().ToString());
+    return *ix;
+  }
+
+  std::shared_ptr<const index::Index> index;
+  MeshView view;
+  LiftedUnfolding unfolding;
+  Lifting lifting;
+  GradientPaths paths;
+  LocalExact exact;
+};
+
+}  // namespace geodex::query::testing

@@ -1,0 +1,94 @@
+#include "core/query/internal/refinement.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <optional>
+#include <tuple>
+
+#include "core/query/internal/chord_walk.h"
+
+namespace geodex::query {
+bool Refiner::Needs(const DistanceOptions& options, bool bounds, bool near, double unfolded) const {
+  return near || bounds || options.tolerance > 0 ||
+         (options.near_pairs != NearPairs::kUnfold && unfolded < refine_below_);
+}
+
+double Refiner::Refine(const SurfacePoint& p_in, const SurfacePoint& q_in, const LiftedPoint& lp,
+                       const LiftedPoint& lq, double unfolded, bool near,
+                       const DistanceOptions& options, QueryScratch* scratch, double* bound) const {
+  const SurfacePoint p = view_.InLowestFaceIfVertex(p_in), q = view_.InLowestFaceIfVertex(q_in);
+  if (!(unfolded < kInf)) {  // different components: exactly unreachable
+    if (bound != nullptr) *bound = bounds_.Of(AnswerKind::kExact, false, unfolded);
+    return unfolded;
+  }
+  // The refinements work from one point to the other: from the smaller, so
+  // that the answer is symmetric.
+  const bool swap = std::tie(q.face, q.w) < std::tie(p.face, p.w);
+  const SurfacePoint& from = swap ? q : p;
+  const SurfacePoint& to = swap ? p : q;
+  auto at_vertex = [](const SurfacePoint& x) { return x.w[0] == 1 || x.w[1] == 1 || x.w[2] == 1; };
+  const bool vertex_pair = at_vertex(p) && at_vertex(q);
+  double d =
+      near ? std::max(unfolded, (view_.PositionOf(p) - view_.PositionOf(q)).norm()) : unfolded;
+  AnswerKind kind = AnswerKind::kUnfold;
+  // The bound of an answer; the spread of an O(1) answer is computed once,
+  // when first needed.
+  std::optional<double> spread;
+  auto bound_of = [&](AnswerKind k, double at) {
+    if (k == AnswerKind::kUnfold && !spread) {
+      spread = bounds_.has_spread() ? unfolding_.Spread(lp, lq, unfolded) : 0;
+    }
+    return bounds_.Of(k, vertex_pair, at, spread.value_or(0));
+  };
+  auto trace = [&] {
+    // The O(1) answer plus its bound: a straight walk longer than that is
+    // doubted (NaN without calibration: none is).
+    const double plausible = unfolded + bound_of(AnswerKind::kUnfold, unfolded);
+    const std::optional<NearPath> t =
+        NearPathLength(view_, paths_, from, to, walk_, std::isnan(plausible) ? kInf : plausible);
+    if (!t) return false;
+    d = t->length;
+    kind = t->wraps ? AnswerKind::kWrappedTrace : AnswerKind::kTrace;
+    return true;
+  };
+  auto exact = [&] {
+    const std::optional<double> e = exact_.NearDistance(from, to, scratch);
+    if (!e) return false;
+    d = *e;
+    kind = AnswerKind::kExact;
+    return true;
+  };
+  // A trace is a surface path, never shorter than the geodesic; one longer
+  // than the O(1) answer plus that answer's bound has settled in a wrong
+  // corridor (round the wrong side of a feature). Under a tolerance it is
+  // answered exactly; by default it stays (an exact propagation per such
+  // pair halved the default mode's throughput for little gain:
+  // tests/bench/README.md). Needs the calibration (else the bound is NaN and
+  // no trace is doubted).
+  auto wrong_corridor = [&] {
+    return (kind == AnswerKind::kTrace || kind == AnswerKind::kWrappedTrace) &&
+           d > unfolded + bound_of(AnswerKind::kUnfold, unfolded);
+  };
+  if (near || unfolded < refine_below_) {
+    switch (options.near_pairs) {
+      case NearPairs::kPath:
+        trace();
+        break;
+      case NearPairs::kExact:
+        exact();
+        break;
+      case NearPairs::kUnfold:
+        break;
+    }
+  }
+  if (options.tolerance > 0) {
+    auto within = [&] { return bound_of(kind, d) <= options.tolerance * d; };
+    if (kind == AnswerKind::kUnfold && !within() && !trace()) exact();
+    if (kind != AnswerKind::kExact && (!within() || wrong_corridor())) exact();
+  }
+  if (bound != nullptr) *bound = bound_of(kind, d);
+  return d;
+}
+
+}  // namespace geodex::query
