@@ -1,0 +1,468 @@
+#include "tests/bench/query_bench_lib.h"
+
+#include <algorithm>
+#include <cstdio>
+#include <limits>
+#include <random>
+#include <span>
+#include <utility>
+
+#include "absl/strings/str_format.h"
+#include "core/builder/builder.h"
+#include "core/mesh/generators.h"
+#include "core/query/internal/exp_map.h"
+#include "core/query/internal/query_engine.h"
+#include "core/query/internal/query_knobs.h"
+#include "core/query/internal/unfold_kernel.h"
+#include "tests/bench/bench_table.h"
+#include "tests/bench/bench_timing.h"
+
+namespace geodex::bench {
+namespace {
+
+using Points = std::vector<mesh::SurfacePoint>;
+using PointPairs = std::vector<std::pair<mesh::SurfacePoint, mesh::SurfacePoint>>;
+
+constexpr int32_t kCorridorSteps = 8;
+
+// The best of three runs of `body`, which handles `n` pairs.
+template <typename F>
+double Rate(int64_t n, F&& body) {
+  double best = 0;
+  for (int rep = 0; rep < 3; ++rep) {
+    const double start = ThreadCpuSeconds();
+    body();
+    const double seconds = ThreadCpuSeconds() - start;
+    best = std::max(best, n / seconds);
+  }
+  return best;
+}
+
+// The sample matrix as the index stores it: full, row-major, m x m float32.
+struct FullMatrix {
+  const index::Index& ix;
+  double operator()(int32_t a, int32_t b) const { return ix.SampleDistance(a, b); }
+};
+
+// The loads of a query: the records and positions of both faces' vertices and
+// the 3x3 block of the sample matrix between the two anchors' corners.
+template <typename Matrix>
+double Gather(const index::Index& ix, const Matrix& matrix, const mesh::SurfacePoint& p,
+              const mesh::SurfacePoint& q) {
+  const auto faces = ix.faces();
+  const auto records = ix.vertices();
+  const auto positions = ix.positions();
+  double acc = 0;
+  const index::VertexRecord* anchor[2];
+  const mesh::SurfacePoint* pts[2] = {&p, &q};
+  for (int k = 0; k < 2; ++k) {
+    const int32_t* f = &faces[3 * pts[k]->face];
+    for (int i = 0; i < 3; ++i) {
+      acc += records[f[i]].distance[0] + positions[3 * f[i]];
+    }
+    anchor[k] = &records[f[0]];
+  }
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) acc += matrix(anchor[0]->corner[i], anchor[1]->corner[j]);
+  }
+  return acc;
+}
+
+// `count` near pairs (the same or adjacent geodesic triangles), drawn from
+// faces close in the file.
+PointPairs DrawNearPairs(const index::Index& ix, const query::QueryEngine& engine, int count) {
+  const auto p = InteriorPoints(ix, 50 * count, 5), q = InteriorPoints(ix, 50 * count, 6);
+  PointPairs out;
+  for (size_t i = 0; i < p.size() && static_cast<int>(out.size()) < count; ++i) {
+    // Meshes are usually stored with neighbouring faces at nearby ids.
+    mesh::SurfacePoint near = q[i];
+    near.face =
+        static_cast<int32_t>((p[i].face + q[i].face % 401 + ix.num_faces() - 200) % ix.num_faces());
+    if (engine.IsNearPair(p[i], near)) out.push_back({p[i], near});
+  }
+  return out;
+}
+
+// Microseconds per near pair of Distance in a near-pair mode.
+double MicrosecondsPerNearPair(const query::QueryEngine& engine, query::NearPairs mode,
+                               const PointPairs& pairs) {
+  query::QueryScratch scratch;
+  volatile double sink = 0;
+  const double t0 = ThreadCpuSeconds();
+  for (const auto& [p, q] : pairs)
+    sink = sink + *engine.Distance(p, q, {.near_pairs = mode}, &scratch);
+  return 1e6 * (ThreadCpuSeconds() - t0) / std::max<size_t>(1, pairs.size());
+}
+
+// The single-call and batch rates of the first table, and the near share.
+void MeasureQueryRates(std::shared_ptr<const index::Index> ix, const query::QueryEngine& engine,
+                       const Points& a, const Points& b, ThroughputFigures* f) {
+  const int n = static_cast<int>(a.size());
+  const auto va = VertexPoints(*ix, n, 3), vb = VertexPoints(*ix, n, 4);
+  std::vector<double> out(n);
+  volatile double sink = 0;
+  f->vertex_rate = Rate(n, [&] {
+    for (int i = 0; i < n; ++i) out[i] = engine.O1Distance(va[i], vb[i]);
+    sink = sink + out[n - 1];
+  });
+  f->interior_rate = Rate(n, [&] {
+    for (int i = 0; i < n; ++i) out[i] = engine.O1Distance(a[i], b[i]);
+    sink = sink + out[n - 1];
+  });
+  f->batch_rate = Rate(n, [&] {
+    (void)engine.DistanceBatch(a, b, out);
+    sink = sink + out[n - 1];
+  });
+  f->unfold_batch_rate = Rate(n, [&] {
+    (void)engine.DistanceBatch(a, b, out, {.near_pairs = query::NearPairs::kUnfold});
+    sink = sink + out[n - 1];
+  });
+  int near = 0;
+  for (int i = 0; i < n; ++i) near += engine.IsNearPair(a[i], b[i]);
+  f->near_percent = 100.0 * near / n;
+  auto scalar_engine = *query::CreateQueryEngine(ix, {}, {.vector_lanes = false});
+  f->scalar_batch_rate = Rate(n, [&] {
+    (void)scalar_engine->DistanceBatch(a, b, out);
+    sink = sink + out[n - 1];
+  });
+}
+
+// The gather-only loops (full and packed matrix) and the linear baseline.
+void MeasureGatherRates(const index::Index& ix, const query::QueryEngine& engine, const Points& a,
+                        const Points& b, ThroughputFigures* f) {
+  const int n = static_cast<int>(a.size());
+  volatile double sink = 0;
+  f->gather_rate = Rate(n, [&] {
+    double acc = 0;
+    for (int i = 0; i < n; ++i) acc += Gather(ix, FullMatrix{ix}, a[i], b[i]);
+    sink = sink + acc;
+  });
+  const PackedMatrix packed(ix);
+  f->packed_gather_rate = Rate(n, [&] {
+    double acc = 0;
+    for (int i = 0; i < n; ++i) acc += Gather(ix, packed, a[i], b[i]);
+    sink = sink + acc;
+  });
+  f->linear_rate = Rate(n, [&] {
+    double acc = 0;
+    for (int i = 0; i < n; ++i) acc += engine.LinearInterpolationDistance(a[i], b[i]);
+    sink = sink + acc;
+  });
+}
+
+// Paths between random interior points, traced (O(k)) and with the exact
+// corridor, and one near pair in the path and exact modes.
+void MeasurePaths(const index::Index& ix, const query::QueryEngine& engine, const Points& a,
+                  const Points& b, ThroughputFigures* f) {
+  volatile double sink = 0;
+  const int num_paths = std::min(static_cast<int>(a.size()), 100);
+  double path_ms[2];
+  for (int e = 0; e < 2; ++e) {
+    const double t0 = ThreadCpuSeconds();
+    size_t points = 0;
+    for (int i = 0; i < num_paths; ++i)
+      points += engine.Path(a[i], b[i], e ? kCorridorSteps : 0)->size();
+    path_ms[e] = 1e3 * (ThreadCpuSeconds() - t0) / num_paths;
+    sink = sink + static_cast<double>(points);
+  }
+  f->path_ms = path_ms[0];
+  f->corridor_ms = path_ms[1];
+  const PointPairs near_pairs = DrawNearPairs(ix, engine, 1000);
+  f->near_path_us = MicrosecondsPerNearPair(engine, query::NearPairs::kPath, near_pairs);
+  f->near_exact_us = MicrosecondsPerNearPair(engine, query::NearPairs::kExact, near_pairs);
+  f->near_pairs = near_pairs.size();
+}
+
+// Pairs/s of DistanceBatch over `a`, `b` with `options` (and bounds), per
+// CPU-second; slow modes run once over at most `cap` pairs.
+double BatchRate(const query::QueryEngine& engine, std::span<const mesh::SurfacePoint> a,
+                 std::span<const mesh::SurfacePoint> b, const query::DistanceOptions& options,
+                 bool bounds, size_t cap) {
+  const size_t n = std::min(a.size(), cap);
+  if (n == 0) return 0;
+  std::vector<double> out(n), bound(bounds ? n : 0);
+  query::QueryScratch scratch;
+  const int reps = cap < a.size() ? 1 : 3;
+  double best = 0;
+  for (int rep = 0; rep < reps; ++rep) {
+    const double start = ThreadCpuSeconds();
+    const absl::Status status =
+        engine.DistanceBatch(a.first(n), b.first(n), out, options, &scratch, bound);
+    if (!status.ok()) return 0;
+    best = std::max(best, n / (ThreadCpuSeconds() - start));
+  }
+  return best;
+}
+
+// Pairs at every scale: uniform pairs, and pairs of faces close in the file
+// (meshes usually store neighbouring faces at nearby ids), by their O(1)
+// distance in units of the scale length L, at most n / 4 per bin.
+constexpr int kScaleBins = 4;
+constexpr const char* kScaleBinNames[kScaleBins] = {"d<L", "L-3L", "3L-10L", ">=10L"};
+
+struct ScaleBins {
+  Points a[kScaleBins], b[kScaleBins];
+};
+
+ScaleBins DrawScalePairs(const index::Index& ix, const query::QueryEngine& engine, int n) {
+  constexpr double kEdges[] = {0, 1, 3, 10, 1e300};
+  const double scale = engine.scale_length();
+  ScaleBins bins;
+  const auto p = InteriorPoints(ix, 4 * n, 7), q = InteriorPoints(ix, 4 * n, 8);
+  const size_t per_bin = std::max(1, n / 4);
+  for (size_t i = 0; i < p.size(); ++i) {
+    mesh::SurfacePoint other = q[i];
+    if (i % 2 == 0) {
+      const int32_t spread = 1 + static_cast<int32_t>(i % 7) * 50;
+      other.face = static_cast<int32_t>(
+          (p[i].face + q[i].face % (2 * spread + 1) + ix.num_faces() - spread) % ix.num_faces());
+    }
+    const double d = engine.O1Distance(p[i], other) / scale;
+    int bin = 0;
+    while (bin < kScaleBins - 1 && d >= kEdges[bin + 1]) ++bin;
+    if (bins.a[bin].size() < per_bin) {
+      bins.a[bin].push_back(p[i]);
+      bins.b[bin].push_back(other);
+    }
+  }
+  return bins;
+}
+
+// One refinement row's rates on the pairs `x`, `y`.
+RefinementFigures MeasureRefinement(const query::QueryEngine& engine,
+                                    const query::QueryEngine& traces_only, const char* name,
+                                    std::span<const mesh::SurfacePoint> x,
+                                    std::span<const mesh::SurfacePoint> y) {
+  const size_t all = x.size();
+  RefinementFigures f;
+  f.pairs = name;
+  f.count = all;
+  f.default_rate = BatchRate(engine, x, y, {}, false, all);
+  f.pure_rate = BatchRate(engine, x, y, {.near_pairs = query::NearPairs::kUnfold}, false, all);
+  f.bounds_rate = BatchRate(engine, x, y, {}, true, all);
+  f.tolerance_rate = BatchRate(engine, x, y, {.tolerance = 0.005}, true, 300);
+  f.traced_rate = BatchRate(traces_only, x, y, {}, false, all);
+  return f;
+}
+
+// The throughput row, then the exponential map table, of a sphere built here.
+int RunOnGeneratedSphere(int pairs) {
+  std::printf("(no --index given: a generated sphere, m = 500)\n");
+  builder::BuildOptions options;
+  options.num_samples = 500;
+  builder::BuildSummary summary;
+  auto data = builder::BuildIndex(mesh::gen::Sphere(5, 1.0), options, &summary);
+  auto ix = index::Index::FromBytes(*index::SerializeIndex(*data));
+  std::printf("%s\n", ThroughputRow("sphere(5)", MeasureThroughput(*ix, pairs)).c_str());
+  std::printf("\n%s", ExpMapHeader().c_str());
+  BenchExpMap("sphere(5)", *ix);
+  return 0;
+}
+
+}  // namespace
+
+std::unique_ptr<CLI::App> QueryBenchFlags(QueryBenchOptions* options) {
+  auto app = std::make_unique<CLI::App>("query_bench: constant-time query throughput, one thread.");
+  app->add_option("--index", options->indexes, "Index files to measure");
+  app->add_option("--pairs", options->pairs, "Pairs per measurement");
+  app->add_flag("--expmap-only", options->expmap_only, "Only the exponential map table");
+  return app;
+}
+
+std::vector<mesh::SurfacePoint> InteriorPoints(const index::Index& ix, int n, uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> u(0, 1);
+  std::vector<mesh::SurfacePoint> out;
+  while (static_cast<int>(out.size()) < n) {
+    const int32_t f = static_cast<int32_t>(rng() % ix.num_faces());
+    double a = u(rng), b = u(rng);
+    if (a + b > 1) a = 1 - a, b = 1 - b;
+    out.push_back({f, {1 - a - b, a, b}});
+  }
+  return out;
+}
+
+std::vector<mesh::SurfacePoint> VertexPoints(const index::Index& ix, int n, uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  std::vector<mesh::SurfacePoint> out;
+  while (static_cast<int>(out.size()) < n) {
+    const int32_t f = static_cast<int32_t>(rng() % ix.num_faces());
+    mesh::SurfacePoint p{f, {0, 0, 0}};
+    p.w[rng() % 3] = 1;
+    out.push_back(p);
+  }
+  return out;
+}
+
+PackedMatrix::PackedMatrix(const index::Index& ix) {
+  const int64_t m = ix.num_samples();
+  values_.reserve(m * (m - 1) / 2);
+  for (int64_t a = 1; a < m; ++a) {
+    for (int64_t b = 0; b < a; ++b) values_.push_back(ix.SampleDistance(a, b));
+  }
+}
+
+double PackedMatrix::operator()(int32_t a, int32_t b) const {
+  if (a == b) return 0;
+  if (a < b) std::swap(a, b);
+  return values_[static_cast<int64_t>(a) * (a - 1) / 2 + b];
+}
+
+ThroughputFigures MeasureThroughput(std::shared_ptr<const index::Index> ix, int n) {
+  auto engine = *query::QueryEngine::Create(ix);
+  ThroughputFigures f;
+  f.vertices = ix->num_vertices();
+  f.samples = ix->num_samples();
+  const Points a = InteriorPoints(*ix, n, 1), b = InteriorPoints(*ix, n, 2);
+  MeasureQueryRates(ix, *engine, a, b, &f);
+  MeasureGatherRates(*ix, *engine, a, b, &f);
+  MeasurePaths(*ix, *engine, a, b, &f);
+  return f;
+}
+
+std::string ThroughputHeader() {
+  return MarkdownHeader(
+      {"index", "vertices", "m", "vertex pairs/s", "interior pairs/s", "batch (validated) pairs/s",
+       "batch, pure O(1)/s (near share)", "batch, one pair at a time/s", "gather-only/s",
+       "gather/batch", "linear baseline/s", "one near pair: path / exact mode (pairs)",
+       "one path: traced / exact corridor", "gather-only, packed matrix/s (full / packed size)"});
+}
+
+std::string ThroughputRow(const std::string& label, const ThroughputFigures& f) {
+  const double m = f.samples;
+  auto millions = [](double rate) { return absl::StrFormat("%.2fM", rate / 1e6); };
+  return MarkdownRow({
+      label,
+      absl::StrFormat("%d", f.vertices),
+      absl::StrFormat("%d", f.samples),
+      millions(f.vertex_rate),
+      millions(f.interior_rate),
+      millions(f.batch_rate),
+      absl::StrFormat("%.2fM (%.2f%% near)", f.unfold_batch_rate / 1e6, f.near_percent),
+      millions(f.scalar_batch_rate),
+      millions(f.gather_rate),
+      absl::StrFormat("%.2f", f.gather_rate / f.batch_rate),
+      millions(f.linear_rate),
+      absl::StrFormat("%.1f / %.1f us (%zu)", f.near_path_us, f.near_exact_us, f.near_pairs),
+      absl::StrFormat("%.2f / %.2f ms", f.path_ms, f.corridor_ms),
+      absl::StrFormat("%.2fM (%.1f / %.1f MiB)", f.packed_gather_rate / 1e6, m * m * 4 / (1 << 20),
+                      m * (m - 1) / 2 * 4 / (1 << 20)),
+  });
+}
+
+void BenchRefinement(const std::string& label, std::shared_ptr<const index::Index> ix, int n) {
+  if (ix->accuracy() == nullptr) {
+    std::printf("| %s | (no accuracy calibration in the index: run geodex-build calibrate) |\n",
+                label.c_str());
+    return;
+  }
+  auto engine = *query::QueryEngine::Create(ix);
+  auto traces_only = *query::CreateQueryEngine(ix, {}, {.walk_near_pairs = false});
+  const auto a = InteriorPoints(*ix, n, 1), b = InteriorPoints(*ix, n, 2);
+  const ScaleBins bins = DrawScalePairs(*ix, *engine, n);
+  // Every row's default rate is also given as a share of the pure O(1) rate
+  // on uniform pairs, the first row's.
+  double pure_uniform = 0;
+  for (int row = -1; row < kScaleBins; ++row) {
+    RefinementFigures f = row < 0 ? MeasureRefinement(*engine, *traces_only, "uniform", a, b)
+                                  : MeasureRefinement(*engine, *traces_only, kScaleBinNames[row],
+                                                      bins.a[row], bins.b[row]);
+    if (pure_uniform == 0) pure_uniform = f.pure_rate;
+    f.pure_uniform_rate = pure_uniform;
+    std::printf("%s\n", RefinementRow(label, f).c_str());
+  }
+}
+
+std::string RefinementHeader() {
+  return "\nRefinement (DistanceOptions), batch pairs/s; tolerance: at most 300 pairs, once\n" +
+         MarkdownHeader({"index", "pairs", "count", "default/s", "pure O(1)/s", "default / pure",
+                         "default / pure uniform", "default + bounds/s", "tolerance 0.005/s",
+                         "default, traces only (no walk)/s", "traces only / pure"});
+}
+
+std::string RefinementRow(const std::string& label, const RefinementFigures& f) {
+  return MarkdownRow({
+      label,
+      f.pairs,
+      absl::StrFormat("%zu", f.count),
+      absl::StrFormat("%.3fM", f.default_rate / 1e6),
+      absl::StrFormat("%.3fM", f.pure_rate / 1e6),
+      absl::StrFormat("%.2f", f.default_rate / f.pure_rate),
+      absl::StrFormat("%.2f", f.default_rate / f.pure_uniform_rate),
+      absl::StrFormat("%.3fM", f.bounds_rate / 1e6),
+      absl::StrFormat("%.4fM", f.tolerance_rate / 1e6),
+      absl::StrFormat("%.3fM", f.traced_rate / 1e6),
+      absl::StrFormat("%.2f", f.traced_rate / f.pure_rate),
+  });
+}
+
+void BenchExpMap(const std::string& label, std::shared_ptr<const index::Index> ix) {
+  auto engine = *query::QueryEngine::Create(ix);
+  const auto centres = InteriorPoints(*ix, 5, 7);
+  const double l = engine->scale_length();
+  for (const double radius : {3 * l, 10 * l, std::numeric_limits<double>::max()}) {
+    double ms[2];
+    size_t mapped = 0;
+    for (int mode = 0; mode < 2; ++mode) {
+      query::ExpMapOptions options;
+      options.radius = radius;
+      if (mode == 1) options.distance.near_pairs = query::NearPairs::kUnfold;
+      query::QueryScratch scratch;
+      (void)query::ExpMap(*engine, centres[0], options, &scratch);  // the lazy exact mesh
+      mapped = 0;
+      const double t0 = ThreadCpuSeconds();
+      for (const mesh::SurfacePoint& c : centres) {
+        mapped += query::ExpMap(*engine, c, options, &scratch)->size();
+      }
+      ms[mode] = 1e3 * (ThreadCpuSeconds() - t0) / centres.size();
+    }
+    ExpMapFigures f;
+    f.radius = radius == std::numeric_limits<double>::max() ? "whole mesh"
+                                                            : absl::StrFormat("%.0f L", radius / l);
+    f.per_map = static_cast<double>(mapped) / centres.size();
+    f.default_ms = ms[0];
+    f.pure_ms = ms[1];
+    std::printf("%s\n", ExpMapRow(label, f).c_str());
+  }
+}
+
+std::string ExpMapHeader() {
+  return MarkdownHeader({"index", "radius", "vertices mapped", "one map, default",
+                         "one map, pure O(1)", "per vertex, default"});
+}
+
+std::string ExpMapRow(const std::string& label, const ExpMapFigures& f) {
+  return MarkdownRow({label, f.radius, absl::StrFormat("%.0f", f.per_map),
+                      absl::StrFormat("%.2f ms", f.default_ms),
+                      absl::StrFormat("%.2f ms", f.pure_ms),
+                      absl::StrFormat("%.2f us", 1e3 * f.default_ms / f.per_map)});
+}
+
+int RunQueryBench(const QueryBenchOptions& options) {
+  std::printf("(batch: far pairs %s)\n", query::kernel::HasAvx2Lanes()
+                                             ? "four at a time with AVX2"
+                                             : "one at a time: no AVX2 in this build or CPU");
+  std::printf("%s", ThroughputHeader().c_str());
+  if (options.indexes.empty()) return RunOnGeneratedSphere(options.pairs);
+  std::vector<std::shared_ptr<const index::Index>> loaded;
+  for (const std::string& path : options.indexes) {
+    auto ix = index::Index::Open(path);
+    if (!ix.ok()) {
+      std::fprintf(stderr, "%s: %s\n", path.c_str(), ix.status().ToString().c_str());
+      return 1;
+    }
+    loaded.push_back(*ix);
+    if (!options.expmap_only) {
+      std::printf("%s\n", ThroughputRow(path, MeasureThroughput(*ix, options.pairs)).c_str());
+    }
+  }
+  std::printf("%s", RefinementHeader().c_str());
+  for (size_t i = 0; i < loaded.size() && !options.expmap_only; ++i) {
+    BenchRefinement(options.indexes[i], loaded[i], std::min(options.pairs, 200'000));
+  }
+  std::printf("\nExponential map (5 interior centres)\n%s", ExpMapHeader().c_str());
+  for (size_t i = 0; i < loaded.size(); ++i) BenchExpMap(options.indexes[i], loaded[i]);
+  return 0;
+}
+
+}  // namespace geodex::bench

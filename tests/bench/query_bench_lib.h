@@ -1,0 +1,116 @@
+#pragma once
+
+// The pieces of query_bench (query_bench.cc): its flags, the pairs it draws,
+// the measurements, and the rows of its three tables.
+//
+// Rates are single-thread and per CPU-second of the measuring thread
+// (ThreadCpuSeconds). Not thread-safe.
+
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "CLI/CLI.hpp"
+#include "core/index/index.h"
+#include "core/mesh/mesh.h"
+
+namespace geodex::bench {
+
+struct QueryBenchOptions {
+  std::vector<std::string> indexes;  // empty: a generated sphere
+  int pairs = 1'000'000;             // pairs per measurement
+  bool expmap_only = false;          // only the exponential map table
+};
+
+// The command line of query_bench, writing into `options` when parsed.
+std::unique_ptr<CLI::App> QueryBenchFlags(QueryBenchOptions* options);
+
+// `n` area-uniform interior points (fixed `seed`): a random face, random
+// barycentric weights.
+std::vector<mesh::SurfacePoint> InteriorPoints(const index::Index& ix, int n, uint64_t seed);
+
+// `n` points at a random corner of a random face (fixed `seed`).
+std::vector<mesh::SurfacePoint> VertexPoints(const index::Index& ix, int n, uint64_t seed);
+
+// The sample matrix packed as its strict lower triangle, m(m-1)/2 float32:
+// the storage alternative to the index's full m x m matrix, measured by the
+// same gather loop. operator()(a, b) is the index's SampleDistance(a, b).
+class PackedMatrix {
+ public:
+  explicit PackedMatrix(const index::Index& ix);
+  double operator()(int32_t a, int32_t b) const;
+
+ private:
+  std::vector<float> values_;
+};
+
+// The first table: one index's throughput figures.
+struct ThroughputFigures {
+  int32_t vertices = 0;
+  int32_t samples = 0;            // m
+  double vertex_rate = 0;         // O1Distance on vertex pairs, pairs/s
+  double interior_rate = 0;       // O1Distance on interior pairs
+  double batch_rate = 0;          // DistanceBatch, default mode
+  double unfold_batch_rate = 0;   // DistanceBatch, pure O(1) mode
+  double near_percent = 0;        // share of the random pairs that are near
+  double scalar_batch_rate = 0;   // DistanceBatch without the AVX2 lanes
+  double gather_rate = 0;         // the loads of a query alone
+  double linear_rate = 0;         // the linear-interpolation baseline
+  double near_path_us = 0;        // one near pair, path mode
+  double near_exact_us = 0;       // one near pair, exact mode
+  size_t near_pairs = 0;          // near pairs those two were measured on
+  double path_ms = 0;             // one Path, traced
+  double corridor_ms = 0;         // one Path with the exact corridor
+  double packed_gather_rate = 0;  // the gather loop over PackedMatrix
+};
+
+// Measures the first table's figures on `n` pairs of `ix`.
+ThroughputFigures MeasureThroughput(std::shared_ptr<const index::Index> ix, int n);
+
+// The first table's header (two lines) and one row of it (no newline).
+std::string ThroughputHeader();
+std::string ThroughputRow(const std::string& label, const ThroughputFigures& f);
+
+// One row of the refinement table: batch rates of one set of pairs.
+struct RefinementFigures {
+  std::string pairs;             // "uniform" or a scale bin ("d<L", ...)
+  size_t count = 0;              // pairs measured
+  double default_rate = 0;       // default mode
+  double pure_rate = 0;          // pure O(1) mode
+  double pure_uniform_rate = 0;  // pure O(1) on the uniform pairs
+  double bounds_rate = 0;        // default with error bounds
+  double tolerance_rate = 0;     // tolerance 0.005, at most 300 pairs, once
+  double traced_rate = 0;        // default, traces only (no walk)
+};
+
+// Measures and prints the refinement table's rows of `ix` on `n` pairs
+// (uniform, then each scale bin); a note row when `ix` has no accuracy
+// calibration.
+void BenchRefinement(const std::string& label, std::shared_ptr<const index::Index> ix, int n);
+
+// The refinement table's title and header, and one row of it (no newline).
+std::string RefinementHeader();
+std::string RefinementRow(const std::string& label, const RefinementFigures& f);
+
+// One row of the exponential map table: one radius.
+struct ExpMapFigures {
+  std::string radius;     // "3 L", "10 L" or "whole mesh"
+  double per_map = 0;     // vertices mapped, mean over the centres
+  double default_ms = 0;  // one map, default mode
+  double pure_ms = 0;     // one map, r from the pure O(1) distance
+};
+
+// Measures and prints the exponential map rows of `ix`.
+void BenchExpMap(const std::string& label, std::shared_ptr<const index::Index> ix);
+
+// The exponential map table's header, and one row of it (no newline).
+std::string ExpMapHeader();
+std::string ExpMapRow(const std::string& label, const ExpMapFigures& f);
+
+// Runs the whole benchmark as the command line asks and returns the exit
+// code: 1 when an index cannot be opened.
+int RunQueryBench(const QueryBenchOptions& options);
+
+}  // namespace geodex::bench

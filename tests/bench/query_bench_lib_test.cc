@@ -1,0 +1,210 @@
+#include "tests/bench/query_bench_lib.h"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <array>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "absl/strings/str_split.h"
+#include "core/mesh/generators.h"
+#include "core/validation/test_index.h"
+#include "gmock/gmock.h"
+#include "gtest/gtest.h"
+#include "tests/bench/bench_flags.h"
+
+namespace geodex::bench {
+namespace {
+
+using ::testing::HasSubstr;
+using ::testing::StartsWith;
+
+// Columns of a Markdown row: its bars less one.
+int Columns(const std::string& row) {
+  return static_cast<int>(std::count(row.begin(), row.end(), '|')) - 1;
+}
+
+std::vector<std::string> Lines(const std::string& text) {
+  return absl::StrSplit(text, '\n', absl::SkipEmpty());
+}
+
+std::shared_ptr<const index::Index> SmallIndex(bool calibrate) {
+  auto bytes = testing::BuildTestIndex(mesh::gen::Sphere(3, 1.0), 40, calibrate);
+  EXPECT_TRUE(bytes.ok()) << bytes.status();
+  auto ix = index::Index::FromBytes(*std::move(bytes));
+  EXPECT_TRUE(ix.ok()) << ix.status();
+  return *ix;
+}
+
+TEST(QueryBenchFlagsTest, DefaultsAndValues) {
+  QueryBenchOptions options;
+  auto app = QueryBenchFlags(&options);
+  std::ostringstream out, err;
+  ASSERT_EQ(ParseFlags(*app, {"query_bench"}, out, err), std::nullopt);
+  EXPECT_TRUE(options.indexes.empty());
+  EXPECT_EQ(options.pairs, 1'000'000);
+  EXPECT_FALSE(options.expmap_only);
+
+  QueryBenchOptions set;
+  auto app2 = QueryBenchFlags(&set);
+  ASSERT_EQ(ParseFlags(*app2,
+                       {"query_bench", "--index", "a.gdx", "--index", "b.gdx", "--pairs", "20",
+                        "--expmap-only"},
+                       out, err),
+            std::nullopt);
+  EXPECT_EQ(set.indexes, (std::vector<std::string>{"a.gdx", "b.gdx"}));
+  EXPECT_EQ(set.pairs, 20);
+  EXPECT_TRUE(set.expmap_only);
+}
+
+TEST(QueryBenchFlagsTest, HelpAndBadValues) {
+  QueryBenchOptions options;
+  const std::string help = QueryBenchFlags(&options)->help();
+  EXPECT_THAT(help, HasSubstr("query_bench: constant-time query throughput, one thread."));
+  EXPECT_THAT(help, HasSubstr("--expmap-only"));
+  auto app = QueryBenchFlags(&options);
+  std::ostringstream out, err;
+  EXPECT_NE(ParseFlags(*app, {"query_bench", "--pairs", "many"}, out, err).value_or(0), 0);
+}
+
+TEST(QueryBenchPointsTest, InteriorPointsAreValidAndSeeded) {
+  const auto ix = SmallIndex(false);
+  const auto p = InteriorPoints(*ix, 200, 3);
+  ASSERT_EQ(p.size(), 200u);
+  for (const mesh::SurfacePoint& x : p) {
+    EXPECT_GE(x.face, 0);
+    EXPECT_LT(x.face, ix->num_faces());
+    for (double w : x.w) EXPECT_GE(w, 0);
+    EXPECT_NEAR(x.w[0] + x.w[1] + x.w[2], 1, 1e-12);
+  }
+  const auto again = InteriorPoints(*ix, 200, 3);
+  EXPECT_EQ(again[17].face, p[17].face);
+  EXPECT_EQ(again[17].w, p[17].w);
+}
+
+TEST(QueryBenchPointsTest, VertexPointsSitAtOneCorner) {
+  const auto ix = SmallIndex(false);
+  for (const mesh::SurfacePoint& x : VertexPoints(*ix, 100, 4)) {
+    EXPECT_LT(x.face, ix->num_faces());
+    std::array<double, 3> w = x.w;
+    std::sort(w.begin(), w.end());
+    EXPECT_EQ(w, (std::array<double, 3>{0, 0, 1}));
+  }
+}
+
+TEST(QueryBenchPointsTest, PackedMatrixIsTheSampleMatrix) {
+  const auto ix = SmallIndex(false);
+  const PackedMatrix packed(*ix);
+  for (int32_t a = 0; a < ix->num_samples(); ++a) {
+    for (int32_t b = 0; b < ix->num_samples(); ++b) {
+      EXPECT_EQ(packed(a, b), static_cast<double>(ix->SampleDistance(a, b))) << a << " " << b;
+    }
+  }
+}
+
+// `header` (title lines, then the header row and its rule) has `title_lines`
+// lines before a header row as wide as `row`.
+void ExpectTable(const std::string& header, size_t title_lines, const std::string& row) {
+  const auto lines = Lines(header);
+  ASSERT_EQ(lines.size(), title_lines + 2);
+  EXPECT_EQ(Columns(lines[title_lines]), Columns(row));
+  EXPECT_EQ(Columns(lines[title_lines + 1]), Columns(row));
+}
+
+TEST(QueryBenchTablesTest, ThroughputRowLayout) {
+  const ThroughputFigures f{.vertices = 4608,
+                            .samples = 200,
+                            .vertex_rate = 5.67e6,
+                            .interior_rate = 4.36e6,
+                            .batch_rate = 0.16e6,
+                            .unfold_batch_rate = 4.6e6,
+                            .near_percent = 1.2,
+                            .scalar_batch_rate = 0.16e6,
+                            .gather_rate = 44.36e6,
+                            .linear_rate = 4.97e6,
+                            .near_path_us = 2.1,
+                            .near_exact_us = 71.7,
+                            .near_pairs = 1000,
+                            .path_ms = 0.54,
+                            .corridor_ms = 2.67,
+                            .packed_gather_rate = 31.92e6};
+  const std::string row = ThroughputRow("t.gdx", f);
+  EXPECT_EQ(row,
+            "| t.gdx | 4608 | 200 | 5.67M | 4.36M | 0.16M | 4.60M (1.20% near) | 0.16M | 44.36M | "
+            "277.25 | 4.97M | 2.1 / 71.7 us (1000) | 0.54 / 2.67 ms | 31.92M (0.2 / 0.1 MiB) |");
+  EXPECT_EQ(Columns(row), 14);
+  ExpectTable(ThroughputHeader(), 0, row);
+}
+
+TEST(QueryBenchTablesTest, RefinementRowLayout) {
+  // d<L, 500 pairs: default, pure O(1), pure O(1) on uniform pairs, with
+  // bounds, tolerance 0.005, traces only.
+  const RefinementFigures f{"d<L", 500, 0.679e6, 4.144e6, 4.398e6, 0.777e6, 0.1727e6, 0.219e6};
+  const std::string row = RefinementRow("t.gdx", f);
+  EXPECT_EQ(row,
+            "| t.gdx | d<L | 500 | 0.679M | 4.144M | 0.16 | 0.15 | 0.777M | 0.1727M | 0.219M | "
+            "0.05 |");
+  ExpectTable(RefinementHeader(), 1, row);
+  EXPECT_THAT(Lines(RefinementHeader())[0], StartsWith("Refinement (DistanceOptions)"));
+}
+
+TEST(QueryBenchTablesTest, ExpMapRowLayout) {
+  const ExpMapFigures f{.radius = "3 L", .per_map = 904, .default_ms = 21.3, .pure_ms = 1.38};
+  const std::string row = ExpMapRow("t.gdx", f);
+  EXPECT_EQ(row, "| t.gdx | 3 L | 904 | 21.30 ms | 1.38 ms | 23.56 us |");
+  ExpectTable(ExpMapHeader(), 0, row);
+}
+
+TEST(QueryBenchRunTest, MeasuresASmallIndex) {
+  const auto ix = SmallIndex(false);
+  const ThroughputFigures f = MeasureThroughput(ix, 50);
+  EXPECT_EQ(f.vertices, ix->num_vertices());
+  EXPECT_EQ(f.samples, 40);
+  EXPECT_GT(f.batch_rate, 0);
+  EXPECT_GE(f.near_percent, 0);
+  EXPECT_LE(f.near_percent, 100);
+  EXPECT_LE(f.near_pairs, 1000u);
+}
+
+// The whole run on a calibrated index in a file: its three tables, each row
+// as wide as its header.
+TEST(QueryBenchRunTest, PrintsThreeTables) {
+  const auto path = std::filesystem::temp_directory_path() /
+                    ("query_bench_lib_test_" + std::to_string(getpid()) + ".gdx");
+  {
+    auto bytes = testing::BuildTestIndex(mesh::gen::Sphere(3, 1.0), 40, /*calibrate=*/true);
+    ASSERT_TRUE(bytes.ok()) << bytes.status();
+    std::ofstream(path, std::ios::binary) << *bytes;
+  }
+  QueryBenchOptions options{.indexes = {path.string()}, .pairs = 40};
+  ::testing::internal::CaptureStdout();
+  const int code = RunQueryBench(options);
+  const std::string out = ::testing::internal::GetCapturedStdout();
+  std::filesystem::remove(path);
+  EXPECT_EQ(code, 0);
+  std::vector<int> widths;
+  for (const std::string& line : Lines(out)) {
+    if (line[0] == '|') widths.push_back(Columns(line));
+  }
+  // Header and rule, one row; header and rule, uniform and four bins;
+  // header and rule, three radii.
+  EXPECT_EQ(widths, (std::vector<int>{14, 14, 14, 11, 11, 11, 11, 11, 11, 11, 6, 6, 6, 6, 6}));
+  EXPECT_THAT(out, HasSubstr("\nExponential map (5 interior centres)\n"));
+}
+
+TEST(QueryBenchRunTest, AnIndexThatCannotBeOpenedExitsOne) {
+  QueryBenchOptions options{.indexes = {"/nonexistent/x.gdx"}, .pairs = 10};
+  ::testing::internal::CaptureStdout();
+  ::testing::internal::CaptureStderr();
+  const int code = RunQueryBench(options);
+  ::testing::internal::GetCapturedStdout();
+  EXPECT_THAT(::testing::internal::GetCapturedStderr(), HasSubstr("/nonexistent/x.gdx: "));
+  EXPECT_EQ(code, 1);
+}
+
+}  // namespace
+}  // namespace geodex::bench
