@@ -157,19 +157,37 @@ absl::Status ExactGeodesicSolver::Propagate(std::span<const SurfacePoint> source
   return absl::OkStatus();
 }
 
-bool ExactGeodesicSolver::OnRegionBorder(int32_t v) {
-  if (region_.empty()) return false;
+uint8_t ExactGeodesicSolver::RegionBorderState(int32_t v) {
+  if (region_.empty()) return kInsideRegion;
   uint8_t& state = region_border_[v];
-  if (state == 0) {
-    state = 1;
-    for (const int32_t o : mesh_.Outgoing(v)) {
-      if (region_[Mesh::FaceOf(o)] == 0) {
-        state = 2;
-        break;
-      }
-    }
+  if (state != kUnknown) return state;
+  // The region's faces round v: their angle, and how many separate fans they
+  // make.
+  const auto fan = mesh_.Outgoing(v);
+  const bool closed = !mesh_.IsBoundaryVertex(v);
+  double angle = 0;
+  int pieces = 0;
+  bool all = true;
+  for (size_t k = 0; k < fan.size(); ++k) {
+    const bool in = region_[Mesh::FaceOf(fan[k])] != 0;
+    all = all && in;
+    if (!in) continue;
+    angle += corner_angle_[fan[k]];
+    const bool previous_in = k > 0 ? region_[Mesh::FaceOf(fan[k - 1])] != 0
+                                   : closed && region_[Mesh::FaceOf(fan.back())] != 0;
+    pieces += !previous_in;
   }
-  return state == 2;
+  // A shortest path inside the region bends round v only where the region's
+  // angle there exceeds pi (a path through a corner of less is shortened by
+  // cutting it) or where it passes from one of its fans to another.
+  if (all) {
+    state = kInsideRegion;
+  } else if (pieces > 1 || angle > std::numbers::pi - kSaddleSlack) {
+    state = kReflexBorder;
+  } else {
+    state = kConvexBorder;
+  }
+  return state;
 }
 
 absl::Status ExactGeodesicSolver::AddSource(const SurfacePoint& p, int32_t source) {
@@ -276,7 +294,7 @@ void ExactGeodesicSolver::EmitFromVertex(int32_t v) {
   // On the border of a face region the vertex bounds the region as a
   // boundary vertex does, with a fan in pieces: emitting everywhere is a
   // superset of its shadow (every window stands for an actual path).
-  const double back = OnRegionBorder(v) ? -1 : BackAngle(v);
+  const double back = RegionBorderState(v) != kInsideRegion ? -1 : BackAngle(v);
   std::array<std::pair<double, double>, 3> shadow;
   int num_shadow = 0;
   constexpr double kMargin = 1e-9;
@@ -337,7 +355,7 @@ void ExactGeodesicSolver::UpdateVertex(int32_t v, double d, int32_t source, Via 
   dist_[v] = d;
   nearest_[v] = source;
   origin_[v] = {via, id};
-  if ((emits_[v] || OnRegionBorder(v)) && d <= stop_radius_) {
+  if ((emits_[v] || RegionBorderState(v) == kReflexBorder) && d <= stop_radius_) {
     queue_.Push(d, ~v);
   }
 }

@@ -69,7 +69,8 @@ struct GeodesicOptions {
   // region R of faces f with face_region[f] != 0, as if the other faces did
   // not exist: distances are those along paths inside R, and a vertex of R
   // with a face outside R is a boundary vertex of R (a pseudo-source in every
-  // direction). Every source must lie in a face of R. Windows that reach an
+  // direction, when R's angle there exceeds pi or R's faces round it make
+  // more than one fan). Every source must lie in a face of R. Windows that reach an
   // edge of R whose other face lies outside R stop there and are kept as
   // BorderWindows(). Read during Propagate only.
   std::span<const uint8_t> face_region;
@@ -194,8 +195,12 @@ class ExactGeodesicSolver {
     if (dist_[v] == kInfinity) touched_vertices_.push_back(v);
   }
   bool InRegion(int32_t face) const { return region_.empty() || region_[face] != 0; }
-  // Whether v has a face outside the region (false without a region).
-  bool OnRegionBorder(int32_t v);
+  // Where v lies in the face region (kInsideRegion without one): inside
+  // (all its faces in the region), or on the border, where it is a
+  // pseudo-source when shortest paths in the region may bend round it
+  // (reflex) and not otherwise (convex).
+  static constexpr uint8_t kUnknown = 0, kInsideRegion = 1, kReflexBorder = 2, kConvexBorder = 3;
+  uint8_t RegionBorderState(int32_t v);
   absl::Status AddSource(const SurfacePoint& p, int32_t source);
   void AddFaceSource(int32_t face, const std::array<double, 3>& w, int32_t source,
                      int32_t skip_halfedge);
@@ -224,8 +229,7 @@ class ExactGeodesicSolver {
   std::vector<double> dist_;
   std::vector<int32_t> nearest_;
   std::vector<VertexOrigin> origin_;
-  // Per vertex, whether it is on the region's border: 0 not known yet,
-  // 1 no, 2 yes.
+  // Per vertex, RegionBorderState, or kUnknown before it is first needed.
   std::vector<uint8_t> region_border_;
   // What the last propagation touched: vertices whose dist_ became finite,
   // half-edges that got a window. full_reset_ when initial distances made
