@@ -90,6 +90,8 @@ class ConfinedGeodesicSolver {
                                                  std::span<const int32_t> seed_faces = {});
 
   const ConfinedStats& stats() const { return stats_; }
+  // The faces of the last call's last region (any order).
+  std::span<const int32_t> region_faces() const { return region_faces_; }
   const Mesh& mesh() const { return mesh_; }
 
  private:
