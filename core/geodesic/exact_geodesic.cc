@@ -35,12 +35,34 @@ ExactGeodesicSolver::ExactGeodesicSolver(const Mesh& mesh)
 }
 
 void ExactGeodesicSolver::Reset() {
-  dist_.assign(mesh_.num_vertices(), kInfinity);
-  nearest_.assign(mesh_.num_vertices(), kNone);
-  origin_.assign(mesh_.num_vertices(), VertexOrigin{});
+  // Clearing only what the last propagation touched keeps a propagation that
+  // reaches a few hundred faces of a large mesh from paying O(n) for it.
+  if (full_reset_) {
+    dist_.assign(mesh_.num_vertices(), kInfinity);
+    nearest_.assign(mesh_.num_vertices(), kNone);
+    origin_.assign(mesh_.num_vertices(), VertexOrigin{});
+    region_border_.assign(mesh_.num_vertices(), 0);
+    edge_head_.assign(mesh_.num_halfedges(), kNone);
+    split_.assign(mesh_.num_halfedges(), Split{});
+    full_reset_ = false;
+  } else {
+    for (const int32_t v : touched_vertices_) {
+      dist_[v] = kInfinity;
+      nearest_[v] = kNone;
+      origin_[v] = VertexOrigin{};
+      region_border_[v] = 0;
+    }
+    for (const int32_t h : touched_halfedges_) {
+      edge_head_[h] = kNone;
+      split_[h] = Split{};
+    }
+  }
+  touched_vertices_.clear();
+  touched_halfedges_.clear();
+  region_ = {};
+  border_windows_.clear();
+  settled_below_ = kInfinity;
   windows_.clear();
-  edge_head_.assign(mesh_.num_halfedges(), kNone);
-  split_.assign(mesh_.num_halfedges(), Split{});
   queue_.Clear();
   face_sources_.clear();
   sources_.clear();
@@ -55,7 +77,22 @@ absl::Status ExactGeodesicSolver::Propagate(std::span<const SurfacePoint> source
     GEODEX_RETURN_IF_ERROR(mesh::ValidateSurfacePoint(mesh_, s));
   }
   GEODEX_RETURN_IF_ERROR(CheckInitialDistances(options.initial_distance, mesh_.num_vertices()));
+  if (!options.face_region.empty()) {
+    if (options.face_region.size() != static_cast<size_t>(mesh_.num_faces())) {
+      return absl::InvalidArgumentError(
+          absl::StrFormat("face_region has %d entries, the mesh %d faces",
+                          options.face_region.size(), mesh_.num_faces()));
+    }
+    for (const SurfacePoint& s : sources) {
+      if (options.face_region[s.face] == 0) {
+        return absl::InvalidArgumentError(
+            absl::StrFormat("a source lies in face %d, outside the face region", s.face));
+      }
+    }
+  }
   if (!options.initial_distance.empty()) {
+    // dist_ becomes finite where no propagation touches it.
+    full_reset_ = true;
     for (int32_t v = 0; v < mesh_.num_vertices(); ++v) {
       const double d = options.initial_distance[v];
       if (d < kInfinity) {
@@ -72,6 +109,7 @@ absl::Status ExactGeodesicSolver::Propagate(std::span<const SurfacePoint> source
       return absl::OutOfRangeError(absl::StrFormat("stop vertex %d out of range", v));
     }
   }
+  region_ = options.face_region;
   stop_radius_ = options.stop_radius;
   stop_vertices_ = options.stop_vertices;
   stop_points_ = options.stop_points;
@@ -94,8 +132,10 @@ absl::Status ExactGeodesicSolver::Propagate(std::span<const SurfacePoint> source
     // Everything still queued is at least `key` away (up to rounding): past
     // the stop radius, or once the targets are no farther, nothing is left
     // to improve.
-    if (key > stop_radius_) break;
-    if (has_targets && (++pops & 63) == 0 && TargetsSettled(key)) break;
+    if (key > stop_radius_ || (has_targets && (++pops & 63) == 0 && TargetsSettled(key))) {
+      settled_below_ = key;
+      break;
+    }
     if (id < 0) {
       const int32_t v = ~id;
       if (key != dist_[v]) continue;  // superseded by a shorter path
@@ -113,7 +153,41 @@ absl::Status ExactGeodesicSolver::Propagate(std::span<const SurfacePoint> source
     }
   }
   queue_.Clear();
+  region_ = {};
   return absl::OkStatus();
+}
+
+uint8_t ExactGeodesicSolver::RegionBorderState(int32_t v) {
+  if (region_.empty()) return kInsideRegion;
+  uint8_t& state = region_border_[v];
+  if (state != kUnknown) return state;
+  // The region's faces round v: their angle, and how many separate fans they
+  // make.
+  const auto fan = mesh_.Outgoing(v);
+  const bool closed = !mesh_.IsBoundaryVertex(v);
+  double angle = 0;
+  int pieces = 0;
+  bool all = true;
+  for (size_t k = 0; k < fan.size(); ++k) {
+    const bool in = region_[Mesh::FaceOf(fan[k])] != 0;
+    all = all && in;
+    if (!in) continue;
+    angle += corner_angle_[fan[k]];
+    const bool previous_in = k > 0 ? region_[Mesh::FaceOf(fan[k - 1])] != 0
+                                   : closed && region_[Mesh::FaceOf(fan.back())] != 0;
+    pieces += !previous_in;
+  }
+  // A shortest path inside the region bends round v only where the region's
+  // angle there exceeds pi (a path through a corner of less is shortened by
+  // cutting it) or where it passes from one of its fans to another.
+  if (all) {
+    state = kInsideRegion;
+  } else if (pieces > 1 || angle > std::numbers::pi - kSaddleSlack) {
+    state = kReflexBorder;
+  } else {
+    state = kConvexBorder;
+  }
+  return state;
 }
 
 absl::Status ExactGeodesicSolver::AddSource(const SurfacePoint& p, int32_t source) {
@@ -121,6 +195,7 @@ absl::Status ExactGeodesicSolver::AddSource(const SurfacePoint& p, int32_t sourc
   if (place.kind == SourcePlace::kVertex) {
     const int32_t v = place.vertex;
     if (dist_[v] > 0 || origin_[v].via == Via::kInitial) {
+      Touch(v);
       dist_[v] = 0;
       nearest_[v] = source;
       origin_[v] = {Via::kSource, source};
@@ -136,7 +211,8 @@ absl::Status ExactGeodesicSolver::AddSource(const SurfacePoint& p, int32_t sourc
   const int32_t h = place.halfedge;
   AddFaceSource(p.face, place.w, source, h);
   const int32_t g = mesh_.Twin(h);
-  if (g != kNone) AddFaceSource(Mesh::FaceOf(g), WeightsInTwin(h, g, place.w), source, g);
+  if (g != kNone && InRegion(Mesh::FaceOf(g)))
+    AddFaceSource(Mesh::FaceOf(g), WeightsInTwin(h, g, place.w), source, g);
   return absl::OkStatus();
 }
 
@@ -206,6 +282,7 @@ void ExactGeodesicSolver::EmitFromVertex(int32_t v) {
   const int32_t source = nearest_[v];
   const auto fan = mesh_.Outgoing(v);
   for (const int32_t o : fan) {
+    if (!InRegion(Mesh::FaceOf(o))) continue;
     UpdateVertex(mesh_.Dest(o), d + mesh_.Length(o), source, Via::kVertex, v);
     UpdateVertex(mesh_.Opposite(o), d + mesh_.Length(Mesh::Prev(o)), source, Via::kVertex, v);
   }
@@ -214,7 +291,10 @@ void ExactGeodesicSolver::EmitFromVertex(int32_t v) {
   // direction it came from (Mitchell, Mount & Papadimitriou 1987).
   double total = 0;
   for (const int32_t o : fan) total += corner_angle_[o];
-  const double back = BackAngle(v);
+  // On the border of a face region the vertex bounds the region as a
+  // boundary vertex does, with a fan in pieces: emitting everywhere is a
+  // superset of its shadow (every window stands for an actual path).
+  const double back = RegionBorderState(v) != kInsideRegion ? -1 : BackAngle(v);
   std::array<std::pair<double, double>, 3> shadow;
   int num_shadow = 0;
   constexpr double kMargin = 1e-9;
@@ -238,7 +318,7 @@ void ExactGeodesicSolver::EmitFromVertex(int32_t v) {
   for (const int32_t o : fan) {
     const double theta = corner_angle_[o];
     const int32_t g = Mesh::Next(o);  // the edge opposite v in this face
-    const int32_t t = mesh_.Twin(g);
+    const int32_t t = InRegion(Mesh::FaceOf(o)) ? mesh_.Twin(g) : kNone;
     for (int k = 0; k < num_shadow && t != kNone; ++k) {
       const double a0 = std::max(shadow[k].first - phi, 0.0);
       const double a1 = std::min(shadow[k].second - phi, theta);
@@ -271,10 +351,11 @@ void ExactGeodesicSolver::EmitFromVertex(int32_t v) {
 
 void ExactGeodesicSolver::UpdateVertex(int32_t v, double d, int32_t source, Via via, int32_t id) {
   if (!(d < dist_[v])) return;
+  Touch(v);
   dist_[v] = d;
   nearest_[v] = source;
   origin_[v] = {via, id};
-  if (emits_[v] && d <= stop_radius_) {
+  if ((emits_[v] || RegionBorderState(v) == kReflexBorder) && d <= stop_radius_) {
     queue_.Push(d, ~v);
   }
 }
@@ -290,12 +371,19 @@ bool ExactGeodesicSolver::IsUseless(const Window& w) const {
 }
 
 void ExactGeodesicSolver::PushWindow(const Window& w) {
+  if (!InRegion(Mesh::FaceOf(w.h))) {
+    // Before every filter: the corners of the face beyond are not reached
+    // inside the region, so they cannot stand in for the window.
+    border_windows_.push_back({w.h, w.b0, w.b1, w.sx, w.sy, w.sigma});
+    return;
+  }
   if (!(w.b1 - w.b0 > 1e-14 * frame_[w.h].length)) return;
   const double key = MinDistance(w);
   if (key > stop_radius_) return;
   if (IsUseless(w)) return;
   const int32_t index = static_cast<int32_t>(windows_.size());
   windows_.push_back(w);
+  if (edge_head_[w.h] == kNone) touched_halfedges_.push_back(w.h);
   windows_.back().next_on_edge = edge_head_[w.h];
   edge_head_[w.h] = index;
   ++stats_.windows_created;

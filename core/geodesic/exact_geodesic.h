@@ -18,6 +18,13 @@
 //   double e = solver.DistanceAt(point);            // any surface point
 //   auto path = solver.PathTo(point);               // polyline back to the source
 //
+// A propagation may be confined to a region of faces (GeodesicOptions::
+// face_region): it then runs as on the sub-mesh those faces make, and keeps
+// the windows that reach the region's border for bounds on the paths that
+// leave it (core/geodesic/confined_geodesic.h). A propagation resets only the
+// state the one before it touched, so a small one costs little on a large
+// mesh.
+//
 // Thread safety: a solver holds per-propagation state and is not thread-safe;
 // use one solver per thread. Any number of solvers may share one const Mesh.
 
@@ -58,6 +65,15 @@ struct GeodesicOptions {
   // Safety net against pathological inputs: ResourceExhausted past this many
   // windows. 0 means 400 per half-edge plus 10^6.
   int64_t max_windows = 0;
+  // If non-empty (one entry per face), the propagation is confined to the
+  // region R of faces f with face_region[f] != 0, as if the other faces did
+  // not exist: distances are those along paths inside R, and a vertex of R
+  // with a face outside R is a boundary vertex of R (a pseudo-source in every
+  // direction, when R's angle there exceeds pi or R's faces round it make
+  // more than one fan). Every source must lie in a face of R. Windows that reach an
+  // edge of R whose other face lies outside R stop there and are kept as
+  // BorderWindows(). Read during Propagate only.
+  std::span<const uint8_t> face_region;
 };
 
 struct GeodesicStats {
@@ -68,6 +84,23 @@ struct GeodesicStats {
 
 class ExactGeodesicSolver {
  public:
+  // A window that reached the border of a face_region: the interval [b0,b1]
+  // of the edge of half-edge `h` (h's face lies outside the region, its
+  // twin's inside), measured from Origin(h), lit by the pseudo-source
+  // (sx,sy), sy <= 0, unfolded into h's frame (origin at Origin(h), x along
+  // the edge, the outside face at y > 0) at distance `sigma` from the source.
+  // Every point x of the interval is reached inside the region by a path of
+  // length sigma + |(sx,sy) - (x,0)|. Kept before any filter, so that the
+  // border windows and the distances of the region's vertices between them
+  // give the exact in-region distance of every point of the border edges
+  // closer than SettledBelow().
+  struct BorderWindow {
+    int32_t h;
+    double b0, b1;
+    double sx, sy;
+    double sigma;
+  };
+
   // `mesh` must outlive the solver.
   explicit ExactGeodesicSolver(const Mesh& mesh);
 
@@ -102,6 +135,14 @@ class ExactGeodesicSolver {
   // point, NotFound when `p` is unreachable, FailedPrecondition when the path
   // runs into a vertex whose distance came from `initial_distance`.
   absl::StatusOr<std::vector<SurfacePoint>> PathTo(const SurfacePoint& p) const;
+
+  // The windows of the last propagation that reached the border of its
+  // face_region (none without one).
+  std::span<const BorderWindow> BorderWindows() const { return border_windows_; }
+  // A distance below which every result of the last propagation is final:
+  // +inf when it ran to the end, else the distance of the front where a stop
+  // radius or the stop targets ended it (at least their distances).
+  double SettledBelow() const { return settled_below_; }
 
   const GeodesicStats& stats() const { return stats_; }
   const Mesh& mesh() const { return mesh_; }
@@ -146,7 +187,20 @@ class ExactGeodesicSolver {
     int32_t id = mesh::kNone;
   };
 
+  // Clears the state of the last propagation: only the entries it touched,
+  // unless it started from initial distances.
   void Reset();
+  // Records the first change of vertex v's state since Reset.
+  void Touch(int32_t v) {
+    if (dist_[v] == kInfinity) touched_vertices_.push_back(v);
+  }
+  bool InRegion(int32_t face) const { return region_.empty() || region_[face] != 0; }
+  // Where v lies in the face region (kInsideRegion without one): inside
+  // (all its faces in the region), or on the border, where it is a
+  // pseudo-source when shortest paths in the region may bend round it
+  // (reflex) and not otherwise (convex).
+  static constexpr uint8_t kUnknown = 0, kInsideRegion = 1, kReflexBorder = 2, kConvexBorder = 3;
+  uint8_t RegionBorderState(int32_t v);
   absl::Status AddSource(const SurfacePoint& p, int32_t source);
   void AddFaceSource(int32_t face, const std::array<double, 3>& w, int32_t source,
                      int32_t skip_halfedge);
@@ -175,6 +229,17 @@ class ExactGeodesicSolver {
   std::vector<double> dist_;
   std::vector<int32_t> nearest_;
   std::vector<VertexOrigin> origin_;
+  // Per vertex, RegionBorderState, or kUnknown before it is first needed.
+  std::vector<uint8_t> region_border_;
+  // What the last propagation touched: vertices whose dist_ became finite,
+  // half-edges that got a window. full_reset_ when initial distances made
+  // dist_ finite elsewhere too.
+  std::vector<int32_t> touched_vertices_;
+  std::vector<int32_t> touched_halfedges_;
+  bool full_reset_ = true;
+  std::span<const uint8_t> region_;
+  std::vector<BorderWindow> border_windows_;
+  double settled_below_ = kInfinity;
   // Reset clears windows_ and queue_ but keeps their memory: a reused solver
   // does not regrow them (on a fresh solver, growing windows_ takes a third
   // or more of the time of a large full propagation).

@@ -400,6 +400,121 @@ TEST(ExactGeodesicTest, ParallelSolversShareOneMesh) {
   }
 }
 
+// A C-shaped piece of a torus with a notch cut into its top.
+std::vector<uint8_t> TorusRegion(const Mesh& m) {
+  std::vector<uint8_t> region(m.num_faces(), 0);
+  for (int32_t f = 0; f < m.num_faces(); ++f) {
+    Vec3 c = Vec3::Zero();
+    for (const int32_t v : m.face(f)) c += m.position(v) / 3;
+    const double theta = std::atan2(c.y(), c.x()) + std::numbers::pi;  // [0, 2pi]
+    const bool notch = theta > 2.0 && theta < 2.5 && c.z() > 0.1;
+    region[f] = theta < 1.5 * std::numbers::pi && !notch;
+  }
+  return region;
+}
+
+TEST(ExactGeodesicTest, FaceRegionPropagatesAsItsSubMesh) {
+  const Mesh m = gen::Torus(40, 16, 1.0, 0.35);
+  const std::vector<uint8_t> region = TorusRegion(m);
+  // The region as a mesh of its own.
+  std::vector<int32_t> local(m.num_vertices(), -1), global;
+  std::vector<Vec3> positions;
+  std::vector<mesh::Triangle> faces;
+  int32_t source_face = -1;
+  for (int32_t f = 0; f < m.num_faces(); ++f) {
+    if (!region[f]) continue;
+    mesh::Triangle t;
+    for (int k = 0; k < 3; ++k) {
+      const int32_t v = m.face(f)[k];
+      if (local[v] < 0) {
+        local[v] = static_cast<int32_t>(positions.size());
+        positions.push_back(m.position(v));
+        global.push_back(v);
+      }
+      t[k] = local[v];
+    }
+    if (source_face < 0 && faces.size() == 200) source_face = f;
+    faces.push_back(t);
+  }
+  const absl::StatusOr<Mesh> sub = Mesh::Create(positions, faces, "torus region");
+  ASSERT_TRUE(sub.ok()) << sub.status();
+  ASSERT_GT(sub->num_boundary_edges(), 0);
+
+  const SurfacePoint source{source_face, {0.2, 0.3, 0.5}};
+  const SurfacePoint sub_source{200, source.w};
+  ExactGeodesicSolver whole(m), part(*sub);
+  GeodesicOptions options;
+  options.face_region = region;
+  ASSERT_TRUE(whole.Propagate({source}, options).ok());
+  ASSERT_TRUE(part.Propagate({sub_source}).ok());
+  for (int32_t v = 0; v < sub->num_vertices(); ++v) {
+    const double want = part.VertexDistance(v);
+    ASSERT_LT(want, kInfinity);
+    EXPECT_NEAR(whole.VertexDistance(global[v]), want, 1e-10 * want) << "vertex " << global[v];
+  }
+  for (int32_t v = 0; v < m.num_vertices(); ++v) {
+    if (local[v] < 0) {
+      EXPECT_EQ(whole.VertexDistance(v), kInfinity);
+    }
+  }
+  // The whole region was reached: windows stopped at both ends of the C and
+  // at the notch, each on an edge leaving the region.
+  ASSERT_FALSE(whole.BorderWindows().empty());
+  for (const ExactGeodesicSolver::BorderWindow& w : whole.BorderWindows()) {
+    EXPECT_FALSE(region[Mesh::FaceOf(w.h)]);
+    EXPECT_TRUE(region[Mesh::FaceOf(m.Twin(w.h))]);
+  }
+  EXPECT_EQ(whole.SettledBelow(), kInfinity);
+}
+
+TEST(ExactGeodesicTest, PropagationsLeaveNoStateBehind) {
+  const Mesh m = gen::Torus(40, 16, 1.0, 0.35);
+  const std::vector<uint8_t> region = TorusRegion(m);
+  int32_t in_region = 0;
+  while (!region[in_region]) ++in_region;
+  const SurfacePoint a = AtVertex(m, 7), b = InFace(in_region, 0.3, 0.3);
+  const SurfacePoint c = OnEdge(m.num_faces() - 1, 1, 0.4);
+  GeodesicOptions confined;
+  confined.face_region = region;
+  GeodesicOptions stopped;
+  stopped.stop_points = {AtVertex(m, 9)};
+  std::vector<double> initial(m.num_vertices(), kInfinity);
+  initial[100] = 0.25;
+  GeodesicOptions from_initial;
+  from_initial.initial_distance = initial;
+
+  ExactGeodesicSolver reused(m);
+  const std::vector<std::pair<SurfacePoint, const GeodesicOptions*>> runs = {
+      {a, nullptr},   {b, &confined}, {c, &stopped}, {a, &from_initial},
+      {b, &confined}, {c, nullptr},   {b, &stopped}, {a, nullptr}};
+  for (const auto& [source, options] : runs) {
+    const GeodesicOptions& o = options != nullptr ? *options : GeodesicOptions{};
+    ExactGeodesicSolver fresh(m);
+    ASSERT_TRUE(fresh.Propagate({source}, o).ok());
+    ASSERT_TRUE(reused.Propagate({source}, o).ok());
+    EXPECT_EQ(reused.VertexDistances(), fresh.VertexDistances());
+    EXPECT_EQ(reused.NearestSources(), fresh.NearestSources());
+    EXPECT_EQ(reused.DistanceAt(c), fresh.DistanceAt(c));
+    EXPECT_EQ(reused.BorderWindows().size(), fresh.BorderWindows().size());
+  }
+}
+
+TEST(ExactGeodesicTest, InvalidFaceRegionsAreRejected) {
+  const Mesh m = gen::Grid(4, 4, 1.0, 1.0);
+  ExactGeodesicSolver solver(m);
+  std::vector<uint8_t> region(m.num_faces() - 1, 1);
+  GeodesicOptions options;
+  options.face_region = region;
+  EXPECT_EQ(solver.Propagate({AtVertex(m, 0)}, options).code(), absl::StatusCode::kInvalidArgument);
+  region.assign(m.num_faces(), 1);
+  region[3] = 0;
+  options.face_region = region;
+  const absl::Status status = solver.Propagate({InFace(3, 0.2, 0.2)}, options);
+  EXPECT_EQ(status.code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(status.message(), HasSubstr("outside the face region"));
+  EXPECT_TRUE(solver.Propagate({InFace(4, 0.2, 0.2)}, options).ok());
+}
+
 TEST(ExactGeodesicTest, InvalidSourcesAreRejected) {
   const Mesh m = gen::Grid(4, 4, 1.0, 1.0);
   ExactGeodesicSolver solver(m);
