@@ -106,8 +106,8 @@ absl::Status WriteAndReport(const index::IndexData& data, BuildSummary& summary,
 }
 
 // The summary's line of a target-error build.
-std::string TargetSummary(const std::vector<validation::TargetFigures>& rounds,
-                          const NextStep& end, double target) {
+std::string TargetSummary(const std::vector<validation::TargetFigures>& rounds, const NextStep& end,
+                          double target) {
   std::string samples;
   for (const validation::TargetFigures& r : rounds) {
     samples += absl::StrFormat("%s%d", samples.empty() ? "" : ", ", r.samples);
@@ -118,8 +118,7 @@ std::string TargetSummary(const std::vector<validation::TargetFigures>& rounds,
       "  error target     %g: %s in %d rounds (m = %s); closest check %s, 95%% upper limit "
       "%.3f%% of %.3f%%\n",
       target, end.reached ? "met" : absl::StrFormat("NOT met (m stopped at %s)", end.stop),
-      rounds.size(), samples,
-      validation::TargetCheckName(worst), 100 * last.upper[worst],
+      rounds.size(), samples, validation::TargetCheckName(worst), 100 * last.upper[worst],
       100 * validation::TargetLimit(worst, target));
 }
 
@@ -282,7 +281,9 @@ absl::StatusOr<BuildReport> BuildIndexFile(const std::string& mesh_path, const s
                           PrepareMesh(repaired.mesh, RecordRepair(repaired),
                                       options.build.num_samples, options.build.refine_long_edges));
   const mesh::Mesh& mesh = prepared.mesh;
-  GEODEX_ASSIGN_OR_RETURN(const Plan plan, MakePlan(mesh, options.build));
+  BuildOptions build = options.build;
+  build.input_vertex_ids = InputVertexIds(prepared);
+  GEODEX_ASSIGN_OR_RETURN(const Plan plan, MakePlan(mesh, build));
   BuildReport report;
   GEODEX_RETURN_IF_ERROR(WriteEdges(mesh, plan, options.edges_obj, &report));
   BuildSummary summary;
@@ -305,7 +306,9 @@ absl::StatusOr<BuildReport> PlanBuild(const std::string& mesh_path, const std::s
                           PrepareMesh(repaired.mesh, RecordRepair(repaired),
                                       options.build.num_samples, options.build.refine_long_edges));
   const mesh::Mesh& mesh = prepared.mesh;
-  GEODEX_ASSIGN_OR_RETURN(const Plan plan, MakePlan(mesh, options.build));
+  BuildOptions build = options.build;
+  build.input_vertex_ids = InputVertexIds(prepared);
+  GEODEX_ASSIGN_OR_RETURN(const Plan plan, MakePlan(mesh, build));
   GEODEX_RETURN_IF_ERROR(SavePlan(mesh, plan, workdir));
   GEODEX_RETURN_IF_ERROR(SaveRepair(prepared.record, plan, workdir));
   BuildReport report;

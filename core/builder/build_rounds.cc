@@ -84,6 +84,7 @@ absl::StatusOr<RoundPlan> PlanFirstRound(const mesh::Mesh& coarse, const RepairR
                        GEODEX_ASSIGN_OR_RETURN(
                            PreparedMesh prepared,
                            PrepareMesh(coarse, repair, m, build.refine_long_edges));
+                       build.input_vertex_ids = InputVertexIds(prepared);
                        GEODEX_ASSIGN_OR_RETURN(Plan plan, MakePlan(prepared.mesh, build));
                        return RoundPlan{std::move(prepared), std::move(plan), {}};
                      });
@@ -103,6 +104,7 @@ absl::StatusOr<RoundPlan> PlanNextRound(const mesh::Mesh& coarse, const RepairRe
         build.num_samples = n;
         GEODEX_ASSIGN_OR_RETURN(PreparedMesh prepared,
                                 PrepareMesh(coarse, repair, n, build.refine_long_edges));
+        build.input_vertex_ids = InputVertexIds(prepared);
         if (!in_order || m > n || !KeepsVertices(previous.prepared.mesh, prepared.mesh)) {
           GEODEX_ASSIGN_OR_RETURN(Plan plan, MakePlan(prepared.mesh, build));
           return RoundPlan{std::move(prepared), std::move(plan), {}};
@@ -147,8 +149,8 @@ NextStep DecideNext(const std::vector<TargetFigures>& rounds, int32_t requested_
   // 3% of the budget spare: the refined mesh, and with it the bytes beside
   // the matrix, grow a little faster than m (bunny_closed_30k: an index
   // predicted to fit came out 1% over).
-  const int32_t fits = validation::SamplesWithinBytes(validation::kMaxIndexBytes * 97 / 100,
-                                                      samples, index_bytes);
+  const int32_t fits =
+      validation::SamplesWithinBytes(validation::kMaxIndexBytes * 97 / 100, samples, index_bytes);
   const validation::PredictionOptions prediction;
   next.num_samples = validation::PredictSamples(rounds, target, std::min(cap, fits), prediction);
   // A round that cannot grow m by the least growth a prediction asks is not
