@@ -175,6 +175,16 @@ std::vector<ScanCase> ScanCases() {
       {"decimated handle",
        mt::ClusterVertices(mt::RawOf(gen::PinchedTorus(128, 48, 1.0, 0.9, 0.04), "blob"), 0.06),
        60});
+  // Clustering closes the torus's hole (0.2 across) into tunnels smaller
+  // than a cube: before the repair located them, m = 30 ended with a wrong
+  // Euler characteristic after 200 rounds.
+  cases.push_back({"decimated tunnel",
+                   mt::ClusterVertices(mt::RawOf(gen::Torus(96, 48, 1.0, 0.9), "torus"), 0.03),
+                   30});
+  // A sheet folded almost flat onto itself, its sides merged.
+  cases.push_back(
+      {"decimated fold",
+       mt::ClusterVertices(mt::RawOf(gen::FoldedSheet(60, 30, 2.0, 1.0, 3.0), "fold"), 0.05), 30});
   return cases;
 }
 
@@ -250,6 +260,44 @@ TEST(ScanBuildTest, ADecimatedSharedScanBuildsAndAnswers) {
   ASSERT_TRUE(out.built) << out.refusal;
   EXPECT_NE(out.repair.find("for wrong Euler characteristic"), std::string::npos) << out.repair;
   EXPECT_LT(out.worst, 0.25);
+}
+
+// A tunnel that clustering closed, smaller than the cells: the component's
+// Euler characteristic is wrong while every local check passes, and the
+// repair finds the loop and samples it.
+TEST(ScanBuildTest, ATunnelTheSamplesMissIsLocatedAndSampled) {
+  const RawMesh raw = mt::ClusterVertices(mt::RawOf(gen::Torus(96, 48, 1.0, 0.9), "torus"), 0.03);
+  absl::StatusOr<mesh::RepairedMesh> repaired = mesh::RepairMesh(raw);
+  ASSERT_TRUE(repaired.ok()) << repaired.status();
+  auto set = sampling::FarthestPointSampling(repaired->mesh, 30, 1);
+  ASSERT_TRUE(set.ok());
+  triangulation::RepairReport report;
+  triangulation::RepairOptions options;
+  options.max_samples = 4 * 30 + 64;
+  auto dual = triangulation::RepairTriangulation(repaired->mesh, &*set, options, &report);
+  ASSERT_TRUE(dual.ok()) << dual.status();
+  std::printf("decimated tunnel: %s\n", report.Summary().c_str());
+  EXPECT_GE(report.added_for[static_cast<int>(triangulation::ViolationKind::kEulerCharacteristic)],
+            1);
+  EXPECT_LE(report.rounds, 40);
+  // Stopped at the round where only the loop is left, the refusal names it.
+  bool named = false;
+  for (int rounds = 0; rounds < report.rounds && !named; ++rounds) {
+    auto again = sampling::FarthestPointSampling(repaired->mesh, 30, 1);
+    ASSERT_TRUE(again.ok());
+    triangulation::RepairReport stopped_report;
+    options.max_rounds = rounds;
+    auto stopped =
+        triangulation::RepairTriangulation(repaired->mesh, &*again, options, &stopped_report);
+    ASSERT_FALSE(stopped.ok());
+    ExpectReadableRefusal(stopped.status());
+    const std::string message(stopped.status().message());
+    if (message.find("a loop the samples miss") == std::string::npos) continue;
+    named = true;
+    std::printf("%s\n", stopped.status().ToString().c_str());
+    EXPECT_NE(message.find(" L long at vertex "), std::string::npos) << message;
+  }
+  EXPECT_TRUE(named);
 }
 
 // Refusals name the place: stop the repair before it is done.

@@ -518,7 +518,7 @@ std::string DescribeViolation(const Mesh& mesh, const sampling::SampleSet& set,
     const Vec3& p = mesh.position(v);
     const int32_t id = input_vertex_ids.empty() ? v : input_vertex_ids[v];
     const std::string name = id == kNone ? std::string("a midpoint") : absl::StrCat("vertex ", id);
-    return absl::StrFormat("%s (%.4g, %.4g, %.4g)", name, p.x(), p.y(), p.z());
+    return absl::StrFormat("%s (%.3g, %.3g, %.3g)", name, p.x(), p.y(), p.z());
   };
   const std::vector<int32_t>& cells = violation.cells;
   std::string samples =
@@ -527,8 +527,7 @@ std::string DescribeViolation(const Mesh& mesh, const sampling::SampleSet& set,
   std::string out;
   if (violation.kind == ViolationKind::kEulerCharacteristic && !violation.vertices.empty()) {
     out = absl::StrFormat(
-        "a loop the samples miss (a handle, tunnel or pinch), %.2g L long, closing between %s and "
-        "%s, in the cells of samples %s",
+        "a loop the samples miss (handle, tunnel or pinch) %.2g L long at %s - %s, samples %s",
         violation.loop_length / spacing, vertex(violation.vertices[0]),
         vertex(violation.vertices[1]), samples);
   } else {
@@ -540,11 +539,11 @@ std::string DescribeViolation(const Mesh& mesh, const sampling::SampleSet& set,
     }
     out = absl::StrFormat("%s at samples %s", ViolationName(violation.kind), samples);
     if (a != kNone) {
-      absl::StrAppendFormat(&out, ", the first at %s, its cell %.2g L across",
-                            vertex(set.samples[a]), radius / spacing);
+      absl::StrAppendFormat(&out, ", the first at %s, its cell %.2g L wide", vertex(set.samples[a]),
+                            radius / spacing);
     }
   }
-  absl::StrAppendFormat(&out, " (L = %.3g)", spacing);
+  absl::StrAppendFormat(&out, "; L = %.3g", spacing);
   return out;
 }
 
@@ -600,10 +599,11 @@ absl::StatusOr<DualComplex> RepairTriangulation(const Mesh& mesh, sampling::Samp
       v.loop_length = loop;
     }
     if (round >= options.max_rounds || m >= options.max_samples) {
-      return refuse(absl::StrFormat("no valid geodesic triangulation after %d repair rounds and %d "
-                                    "samples, %d violations left",
-                                    round, m, dual.violations.size()),
-                    dual.violations.front());
+      return refuse(
+          absl::StrFormat("no valid geodesic triangulation after %d rounds, %d samples, %d "
+                          "violations left",
+                          round, m, dual.violations.size()),
+          dual.violations.front());
     }
     // The farthest vertex of each cell.
     std::vector<int32_t> far(m, kNone);
