@@ -281,7 +281,9 @@ absl::StatusOr<BuildReport> BuildIndexFile(const std::string& mesh_path, const s
                           PrepareMesh(repaired.mesh, RecordRepair(repaired),
                                       options.build.num_samples, options.build.refine_long_edges));
   const mesh::Mesh& mesh = prepared.mesh;
-  GEODEX_ASSIGN_OR_RETURN(const Plan plan, MakePlan(mesh, options.build));
+  BuildOptions build = options.build;
+  build.input_vertex_ids = InputVertexIds(prepared);
+  GEODEX_ASSIGN_OR_RETURN(const Plan plan, MakePlan(mesh, build));
   BuildReport report;
   GEODEX_RETURN_IF_ERROR(WriteEdges(mesh, plan, options.edges_obj, &report));
   BuildSummary summary;
@@ -304,7 +306,9 @@ absl::StatusOr<BuildReport> PlanBuild(const std::string& mesh_path, const std::s
                           PrepareMesh(repaired.mesh, RecordRepair(repaired),
                                       options.build.num_samples, options.build.refine_long_edges));
   const mesh::Mesh& mesh = prepared.mesh;
-  GEODEX_ASSIGN_OR_RETURN(const Plan plan, MakePlan(mesh, options.build));
+  BuildOptions build = options.build;
+  build.input_vertex_ids = InputVertexIds(prepared);
+  GEODEX_ASSIGN_OR_RETURN(const Plan plan, MakePlan(mesh, build));
   GEODEX_RETURN_IF_ERROR(SavePlan(mesh, plan, workdir));
   GEODEX_RETURN_IF_ERROR(SaveRepair(prepared.record, plan, workdir));
   BuildReport report;

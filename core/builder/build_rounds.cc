@@ -84,6 +84,7 @@ absl::StatusOr<RoundPlan> PlanFirstRound(const mesh::Mesh& coarse, const RepairR
                        GEODEX_ASSIGN_OR_RETURN(
                            PreparedMesh prepared,
                            PrepareMesh(coarse, repair, m, build.refine_long_edges));
+                       build.input_vertex_ids = InputVertexIds(prepared);
                        GEODEX_ASSIGN_OR_RETURN(Plan plan, MakePlan(prepared.mesh, build));
                        return RoundPlan{std::move(prepared), std::move(plan), {}};
                      });
@@ -103,6 +104,7 @@ absl::StatusOr<RoundPlan> PlanNextRound(const mesh::Mesh& coarse, const RepairRe
         build.num_samples = n;
         GEODEX_ASSIGN_OR_RETURN(PreparedMesh prepared,
                                 PrepareMesh(coarse, repair, n, build.refine_long_edges));
+        build.input_vertex_ids = InputVertexIds(prepared);
         if (!in_order || m > n || !KeepsVertices(previous.prepared.mesh, prepared.mesh)) {
           GEODEX_ASSIGN_OR_RETURN(Plan plan, MakePlan(prepared.mesh, build));
           return RoundPlan{std::move(prepared), std::move(plan), {}};

@@ -233,6 +233,26 @@ class CarriedCellReach {
   double longest_edge_ = 0;
 };
 
+// Samples the repair may add beyond 4m + 64 for the mesh's topology: a
+// closed component needs 4 samples at least (a tetrahedron), and each handle
+// or boundary loop (2 - chi of its component, a scan's slits and tiny handles
+// among them) a ring of cells round it: 2 to 3.2 samples a non-manifold edge
+// cut on clustered scans (core/README.md#topology-the-samples-miss); 16 each
+// leaves room.
+int64_t TopologyBudget(const Mesh& mesh) {
+  std::vector<int64_t> chi(mesh.num_components(), 0);
+  for (int32_t v = 0; v < mesh.num_vertices(); ++v) {
+    if (mesh.IsReferenced(v)) ++chi[mesh.VertexComponent(v)];
+  }
+  for (int32_t h = 0; h < mesh.num_halfedges(); ++h) {
+    if (mesh.Twin(h) == kNone || mesh.Twin(h) > h) --chi[mesh.FaceComponent(Mesh::FaceOf(h))];
+  }
+  for (int32_t f = 0; f < mesh.num_faces(); ++f) ++chi[mesh.FaceComponent(f)];
+  int64_t budget = 0;
+  for (int64_t c : chi) budget += 4 + 16 * std::max<int64_t>(0, 2 - c);
+  return budget;
+}
+
 // MakePlan's second half, shared with ExtendPlan: the repair of `set` into
 // a valid triangulation, and the plan made of both.
 absl::Status RepairIntoPlan(const Mesh& mesh, sampling::SampleSet set, const BuildOptions& options,
@@ -244,8 +264,10 @@ absl::Status RepairIntoPlan(const Mesh& mesh, sampling::SampleSet set, const Bui
   if (options.progress) options.progress({"repair", 0, 1});
   triangulation::RepairOptions repair;
   repair.max_rounds = options.max_repair_rounds;
-  repair.max_samples =
-      std::min<int32_t>(std::max<int32_t>(4 * options.num_samples + 64, 256), mesh.num_vertices());
+  repair.max_samples = static_cast<int32_t>(std::min<int64_t>(
+      std::max<int64_t>(4 * int64_t{options.num_samples} + 64, 256) + TopologyBudget(mesh),
+      mesh.num_vertices()));
+  repair.input_vertex_ids = options.input_vertex_ids;
   repair.check_edges = options.check_edges;
   repair.threads = ThreadCount(options);
   GEODEX_ASSIGN_OR_RETURN(triangulation::DualComplex dual,

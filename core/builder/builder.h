@@ -56,6 +56,10 @@ struct BuildOptions {
   // samples about 1 / weight apart relative to elsewhere. Empty: plain
   // farthest-point sampling.
   std::vector<double> spacing_weight;
+  // For refusal messages: the input file's id of each vertex of the mesh
+  // being built (kNone for a midpoint of the flat refinement); empty when the
+  // mesh's ids are the file's (InputVertexIds in mesh_arrays.h).
+  std::vector<int32_t> input_vertex_ids;
   // Called from builder threads (serialised by the builder) as work advances.
   std::function<void(const Progress&)> progress;
 };
@@ -104,10 +108,13 @@ struct BuildSummary {
 // same plan whatever options.threads (used to trace edges). Reports the
 // "sampling" and "repair" phases through options.progress, from the calling
 // thread.
+// The repair may add samples up to 4 num_samples + 64 (256 at least), plus
+// 16 for each handle or boundary loop and 4 for each component of the mesh.
 // Errors: InvalidArgument if num_samples < 1 or exceeds the mesh's
 // referenced vertices; FailedPrecondition when no valid triangulation is
-// reached within max_repair_rounds rounds or the sample limit; errors of the
-// exact propagation and of edge tracing.
+// reached within max_repair_rounds rounds or the sample limit, naming the
+// place in one line (triangulation::RepairTriangulation); errors of the exact
+// propagation and of edge tracing.
 // Thread safety: reentrant; `mesh` is only read.
 absl::StatusOr<Plan> MakePlan(const mesh::Mesh& mesh, const BuildOptions& options);
 

@@ -87,4 +87,14 @@ absl::StatusOr<PreparedMesh> PrepareMesh(const mesh::Mesh& coarse, RepairRecord 
   return PreparedMesh{std::move(split->mesh), std::move(repair)};
 }
 
+std::vector<int32_t> InputVertexIds(const PreparedMesh& prepared) {
+  const RepairRecord& record = prepared.record;
+  const int32_t nv = prepared.mesh.num_vertices();
+  const int32_t coarse = nv - record.refinement_vertices;
+  const int32_t input = coarse - static_cast<int32_t>(record.vertex_copies.size());
+  std::vector<int32_t> ids(nv, mesh::kNone);
+  for (int32_t v = 0; v < coarse; ++v) ids[v] = v < input ? v : record.vertex_copies[v - input];
+  return ids;
+}
+
 }  // namespace geodex::builder

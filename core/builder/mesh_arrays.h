@@ -69,4 +69,9 @@ struct PreparedMesh {
 absl::StatusOr<PreparedMesh> PrepareMesh(const mesh::Mesh& coarse, RepairRecord repair,
                                          int32_t num_samples, bool refine);
 
+// The input file's id of each vertex of `prepared.mesh`: its own below the
+// repair's copies, the vertex a copy stands for, mesh::kNone for a midpoint
+// of the refinement (BuildOptions::input_vertex_ids, for refusal messages).
+std::vector<int32_t> InputVertexIds(const PreparedMesh& prepared);
+
 }  // namespace geodex::builder

@@ -4,8 +4,10 @@
 // unrepairable Möbius strip), for the tests of core/mesh/mesh_repair.h and of
 // the queries over repaired indexes. Test-only, header-only.
 
+#include <array>
 #include <cmath>
 #include <cstdint>
+#include <map>
 #include <numbers>
 #include <string>
 #include <utility>
@@ -211,6 +213,98 @@ inline int32_t AddZeroAreaFace(RawMesh* raw, int32_t face) {
   AddTriangle(raw, {b, c, d});
   AddTriangle(raw, {a, c, b});
   return static_cast<int32_t>(raw->triangles.size() - 1);
+}
+
+// Decimation by vertex clustering (Rossignac & Borrel 1993), the way scans
+// are often thinned: every vertex moves to the mean of the vertices in its
+// cube of a grid of `cell` (in the mesh's units), and triangles left with a
+// repeated corner are dropped. Where the surface is thinner than a cube,
+// its sides merge: non-manifold edges and vertices, duplicate faces, and
+// handles and tunnels of about the cube's size, as decimated scans have.
+inline RawMesh ClusterVertices(const RawMesh& raw, double cell) {
+  Vec3 lo = raw.positions.front();
+  for (const Vec3& p : raw.positions) lo = lo.cwiseMin(p);
+  std::map<std::array<int64_t, 3>, int32_t> cluster;
+  std::vector<Vec3> sum;
+  std::vector<int32_t> count, id(raw.positions.size());
+  for (size_t v = 0; v < raw.positions.size(); ++v) {
+    const Vec3 q = (raw.positions[v] - lo) / cell;
+    const std::array<int64_t, 3> key = {static_cast<int64_t>(std::floor(q.x())),
+                                        static_cast<int64_t>(std::floor(q.y())),
+                                        static_cast<int64_t>(std::floor(q.z()))};
+    const auto [it, inserted] = cluster.try_emplace(key, static_cast<int32_t>(sum.size()));
+    if (inserted) {
+      sum.push_back(Vec3::Zero());
+      count.push_back(0);
+    }
+    id[v] = it->second;
+    sum[id[v]] += raw.positions[v];
+    ++count[id[v]];
+  }
+  RawMesh out;
+  out.name = raw.name + " (clustered)";
+  std::vector<int32_t> renumber(sum.size(), kNone);
+  for (const Triangle& t : raw.triangles) {
+    const Triangle c = {id[t[0]], id[t[1]], id[t[2]]};
+    if (c[0] == c[1] || c[1] == c[2] || c[0] == c[2]) continue;
+    Triangle kept;
+    for (int i = 0; i < 3; ++i) {
+      if (renumber[c[i]] == kNone) {
+        renumber[c[i]] = static_cast<int32_t>(out.positions.size());
+        out.positions.push_back(sum[c[i]] / count[c[i]]);
+      }
+      kept[i] = renumber[c[i]];
+    }
+    AddTriangle(&out, kept);
+  }
+  return out;
+}
+
+// Two spheres (icospheres of `subdivisions`, radius 1) touching at one
+// vertex, which both share: a pinched vertex with two fans.
+inline RawMesh TwoSpheresTouchingAtAVertex(int subdivisions) {
+  const Mesh sphere = gen::Sphere(subdivisions, 1.0);
+  RawMesh raw = RawOf(sphere, "two spheres touching");
+  // Vertex 0 of the icosphere lies at (-1, t, 0) / |.|: the second sphere is
+  // the first mirrored through that point, sharing it.
+  const Vec3 touch = sphere.position(0);
+  const int32_t n = sphere.num_vertices();
+  for (int32_t v = 0; v < n; ++v) raw.positions.push_back(2 * touch - sphere.position(v));
+  for (const Triangle& t : sphere.faces()) {
+    Triangle u;
+    for (int i = 0; i < 3; ++i) u[i] = t[i] == 0 ? 0 : t[i] + n;
+    // A point reflection turns faces inside out: turn them back.
+    AddTriangle(&raw, {u[0], u[2], u[1]});
+  }
+  return raw;
+}
+
+// `count` small closed spheres (icospheres of one subdivision, radius 0.05)
+// in a row beside a unit sphere of `subdivisions`: many tiny components.
+inline RawMesh ManyTinyComponents(int count, int subdivisions) {
+  RawMesh raw = RawOf(gen::Sphere(subdivisions, 1.0), "many tiny components");
+  const Mesh tiny = gen::Sphere(1, 0.05);
+  for (int k = 0; k < count; ++k) {
+    const int32_t base = static_cast<int32_t>(raw.positions.size());
+    const Vec3 at(1.5 + 0.2 * (k % 10), 0.2 * (k / 10), 0);
+    for (const Vec3& p : tiny.positions()) raw.positions.push_back(p + at);
+    for (const Triangle& t : tiny.faces())
+      AddTriangle(&raw, {t[0] + base, t[1] + base, t[2] + base});
+  }
+  return raw;
+}
+
+// `raw` with every `every`-th triangle repeated (a duplicate face, corners
+// turned round once) and every `every`-th after the first split by a
+// zero-area face (AddZeroAreaFace).
+inline RawMesh WithDuplicateAndZeroAreaFaces(RawMesh raw, int every) {
+  const int32_t nf = static_cast<int32_t>(raw.triangles.size());
+  for (int32_t f = 0; f < nf; f += every) {
+    const Triangle t = raw.triangles[f];
+    AddTriangle(&raw, {t[1], t[2], t[0]});
+  }
+  for (int32_t f = every / 2; f < nf; f += every) AddZeroAreaFace(&raw, f);
+  return raw;
 }
 
 }  // namespace geodex::mesh::testing

@@ -1,5 +1,6 @@
 #include "core/mesh/generators.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -313,6 +314,86 @@ Mesh Torus(int n_major, int n_minor, double major_radius, double minor_radius) {
     }
   }
   return MustCreate(std::move(positions), std::move(faces), "Torus");
+}
+
+Mesh PinchedTorus(int n_major, int n_minor, double major_radius, double minor_radius_max,
+                  double minor_radius_min) {
+  Check(n_major >= 3 && n_minor >= 3, "PinchedTorus", "n_major and n_minor must be >= 3");
+  Check(minor_radius_min > 0 && minor_radius_max >= minor_radius_min &&
+            major_radius > minor_radius_max,
+        "PinchedTorus", "needs major_radius > minor_radius_max >= minor_radius_min > 0");
+  std::vector<Vec3> positions;
+  for (int i = 0; i < n_major; ++i) {
+    const double u = 2 * std::numbers::pi * i / n_major;
+    const double r =
+        minor_radius_min + (minor_radius_max - minor_radius_min) * (1 + std::cos(u)) / 2;
+    for (int j = 0; j < n_minor; ++j) {
+      const double v = 2 * std::numbers::pi * j / n_minor;
+      const double ring = major_radius + r * std::cos(v);
+      positions.push_back(Vec3(ring * std::cos(u), ring * std::sin(u), r * std::sin(v)));
+    }
+  }
+  auto id = [&](int i, int j) {
+    return static_cast<int32_t>((i % n_major) * n_minor + j % n_minor);
+  };
+  std::vector<Triangle> faces;
+  for (int i = 0; i < n_major; ++i) {
+    for (int j = 0; j < n_minor; ++j) {
+      AddQuad(faces, id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1), false);
+    }
+  }
+  return MustCreate(std::move(positions), std::move(faces), "PinchedTorus");
+}
+
+Mesh Dumbbell(int n_around, double sphere_radius, double tube_radius, double tube_length) {
+  Check(n_around >= 3, "Dumbbell", "n_around must be >= 3");
+  Check(sphere_radius > tube_radius && tube_radius > 0 && tube_length > 0, "Dumbbell",
+        "needs sphere_radius > tube_radius > 0 and tube_length > 0");
+  // The profile (ring radius, z) from the bottom pole to the top one: the
+  // lower sphere up to where it is tube_radius wide, the tube, the upper
+  // sphere mirrored.
+  const double join = std::numbers::pi - std::asin(tube_radius / sphere_radius);
+  const double half = tube_length / 2;
+  const double centre = half + sphere_radius * std::cos(std::asin(tube_radius / sphere_radius));
+  const int sphere_rings = std::max(2, n_around / 2);
+  const double tube_step = 2 * std::numbers::pi * tube_radius / n_around;
+  const int tube_rings = std::max(1, static_cast<int>(std::ceil(tube_length / tube_step)));
+  std::vector<std::pair<double, double>> profile;
+  for (int k = 1; k <= sphere_rings; ++k) {
+    const double theta = join * k / sphere_rings;
+    profile.push_back({sphere_radius * std::sin(theta), -centre - sphere_radius * std::cos(theta)});
+  }
+  for (int k = 1; k < tube_rings; ++k) {
+    profile.push_back({tube_radius, -half + tube_length * k / tube_rings});
+  }
+  for (int k = sphere_rings; k >= 1; --k) {
+    const double theta = join * k / sphere_rings;
+    profile.push_back({sphere_radius * std::sin(theta), centre + sphere_radius * std::cos(theta)});
+  }
+  std::vector<Vec3> positions = {Vec3(0, 0, -centre - sphere_radius)};
+  for (const auto& [rho, z] : profile) {
+    for (int j = 0; j < n_around; ++j) {
+      const double u = 2 * std::numbers::pi * j / n_around;
+      positions.push_back(Vec3(rho * std::cos(u), rho * std::sin(u), z));
+    }
+  }
+  const int32_t top = static_cast<int32_t>(positions.size());
+  positions.push_back(Vec3(0, 0, centre + sphere_radius));
+  const int rings = static_cast<int>(profile.size());
+  auto id = [&](int ring, int j) {
+    return static_cast<int32_t>(1 + ring * n_around + j % n_around);
+  };
+  // Rings run counter-clockwise seen from +z, and z grows ring by ring:
+  // these turns point the faces outwards.
+  std::vector<Triangle> faces;
+  for (int j = 0; j < n_around; ++j) faces.push_back({0, id(0, j + 1), id(0, j)});
+  for (int ring = 0; ring + 1 < rings; ++ring) {
+    for (int j = 0; j < n_around; ++j) {
+      AddQuad(faces, id(ring, j), id(ring, j + 1), id(ring + 1, j + 1), id(ring + 1, j), false);
+    }
+  }
+  for (int j = 0; j < n_around; ++j) faces.push_back({top, id(rings - 1, j), id(rings - 1, j + 1)});
+  return MustCreate(std::move(positions), std::move(faces), "Dumbbell");
 }
 
 Mesh DoubleTorus(int resolution, double size) {

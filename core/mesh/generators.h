@@ -49,6 +49,22 @@ Mesh Sphere(int subdivisions, double radius);
 // Torus around the z axis: major radius R, minor radius r.
 Mesh Torus(int n_major, int n_minor, double major_radius, double minor_radius);
 
+// Torus whose tube radius shrinks round the major circle: minor_radius_max
+// at angle 0 (the +x side), minor_radius_min opposite it, varying as
+// (1 + cos u) / 2 between. With minor_radius_max near major_radius it is a
+// blob with a thin handle; with minor_radius_min a few edge lengths, a torus
+// pinched almost shut. Needs major_radius > minor_radius_max >=
+// minor_radius_min > 0.
+Mesh PinchedTorus(int n_major, int n_minor, double major_radius, double minor_radius_max,
+                  double minor_radius_min);
+
+// Two spheres of `sphere_radius` on the z axis joined by a tube of
+// `tube_radius` and `tube_length` between them (a surface of revolution,
+// genus 0), n_around vertices round every ring; the tube's rings are spaced
+// about as far apart as its vertices round it. Needs sphere_radius >
+// tube_radius > 0, tube_length > 0, n_around >= 3.
+Mesh Dumbbell(int n_around, double sphere_radius, double tube_radius, double tube_length);
+
 // Closed genus-2 surface (two tori joined), roughly `size` across.
 Mesh DoubleTorus(int resolution, double size);
 

@@ -1,6 +1,7 @@
 #include "core/triangulation/geodesic_triangulation.h"
 
 #include <algorithm>
+#include <cmath>
 #include <map>
 #include <numeric>
 
@@ -14,6 +15,7 @@ namespace {
 
 using mesh::kNone;
 using mesh::Mesh;
+using mesh::Vec3;
 
 int32_t Find(std::vector<int32_t>& parent, int32_t x) {
   while (parent[x] != x) x = parent[x] = parent[parent[x]];
@@ -30,7 +32,7 @@ static_assert(static_cast<int>(ViolationKind::kEdgesCross) + 1 == kNumViolationK
               "kNumViolationKinds must count every ViolationKind");
 
 void Violate(DualComplex* out, ViolationKind kind, std::vector<int32_t> cells) {
-  out->violations.push_back({kind, std::move(cells)});
+  out->violations.push_back({kind, std::move(cells), {}, 0});
 }
 
 // CheckDual's steps, in its order.
@@ -224,8 +226,67 @@ void CheckCellsAreConnected(const Mesh& mesh, const std::vector<int32_t>& neares
   }
 }
 
+// Euler characteristics at vertex resolution of the cells and of the unions
+// of two and three cells, from counts of the simplices whose corners carry
+// exactly those labels: a cell, or two or three neighbouring cells, that the
+// dual takes for a disk must be one on the mesh (Euler characteristic 1).
+class UnionEuler {
+ public:
+  UnionEuler(const Mesh& mesh, const std::vector<int32_t>& nearest, int32_t num_samples)
+      : cell_(num_samples, 0) {
+    for (int32_t v = 0; v < mesh.num_vertices(); ++v) {
+      if (mesh.IsReferenced(v) && nearest[v] != kNone) ++cell_[nearest[v]];
+    }
+    for (int32_t h = 0; h < mesh.num_halfedges(); ++h) {
+      if (mesh.Twin(h) != kNone && mesh.Twin(h) < h) continue;
+      const int32_t a = nearest[mesh.Origin(h)], b = nearest[mesh.Dest(h)];
+      if (a == kNone || b == kNone) continue;
+      if (a == b) {
+        --cell_[a];
+      } else {
+        --pair_[{std::min(a, b), std::max(a, b)}];
+      }
+    }
+    for (int32_t f = 0; f < mesh.num_faces(); ++f) {
+      const auto& t = mesh.face(f);
+      std::array<int32_t, 3> l = {nearest[t[0]], nearest[t[1]], nearest[t[2]]};
+      if (l[0] == kNone || l[1] == kNone || l[2] == kNone) continue;
+      std::sort(l.begin(), l.end());
+      if (l[0] == l[2]) {
+        ++cell_[l[0]];
+      } else if (l[0] == l[1] || l[1] == l[2]) {
+        ++pair_[{l[0], l[2]}];
+      } else {
+        ++triple_[l];
+      }
+    }
+  }
+
+  int64_t Cell(int32_t a) const { return cell_[a]; }
+  int64_t Pair(int32_t a, int32_t b) const {
+    const auto it = pair_.find({std::min(a, b), std::max(a, b)});
+    return Cell(a) + Cell(b) + (it == pair_.end() ? 0 : it->second);
+  }
+  // `t`: a dual triangle.
+  int64_t Triple(const std::array<int32_t, 3>& t) const {
+    std::array<int32_t, 3> key = t;
+    std::sort(key.begin(), key.end());
+    const auto it = triple_.find(key);
+    return Pair(t[0], t[1]) + Pair(t[1], t[2]) + Pair(t[0], t[2]) - Cell(t[0]) - Cell(t[1]) -
+           Cell(t[2]) + (it == triple_.end() ? 0 : it->second);
+  }
+
+ private:
+  std::vector<int64_t> cell_;
+  std::map<std::pair<int32_t, int32_t>, int64_t> pair_;
+  std::map<std::array<int32_t, 3>, int64_t> triple_;
+};
+
 // 5. Same Euler characteristic as the mesh, component by component. `sides`:
-// CheckDualEdges' result.
+// CheckDualEdges' result. A component that differs is narrowed down to the
+// cells, touching pairs of cells, or dual triangles (the smallest kind that
+// has any) whose union is not a disk on the mesh; only when none is, the
+// violation names every cell of the component.
 void CheckEulerCharacteristic(const Mesh& mesh, const std::vector<int32_t>& nearest,
                               int32_t num_samples, const std::vector<DualSide>& sides,
                               DualComplex* out) {
@@ -252,15 +313,151 @@ void CheckEulerCharacteristic(const Mesh& mesh, const std::vector<int32_t>& near
     }
   }
   for (const auto& t : out->triangles) ++dual_chi[sample_component[t[0]]];
-  for (int32_t c = 0; c < nc; ++c) {
-    if (mesh_chi[c] != dual_chi[c]) {
-      std::vector<int32_t> cells;
-      for (int32_t a = 0; a < num_samples; ++a) {
-        if (sample_component[a] == c) cells.push_back(a);
-      }
-      Violate(out, ViolationKind::kEulerCharacteristic, std::move(cells));
+  std::vector<uint8_t> wrong(nc, 0);
+  bool any = false;
+  for (int32_t c = 0; c < nc; ++c) any |= (wrong[c] = mesh_chi[c] != dual_chi[c]) != 0;
+  if (!any) return;
+  const UnionEuler chi(mesh, nearest, num_samples);
+  std::vector<uint8_t> located(nc, 0);
+  for (int32_t a = 0; a < num_samples; ++a) {
+    const int32_t c = sample_component[a];
+    if (c != kNone && wrong[c] && chi.Cell(a) < 1) {
+      Violate(out, ViolationKind::kEulerCharacteristic, {a});
+      located[c] = 1;
     }
   }
+  for (size_t i = 0; i < sides.size(); ++i) {
+    if (i > 0 && sides[i].a == sides[i - 1].a && sides[i].b == sides[i - 1].b) continue;
+    const int32_t c = sample_component[sides[i].a];
+    if (wrong[c] && (!located[c] || located[c] == 2) && chi.Pair(sides[i].a, sides[i].b) < 1) {
+      Violate(out, ViolationKind::kEulerCharacteristic, {sides[i].a, sides[i].b});
+      located[c] = 2;
+    }
+  }
+  for (const auto& t : out->triangles) {
+    const int32_t c = sample_component[t[0]];
+    if (wrong[c] && (!located[c] || located[c] == 3) && chi.Triple(t) < 1) {
+      Violate(out, ViolationKind::kEulerCharacteristic, {t[0], t[1], t[2]});
+      located[c] = 3;
+    }
+  }
+  for (int32_t c = 0; c < nc; ++c) {
+    if (!wrong[c] || located[c]) continue;
+    std::vector<int32_t> cells;
+    for (int32_t a = 0; a < num_samples; ++a) {
+      if (sample_component[a] == c) cells.push_back(a);
+    }
+    Violate(out, ViolationKind::kEulerCharacteristic, std::move(cells));
+  }
+}
+
+// Faces with a corner in each cell.
+std::vector<std::vector<int32_t>> CellFaces(const Mesh& mesh, const std::vector<int32_t>& nearest,
+                                            int32_t num_samples) {
+  std::vector<std::vector<int32_t>> faces(num_samples);
+  for (int32_t f = 0; f < mesh.num_faces(); ++f) {
+    const auto& t = mesh.face(f);
+    for (int i = 0; i < 3; ++i) {
+      const int32_t a = nearest[t[i]];
+      if (a == kNone) continue;
+      if ((i > 0 && nearest[t[0]] == a) || (i > 1 && nearest[t[1]] == a)) continue;
+      faces[a].push_back(f);
+    }
+  }
+  return faces;
+}
+
+// The mesh edge where the cells `cells` close on themselves: of the loops
+// that a spanning tree of their vertices (grown in order of distance from the
+// samples) and a dual spanning tree of their faces leave, the shortest
+// (Erickson & Whittlesey 2005: the dual tree is the longest, so the loops
+// left are the shortest). Returns a half-edge, or kNone when the union has no
+// such loop; `loop` is the loop's length through the samples.
+int32_t ClosingEdge(const Mesh& mesh, const sampling::SampleSet& set,
+                    const std::vector<int32_t>& cells,
+                    const std::vector<std::vector<int32_t>>& cell_faces, double* loop) {
+  auto inside = [&](int32_t v) {
+    const int32_t a = set.nearest[v];
+    return a != kNone && std::find(cells.begin(), cells.end(), a) != cells.end();
+  };
+  std::vector<int32_t> faces;
+  for (int32_t a : cells) faces.insert(faces.end(), cell_faces[a].begin(), cell_faces[a].end());
+  std::sort(faces.begin(), faces.end());
+  faces.erase(std::unique(faces.begin(), faces.end()), faces.end());
+  // The union's faces (all corners inside) are dual nodes 0..n-1; node n is
+  // everything outside.
+  std::vector<int32_t> inner;
+  std::vector<int32_t> vertices;
+  struct Edge {
+    double filtration, tie, loop;
+    int32_t h;
+  };
+  std::vector<Edge> edges;
+  for (int32_t f : faces) {
+    const auto& t = mesh.face(f);
+    const bool all = inside(t[0]) && inside(t[1]) && inside(t[2]);
+    if (all) inner.push_back(f);
+    for (int i = 0; i < 3; ++i) {
+      const int32_t h = 3 * f + i, u = t[i], v = t[(i + 1) % 3];
+      if (!inside(u) || !inside(v) || (mesh.Twin(h) != kNone && mesh.Twin(h) < h)) continue;
+      const double du = set.distance[u], dv = set.distance[v];
+      edges.push_back({std::max(du, dv), std::min(du, dv), du + dv + mesh.Length(h), h});
+      vertices.push_back(u);
+      vertices.push_back(v);
+    }
+  }
+  std::sort(vertices.begin(), vertices.end());
+  vertices.erase(std::unique(vertices.begin(), vertices.end()), vertices.end());
+  auto vertex_node = [&](int32_t v) {
+    return static_cast<int32_t>(std::lower_bound(vertices.begin(), vertices.end(), v) -
+                                vertices.begin());
+  };
+  const int32_t outside = static_cast<int32_t>(inner.size());
+  auto face_node = [&](int32_t h) {
+    if (h == kNone) return outside;
+    const auto it = std::lower_bound(inner.begin(), inner.end(), Mesh::FaceOf(h));
+    return it != inner.end() && *it == Mesh::FaceOf(h) ? static_cast<int32_t>(it - inner.begin())
+                                                       : outside;
+  };
+  // The tree, grown as the cells grow from their samples.
+  std::sort(edges.begin(), edges.end(), [](const Edge& x, const Edge& y) {
+    return std::tie(x.filtration, x.tie, x.h) < std::tie(y.filtration, y.tie, y.h);
+  });
+  std::vector<int32_t> parent(vertices.size());
+  std::iota(parent.begin(), parent.end(), 0);
+  std::vector<Edge> rest;
+  for (const Edge& e : edges) {
+    const int32_t x = Find(parent, vertex_node(mesh.Origin(e.h)));
+    const int32_t y = Find(parent, vertex_node(mesh.Dest(e.h)));
+    if (x != y) {
+      parent[x] = y;
+    } else {
+      rest.push_back(e);
+    }
+  }
+  // The dual tree, longest loops first; what it cannot take closes a loop.
+  std::sort(rest.begin(), rest.end(), [](const Edge& x, const Edge& y) {
+    return std::tie(y.loop, y.h) < std::tie(x.loop, x.h);
+  });
+  parent.resize(inner.size() + 1);
+  std::iota(parent.begin(), parent.end(), 0);
+  int32_t best = kNone;
+  for (const Edge& e : rest) {
+    const int32_t x = Find(parent, face_node(e.h));
+    const int32_t y = Find(parent, face_node(mesh.Twin(e.h)));
+    if (x != y) {
+      parent[x] = y;
+    } else {
+      best = e.h;
+      *loop = e.loop;
+    }
+  }
+  return best;
+}
+
+// The sample spacing L = sqrt(2 A / (sqrt(3) m)).
+double SampleSpacing(const Mesh& mesh, int32_t num_samples) {
+  return std::sqrt(2 * mesh.TotalArea() / (std::sqrt(3.0) * std::max(num_samples, 1)));
 }
 
 }  // namespace
@@ -312,10 +509,56 @@ DualComplex CheckDual(const Mesh& mesh, const std::vector<int32_t>& nearest, int
   return out;
 }
 
+std::string DescribeViolation(const Mesh& mesh, const sampling::SampleSet& set,
+                              const Violation& violation,
+                              const std::vector<int32_t>& input_vertex_ids) {
+  const int32_t m = static_cast<int32_t>(set.samples.size());
+  const double spacing = SampleSpacing(mesh, m);
+  auto vertex = [&](int32_t v) {
+    const Vec3& p = mesh.position(v);
+    const int32_t id = input_vertex_ids.empty() ? v : input_vertex_ids[v];
+    const std::string name = id == kNone ? std::string("a midpoint") : absl::StrCat("vertex ", id);
+    return absl::StrFormat("%s (%.3g, %.3g, %.3g)", name, p.x(), p.y(), p.z());
+  };
+  const std::vector<int32_t>& cells = violation.cells;
+  std::string samples =
+      absl::StrJoin(cells.begin(), cells.begin() + std::min<size_t>(3, cells.size()), ",");
+  if (cells.size() > 3) absl::StrAppend(&samples, ",... (", cells.size(), " cells)");
+  std::string out;
+  if (violation.kind == ViolationKind::kEulerCharacteristic && !violation.vertices.empty()) {
+    out = absl::StrFormat(
+        "a loop the samples miss (handle, tunnel or pinch) %.2g L long at %s - %s, samples %s",
+        violation.loop_length / spacing, vertex(violation.vertices[0]),
+        vertex(violation.vertices[1]), samples);
+  } else {
+    // The first cell's sample and its radius.
+    double radius = 0;
+    const int32_t a = cells.empty() ? kNone : cells.front();
+    for (size_t v = 0; v < set.nearest.size() && a != kNone; ++v) {
+      if (set.nearest[v] == a) radius = std::max(radius, set.distance[v]);
+    }
+    out = absl::StrFormat("%s at samples %s", ViolationName(violation.kind), samples);
+    if (a != kNone) {
+      absl::StrAppendFormat(&out, ", the first at %s, its cell %.2g L wide", vertex(set.samples[a]),
+                            radius / spacing);
+    }
+  }
+  absl::StrAppendFormat(&out, "; L = %.3g", spacing);
+  return out;
+}
+
 absl::StatusOr<DualComplex> RepairTriangulation(const Mesh& mesh, sampling::SampleSet* set,
                                                 const RepairOptions& options,
                                                 RepairReport* report) {
   geodesic::VertexGeodesicSolver solver(mesh);
+  // A refusal: `what`, then where the first violation lies, in one line of
+  // at most kMaxRefusalLength characters.
+  auto refuse = [&](const std::string& what, const Violation& first) {
+    std::string message = absl::StrCat(
+        what, "; first: ", DescribeViolation(mesh, *set, first, options.input_vertex_ids));
+    if (message.size() > kMaxRefusalLength) message.resize(kMaxRefusalLength);
+    return absl::FailedPreconditionError(message);
+  };
   for (int32_t round = 0;; ++round) {
     const int32_t m = static_cast<int32_t>(set->samples.size());
     DualComplex dual = CheckDual(mesh, set->nearest, m);
@@ -337,17 +580,30 @@ absl::StatusOr<DualComplex> RepairTriangulation(const Mesh& mesh, sampling::Samp
         const GeodesicEdge& g = dual.edges[c.second];
         dual.violations.push_back(
             {ViolationKind::kEdgesCross,
-             {set->nearest[mesh.face(c.point.face)[corner]], e.a, e.b, g.a, g.b}});
+             {set->nearest[mesh.face(c.point.face)[corner]], e.a, e.b, g.a, g.b},
+             {},
+             0});
       }
       if (!crossings.empty()) dual.edges.clear();
     }
     if (dual.violations.empty()) return dual;
+    // Where the cells of a wrong Euler characteristic close on themselves.
+    std::vector<std::vector<int32_t>> cell_faces;
+    for (Violation& v : dual.violations) {
+      if (v.kind != ViolationKind::kEulerCharacteristic || v.cells.size() > 3) continue;
+      if (cell_faces.empty()) cell_faces = CellFaces(mesh, set->nearest, m);
+      double loop = 0;
+      const int32_t h = ClosingEdge(mesh, *set, v.cells, cell_faces, &loop);
+      if (h == kNone) continue;
+      v.vertices = {mesh.Origin(h), mesh.Dest(h)};
+      v.loop_length = loop;
+    }
     if (round >= options.max_rounds || m >= options.max_samples) {
-      const Violation& v = dual.violations.front();
-      return absl::FailedPreconditionError(absl::StrFormat(
-          "no valid geodesic triangulation after %d repair rounds and %d samples: %d violations "
-          "left, e.g. %s at samples %s",
-          round, m, dual.violations.size(), ViolationName(v.kind), absl::StrJoin(v.cells, ",")));
+      return refuse(
+          absl::StrFormat("no valid geodesic triangulation after %d rounds, %d samples, %d "
+                          "violations left",
+                          round, m, dual.violations.size()),
+          dual.violations.front());
     }
     // The farthest vertex of each cell.
     std::vector<int32_t> far(m, kNone);
@@ -360,7 +616,13 @@ absl::StatusOr<DualComplex> RepairTriangulation(const Mesh& mesh, sampling::Samp
     std::vector<std::pair<int32_t, ViolationKind>> insert;  // (vertex, reason)
     for (const Violation& v : dual.violations) {
       int32_t best = kNone;
-      if (v.kind == ViolationKind::kEdgesCross && radius(v.cells[0]) > 0) {
+      if (!v.vertices.empty()) {
+        // A loop the samples miss: the farther end of the edge that closes
+        // it. The cells there shrink round the feature, round by round, until
+        // the feature spans several cells and the dual sees it.
+        const int32_t x = v.vertices[0], y = v.vertices[1];
+        best = set->distance[x] >= set->distance[y] ? x : y;
+      } else if (v.kind == ViolationKind::kEdgesCross && radius(v.cells[0]) > 0) {
         // Crossing edges: the farthest vertex of the cell where they cross.
         // Like a farthest-point sample it lies at least that cell's radius
         // from every sample, so spacing stays bounded below while the
@@ -380,6 +642,23 @@ absl::StatusOr<DualComplex> RepairTriangulation(const Mesh& mesh, sampling::Samp
           }
         }
       }
+      if (best == kNone || set->distance[best] == 0) {
+        // Cells of one vertex each (samples next to each other, e.g. on a
+        // sliver or round a pinch): the farthest vertex of the faces round
+        // them that is not a sample yet.
+        if (cell_faces.empty()) cell_faces = CellFaces(mesh, set->nearest, m);
+        best = kNone;
+        for (int32_t a : v.cells) {
+          for (int32_t f : cell_faces[a]) {
+            for (int32_t u : mesh.face(f)) {
+              if (set->distance[u] > 0 &&
+                  (best == kNone || set->distance[u] > set->distance[best])) {
+                best = u;
+              }
+            }
+          }
+        }
+      }
       if (best != kNone && set->distance[best] > 0) insert.push_back({best, v.kind});
     }
     std::sort(insert.begin(), insert.end());
@@ -387,8 +666,8 @@ absl::StatusOr<DualComplex> RepairTriangulation(const Mesh& mesh, sampling::Samp
                              [](const auto& x, const auto& y) { return x.first == y.first; }),
                  insert.end());
     if (insert.empty()) {
-      return absl::FailedPreconditionError(
-          "geodesic triangulation is invalid and no sample can be added to repair it");
+      return refuse("geodesic triangulation is invalid and no sample can be added to repair it",
+                    dual.violations.front());
     }
     for (const auto& [vertex, kind] : insert) {
       if (set->distance[vertex] == 0) continue;

@@ -44,7 +44,17 @@ const char* ViolationName(ViolationKind kind);
 
 struct Violation {
   ViolationKind kind;
-  std::vector<int32_t> cells;  // samples involved
+  // Samples involved. A wrong Euler characteristic names the one, two or
+  // three neighbouring cells whose union holds a loop the samples miss (a
+  // handle, tunnel or pinch smaller than the cells), or every cell of the
+  // component when no such union is found.
+  std::vector<int32_t> cells;
+  // Where RepairTriangulation placed its sample for it, when it placed one by
+  // the loop it found: the two ends of the mesh edge that closes the loop, and
+  // the loop's length (through the cells' samples, an upper bound on the
+  // feature's size). Empty and 0 otherwise.
+  std::vector<int32_t> vertices;
+  double loop_length = 0;
 };
 
 struct DualComplex {
@@ -81,13 +91,43 @@ struct RepairOptions {
   // DualComplex::edges.
   bool check_edges = false;
   int threads = 1;  // for tracing; 0: all hardware threads
+  // For messages: the input file's id of each mesh vertex (kNone for a
+  // vertex the file does not have, e.g. a midpoint of the flat refinement);
+  // empty when the mesh's ids are the file's.
+  std::vector<int32_t> input_vertex_ids;
 };
+
+// Every refusal of the builder fits one line of this many characters.
+inline constexpr size_t kMaxRefusalLength = 300;
+
+// One line (at most kMaxRefusalLength characters) naming where `violation`
+// lies: its kind, up to two vertices with positions (in the file's ids when
+// `input_vertex_ids` is non-empty), a loop's length against the sample spacing
+// L = sqrt(2 A / (sqrt(3) m)) of `num_samples` samples, and a few of its cells.
+std::string DescribeViolation(const mesh::Mesh& mesh, const sampling::SampleSet& set,
+                              const Violation& violation,
+                              const std::vector<int32_t>& input_vertex_ids = {});
 
 // Adds samples to `set` until CheckDual (and, with check_edges, FindCrossings)
 // finds no violation, and returns the valid dual. The result does not depend
-// on `threads`. Errors: FailedPrecondition when no valid triangulation is
-// found within `max_rounds` rounds or once samples reach `max_samples`; errors
-// of TraceEdges / FindCrossings.
+// on `threads`.
+//
+// Topology the samples miss. Where a component's dual has the wrong Euler
+// characteristic although every local check passes, some cell, or the union
+// of two or three neighbouring cells, is not a disk on the mesh: a handle,
+// tunnel or pinch smaller than the cells lies inside it. Such a union is found
+// by its own Euler characteristic at vertex resolution (below 1); its cells
+// are grown from their samples (a spanning tree of its vertices in order of
+// distance) and the mesh edge where they close on themselves is the end of
+// the shortest loop the tree and its dual tree leave (Erickson & Whittlesey
+// 2005's greedy loops). The next sample is that edge's farther end, so the
+// cells shrink round the feature until the dual sees it: a few rounds, about
+// ten samples a feature.
+//
+// Errors: FailedPrecondition when no valid triangulation is found within
+// `max_rounds` rounds or once samples reach `max_samples`, naming the first
+// violation's place in one line of at most kMaxRefusalLength characters
+// (RefusalMessage); errors of TraceEdges / FindCrossings.
 absl::StatusOr<DualComplex> RepairTriangulation(const mesh::Mesh& mesh, sampling::SampleSet* set,
                                                 const RepairOptions& options, RepairReport* report);
 

@@ -9,7 +9,7 @@
 #
 #   tests/fuzz/run_fuzzers.sh [--seconds N] [--timeout S] [--build-dir DIR] [--keep DIR] [TARGET...]
 #
-# TARGET: obj ply off stl gltf repair index pairs request (default: all). With --keep, the
+# TARGET: obj ply off stl gltf repair build index pairs request (default: all). With --keep, the
 # grown corpora and any crashing inputs are left in DIR (a temporary
 # directory, removed at exit, otherwise).
 set -euo pipefail
@@ -31,12 +31,13 @@ while [[ $# -gt 0 ]]; do
     *) targets+=("$1"); shift ;;
   esac
 done
-[[ ${#targets[@]} -gt 0 ]] || targets=(obj ply off stl gltf repair index pairs request)
+[[ ${#targets[@]} -gt 0 ]] || targets=(obj ply off stl gltf repair build index pairs request)
 
 # Longest input worth mutating, per target: meshes and requests of a few
 # hundred elements exercise every path; longer inputs only slow the search.
 # A repair soup of 512 bytes has up to 170 triangles on at most 18 vertices.
-declare -A max_len=([obj]=4096 [ply]=4096 [off]=4096 [stl]=4096 [gltf]=4096 [repair]=512
+# A build input reads at most 64 extra triangles (196 bytes).
+declare -A max_len=([obj]=4096 [ply]=4096 [off]=4096 [stl]=4096 [gltf]=4096 [repair]=512 [build]=196
   [index]=16384 [pairs]=2048 [request]=2048)
 
 if [[ ! -f "$build_dir/build.ninja" ]]; then
