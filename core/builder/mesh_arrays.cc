@@ -90,7 +90,7 @@ absl::StatusOr<PreparedMesh> PrepareMesh(const mesh::Mesh& coarse, RepairRecord 
 std::vector<int32_t> InputVertexIds(const PreparedMesh& prepared) {
   const RepairRecord& record = prepared.record;
   const int32_t nv = prepared.mesh.num_vertices();
-  const int32_t coarse = nv - record.refinement_vertices;
+  const int32_t coarse = nv - record.split_vertices;
   const int32_t input = coarse - static_cast<int32_t>(record.vertex_copies.size());
   std::vector<int32_t> ids(nv, mesh::kNone);
   for (int32_t v = 0; v < coarse; ++v) ids[v] = v < input ? v : record.vertex_copies[v - input];

@@ -29,7 +29,7 @@
 #include "core/mesh/generators.h"
 #include "core/mesh/mesh_io.h"
 #include "core/mesh/mesh_repair.h"
-#include "core/query/query_engine.h"
+#include "core/query/internal/query_engine.h"
 #include "core/triangulation/geodesic_triangulation.h"
 #include "gtest/gtest.h"
 
