@@ -1,6 +1,6 @@
 #pragma once
 
-// The geodex-build job as library calls; core/tools/build_main.cc is only
+// The geodex-build job as library calls; core/tools/build_cli.h is only
 // their command line.
 //
 //   BuildIndexFile      mesh -> repair -> long-edge split -> plan -> rows ->
