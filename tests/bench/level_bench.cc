@@ -1,7 +1,5 @@
-// level_bench: what levels of samples would cost and gain, on indexes of one
-// mesh built at several m (tests/bench/level_measure.h). Pure O(1) answers
-// against exact distances of pairs drawn with a seed of their own.
-//
+// level_bench: levels of samples' cost and gain on indexes of one mesh at
+// several m (level_measure.h); pure O(1) answers against exact distances:
 //   level_bench --mesh M.obj --index m250.gdx --index m1000.gdx --index m4000.gdx
 
 #include <algorithm>
