@@ -20,9 +20,7 @@ class ConvertTest : public ::testing::Test {
   void SetUp() override {
     auto index = index::Index::FromBytes(testing::SphereIndexBytes());
     ASSERT_TRUE(index.ok()) << index.status();
-    auto engine = query::QueryEngine::Create(*index);
-    ASSERT_TRUE(engine.ok()) << engine.status();
-    auto queries = query::InputQueries::Create(*engine);
+    auto queries = query::InputQueries::Create(*index);
     ASSERT_TRUE(queries.ok()) << queries.status();
     queries_ = *queries;
   }

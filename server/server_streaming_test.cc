@@ -414,7 +414,7 @@ TEST(ServerTest, ExpMapIsTheEnginesToTheBit) {
   query::ExpMapOptions options;
   options.radius = 1.5;
   options.reference_direction = mesh::Vec3(0.3, -1.0, 0.2);
-  auto map = query::ExpMap(*engine, {17, {0.2, 0.3, 0.5}}, options);
+  auto map = engine->ExpMap({17, {0.2, 0.3, 0.5}}, options);
   ASSERT_TRUE(map.ok()) << map.status();
   ASSERT_GT(map->size(), 50u);
   ASSERT_EQ(chunk.num_vertices(), static_cast<int64_t>(map->size()));
