@@ -11,55 +11,6 @@ using geometry::Cross;
 using geometry::Vec2;
 using mesh::Vec3;
 
-FlatFace LayOutFace(const MeshView& view, int32_t f) {
-  FlatFace flat{f, {view.Vertex(f, 0), view.Vertex(f, 1), view.Vertex(f, 2)}, {}};
-  const Vec3 a = view.Position(flat.vertices[0]);
-  const Vec3 e1 = view.Position(flat.vertices[1]) - a;
-  const Vec3 e2 = view.Position(flat.vertices[2]) - a;
-  const double l = e1.norm(), cx = e1.dot(e2) / l;
-  flat.corners = {Vec2::Zero(), Vec2(l, 0),
-                  Vec2(cx, std::sqrt(std::max(e2.squaredNorm() - cx * cx, 0.0)))};
-  return flat;
-}
-
-FlatFace UnfoldAcross(const MeshView& view, const FlatFace& prev, int32_t g, int32_t a, int32_t b,
-                      EdgeMeasure measure) {
-  FlatFace flat{g, {view.Vertex(g, 0), view.Vertex(g, 1), view.Vertex(g, 2)}, {}};
-  const Vec2 pa = prev.At(a), pb = prev.At(b);
-  const Vec2 behind = prev.At(prev.Opposite(a, b));
-  const Vec3 c = view.Position(flat.Opposite(a, b));
-  double l;
-  Vec2 ux;
-  bool right;  // prev's third corner is left of a -> b, so g's goes right
-  if (measure == EdgeMeasure::kInPlane) {
-    l = (pb - pa).norm();
-    ux = (pb - pa) / l;
-    right = Cross(ux, behind - pa) > 0;
-  } else {
-    l = (view.Position(b) - view.Position(a)).norm();
-    ux = (pb - pa) * (1 / l);
-    right = Cross(pb - pa, behind - pa) > 0;
-  }
-  double x, y;
-  geometry::Place(l, (c - view.Position(a)).norm(), (c - view.Position(b)).norm(), &x, &y);
-  Vec2 uy(-ux.y(), ux.x());
-  if (right) uy = -uy;
-  const Vec2 pc = pa + x * ux + y * uy;
-  for (int i = 0; i < 3; ++i) {
-    flat.corners[i] = flat.vertices[i] == a ? pa : flat.vertices[i] == b ? pb : pc;
-  }
-  return flat;
-}
-
-Vec2 LocateInFlat(const MeshView& view, const FlatFace& flat, const mesh::SurfacePoint& p,
-                  double min_weight) {
-  Vec2 out = Vec2::Zero();
-  for (int i = 0; i < 3; ++i) {
-    if (p.w[i] > min_weight) out += p.w[i] * flat.At(view.Vertex(p.face, i));
-  }
-  return out;
-}
-
 bool FaceHolds(const MeshView& view, int32_t f, const mesh::SurfacePoint& p) {
   for (int i = 0; i < 3; ++i) {
     if (p.w[i] > 1e-12 && view.Corner(f, view.Vertex(p.face, i)) < 0) return false;

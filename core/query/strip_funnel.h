@@ -16,12 +16,15 @@
 //
 // Thread safety: pure functions of immutable data.
 
+#include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <optional>
 #include <span>
 
 #include "absl/container/inlined_vector.h"
+#include "core/geometry/unfolding.h"
 #include "core/geometry/vec2.h"
 #include "core/mesh/mesh.h"
 #include "core/query/mesh_view.h"
@@ -35,20 +38,17 @@ struct FlatFace {
   std::array<int32_t, 3> vertices;
   std::array<geometry::Vec2, 3> corners;
 
-  // The position of mesh vertex v; corner 0's when the face does not hold v.
-  const geometry::Vec2& At(int32_t v) const {
-    for (int i = 0; i < 3; ++i) {
-      if (vertices[i] == v) return corners[i];
-    }
-    return corners[0];
+  // The corner at mesh vertex v; 0 when the face does not hold v.
+  int CornerOf(int32_t v) const {
+    return vertices[0] == v ? 0 : vertices[1] == v ? 1 : vertices[2] == v ? 2 : 0;
   }
+  // The position of mesh vertex v; corner 0's when the face does not hold v.
+  const geometry::Vec2& At(int32_t v) const { return corners[CornerOf(v)]; }
+  // The corner that is neither i nor j (i != j).
+  static int ThirdCorner(int i, int j) { return i != j ? 3 - i - j : (i + 1) % 3; }
   // The vertex of the face that is neither a nor b.
   int32_t Opposite(int32_t a, int32_t b) const {
-    int32_t c = -1;
-    for (int32_t v : vertices) {
-      if (v != a && v != b) c = v;
-    }
-    return c;
+    return vertices[ThirdCorner(CornerOf(a), CornerOf(b))];
   }
 };
 
@@ -132,5 +132,57 @@ struct FunnelPath {
 // through may be a bend too (turning by 0).
 FunnelPath Funnel(const geometry::Vec2& start, std::span<const Portal> portals,
                   const geometry::Vec2& end);
+
+// Inline: on the path of every near pair.
+
+inline FlatFace LayOutFace(const MeshView& view, int32_t f) {
+  FlatFace flat{f, {view.Vertex(f, 0), view.Vertex(f, 1), view.Vertex(f, 2)}, {}};
+  const mesh::Vec3 a = view.Position(flat.vertices[0]);
+  const mesh::Vec3 e1 = view.Position(flat.vertices[1]) - a;
+  const mesh::Vec3 e2 = view.Position(flat.vertices[2]) - a;
+  const double l = e1.norm(), cx = e1.dot(e2) / l;
+  flat.corners = {geometry::Vec2::Zero(), geometry::Vec2(l, 0),
+                  geometry::Vec2(cx, std::sqrt(std::max(e2.squaredNorm() - cx * cx, 0.0)))};
+  return flat;
+}
+
+inline FlatFace UnfoldAcross(const MeshView& view, const FlatFace& prev, int32_t g, int32_t a,
+                             int32_t b, EdgeMeasure measure) {
+  const int ia = prev.CornerOf(a), ib = prev.CornerOf(b);
+  const geometry::Vec2 pa = prev.corners[ia], pb = prev.corners[ib];
+  const geometry::Vec2 behind = prev.corners[FlatFace::ThirdCorner(ia, ib)];
+  FlatFace flat{g, {view.Vertex(g, 0), view.Vertex(g, 1), view.Vertex(g, 2)}, {}};
+  const int ja = flat.CornerOf(a), jb = flat.CornerOf(b), k = FlatFace::ThirdCorner(ja, jb);
+  const mesh::Vec3 c = view.Position(flat.vertices[k]);
+  double l;
+  geometry::Vec2 ux;
+  bool right;  // prev's third corner is left of a -> b, so g's goes right
+  if (measure == EdgeMeasure::kInPlane) {
+    l = (pb - pa).norm();
+    ux = (pb - pa) / l;
+    right = geometry::Cross(ux, behind - pa) > 0;
+  } else {
+    l = (view.Position(b) - view.Position(a)).norm();
+    ux = (pb - pa) * (1 / l);
+    right = geometry::Cross(pb - pa, behind - pa) > 0;
+  }
+  double x, y;
+  geometry::Place(l, (c - view.Position(a)).norm(), (c - view.Position(b)).norm(), &x, &y);
+  geometry::Vec2 uy(-ux.y(), ux.x());
+  if (right) uy = -uy;
+  flat.corners[ja] = pa;
+  flat.corners[jb] = pb;
+  flat.corners[k] = pa + x * ux + y * uy;
+  return flat;
+}
+
+inline geometry::Vec2 LocateInFlat(const MeshView& view, const FlatFace& flat,
+                                   const mesh::SurfacePoint& p, double min_weight) {
+  geometry::Vec2 out = geometry::Vec2::Zero();
+  for (int i = 0; i < 3; ++i) {
+    if (p.w[i] > min_weight) out += p.w[i] * flat.At(view.Vertex(p.face, i));
+  }
+  return out;
+}
 
 }  // namespace geodex::query
