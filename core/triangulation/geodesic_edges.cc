@@ -12,6 +12,7 @@
 #include "core/common/status_macros.h"
 #include "core/common/threads.h"
 #include "core/geodesic/exact_geodesic.h"
+#include "core/geometry/vec2.h"
 
 namespace geodex::triangulation {
 namespace {
@@ -130,6 +131,8 @@ std::array<double, 3> WeightsIn(const Mesh& mesh, const Location& at, int32_t f)
   return w;
 }
 
+using geometry::Vec2;
+
 // A face in its own planar frame: corner 0 at the origin, corner 1 at (l, 0),
 // corner 2 at (cx, cy) with cy > 0.
 struct FaceFrame {
@@ -145,10 +148,8 @@ struct FaceFrame {
     cy = e1.cross(e2).norm() / l;
     size = std::max({l, e2.norm(), (e2 - e1).norm()});
   }
-  std::array<double, 2> Map(const std::array<double, 3>& w) const {
-    return {w[1] * l + w[2] * cx, w[2] * cy};
-  }
-  SurfacePoint Unmap(int32_t f, const std::array<double, 2>& p) const {
+  Vec2 Map(const std::array<double, 3>& w) const { return {w[1] * l + w[2] * cx, w[2] * cy}; }
+  SurfacePoint Unmap(int32_t f, const Vec2& p) const {
     SurfacePoint out;
     out.face = f;
     const double w2 = std::clamp(p[1] / cy, 0.0, 1.0);
@@ -157,8 +158,6 @@ struct FaceFrame {
     return out;
   }
 };
-
-using Vec2 = std::array<double, 2>;
 
 double Cross(const Vec2& o, const Vec2& a, const Vec2& b) {
   return (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0]);

@@ -6,11 +6,15 @@
 
 #include "absl/container/inlined_vector.h"
 #include "core/geometry/planar_unfolding.h"
+#include "core/geometry/vec2.h"
 #include "core/query/internal/path_straightening.h"
+#include "core/query/internal/strip_funnel.h"
 
 namespace geodex::query {
 namespace {
 
+using geometry::Cross;
+using geometry::Vec2;
 using mesh::Vec3;
 
 // The barycentric velocity (sum 0) of moving along `dir` in face f.
@@ -43,23 +47,14 @@ Vec3 UnfoldHeading(const MeshView& view, int32_t f, const std::array<int32_t, 2>
   return along * e + (d - along * e).norm() * into.normalized();
 }
 
-// True when every vertex `p` has weight on (weight > 1e-12) is a vertex of f.
-bool FaceHolds(const MeshView& view, int32_t f, const SurfacePoint& p) {
-  for (int i = 0; i < 3; ++i) {
-    if (p.w[i] > 1e-12 && view.Corner(f, view.Vertex(p.face, i)) < 0) return false;
-  }
-  return true;
-}
-
 // A corridor of faces (consecutive ones share an edge) unfolded into one
-// plane, with the points it runs between. The shortest path through it is
-// found by the funnel algorithm on the unfolded edges it crosses
-// (portals), in a few flops a face; where that path bends round a vertex
-// short of a straight angle on the vertex's other side, the corridor is
-// moved to that side (Release).
+// plane (strip_funnel.h), with the points it runs between. The shortest
+// path through it is found by the funnel algorithm on the unfolded edges it
+// crosses (portals), in a few flops a face; where that path bends round a
+// vertex short of a straight angle on the vertex's other side, the
+// corridor is moved to that side (Release).
 class Corridor {
  public:
-  using Vec2 = Eigen::Vector2d;
   // Where the funnel's path bends: the vertex, the run of portals
   // [first, last] that end at it on the side it is on, and the angle the
   // path turns by.
@@ -76,17 +71,8 @@ class Corridor {
   // last face holds). False when consecutive faces share no edge.
   bool Unfold(const MeshView& view, const SurfacePoint& from, const SurfacePoint& to) {
     portals_.clear();
-    ids_.clear();
-    const int32_t f0 = faces_[0];
-    const Vec3 a = view.Position(view.Vertex(f0, 0));
-    const Vec3 e1 = view.Position(view.Vertex(f0, 1)) - a;
-    const Vec3 e2 = view.Position(view.Vertex(f0, 2)) - a;
-    const double l = e1.norm(), cx = e1.dot(e2) / l;
-    // Counterclockwise, as every face of the oriented mesh then is.
-    corner_[0] = Vec2::Zero();
-    corner_[1] = Vec2(l, 0);
-    corner_[2] = Vec2(cx, std::sqrt(std::max(e2.squaredNorm() - cx * cx, 0.0)));
-    start_ = At(view, f0, from);
+    FlatFace flat = LayOutFace(view, faces_[0]);
+    start_ = LocateInFlat(view, flat, from, 0);
     for (size_t t = 0; t + 1 < faces_.size(); ++t) {
       const int32_t f = faces_[t];
       int edge = -1;
@@ -95,71 +81,45 @@ class Corridor {
         if (h >= 0 && h / 3 == faces_[t + 1]) edge = i;
       }
       if (edge < 0) return false;
-      Cross(view, f, edge, view.twins[3 * f + edge]);
+      // The half-edge runs from corner `edge` to the next, with f on its
+      // left: going out of f, its end is on the left.
+      const int left = (edge + 1) % 3;
+      const int32_t a = view.Vertex(f, left), b = view.Vertex(f, edge);
+      portals_.push_back({{flat.corners[left], flat.corners[edge]}, {a, b}});
+      flat = UnfoldAcross(view, flat, faces_[t + 1], a, b, EdgeMeasure::kInPlane);
     }
-    end_ = At(view, faces_.back(), to);
+    end_ = LocateInFlat(view, flat, to, 0);
     return true;
   }
 
   // |end - start| when that segment passes through every portal.
   std::optional<double> StraightLength() const {
-    const Vec2 d = end_ - start_;
-    const double slack = 1e-12 * d.squaredNorm();
-    for (const auto& [p, q] : portals_) {
-      const double sp = Cross2(d, p - start_), sq = Cross2(d, q - start_);
-      if (std::min(sp, sq) > slack || std::max(sp, sq) < -slack) return std::nullopt;
-    }
-    return d.norm();
+    return query::StraightLength(start_, portals_, end_);
   }
 
   // The length of the shortest path through the corridor (the funnel
   // algorithm, Lee & Preparata 1984) and where it bends.
-  double Funnel(Bends* bends) const {
-    const size_t n = portals_.size();
-    auto end_of = [&](size_t i, int side) { return i < n ? portals_[i][side] : end_; };
-    absl::InlinedVector<Vec2, 8> apexes = {start_};
+  double Shortest(Bends* bends) const {
+    const FunnelPath path = query::Funnel(start_, portals_, end_);
+    const size_t n = portals_.size(), count = path.bends.size();
+    // The path's k-th vertex: the start, the bends, the end.
+    auto point = [&](size_t k) -> const Vec2& {
+      if (k == 0) return start_;
+      if (k > count) return end_;
+      const FunnelBend& bend = path.bends[k - 1];
+      return portals_[bend.portal].ends[bend.side];
+    };
     bends->clear();
-    Vec2 apex = start_, side_at[2] = {end_of(0, 0), end_of(0, 1)};
-    size_t index[2] = {0, 0};
-    for (size_t i = 1; i <= n; ++i) {
-      // Side 1 (right) narrows when the new end is left of the apex's ray
-      // to it, side 0 (left) when it is right; crossing the other side's
-      // ray, the path bends round that side's end.
-      for (int side : {1, 0}) {
-        const double sign = side == 1 ? 1 : -1;
-        const Vec2 next = end_of(i, side);
-        if (sign * Cross2(side_at[side] - apex, next - apex) < 0) continue;  // widens
-        const int other = 1 - side;
-        if (apex == side_at[side] || sign * Cross2(side_at[other] - apex, next - apex) < 0) {
-          side_at[side] = next;
-          index[side] = i;
-          continue;
-        }
-        const size_t at = index[other];
-        if (at == n) break;  // the other side's end is the end point
-        apex = side_at[other];
-        apexes.push_back(apex);
-        const int32_t v = ids_[at][other];
-        size_t first = at, last = at;
-        while (first > 0 && ids_[first - 1][other] == v) --first;
-        while (last + 1 < n && ids_[last + 1][other] == v) ++last;
-        bends->push_back({v, first, last, 0});
-        side_at[0] = side_at[1] = apex;
-        index[0] = index[1] = i = at;
-        break;
-      }
+    for (size_t k = 0; k < count; ++k) {
+      const auto [at, side] = path.bends[k];
+      const int32_t v = portals_[at].vertices[side];
+      size_t first = at, last = at;
+      while (first > 0 && portals_[first - 1].vertices[side] == v) --first;
+      while (last + 1 < n && portals_[last + 1].vertices[side] == v) ++last;
+      const Vec2 d = point(k + 1) - point(k), e = point(k + 2) - point(k + 1);
+      bends->push_back({v, first, last, std::atan2(std::abs(Cross(d, e)), d.dot(e))});
     }
-    apexes.push_back(end_);
-    double length = 0;
-    for (size_t k = 1; k < apexes.size(); ++k) {
-      const Vec2 d = apexes[k] - apexes[k - 1];
-      length += d.norm();
-      if (k + 1 < apexes.size()) {
-        const Vec2 e = apexes[k + 1] - apexes[k];
-        (*bends)[k - 1].turn = std::atan2(std::abs(Cross2(d, e)), d.dot(e));
-      }
-    }
-    return length;
+    return path.length;
   }
 
   // Moves the corridor to the other side of the bend's vertex: the faces
@@ -169,58 +129,17 @@ class Corridor {
     const int32_t v = bend.vertex;
     const int32_t from = faces_[bend.first], to = faces_[bend.last + 1];
     const int32_t skip = faces_[bend.first + 1];
-    int dir = view.Turn(from, v, 0) == skip ? 1 : 0;
+    const int dir = view.Turn(from, v, 0) == skip ? 1 : 0;
     absl::InlinedVector<int32_t, 16> round;
-    int32_t g = from;
-    for (int step = 0; step < MeshView::kMaxFanSteps; ++step) {
-      g = view.Turn(g, v, dir);
-      if (g < 0 || g == from) return false;
-      if (g == to) break;
-      round.push_back(g);
-    }
-    if (g != to) return false;
+    if (!FacesBetween(view, v, from, to, dir, &round)) return false;
     faces_.erase(faces_.begin() + bend.first + 1, faces_.begin() + bend.last + 1);
     faces_.insert(faces_.begin() + bend.first + 1, round.begin(), round.end());
     return true;
   }
 
  private:
-  static double Cross2(const Vec2& a, const Vec2& b) { return a.x() * b.y() - a.y() * b.x(); }
-
-  // Steps from face f over its edge `edge` (from corner edge to edge + 1)
-  // into the face of the twin half-edge h: the portal, then h's face's
-  // third corner unfolded on the far side of the edge.
-  void Cross(const MeshView& view, int32_t f, int edge, int32_t h) {
-    const int i1 = edge, i2 = (edge + 1) % 3, behind = (edge + 2) % 3;
-    const Vec2 a = corner_[i2], b = corner_[i1];  // left and right going out
-    portals_.push_back({a, b});
-    ids_.push_back({view.Vertex(f, i2), view.Vertex(f, i1)});
-    const int32_t g = h / 3, k = (h % 3 + 2) % 3;  // h runs from f's corner i2 to i1
-    const Vec3 c = view.Position(view.Vertex(g, k));
-    const double l = (b - a).norm();
-    double x, y;
-    geometry::Place(l, (c - view.Position(view.Vertex(f, i2))).norm(),
-                    (c - view.Position(view.Vertex(f, i1))).norm(), &x, &y);
-    const Vec2 ux = (b - a) / l;
-    Vec2 uy(-ux.y(), ux.x());
-    if (Cross2(ux, corner_[behind] - a) > 0) uy = -uy;  // away from f
-    corner_[h % 3] = a;
-    corner_[(h % 3 + 1) % 3] = b;
-    corner_[k] = a + x * ux + y * uy;
-  }
-  // Point p (whose weighted vertices face f holds) in the plane.
-  Vec2 At(const MeshView& view, int32_t f, const SurfacePoint& p) const {
-    Vec2 out = Vec2::Zero();
-    for (int i = 0; i < 3; ++i) {
-      if (p.w[i] > 0) out += p.w[i] * corner_[std::max(0, view.Corner(f, view.Vertex(p.face, i)))];
-    }
-    return out;
-  }
-
   std::vector<int32_t> faces_;
-  Vec2 corner_[3];  // of the face last unfolded
-  absl::InlinedVector<std::array<Vec2, 2>, 32> portals_;
-  absl::InlinedVector<std::array<int32_t, 2>, 32> ids_;  // the portals' vertices
+  absl::InlinedVector<Portal, 32> portals_;
   Vec2 start_ = Vec2::Zero(), end_ = Vec2::Zero();
 };
 
@@ -309,15 +228,6 @@ bool WalkCorridor(const MeshView& view, const PathPoint& from, const PathPoint& 
   return false;
 }
 
-// The angle of face g at its vertex v.
-double CornerAngle(const MeshView& view, int32_t g, int32_t v) {
-  const int k = view.Corner(g, v);
-  const Vec3 o = view.Position(v);
-  const Vec3 a = view.Position(view.Vertex(g, (k + 1) % 3)) - o;
-  const Vec3 b = view.Position(view.Vertex(g, (k + 2) % 3)) - o;
-  return std::atan2(a.cross(b).norm(), a.dot(b));
-}
-
 // A path through a vertex is locally shortest when the surface angle on
 // either side of it is at least pi (Mitchell, Mount & Papadimitriou 1987),
 // so when it turns by at most the vertex's angle excess (sum - 2 pi), to
@@ -376,7 +286,7 @@ std::optional<NearPath> NearPathLength(const MeshView& view, const GradientPaths
       continue;
     }
     for (int release = 0; release <= kMaxReleases; ++release) {
-      const double length = corridor.Funnel(&bends);
+      const double length = corridor.Shortest(&bends);
       const Corridor::Bend* shortcut = nullptr;
       bool judged = true;
       for (const Corridor::Bend& bend : bends) {

@@ -14,6 +14,7 @@
 #include "absl/strings/str_format.h"
 #include "core/common/status_macros.h"
 #include "core/geometry/planar_unfolding.h"
+#include "core/geometry/vec2.h"
 #include "core/query/internal/mesh_view.h"
 
 namespace geodex::query {
@@ -33,14 +34,9 @@ constexpr double kMoved = 1e-12;
 // curved surface need not settle exactly.
 constexpr int kMaxPlacements = 16;
 
-struct Vec2 {
-  double x = 0, y = 0;
-};
-Vec2 operator+(Vec2 a, Vec2 b) { return {a.x + b.x, a.y + b.y}; }
-Vec2 operator-(Vec2 a, Vec2 b) { return {a.x - b.x, a.y - b.y}; }
-Vec2 operator*(double s, Vec2 a) { return {s * a.x, s * a.y}; }
-double Cross(Vec2 a, Vec2 b) { return a.x * b.y - a.y * b.x; }
-double Norm(Vec2 a) { return std::hypot(a.x, a.y); }
+using geometry::Cross;
+using geometry::Vec2;
+double Norm(const Vec2& a) { return std::hypot(a.x(), a.y()); }
 
 // Into (-pi, pi].
 double WrapAngle(double a) {
@@ -53,7 +49,7 @@ struct Node {
   int32_t face = -1;  // a face holding the vertex
   double r = 0;       // distance from the centre
   double theta = 0;
-  Vec2 at;  // r (cos, sin) theta: the vertex in the centre's tangent plane
+  Vec2 at = Vec2::Zero();  // r (cos, sin) theta: the vertex in the centre's tangent plane
   // The length of the path theta was taken from: the unfolded ray, or the
   // way round a placed neighbour (longer than r when that was a stopgap).
   double path = 0;
@@ -86,7 +82,7 @@ class ExpMapper {
   void SeedFromFaces();
   void SeedFromVertex(int32_t v);
   // Records a vertex placed at `at` in the tangent plane.
-  void Seed(int32_t v, int32_t face, Vec2 at);
+  void Seed(int32_t v, int32_t face, const Vec2& at);
   // The angle of a vertex from its placed neighbours (the header comment),
   // and the length of the path it comes from.
   struct Angle {
@@ -105,7 +101,7 @@ class ExpMapper {
 
   Vec2 InFrame(const Vec3& x) const {
     const Vec3 d = x - origin_;
-    return {d.dot(e1_), d.dot(e2_)};
+    return Vec2(d.dot(e1_), d.dot(e2_));
   }
   double Edge(int32_t a, int32_t b) const { return (view_.Position(a) - view_.Position(b)).norm(); }
 
@@ -152,11 +148,11 @@ absl::Status ExpMapper::MakeFrame() {
   return absl::OkStatus();
 }
 
-void ExpMapper::Seed(int32_t v, int32_t face, Vec2 at) {
+void ExpMapper::Seed(int32_t v, int32_t face, const Vec2& at) {
   Node& node = nodes_[v];
   node.face = face;
   node.r = Norm(at);
-  node.theta = node.r > 0 ? std::atan2(at.y, at.x) : 0;
+  node.theta = node.r > 0 ? std::atan2(at.y(), at.x()) : 0;
   node.at = at;
   node.path = node.r;
   node.done = true;
@@ -181,7 +177,7 @@ void ExpMapper::SeedFromFaces() {
     const double l = Norm(ua - ub);
     double x, hgt;
     geometry::Place(l, Edge(b, y), Edge(a, y), &x, &hgt);
-    const Vec2 along = (1 / l) * (ua - ub), left = {-along.y, along.x};
+    const Vec2 along = (1 / l) * (ua - ub), left(-along.y(), along.x());
     Seed(y, g / 3, ub + x * along + hgt * left);
   }
 }
@@ -229,12 +225,12 @@ void ExpMapper::SeedFromVertex(int32_t v) {
     const Vec3 ea = (view_.Position(w.a) - view_.Position(v)).normalized();
     reference = w.from + std::atan2(e1_.dot(normal_.cross(ea)), e1_.dot(ea));
   }
-  Seed(v, centre_.face, {0, 0});
+  Seed(v, centre_.face, Vec2::Zero());
   for (const Wedge& w : fan) {
     for (const auto& [u, angle] : {std::pair{w.a, w.from}, std::pair{w.b, w.from + w.angle}}) {
       const double theta = WrapAngle(scale * (angle - reference));
       const double r = Edge(v, u);
-      Seed(u, w.face, {r * std::cos(theta), r * std::sin(theta)});
+      Seed(u, w.face, Vec2(r * std::cos(theta), r * std::sin(theta)));
     }
   }
 }
@@ -272,9 +268,9 @@ ExpMapper::Angle ExpMapper::AngleOf(int32_t w, const Node& node) const {
     double wx, wy, sx, sy;
     geometry::Place(l, Edge(w, a), Edge(w, b), &wx, &wy);
     geometry::Place(l, ia->second.r, ib->second.r, &sx, &sy);
-    const Vec2 to_a = {-sx, sy}, to_b = {l - sx, sy}, to_w = {wx - sx, wy + sy};
-    const double span = std::atan2(Cross(to_a, to_b), to_a.x * to_b.x + to_a.y * to_b.y);
-    const double part = std::atan2(Cross(to_a, to_w), to_a.x * to_w.x + to_a.y * to_w.y);
+    const Vec2 to_a(-sx, sy), to_b(l - sx, sy), to_w(wx - sx, wy + sy);
+    const double span = std::atan2(Cross(to_a, to_b), to_a.x() * to_b.x() + to_a.y() * to_b.y());
+    const double part = std::atan2(Cross(to_a, to_w), to_a.x() * to_w.x() + to_a.y() * to_w.y());
     if (!(std::abs(span) > 0)) continue;
     const double share = part / span;
     if (!(share >= 0 && share <= 1)) continue;
@@ -403,7 +399,7 @@ absl::StatusOr<std::vector<ExpMapVertex>> ExpMapper::Run() {
   std::vector<ExpMapVertex> out;
   for (const auto& [v, node] : nodes_) {
     if (!node.done || !(node.r <= options_.radius)) continue;
-    out.push_back({v, node.r, WrapAngle(node.theta), node.at.x, node.at.y});
+    out.push_back({v, node.r, WrapAngle(node.theta), node.at.x(), node.at.y()});
   }
   std::sort(out.begin(), out.end(),
             [](const ExpMapVertex& a, const ExpMapVertex& b) { return a.vertex < b.vertex; });

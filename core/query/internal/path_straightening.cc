@@ -4,10 +4,11 @@
 #include <array>
 #include <cmath>
 #include <limits>
-#include <optional>
 
 #include "absl/container/inlined_vector.h"
 #include "core/geometry/planar_unfolding.h"
+#include "core/geometry/vec2.h"
+#include "core/query/internal/strip_funnel.h"
 
 namespace geodex::query {
 namespace {
@@ -18,19 +19,13 @@ constexpr double kZero = 1e-12;  // barycentric weights below this are on an edg
 template <typename T>
 using Small = absl::InlinedVector<T, 16>;
 
-struct Vec2 {
-  double x, y;
-  Vec2 operator-(const Vec2& o) const { return {x - o.x, y - o.y}; }
-  Vec2 operator+(const Vec2& o) const { return {x + o.x, y + o.y}; }
-  Vec2 operator*(double s) const { return {x * s, y * s}; }
-};
-inline double Cross(const Vec2& a, const Vec2& b) { return a.x * b.y - a.y * b.x; }
+using geometry::Cross;
+using geometry::Vec2;
 
 // The vertices a point is a convex combination of (weights > kZero).
 struct Support {
   int count = 0;
   std::array<int32_t, 3> vertex;
-  std::array<double, 3> weight;
 };
 
 class Straightener {
@@ -41,16 +36,16 @@ class Straightener {
   // the next pass releases it to the vertex's narrower side, which may hold
   // a shortcut the strip did not. Passes stop when nothing shortens.
   std::vector<PathPoint> Run(std::vector<PathPoint> path) {
-    double length = Length(path);
+    double length = PathLength(path);
     for (int pass = 0; pass < 256 && path.size() >= 3; ++pass) {
       std::vector<PathPoint> straight;
       if (!Straighten(path, &straight)) break;
-      const double shorter = Length(straight);
+      const double shorter = PathLength(straight);
       if (!(shorter < length * (1 - 1e-14))) break;
       path = std::move(straight);
       length = shorter;
       // Without vertex points to release, another pass builds the same strip.
-      if (!HasInteriorVertexPoint(path)) break;
+      if (!WrapsRoundAVertex(path)) break;
     }
     return path;
   }
@@ -64,18 +59,10 @@ class Straightener {
     Support s;
     for (int i = 0; i < 3; ++i) {
       if (p.w[i] > kZero) {
-        s.vertex[s.count] = mesh_.Vertex(p.face, i);
-        s.weight[s.count] = p.w[i];
-        ++s.count;
+        s.vertex[s.count++] = mesh_.Vertex(p.face, i);
       }
     }
     return s;
-  }
-  bool FaceHolds(int32_t f, const Support& s) const {
-    for (int i = 0; i < s.count; ++i) {
-      if (!HasVertex(f, s.vertex[i])) return false;
-    }
-    return true;
   }
   // The face across the edge (a, b) of face f, or -1.
   int32_t Across(int32_t f, int32_t a, int32_t b) const {
@@ -88,83 +75,15 @@ class Straightener {
     }
     return -1;
   }
-  static bool HasInteriorVertexPoint(const std::vector<PathPoint>& path) {
-    for (size_t i = 1; i + 1 < path.size(); ++i) {
-      const std::array<double, 3>& w = path[i].point.w;
-      if (w[0] == 1 || w[1] == 1 || w[2] == 1) return true;
-    }
-    return false;
-  }
-  static double Length(const std::vector<PathPoint>& path) {
-    double length = 0;
-    for (size_t i = 1; i < path.size(); ++i)
-      length += (path[i].position - path[i - 1].position).norm();
-    return length;
-  }
 
-  // Unfolded face: its vertex ids and their planar positions.
-  struct Flat {
-    int32_t face;
-    std::array<int32_t, 3> v;
-    std::array<Vec2, 3> p;
-    Vec2 At(int32_t vertex) const {
-      for (int i = 0; i < 3; ++i) {
-        if (v[i] == vertex) return p[i];
-      }
-      return p[0];
-    }
-  };
-
-  Flat FirstFlat(int32_t f) const {
-    Flat flat{f, {mesh_.Vertex(f, 0), mesh_.Vertex(f, 1), mesh_.Vertex(f, 2)}, {}};
-    const mesh::Vec3 a = mesh_.Position(flat.v[0]), e1 = mesh_.Position(flat.v[1]) - a,
-                     e2 = mesh_.Position(flat.v[2]) - a;
-    const double l = e1.norm();
-    const double cx = e1.dot(e2) / l;
-    const double cy = std::sqrt(std::max(e2.squaredNorm() - cx * cx, 0.0));
-    flat.p = {Vec2{0, 0}, Vec2{l, 0}, Vec2{cx, cy}};
-    return flat;
-  }
-
-  // Face g unfolded across its edge (a, b) shared with `prev`, on the other
-  // side of that edge from prev's third vertex.
-  Flat NextFlat(const Flat& prev, int32_t g, int32_t a, int32_t b) const {
-    Flat flat{g, {mesh_.Vertex(g, 0), mesh_.Vertex(g, 1), mesh_.Vertex(g, 2)}, {}};
-    const Vec2 pa = prev.At(a), pb = prev.At(b);
-    int32_t c = -1, behind = -1;
-    for (int i = 0; i < 3; ++i) {
-      if (flat.v[i] != a && flat.v[i] != b) c = flat.v[i];
-      if (prev.v[i] != a && prev.v[i] != b) behind = prev.v[i];
-    }
-    const double l = (mesh_.Position(b) - mesh_.Position(a)).norm();
-    const double da = (mesh_.Position(c) - mesh_.Position(a)).norm(),
-                 db = (mesh_.Position(c) - mesh_.Position(b)).norm();
-    double x, y;
-    geometry::Place(l, da, db, &x, &y);
-    const Vec2 ux = (pb - pa) * (1 / l);
-    Vec2 uy{-ux.y, ux.x};
-    if (Cross(pb - pa, prev.At(behind) - pa) > 0) uy = uy * -1;  // away from prev
-    const Vec2 pc = pa + ux * x + uy * y;
-    for (int i = 0; i < 3; ++i) flat.p[i] = flat.v[i] == a ? pa : flat.v[i] == b ? pb : pc;
-    return flat;
-  }
-
-  Vec2 Place(const Flat& flat, const Support& s) const {
-    Vec2 out{0, 0};
-    for (int i = 0; i < s.count; ++i) out = out + flat.At(s.vertex[i]) * s.weight[i];
-    return out;
-  }
-
-  struct Portal {
-    Vec2 left, right;
-    int32_t left_id, right_id;  // mesh vertices; -1 for the ends
-    int32_t face;               // the face before the portal (holds both ends)
-  };
-  // An apex of the funnel: an index into the portals and a side (0 start or
-  // end, +1 left, -1 right).
-  struct Apex {
-    size_t portal;
-    int side;
+  // The strip unfolded: the edges it crosses (the faces before them
+  // alongside), and the run's ends in its plane with their mesh vertices
+  // (-1 unless a vertex point).
+  struct Strip {
+    Small<Portal> portals;
+    Small<int32_t> faces;
+    Vec2 start, end;
+    int32_t start_vertex, end_vertex;
   };
 
   // A face holding the point, and each face holding both it and `other`.
@@ -179,32 +98,20 @@ class Straightener {
     return out;
   }
 
-  double AngleAt(int32_t f, int32_t v) const {
-    int k = 0;
-    while (mesh_.Vertex(f, k) != v) ++k;
-    const mesh::Vec3 a = mesh_.Position(mesh_.Vertex(f, (k + 1) % 3)) - mesh_.Position(v),
-                     b = mesh_.Position(mesh_.Vertex(f, (k + 2) % 3)) - mesh_.Position(v);
-    return std::atan2(a.cross(b).norm(), a.dot(b));
-  }
-
   // The faces around v strictly after `from` up to `to`, on the side whose
   // angle at v is smaller (the side a shortest path hugs). False if neither
   // side connects them (boundary on both).
   bool Fan(int32_t v, int32_t from, int32_t to, Small<int32_t>* fan) const {
     double best = std::numeric_limits<double>::infinity();
+    Small<int32_t> between;
     for (int dir = 0; dir < 2; ++dir) {
-      Small<int32_t> faces;
+      if (!FacesBetween(mesh_, v, from, to, dir, &between)) continue;
       double angle = 0;
-      int32_t f = from;
-      for (int guard = 0; guard < MeshView::kMaxFanSteps && f != to; ++guard) {
-        f = mesh_.Turn(f, v, dir);
-        if (f < 0 || f == from) break;
-        faces.push_back(f);
-        if (f != to) angle += AngleAt(f, v);
-      }
-      if (f == to && angle < best) {
+      for (int32_t f : between) angle += CornerAngle(mesh_, f, v);
+      if (angle < best) {
         best = angle;
-        *fan = std::move(faces);
+        *fan = between;
+        fan->push_back(to);
       }
     }
     return best < std::numeric_limits<double>::infinity();
@@ -222,10 +129,9 @@ class Straightener {
     Small<int32_t> strip = {seg[0]};
     Small<std::array<int32_t, 2>> edges;
     if (!BuildStrip(support, seg, &strip, &edges)) return false;
-    Small<Portal> portals;
-    Vec2 start, end;
-    if (!UnfoldStrip(strip, edges, support, &portals, &start, &end)) return false;
-    return Rebuild(run, portals, Funnel(portals, start), start, end, out);
+    Strip unfolded;
+    if (!UnfoldStrip(run, strip, edges, support, &unfolded)) return false;
+    return Rebuild(run, unfolded, Funnel(unfolded.start, unfolded.portals, unfolded.end), out);
   }
 
   // Segment faces: segment i (run[i] -> run[i+1]) lies in face (*seg)[i].
@@ -236,7 +142,7 @@ class Straightener {
     Small<int32_t>& seg = *seg_out;
     for (size_t i = 0; i + 1 < k; ++i) {
       for (int32_t f : FacesOf(run[i].point, support[i])) {
-        if (FaceHolds(f, support[i + 1])) {
+        if (FaceHolds(mesh_, f, run[i + 1].point)) {
           seg[i] = f;
           break;
         }
@@ -293,157 +199,89 @@ class Straightener {
     return true;
   }
 
-  // Unfolds the strip and collects its portals, the start and end points
-  // first and last as degenerate portals. False if the end is not in the
-  // strip's last face.
-  bool UnfoldStrip(const Small<int32_t>& strip, const Small<std::array<int32_t, 2>>& edges,
-                   const Small<Support>& support, Small<Portal>* portals_out, Vec2* start_out,
-                   Vec2* end_out) const {
+  // Unfolds the strip and collects its portals. False if the end is not in
+  // the strip's last face.
+  bool UnfoldStrip(const std::vector<PathPoint>& run, const Small<int32_t>& strip,
+                   const Small<std::array<int32_t, 2>>& edges, const Small<Support>& support,
+                   Strip* out) const {
     const size_t k = support.size();
-    Small<Portal>& portals = *portals_out;
-    Vec2& start = *start_out;
-    Vec2& end = *end_out;
-    Small<Flat> flats = {FirstFlat(strip[0])};
-    start = Place(flats[0], support[0]);
-    const int32_t start_id = support[0].count == 1 ? support[0].vertex[0] : -1;
-    portals.push_back({start, start, start_id, start_id, strip[0]});
+    FlatFace flat = LayOutFace(mesh_, strip[0]);
+    out->start = LocateInFlat(mesh_, flat, run[0].point, kZero);
+    out->start_vertex = support[0].count == 1 ? support[0].vertex[0] : -1;
     for (size_t i = 0; i < edges.size(); ++i) {
       const int32_t a = edges[i][0], b = edges[i][1];
-      const Flat& prev = flats.back();
-      int32_t behind = -1;
-      for (int j = 0; j < 3; ++j) {
-        if (prev.v[j] != a && prev.v[j] != b) behind = prev.v[j];
-      }
-      Portal portal{prev.At(a), prev.At(b), a, b, prev.face};
+      const Vec2& behind = flat.At(flat.Opposite(a, b));
+      Portal portal{{flat.At(a), flat.At(b)}, {a, b}};
       // (behind, right, left) counter-clockwise: left is on the left of travel.
-      if (Cross(portal.left - prev.At(behind), portal.right - prev.At(behind)) > 0) {
-        std::swap(portal.left, portal.right);
-        std::swap(portal.left_id, portal.right_id);
+      if (Cross(portal.ends[Portal::kLeft] - behind, portal.ends[Portal::kRight] - behind) > 0) {
+        std::swap(portal.ends[0], portal.ends[1]);
+        std::swap(portal.vertices[0], portal.vertices[1]);
       }
-      portals.push_back(portal);
-      flats.push_back(NextFlat(prev, strip[i + 1], a, b));
+      out->portals.push_back(portal);
+      out->faces.push_back(flat.face);
+      flat = UnfoldAcross(mesh_, flat, strip[i + 1], a, b, EdgeMeasure::kOnMesh);
     }
-    end = Place(flats.back(), support[k - 1]);
-    if (!FaceHolds(flats.back().face, support[k - 1])) return false;
-    const int32_t end_id = support[k - 1].count == 1 ? support[k - 1].vertex[0] : -1;
-    portals.push_back({end, end, end_id, end_id, flats.back().face});
+    out->end = LocateInFlat(mesh_, flat, run[k - 1].point, kZero);
+    if (!FaceHolds(mesh_, flat.face, run[k - 1].point)) return false;
+    out->end_vertex = support[k - 1].count == 1 ? support[k - 1].vertex[0] : -1;
     return true;
   }
 
-  // The funnel: the apexes of the shortest path through the portals, from
-  // the start (portal 0) to the end (the last portal).
-  Small<Apex> Funnel(const Small<Portal>& portals, const Vec2& start) const {
-    Small<Apex> apexes = {{0, 0}};
-    Vec2 apex = start, left = start, right = start;
-    size_t apex_index = 0, left_index = 0, right_index = 0;
-    const size_t n = portals.size();
-    for (size_t i = 1; i < n; ++i) {
-      const Vec2 l = portals[i].left, r = portals[i].right;
-      // Tighten the right side.
-      if (Cross(right - apex, r - apex) >= 0) {
-        if ((apex.x == right.x && apex.y == right.y) || Cross(left - apex, r - apex) < 0) {
-          right = r;
-          right_index = i;
-        } else {
-          apexes.push_back({left_index, +1});
-          apex = right = left;
-          apex_index = right_index = left_index;
-          i = apex_index;
-          continue;
-        }
-      }
-      // Tighten the left side.
-      if (Cross(left - apex, l - apex) <= 0) {
-        if ((apex.x == left.x && apex.y == left.y) || Cross(right - apex, l - apex) > 0) {
-          left = l;
-          left_index = i;
-        } else {
-          apexes.push_back({right_index, -1});
-          apex = left = right;
-          apex_index = left_index = right_index;
-          i = apex_index;
-          continue;
-        }
-      }
-    }
-    // The end itself may have become an apex (one side of the last portal).
-    if (apexes.back().portal == n - 1) apexes.pop_back();
-    apexes.push_back({n - 1, 0});
-
-    return apexes;
-  }
-
   // Rebuild the path: the crossings of each straight section with the
-  // portals it passes, and the apexes as vertex points. False on a
-  // degenerate crossing or an apex that is not a mesh vertex.
-  bool Rebuild(const std::vector<PathPoint>& run, const Small<Portal>& portals,
-               const Small<Apex>& apexes, const Vec2& start, const Vec2& end,
+  // portals it passes, and the bends as vertex points. False on a
+  // degenerate crossing.
+  bool Rebuild(const std::vector<PathPoint>& run, const Strip& strip, const FunnelPath& funnel,
                std::vector<PathPoint>* out) const {
-    auto apex_point = [&](const Apex& a) -> Vec2 {
-      return a.side > 0 ? portals[a.portal].left : portals[a.portal].right;
+    // The path's vertices: the start, the bends, the end, each with its
+    // place in the sequence of portals (the start before the first, the end
+    // after the last) and its mesh vertex.
+    struct Stop {
+      size_t after;  // the portals strictly before it: [0, after)
+      Vec2 at;
+      int32_t vertex;
     };
-    auto apex_vertex = [&](const Apex& a) -> int32_t {
-      return a.side >= 0 ? portals[a.portal].left_id : portals[a.portal].right_id;
+    const size_t count = funnel.bends.size();
+    auto stop = [&](size_t s) -> Stop {
+      if (s == 0) return {0, strip.start, strip.start_vertex};
+      if (s > count) return {strip.portals.size() + 1, strip.end, strip.end_vertex};
+      const FunnelBend& bend = funnel.bends[s - 1];
+      const Portal& portal = strip.portals[bend.portal];
+      return {bend.portal + 1, portal.ends[bend.side], portal.vertices[bend.side]};
     };
     out->assign({run[0]});
-    for (size_t s = 0; s + 1 < apexes.size(); ++s) {
-      const Apex a = apexes[s], b = apexes[s + 1];
-      const Vec2 pa = s == 0 ? start : apex_point(a);
-      const Vec2 pb = s + 2 == apexes.size() ? end : apex_point(b);
-      const int32_t va = apex_vertex(a), vb = apex_vertex(b);
-      for (size_t j = a.portal + 1; j < b.portal; ++j) {
-        const Portal& portal = portals[j];
-        if ((va >= 0 && (portal.left_id == va || portal.right_id == va)) ||
-            (vb >= 0 && (portal.left_id == vb || portal.right_id == vb))) {
+    for (size_t s = 0; s <= count; ++s) {
+      const Stop a = stop(s), b = stop(s + 1);
+      const Vec2 dir = b.at - a.at;
+      for (size_t j = a.after; j + 1 < b.after; ++j) {
+        const Portal& portal = strip.portals[j];
+        const Vec2 &left = portal.ends[Portal::kLeft], &right = portal.ends[Portal::kRight];
+        const int32_t left_id = portal.vertices[Portal::kLeft],
+                      right_id = portal.vertices[Portal::kRight];
+        if ((a.vertex >= 0 && (left_id == a.vertex || right_id == a.vertex)) ||
+            (b.vertex >= 0 && (left_id == b.vertex || right_id == b.vertex))) {
           continue;  // the section passes through this portal's end
         }
-        const Vec2 dir = pb - pa;
-        const double denom = Cross(dir, portal.left - portal.right);
+        const double denom = Cross(dir, left - right);
         if (denom == 0) return false;
-        const double t = std::clamp(Cross(dir, pa - portal.right) / denom, 0.0, 1.0);
-        SurfacePoint point{portal.face, {0, 0, 0}};
+        const double t = std::clamp(Cross(dir, a.at - right) / denom, 0.0, 1.0);
+        SurfacePoint point{strip.faces[j], {0, 0, 0}};
         for (int c = 0; c < 3; ++c) {
-          const int32_t v = mesh_.Vertex(portal.face, c);
-          if (v == portal.right_id) point.w[c] = 1 - t;
-          if (v == portal.left_id) point.w[c] = t;
+          const int32_t v = mesh_.Vertex(point.face, c);
+          if (v == right_id) point.w[c] = 1 - t;
+          if (v == left_id) point.w[c] = t;
         }
-        out->push_back({point, (1 - t) * mesh_.Position(portal.right_id) +
-                                   t * mesh_.Position(portal.left_id)});
+        out->push_back({point, (1 - t) * mesh_.Position(right_id) + t * mesh_.Position(left_id)});
       }
-      if (s + 2 < apexes.size()) {
-        if (vb < 0) return false;
-        SurfacePoint point{portals[b.portal].face, {0, 0, 0}};
+      if (s < count) {
+        SurfacePoint point{strip.faces[b.after - 1], {0, 0, 0}};
         for (int c = 0; c < 3; ++c) {
-          if (mesh_.Vertex(point.face, c) == vb) point.w[c] = 1;
+          if (mesh_.Vertex(point.face, c) == b.vertex) point.w[c] = 1;
         }
-        out->push_back({point, mesh_.Position(vb)});
+        out->push_back({point, mesh_.Position(b.vertex)});
       }
     }
     out->push_back(run.back());
     return true;
-  }
-
- public:
-  // The length of the straight path through the strip of faces `run`
-  // crosses; nullopt when the funnel wraps round a strip vertex or the run
-  // is not a proper strip.
-  std::optional<double> StraightLength(const std::vector<PathPoint>& run) const {
-    const size_t k = run.size();
-    if (k < 3)
-      return k == 2 ? std::optional((run[1].position - run[0].position).norm()) : std::nullopt;
-    Small<Support> support(k);
-    for (size_t i = 0; i < k; ++i) support[i] = SupportOf(run[i].point);
-    Small<int32_t> seg(k - 1, -1);
-    if (!SegmentFaces(run, support, &seg)) return std::nullopt;
-    Small<int32_t> strip = {seg[0]};
-    Small<std::array<int32_t, 2>> edges;
-    if (!BuildStrip(support, seg, &strip, &edges)) return std::nullopt;
-    Small<Portal> portals;
-    Vec2 start, end;
-    if (!UnfoldStrip(strip, edges, support, &portals, &start, &end)) return std::nullopt;
-    if (Funnel(portals, start).size() != 2) return std::nullopt;
-    const Vec2 d = end - start;
-    return std::sqrt(d.x * d.x + d.y * d.y);
   }
 
  private:
@@ -451,10 +289,6 @@ class Straightener {
 };
 
 }  // namespace
-
-std::optional<double> StraightLength(const MeshView& mesh, const std::vector<PathPoint>& path) {
-  return Straightener(mesh).StraightLength(path);
-}
 
 std::vector<PathPoint> StraightenPath(const MeshView& mesh, std::vector<PathPoint> path) {
   return Straightener(mesh).Run(std::move(path));

@@ -15,7 +15,6 @@
 // Thread safety: reentrant.
 
 #include <cstdint>
-#include <optional>
 #include <span>
 #include <vector>
 
@@ -24,9 +23,6 @@
 
 namespace geodex::query {
 
-// Returns the straightened path; the endpoints are kept exactly. Consecutive
-// input points must share a face (as QueryEngine::Path produces); runs that
-// do not are returned unchanged.
 // True when a point strictly inside the path is a mesh vertex: there the
 // funnel of StraightenPath wrapped round the vertex.
 bool WrapsRoundAVertex(const std::vector<PathPoint>& path);
@@ -34,11 +30,9 @@ bool WrapsRoundAVertex(const std::vector<PathPoint>& path);
 // The sum of the path's 3D segments.
 double PathLength(const std::vector<PathPoint>& path);
 
+// Returns the straightened path; the endpoints are kept exactly. Consecutive
+// input points must share a face (as QueryEngine::Path produces); runs that
+// do not are returned unchanged.
 std::vector<PathPoint> StraightenPath(const MeshView& mesh, std::vector<PathPoint> path);
-
-// The length StraightenPath gives when the straightened path is one straight
-// segment through the strip (it wraps round no vertex), without building
-// it; nullopt otherwise (then StraightenPath may still shorten the path).
-std::optional<double> StraightLength(const MeshView& mesh, const std::vector<PathPoint>& path);
 
 }  // namespace geodex::query
