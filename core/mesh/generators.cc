@@ -290,17 +290,20 @@ Mesh Sphere(int subdivisions, double radius) {
   return MustCreate(std::move(positions), std::move(faces), "Sphere");
 }
 
-Mesh Torus(int n_major, int n_minor, double major_radius, double minor_radius) {
-  Check(n_major >= 3 && n_minor >= 3, "Torus", "n_major and n_minor must be >= 3");
-  Check(minor_radius > 0 && major_radius > minor_radius, "Torus",
-        "needs major_radius > minor_radius > 0");
+namespace {
+
+// A torus whose tube has radius minor_radius(u) at angle u round the axis.
+template <typename MinorRadius>
+Mesh TorusOf(int n_major, int n_minor, double major_radius, MinorRadius minor_radius,
+             const char* name) {
   std::vector<Vec3> positions;
   for (int i = 0; i < n_major; ++i) {
     const double u = 2 * std::numbers::pi * i / n_major;
+    const double r = minor_radius(u);
     for (int j = 0; j < n_minor; ++j) {
       const double v = 2 * std::numbers::pi * j / n_minor;
-      const double ring = major_radius + minor_radius * std::cos(v);
-      positions.push_back(Vec3(ring * std::cos(u), ring * std::sin(u), minor_radius * std::sin(v)));
+      const double ring = major_radius + r * std::cos(v);
+      positions.push_back(Vec3(ring * std::cos(u), ring * std::sin(u), r * std::sin(v)));
     }
   }
   auto id = [&](int i, int j) {
@@ -313,7 +316,17 @@ Mesh Torus(int n_major, int n_minor, double major_radius, double minor_radius) {
       AddQuad(faces, id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1), false);
     }
   }
-  return MustCreate(std::move(positions), std::move(faces), "Torus");
+  return MustCreate(std::move(positions), std::move(faces), name);
+}
+
+}  // namespace
+
+Mesh Torus(int n_major, int n_minor, double major_radius, double minor_radius) {
+  Check(n_major >= 3 && n_minor >= 3, "Torus", "n_major and n_minor must be >= 3");
+  Check(minor_radius > 0 && major_radius > minor_radius, "Torus",
+        "needs major_radius > minor_radius > 0");
+  return TorusOf(
+      n_major, n_minor, major_radius, [&](double) { return minor_radius; }, "Torus");
 }
 
 Mesh PinchedTorus(int n_major, int n_minor, double major_radius, double minor_radius_max,
@@ -322,27 +335,10 @@ Mesh PinchedTorus(int n_major, int n_minor, double major_radius, double minor_ra
   Check(minor_radius_min > 0 && minor_radius_max >= minor_radius_min &&
             major_radius > minor_radius_max,
         "PinchedTorus", "needs major_radius > minor_radius_max >= minor_radius_min > 0");
-  std::vector<Vec3> positions;
-  for (int i = 0; i < n_major; ++i) {
-    const double u = 2 * std::numbers::pi * i / n_major;
-    const double r =
-        minor_radius_min + (minor_radius_max - minor_radius_min) * (1 + std::cos(u)) / 2;
-    for (int j = 0; j < n_minor; ++j) {
-      const double v = 2 * std::numbers::pi * j / n_minor;
-      const double ring = major_radius + r * std::cos(v);
-      positions.push_back(Vec3(ring * std::cos(u), ring * std::sin(u), r * std::sin(v)));
-    }
-  }
-  auto id = [&](int i, int j) {
-    return static_cast<int32_t>((i % n_major) * n_minor + j % n_minor);
+  auto radius = [&](double u) {
+    return minor_radius_min + (minor_radius_max - minor_radius_min) * (1 + std::cos(u)) / 2;
   };
-  std::vector<Triangle> faces;
-  for (int i = 0; i < n_major; ++i) {
-    for (int j = 0; j < n_minor; ++j) {
-      AddQuad(faces, id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1), false);
-    }
-  }
-  return MustCreate(std::move(positions), std::move(faces), "PinchedTorus");
+  return TorusOf(n_major, n_minor, major_radius, radius, "PinchedTorus");
 }
 
 Mesh Dumbbell(int n_around, double sphere_radius, double tube_radius, double tube_length) {

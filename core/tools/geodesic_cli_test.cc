@@ -10,6 +10,7 @@
 
 #include "absl/strings/str_split.h"
 #include "core/mesh/generators.h"
+#include "core/tools/cli_testing.h"
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
 
@@ -17,29 +18,14 @@ namespace geodex::tools {
 namespace {
 
 using ::testing::HasSubstr;
+using tools::testing::Lines;
+using tools::testing::ReadTestFile;
+
+std::string WriteTestFile(const std::string& file, const std::string& text) {
+  return tools::testing::WriteTestFile(tools::testing::TestDir("geodex_geodesic_cli_test"), file,
+                                       text);
+}
 using ::testing::StartsWith;
-
-std::filesystem::path TestDir() {
-  const auto dir = std::filesystem::temp_directory_path() / "geodex_geodesic_cli_test";
-  std::filesystem::create_directories(dir);
-  return dir;
-}
-
-std::string WriteTestFile(const std::string& name, const std::string& text) {
-  const std::string path = (TestDir() / name).string();
-  std::ofstream(path) << text;
-  return path;
-}
-
-std::string ReadTestFile(const std::string& path) {
-  std::ostringstream text;
-  text << std::ifstream(path).rdbuf();
-  return text.str();
-}
-
-std::vector<std::string> Lines(const std::string& text) {
-  return absl::StrSplit(text, '\n', absl::SkipEmpty());
-}
 
 // The flat 4x4 grid of unit cells: geodesic distance = Euclidean distance;
 // vertex v sits at (v % 5, v / 5).
@@ -57,7 +43,8 @@ std::string PointText(const mesh::Mesh& m, int32_t v) {
 
 // FlatGrid written as OBJ.
 std::string GridFile() {
-  const std::string path = (TestDir() / "grid.obj").string();
+  const std::string path =
+      (tools::testing::TestDir("geodex_geodesic_cli_test") / "grid.obj").string();
   EXPECT_TRUE(mesh::WriteObj(FlatGrid(), path).ok());
   return path;
 }
@@ -154,7 +141,7 @@ TEST(GeodesicToolTest, BadPairLineIsNamed) {
 TEST(GeodesicToolTest, DistancesFromVertexToAFile) {
   GeodesicToolArgs args;
   args.mesh_path = GridFile();
-  args.out = (TestDir() / "from12.txt").string();
+  args.out = (tools::testing::TestDir("geodex_geodesic_cli_test") / "from12.txt").string();
   for (const char* engine : {"wavefront", "windows"}) {
     args.engine = engine;
     args.source_vertex = 12;

@@ -11,6 +11,7 @@
 #include "absl/strings/str_split.h"
 #include "core/common/file_util.h"
 #include "core/mesh/generators.h"
+#include "core/tools/cli_testing.h"
 #include "core/validation/test_index.h"
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
@@ -20,23 +21,14 @@ namespace {
 
 using ::testing::EndsWith;
 using ::testing::HasSubstr;
+using tools::testing::Lines;
+using tools::testing::ReadTestFile;
+
+std::string WriteTestFile(const std::string& file, const std::string& text) {
+  return tools::testing::WriteTestFile(tools::testing::TestDir("geodex_query_cli_test"), file,
+                                       text);
+}
 using ::testing::StartsWith;
-
-std::filesystem::path TestDir() {
-  const auto dir = std::filesystem::temp_directory_path() / "geodex_query_cli_test";
-  std::filesystem::create_directories(dir);
-  return dir;
-}
-
-std::string WriteTestFile(const std::string& name, const std::string& text) {
-  const std::string path = (TestDir() / name).string();
-  std::ofstream(path) << text;
-  return path;
-}
-
-std::vector<std::string> Lines(const std::string& text) {
-  return absl::StrSplit(text, '\n', absl::SkipEmpty());
-}
 
 // Parses `command_line` (without the program name) into a fresh
 // QueryCommandLine's args; CLI11's errors are thrown.
@@ -134,7 +126,8 @@ class QueryToolIndexTest : public ::testing::Test {
     absl::StatusOr<std::string> bytes =
         geodex::testing::BuildTestIndex(*mesh_, 40, /*calibrate=*/true);
     ASSERT_TRUE(bytes.ok()) << bytes.status();
-    index_path_ = new std::string((TestDir() / "sphere.gdx").string());
+    index_path_ =
+        new std::string((tools::testing::TestDir("geodex_query_cli_test") / "sphere.gdx").string());
     ASSERT_TRUE(AtomicWriteFile(*index_path_, *bytes).ok());
   }
   static void TearDownTestSuite() {
@@ -176,7 +169,7 @@ TEST_F(QueryToolIndexTest, NoQueryIsInvalid) {
 
 TEST_F(QueryToolIndexTest, MissingIndexIsAnError) {
   QueryToolArgs args = Args();
-  args.index = (TestDir() / "no_such.gdx").string();
+  args.index = (tools::testing::TestDir("geodex_query_cli_test") / "no_such.gdx").string();
   args.info = true;
   EXPECT_FALSE(AnswerQueryTool(args).ok());
 }
