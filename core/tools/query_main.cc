@@ -6,7 +6,7 @@
 //   geodex-query INDEX --field SOURCES [--nearest]
 //   geodex-query INDEX --locate POINTS
 //   geodex-query INDEX --expmap "F W0 W1 W2" --radius R [--direction X Y Z]
-//   geodex-query INDEX --info
+//   geodex-query INDEX --info [--format text|json]
 //
 // FILE holds lines "fa a0 a1 a2 fb b0 b1 b2" (core/mesh/pairs_io.h); SOURCES
 // lines "f w0 w1 w2"; POINTS lines "x y z". "-" reads standard input.
@@ -25,6 +25,7 @@
 #include "CLI/CLI.hpp"
 #include "absl/strings/str_format.h"
 #include "core/common/status_macros.h"
+#include "core/index/index_report.h"
 #include "core/mesh/pairs_io.h"
 #include "core/query/input_queries.h"
 
@@ -40,27 +41,6 @@ struct Args {
   double tolerance = 0;
   int32_t exact_path_corridor = 0;
 };
-
-// The header's counts, then the builder's report (with the accuracy
-// calibration's figures when the index has one). Vertices and faces count
-// the mesh file's; the counts of the mesh the index answers on (repaired,
-// refined) follow.
-std::string Info(const query::InputQueries& queries) {
-  const index::Index& index = queries.index();
-  const index::FileHeader& h = index.header();
-  std::string out = absl::StrFormat(
-      "format = %d.%d\nbuilder = %s\nvertices = %d\nfaces = %d\nsamples = %d\n"
-      "requested_samples = %d\ntriangles = %d\nbytes = %d\nerror_bounds = %s\n",
-      h.format_major, h.format_minor, index.builder_version(), queries.num_vertices(),
-      queries.num_faces(), index.num_samples(), h.params.requested_samples, index.num_triangles(),
-      index.size_bytes(),
-      index.accuracy() != nullptr ? "yes" : "no (geodex-build calibrate adds them)");
-  if (!queries.identity()) {
-    out += absl::StrFormat("internal_vertices = %d\ninternal_faces = %d\n", index.num_vertices(),
-                           index.num_faces());
-  }
-  return out + std::string(index.report());
-}
 
 // The pairs of `path`, read into `a` and `b`; errors name the line.
 absl::StatusOr<std::vector<mesh::PointPair>> ReadPairs(const query::InputQueries& queries,
@@ -216,7 +196,10 @@ absl::Status Run(const Args& args) {
   distance_options.tolerance = args.tolerance;
   absl::StatusOr<std::string> out;
   if (args.info) {
-    out = Info(*queries);
+    // The build report (core/index/index_report.h).
+    const index::IndexReport report = index::MakeIndexReport(queries->index());
+    out = args.format == "json" ? index::IndexReportJson(report)
+                                : index::IndexReportText(report, args.index);
   } else if (!args.pairs.empty()) {
     out = Distances(*queries, args, distance_options);
   } else if (!args.paths.empty()) {
@@ -256,8 +239,10 @@ int main(int argc, char** argv) {
                  "the centre's face; default its first edge")
       ->expected(3)
       ->needs(expmap);
-  auto* info = app.add_flag("--info", args.info,
-                            "The index's counts and build report, with its accuracy figures");
+  auto* info =
+      app.add_flag("--info", args.info,
+                   "The index's build report: mesh, samples, size, error target and accuracy by "
+                   "distance (--format json: one JSON object)");
   pairs->excludes(paths)->excludes(field)->excludes(locate)->excludes(info)->excludes(expmap);
   paths->excludes(field)->excludes(locate)->excludes(expmap);
   field->excludes(locate)->excludes(expmap);
@@ -281,8 +266,9 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(0, 64));
   app.add_flag("--linear-baseline", args.baseline, "The paper's linear interpolation (§6.3)");
   app.add_flag("--nearest", args.nearest, "With --field: also print the nearest source");
-  app.add_option("--format", args.format, "Path output: xyz (blank line between paths) or json")
-      ->check(CLI::IsMember({"xyz", "json"}));
+  app.add_option("--format", args.format,
+                 "Path output: xyz (blank line between paths) or json; --info: text or json")
+      ->check(CLI::IsMember({"xyz", "json", "text"}));
   CLI11_PARSE(app, argc, argv);
   const absl::Status status = geodex::Run(args);
   if (!status.ok()) {
