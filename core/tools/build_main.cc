@@ -3,6 +3,7 @@
 //
 //   geodex-build MESH -o OUT.gdx [--target-error E] [--samples M0] [--max-samples CAP]
 //   geodex-build MESH -o OUT.gdx --samples M [--threads N] [--seed S] [--edges-obj FILE]
+//                [--report-png FILE]
 //   geodex-build plan MESH [--target-error E | --samples M] [--seed S] -o WORKDIR
 //   geodex-build rows WORKDIR --shard I/N [--threads T]
 //   geodex-build merge WORKDIR -o OUT.gdx [--threads T]
@@ -111,6 +112,11 @@ int main(int argc, char** argv) {
   for (CLI::App* cmd : {&app, merge_cmd}) {
     cmd->add_flag("--no-calibration", no_calibration,
                   "Skip the accuracy calibration (no error bounds or tolerance in queries)");
+  }
+  for (CLI::App* cmd : {&app, merge_cmd, calibrate_cmd}) {
+    cmd->add_option("--report-png", o.report_png,
+                    "Also draw the index's relative error by distance (p99, RMS, the target's "
+                    "limit) as a PNG here");
   }
   calibrate_cmd->add_option("mesh", mesh_path, "The mesh the index was built from")->required();
   calibrate_cmd->add_option("index", index_path, "Index file (.gdx)")->required();
