@@ -111,6 +111,7 @@ ModelInfo FromProto(const v1::ModelInfo& m) {
   info.build_report.insert(m.build_report().begin(), m.build_report().end());
   info.mapped_bytes = m.mapped_bytes();
   info.mesh_hash = m.mesh_hash();
+  info.report_json = m.report_json();
   return info;
 }
 

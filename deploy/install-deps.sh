@@ -30,6 +30,7 @@ BUILD_PACKAGES=(
   libprotobuf-dev protobuf-compiler libgrpc++-dev protobuf-compiler-grpc
   prometheus-cpp-dev
   libcpp-httplib-dev  # the HTTP server of `geodex web`
+  zlib1g-dev          # PNG output: geodex expmap --png, geodex-build --report-png
   libjs-three         # three.js for the web viewer, copied into the build and install trees
   # The Python package geodex: its stubs (grpc_tools), the in-process module
   # (pybind11, python3-dev) and what it imports at run time.

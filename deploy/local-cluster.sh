@@ -204,7 +204,7 @@ start_replica() {
 # served_version ADDR: the model's newest served version as `geodex info`
 # reports it, or nothing.
 served_version() {
-  "$CLIENT_BIN" info --server "$1" --model "$MODEL" --attempts 1 --timeout 2 2>/dev/null |
+  "$CLIENT_BIN" info --server "$1" --model "$MODEL" --format json --attempts 1 --timeout 2 2>/dev/null |
     sed -n 's/^  "version": \([0-9]*\),$/\1/p'
 }
 
@@ -242,7 +242,8 @@ build_version 1 "$FLAGS_V1"
 cmp -s "$WORK/one-process-v1.gdx" "$REPO/$MODEL/1/index.gdx" ||
   die "the distributed target-error build differs from the one-process build"
 log "v1: ${ROUNDS_V[1]} rounds, the same bytes as the one-process build"
-FACES="$("$QUERY_BIN" "$REPO/$MODEL/1/index.gdx" --info | sed -n 's/^faces = \([0-9]*\)$/\1/p')" ||
+FACES="$("$QUERY_BIN" "$REPO/$MODEL/1/index.gdx" --info --format json |
+  sed -n 's/^    "faces": \([0-9]*\),$/\1/p')" ||
   die "geodex-query --info on v1"
 if ! [[ "$FACES" =~ ^[1-9][0-9]*$ ]]; then die "cannot tell the mesh's face count"; fi
 # Pairs inside faces and at vertices, spread over the mesh (fixed seed).

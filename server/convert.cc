@@ -9,6 +9,7 @@
 #include "absl/strings/ascii.h"
 #include "absl/strings/str_format.h"
 #include "absl/strings/str_split.h"
+#include "core/index/index_report.h"
 
 namespace geodex::server {
 
@@ -250,6 +251,7 @@ void ModelInfoToProto(const ModelSnapshot& model, const ServedVersion* version,
   info->set_builder_version(ix.builder_version());
   info->set_mapped_bytes(version->mapped_bytes());
   info->set_mesh_hash(h.mesh_hash);
+  info->set_report_json(index::IndexReportJson(index::MakeIndexReport(ix)));
   auto* report = info->mutable_build_report();
   const std::string text(ix.report());
   for (absl::string_view line : absl::StrSplit(text, '\n')) {

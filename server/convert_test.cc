@@ -5,6 +5,7 @@
 #include <limits>
 
 #include "absl/strings/str_format.h"
+#include "core/index/index_report.h"
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
 #include "server/test_util.h"
@@ -216,6 +217,9 @@ TEST(ConvertModelInfoTest, DescribesAServedVersion) {
     EXPECT_FALSE(key.empty());
     EXPECT_EQ(key.find(' '), std::string::npos) << key;
   }
+  // The report's JSON is the core's, for the served index.
+  EXPECT_EQ(info.report_json(), index::IndexReportJson(index::MakeIndexReport(ix)));
+  EXPECT_THAT(info.report_json(), HasSubstr("\"samples\": {\"requested\": 40,"));
 }
 
 }  // namespace

@@ -82,7 +82,10 @@ for mesh in "${meshes[@]}"; do
   # Query the same index file (the one built before) with both query tools,
   # so that a difference in the answers is the query code's.
   index="$work/before.$name.gdx"
-  faces=$("$before/geodex-query" "$index" --info | awk -F' = ' '$1 == "faces" { print $2 }')
+  # --format json: the build report's JSON; a geodex-query older than it
+  # prints "faces = N" lines there instead.
+  faces=$("$before/geodex-query" "$index" --info --format json |
+    sed -n 's/^faces = \([0-9]*\)$/\1/p; s/^    "faces": \([0-9]*\),$/\1/p')
   [ -n "$faces" ] || { echo "check_same_answers: no face count for $name" >&2; exit 1; }
   paste -d' ' <(points "$faces" 600 11) <(points "$faces" 600 12) >"$work/pairs"
   # Near pairs too: the second point in the first point's face.

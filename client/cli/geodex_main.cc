@@ -1,7 +1,7 @@
 // geodex: the command-line client of a geodex server.
 //
 //   geodex models                                   models the server knows
-//   geodex info --model M                           one model, with its build report
+//   geodex info --model M [--format text|json]      one model and its build report
 //   geodex distance --model M --pairs FILE|- [--xyz] [--near-pairs MODE] [--tolerance X]
 //                   [--error-bounds]
 //   geodex path --model M --pairs FILE --format obj|ply|json --out F

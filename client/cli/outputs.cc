@@ -7,6 +7,8 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "absl/strings/str_join.h"
+#include "absl/strings/str_replace.h"
+#include "absl/strings/strip.h"
 
 namespace geodex::client::cli {
 namespace {
@@ -178,7 +180,14 @@ std::string ModelToJson(const ModelInfo& m) {
       ",\n  \"builder_version\": ", JsonString(m.builder_version),
       ",\n  \"mapped_bytes\": ", m.mapped_bytes, ",\n  \"mesh_hash\": ", m.mesh_hash,
       ",\n  \"build_report\": {", report.empty() ? "" : "\n", absl::StrJoin(report, ",\n"),
-      report.empty() ? "}" : "\n  }", "\n}\n");
+      report.empty() ? "}" : "\n  }",
+      // The server's report JSON, verbatim but for its indentation.
+      m.report_json.empty()
+          ? ""
+          : absl::StrCat(",\n  \"report\": ",
+                         absl::StrReplaceAll(absl::StripTrailingAsciiWhitespace(m.report_json),
+                                             {{"\n", "\n  "}})),
+      "\n}\n");
 }
 
 std::string JsonString(const std::string& s) {

@@ -45,7 +45,9 @@ std::array<uint8_t, 3> RampColor(double t);
 // One line per model: name, version, state, vertices, faces, samples.
 std::string ModelsTable(const std::vector<ModelInfo>& models);
 
-// A model's full description as JSON.
+// A model's full description as JSON: ModelInfo's fields under their proto
+// names, and the build report's JSON (report_json) as "report" when the
+// server sent it.
 std::string ModelToJson(const ModelInfo& model);
 
 // `s` as a JSON string literal, quotes included.

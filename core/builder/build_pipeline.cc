@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <optional>
 
+#include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "core/builder/build_progress.h"
 #include "core/builder/build_rounds.h"
@@ -13,21 +14,13 @@
 #include "core/common/file_util.h"
 #include "core/common/status_macros.h"
 #include "core/index/index.h"
+#include "core/index/index_report.h"
+#include "core/index/report_chart.h"
 #include "core/mesh/generators.h"
 #include "core/validation/calibration.h"
 
 namespace geodex::builder {
 namespace {
-
-// The value of report line `name` ("mesh_repairs"), or `absent`.
-std::string ReportLine(const std::string& report, const std::string& name,
-                       const std::string& absent) {
-  const std::string key = name + " = ";
-  const size_t at = report.find(key);
-  if (at == std::string::npos) return absent;
-  const size_t end = report.find('\n', at);
-  return report.substr(at + key.size(), end == std::string::npos ? end : end - at - key.size());
-}
 
 std::string EdgeLine(int32_t edges, int32_t crossings, double total, double longest) {
   if (edges == 0) return "not traced";
@@ -37,27 +30,37 @@ std::string EdgeLine(int32_t edges, int32_t crossings, double total, double long
       edges, crossings, total, longest);
 }
 
-std::string SummaryText(const BuildSummary& s, const std::string& out, const std::string& repairs,
-                        const std::string& refinement) {
-  return absl::StrFormat(
-      "geodex-build: wrote %s (%.1f MiB)\n"
-      "  mesh repairs     %s\n"
-      "  mesh refinement  %s\n"
-      "  samples          %d requested, %d final (%s)\n"
-      "  triangles        %d geodesic triangles\n"
-      "  edges            %s\n"
-      "  vertices         %lld referenced, %lld unassigned\n"
-      "  outside [-0.01,1.01]  %.4f%% of vertices\n"
-      "  longest edge     %.6g (%.4f of the bounding-box diagonal)\n"
-      "  time             sampling %s, triangulation %s, rows %s, merge %s\n",
-      out, s.index_bytes / 1048576.0, repairs, refinement, s.requested_samples, s.num_samples,
-      s.repair, s.num_triangles,
-      EdgeLine(s.geodesic_edges, s.edge_crossings_found, s.edge_length_total, s.edge_length_max),
-      static_cast<long long>(s.referenced_vertices), static_cast<long long>(s.unassigned_vertices),
-      100 * s.share_outside, s.longest_edge,
-      s.bbox_diagonal > 0 ? s.longest_edge / s.bbox_diagonal : 0.0,
+// The closing lines of a build: the index's report (core/index/index_report.h),
+// then what only the build knows: its triangulation's figures and its times.
+std::string ClosingText(const BuildSummary& s, const index::IndexReport& report,
+                        const std::string& out, double calibration_seconds) {
+  std::string text =
+      absl::StrFormat("geodex-build: wrote %s\n%s", out, index::IndexReportText(report, out));
+  absl::StrAppendFormat(
+      &text,
+      "  triangulation %s; %.2f%% of vertices outside [-0.01,1.01]; longest edge %.4f of the "
+      "bounding-box diagonal\n",
+      s.geodesic_edges == 0 ? std::string("edges not traced")
+                            : absl::StrFormat("%d edges traced exactly, %d crossings repaired",
+                                              s.geodesic_edges, s.edge_crossings_found),
+      100 * s.share_outside, s.bbox_diagonal > 0 ? s.longest_edge / s.bbox_diagonal : 0.0);
+  absl::StrAppendFormat(
+      &text, "  time          sampling %s, triangulation %s, rows %s, merge %s%s\n",
       FormatSeconds(s.sampling_seconds), FormatSeconds(s.triangulation_seconds),
-      FormatSeconds(s.rows_seconds), FormatSeconds(s.merge_seconds));
+      FormatSeconds(s.rows_seconds), FormatSeconds(s.merge_seconds),
+      calibration_seconds > 0 ? absl::StrCat(", calibration ", FormatSeconds(calibration_seconds))
+                              : "");
+  return text;
+}
+
+// Writes the report's chart to options.report_png, when asked for.
+absl::Status WriteReportChart(const index::IndexReport& report, const PipelineOptions& options,
+                              BuildReport* out) {
+  if (options.report_png.empty()) return absl::OkStatus();
+  GEODEX_RETURN_IF_ERROR(index::WriteReportPng(report, options.report_png));
+  out->text +=
+      absl::StrFormat("geodex-build: wrote the accuracy chart to %s\n", options.report_png);
+  return absl::OkStatus();
 }
 
 // Writes the plan's traced edges (nothing when `path` is empty).
@@ -71,55 +74,32 @@ absl::Status WriteEdges(const mesh::Mesh& mesh, const Plan& plan, const std::str
 }
 
 // Measures the index against held-out exact propagations and stores its
-// accuracy calibration (error bounds) and the figures in its report.
+// accuracy calibration (error bounds) and the figures in its report;
+// `seconds` receives the time it took.
 absl::Status AddCalibration(const mesh::Mesh& mesh, index::IndexData& data, int threads,
-                            BuildReport* report) {
+                            double* seconds) {
   const auto start = std::chrono::steady_clock::now();
   validation::CalibrationOptions options;
   options.pairs.threads = threads;
   GEODEX_RETURN_IF_ERROR(validation::AddCalibration(mesh, data, options));
-  const index::AccuracyRecord& r = data.accuracy[0];
-  data.report += validation::CalibrationText(r);
-  report->text += absl::StrFormat(
-      "  accuracy         relative error by scale (held-out pairs, default answer): RMS "
-      "%.3f%% / %.3f%% / %.3f%% / %.3f%%, p99 %.3f%% / %.3f%% / %.3f%% / %.3f%% "
-      "(d<L, L-3L, 3L-10L, >=10L; L = %.4g), calibrated in %s\n",
-      100 * r.rms[0], 100 * r.rms[1], 100 * r.rms[2], 100 * r.rms[3], 100 * r.p99[0],
-      100 * r.p99[1], 100 * r.p99[2], 100 * r.p99[3], r.scale_length,
-      FormatSeconds(
-          std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count()));
+  data.report += validation::CalibrationText(data.accuracy[0]);
+  *seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return absl::OkStatus();
 }
 
-// Writes `data` to `out`, checks that it reads back, and adds the summary.
+// Writes `data` to `out`, checks that it reads back, and adds the closing
+// lines (and the chart).
 absl::Status WriteAndReport(const index::IndexData& data, BuildSummary& summary,
-                            const std::string& out, BuildReport* report) {
+                            const std::string& out, const PipelineOptions& options,
+                            double calibration_seconds, BuildReport* report) {
   GEODEX_RETURN_IF_ERROR(index::WriteIndexFile(data, out));
   GEODEX_ASSIGN_OR_RETURN(auto loaded, index::Index::Open(out));  // validate what we wrote
   summary.index_bytes = loaded->size_bytes();
   report->index_bytes = summary.index_bytes;
   report->num_samples = loaded->num_samples();
-  report->text +=
-      SummaryText(summary, out, ReportLine(data.report, "mesh_repairs", "none recorded"),
-                  ReportLine(data.report, "mesh_refinement", "none (no edge longer than L/2)"));
-  return absl::OkStatus();
-}
-
-// The summary's line of a target-error build.
-std::string TargetSummary(const std::vector<validation::TargetFigures>& rounds, const NextStep& end,
-                          double target) {
-  std::string samples;
-  for (const validation::TargetFigures& r : rounds) {
-    samples += absl::StrFormat("%s%d", samples.empty() ? "" : ", ", r.samples);
-  }
-  const validation::TargetFigures& last = rounds.back();
-  const int worst = validation::WorstCheck(last, target);
-  return absl::StrFormat(
-      "  error target     %g: %s in %d rounds (m = %s); closest check %s, 95%% upper limit "
-      "%.3f%% of %.3f%%\n",
-      target, end.reached ? "met" : absl::StrFormat("NOT met (m stopped at %s)", end.stop),
-      rounds.size(), samples, validation::TargetCheckName(worst), 100 * last.upper[worst],
-      100 * validation::TargetLimit(worst, target));
+  const index::IndexReport index_report = index::MakeIndexReport(*loaded);
+  report->text += ClosingText(summary, index_report, out, calibration_seconds);
+  return WriteReportChart(index_report, options, report);
 }
 
 void Log(const PipelineOptions& options, const std::string& line) {
@@ -146,8 +126,7 @@ absl::StatusOr<BuildReport> BuildToTargetError(const mesh::RepairedMesh& repaire
   }
   BuildReport report;
   GEODEX_RETURN_IF_ERROR(WriteEdges(result.mesh, result.plan, options.edges_obj, &report));
-  GEODEX_RETURN_IF_ERROR(WriteAndReport(result.data, result.summary, out, &report));
-  report.text += TargetSummary(result.rounds, result.last, options.target_error);
+  GEODEX_RETURN_IF_ERROR(WriteAndReport(result.data, result.summary, out, options, 0, &report));
   return report;
 }
 
@@ -225,8 +204,7 @@ absl::StatusOr<BuildReport> MergeTargetRound(const std::string& workdir, TargetS
                                    "(%s); writing the last round's index",
                                    result.figures.samples, next.stop));
     }
-    GEODEX_RETURN_IF_ERROR(WriteAndReport(result.data, result.summary, out, &report));
-    report.text += TargetSummary(state.rounds, next, state.target);
+    GEODEX_RETURN_IF_ERROR(WriteAndReport(result.data, result.summary, out, options, 0, &report));
     return report;
   }
   GEODEX_ASSIGN_OR_RETURN(auto coarse, LoadCoarseMesh(workdir));
@@ -289,10 +267,11 @@ absl::StatusOr<BuildReport> BuildIndexFile(const std::string& mesh_path, const s
   BuildSummary summary;
   GEODEX_ASSIGN_OR_RETURN(auto data, BuildIndexFromPlan(mesh, plan, options.build, &summary));
   AddRepair(prepared.record, &data);
+  double calibration_seconds = 0;
   if (options.calibrate) {
-    GEODEX_RETURN_IF_ERROR(AddCalibration(mesh, data, options.build.threads, &report));
+    GEODEX_RETURN_IF_ERROR(AddCalibration(mesh, data, options.build.threads, &calibration_seconds));
   }
-  GEODEX_RETURN_IF_ERROR(WriteAndReport(data, summary, out, &report));
+  GEODEX_RETURN_IF_ERROR(WriteAndReport(data, summary, out, options, calibration_seconds, &report));
   return report;
 }
 
@@ -371,10 +350,11 @@ absl::StatusOr<BuildReport> MergeBuild(const std::string& workdir, const std::st
   GEODEX_ASSIGN_OR_RETURN(auto data, Merge(mesh, plan, std::move(rows), &summary));
   AddRepair(repair, &data);
   BuildReport report;
+  double calibration_seconds = 0;
   if (options.calibrate) {
-    GEODEX_RETURN_IF_ERROR(AddCalibration(mesh, data, options.build.threads, &report));
+    GEODEX_RETURN_IF_ERROR(AddCalibration(mesh, data, options.build.threads, &calibration_seconds));
   }
-  GEODEX_RETURN_IF_ERROR(WriteAndReport(data, summary, out, &report));
+  GEODEX_RETURN_IF_ERROR(WriteAndReport(data, summary, out, options, calibration_seconds, &report));
   return report;
 }
 
@@ -398,10 +378,16 @@ absl::StatusOr<BuildReport> CalibrateIndexFile(const std::string& mesh_path,
   }
   index::IndexData data = index::ToIndexData(*index);
   BuildReport report;
-  GEODEX_RETURN_IF_ERROR(AddCalibration(mesh, data, options.build.threads, &report));
+  double seconds = 0;
+  GEODEX_RETURN_IF_ERROR(AddCalibration(mesh, data, options.build.threads, &seconds));
   GEODEX_RETURN_IF_ERROR(index::WriteIndexFile(data, out));
-  report.text += absl::StrFormat("geodex-build calibrate: wrote %s\n", out);
+  GEODEX_ASSIGN_OR_RETURN(auto calibrated, index::Index::Open(out));  // validate what we wrote
+  const index::IndexReport index_report = index::MakeIndexReport(*calibrated);
+  report.text +=
+      absl::StrFormat("geodex-build calibrate: wrote %s\n%s  time          calibration %s\n", out,
+                      index::IndexReportText(index_report, out), FormatSeconds(seconds));
   report.num_samples = index->num_samples();
+  GEODEX_RETURN_IF_ERROR(WriteReportChart(index_report, options, &report));
   return report;
 }
 

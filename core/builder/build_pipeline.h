@@ -55,6 +55,9 @@ struct PipelineOptions {
   int32_t max_samples = 0;
   // Also write the geodesic Delaunay edges as OBJ polylines here.
   std::string edges_obj;
+  // Also draw the written index's accuracy by distance as a PNG here
+  // (core/index/report_chart.h; the index must be calibrated).
+  std::string report_png;
   // Lines for the user about the rounds of a target-error build (stderr in
   // geodex-build); may be empty.
   std::function<void(const std::string&)> log;

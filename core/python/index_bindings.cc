@@ -24,6 +24,7 @@
 
 #include "absl/status/status.h"
 #include "absl/strings/str_format.h"
+#include "core/index/index_report.h"
 #include "core/python/bindings.h"
 #include "core/python/python_status.h"
 #include "core/query/input_queries.h"
@@ -115,6 +116,11 @@ class Index {
   int32_t num_samples() const { return queries_->index().num_samples(); }
   bool has_error_bounds() const { return queries_->has_error_bounds(); }
   std::string report() const { return std::string(queries_->index().report()); }
+  // The build report as JSON (core/index/index_report.h), as the server's
+  // GetModel sends it.
+  std::string report_json() const {
+    return index::IndexReportJson(index::MakeIndexReport(queries_->index()));
+  }
 
   // (distances, bounds or None) of pairs (a[i], b[i]).
   py::tuple Distance(const Faces& a_faces, const Weights& a_weights, const Faces& b_faces,
@@ -383,6 +389,7 @@ void BindIndex(py::module_& m) {
       .def_property_readonly("num_samples", &Index::num_samples)
       .def_property_readonly("has_error_bounds", &Index::has_error_bounds)
       .def_property_readonly("report", &Index::report)
+      .def_property_readonly("report_json", &Index::report_json)
       .def("distance", &Index::Distance)
       .def("matrix", &Index::Matrix)
       .def("path", &Index::Path)

@@ -75,6 +75,11 @@ void BuildCommandLine::AddSubcommandOptions() {
     cmd->add_flag("--no-calibration", args_.no_calibration,
                   "Skip the accuracy calibration (no error bounds or tolerance in queries)");
   }
+  for (CLI::App* cmd : {&app_, merge_, calibrate_}) {
+    cmd->add_option("--report-png", args_.pipeline.report_png,
+                    "Also draw the index's relative error by distance (p99, RMS, the target's "
+                    "limit) as a PNG here");
+  }
   calibrate_->add_option("mesh", args_.mesh_path, "The mesh the index was built from")->required();
   calibrate_->add_option("index", args_.index_path, "Index file (.gdx)")->required();
   calibrate_->add_option("-o,--output", args_.out, "Output index file (.gdx)")->required();

@@ -3,6 +3,7 @@
 //
 //   geodex-build MESH -o OUT.gdx [--target-error E] [--samples M0] [--max-samples CAP]
 //   geodex-build MESH -o OUT.gdx --samples M [--threads N] [--seed S] [--edges-obj FILE]
+//                [--report-png FILE]
 //   geodex-build plan MESH [--target-error E | --samples M] [--seed S] -o WORKDIR
 //   geodex-build rows WORKDIR --shard I/N [--threads T]
 //   geodex-build merge WORKDIR -o OUT.gdx [--threads T]

@@ -5,6 +5,7 @@
 
 #include "absl/strings/str_format.h"
 #include "core/common/status_macros.h"
+#include "core/index/index_report.h"
 #include "core/mesh/pairs_io.h"
 
 namespace geodex::tools {
@@ -88,8 +89,10 @@ void QueryCommandLine::AddQueryOptions() {
                   "the centre's face; default its first edge")
       ->expected(3)
       ->needs(expmap);
-  auto* info = app_.add_flag("--info", a.info,
-                             "The index's counts and build report, with its accuracy figures");
+  auto* info =
+      app_.add_flag("--info", a.info,
+                    "The index's build report: mesh, samples, size, error target and accuracy by "
+                    "distance (--format json: one JSON object)");
   pairs->excludes(paths)->excludes(field)->excludes(locate)->excludes(info)->excludes(expmap);
   paths->excludes(field)->excludes(locate)->excludes(expmap);
   field->excludes(locate)->excludes(expmap);
@@ -117,8 +120,9 @@ void QueryCommandLine::AddAnswerOptions() {
       ->check(CLI::Range(0, 64));
   app_.add_flag("--linear-baseline", a.baseline, "The paper's linear interpolation (§6.3)");
   app_.add_flag("--nearest", a.nearest, "With --field: also print the nearest source");
-  app_.add_option("--format", a.format, "Path output: xyz (blank line between paths) or json")
-      ->check(CLI::IsMember({"xyz", "json"}));
+  app_.add_option("--format", a.format,
+                  "Path output: xyz (blank line between paths) or json; --info: text or json")
+      ->check(CLI::IsMember({"xyz", "json", "text"}));
 }
 
 query::DistanceOptions DistanceOptionsOf(const QueryToolArgs& args) {
@@ -132,21 +136,10 @@ query::DistanceOptions DistanceOptionsOf(const QueryToolArgs& args) {
 
 // Vertices and faces count the mesh file's; the counts of the mesh the index
 // answers on (repaired, refined) follow.
-std::string IndexInfoText(const query::InputQueries& queries) {
-  const index::Index& index = queries.index();
-  const index::FileHeader& h = index.header();
-  std::string out = absl::StrFormat(
-      "format = %d.%d\nbuilder = %s\nvertices = %d\nfaces = %d\nsamples = %d\n"
-      "requested_samples = %d\ntriangles = %d\nbytes = %d\nerror_bounds = %s\n",
-      h.format_major, h.format_minor, index.builder_version(), queries.num_vertices(),
-      queries.num_faces(), index.num_samples(), h.params.requested_samples, index.num_triangles(),
-      index.size_bytes(),
-      index.accuracy() != nullptr ? "yes" : "no (geodex-build calibrate adds them)");
-  if (!queries.identity()) {
-    out += absl::StrFormat("internal_vertices = %d\ninternal_faces = %d\n", index.num_vertices(),
-                           index.num_faces());
-  }
-  return out + std::string(index.report());
+std::string IndexInfoText(const query::InputQueries& queries, const QueryToolArgs& args) {
+  const index::IndexReport report = index::MakeIndexReport(queries.index());
+  return args.format == "json" ? index::IndexReportJson(report)
+                               : index::IndexReportText(report, args.index);
 }
 
 absl::StatusOr<std::string> PairDistancesText(const query::InputQueries& queries,
@@ -261,7 +254,7 @@ absl::StatusOr<std::string> AnswerQueryTool(const QueryToolArgs& args) {
   options.exact_path_corridor = args.exact_path_corridor;
   GEODEX_ASSIGN_OR_RETURN(const auto queries, query::InputQueries::Open(args.index, options));
   const query::DistanceOptions distance_options = DistanceOptionsOf(args);
-  if (args.info) return IndexInfoText(*queries);
+  if (args.info) return IndexInfoText(*queries, args);
   if (!args.pairs.empty()) return PairDistancesText(*queries, args, distance_options);
   if (!args.paths.empty()) return PathsText(*queries, args);
   if (!args.field.empty()) return FieldText(*queries, args);

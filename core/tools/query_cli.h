@@ -70,9 +70,9 @@ class QueryCommandLine {
 // The distance options the flags ask for (near pairs, tolerance).
 query::DistanceOptions DistanceOptionsOf(const QueryToolArgs& args);
 
-// --info: the header's counts, then the builder's report (with the accuracy
-// calibration's figures when the index has one), "key = value" lines.
-std::string IndexInfoText(const query::InputQueries& queries);
+// The index's build report (core/index/index_report.h) for --info: text
+// for a person, or with --format json one JSON object.
+std::string IndexInfoText(const query::InputQueries& queries, const QueryToolArgs& args);
 
 // --pairs: "distance" per pair ("distance bound" with error_bounds), in
 // input order. Errors: the file's, InvalidArgument/OutOfRange for a bad point

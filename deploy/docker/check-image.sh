@@ -307,7 +307,8 @@ in_image /bin/sh -c "set -e
 [ -s "$MODELS/$MODEL/1/index.gdx" ] || die "no $MODEL/1/index.gdx in the repository"
 log "model: $(du -k "$MODELS/$MODEL/1/index.gdx" | cut -f1) KiB in $((SECONDS - start)) s, owned by $(stat -c %u:%g "$MODELS/$MODEL/1/index.gdx")"
 
-FACES="$(in_image /usr/local/bin/geodex-query "/models/$MODEL/1/index.gdx" --info | sed -n 's/^faces = \([0-9]*\)$/\1/p')" ||
+FACES="$(in_image /usr/local/bin/geodex-query "/models/$MODEL/1/index.gdx" --info --format json |
+  sed -n 's/^    "faces": \([0-9]*\),$/\1/p')" ||
   die "geodex-query --info in the image"
 [[ "$FACES" =~ ^[1-9][0-9]*$ ]] || die "geodex-query --info in the image gave no face count"
 # Pairs inside faces and at vertices, spread over the mesh (fixed seed).
@@ -335,7 +336,7 @@ log "server: pid $SERVER_PID, uid $SERVER_UID, listening on port $PORT"
 ADDR="127.0.0.1:$PORT"
 served=""
 for _ in $(seq 1 150); do
-  served="$(in_image /usr/local/bin/geodex info --server "$ADDR" --model "$MODEL" --attempts 1 --timeout 2 2>/dev/null |
+  served="$(in_image /usr/local/bin/geodex info --server "$ADDR" --model "$MODEL" --format json --attempts 1 --timeout 2 2>/dev/null |
     sed -n 's/^  "version": \([0-9]*\),$/\1/p')" || true
   [ "$served" = 1 ] && break
   kill -0 "$SERVER_PID" 2>/dev/null || { cat "$WORK/server.log" >&2; die "geodex-server exited"; }

@@ -68,7 +68,7 @@ MESH=builtin:torus
 START_MS=$(date +%s%3N)
 "$BUILD_BIN" "$MESH" -o ref.gdx --samples 90 --seed 2 > ref.log 2>&1 || { cat ref.log; fail "build ref"; }
 BUILD_MS=$(($(date +%s%3N) - START_MS))
-FACES=$("$QUERY_BIN" ref.gdx --info | awk '$1 == "faces" { print $3; exit }')
+FACES=$("$QUERY_BIN" ref.gdx --info --format json | sed -n 's/^    "faces": \([0-9]*\),$/\1/p')
 [ -n "$FACES" ] && [ "$FACES" -gt 0 ] || fail "no face count from geodex-query --info"
 awk -v f="$FACES" 'BEGIN { srand(7);
   for (i = 0; i < 40; i++)

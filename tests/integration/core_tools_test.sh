@@ -41,7 +41,7 @@ within() {
 # geodex-build: one process, and the sharded pipeline.
 "$tools/geodex-build" builtin:sphere -o "$work/one.gdx" --samples 40 --threads 2 >"$work/build.out" 2>&1
 exits 0 "geodex-build"
-check "build prints a summary" grep -q "unassigned" "$work/build.out"
+check "build prints its report" sh -c "grep -q '^  samples       m = [0-9]*: 40 requested' '$work/build.out' && grep -q '^  time  ' '$work/build.out'"
 "$tools/geodex-build" plan builtin:sphere --samples 40 -o "$work/wd" >/dev/null 2>&1
 exits 0 "geodex-build plan"
 for i in 0 1 2; do
@@ -77,7 +77,31 @@ check "geodex-query --error-bounds prints distance and bound" \
 check "geodex-query --tolerance 0.005 is within 0.5% of exact" within 0.005 "$work/exact.txt" "$work/bounded.txt" 3
 "$tools/geodex-query" "$work/one.gdx" --info >"$work/info.txt" 2>&1
 exits 0 "geodex-query --info"
-check "geodex-query --info shows the accuracy figures" grep -q "accuracy_p99_3L_10L" "$work/info.txt"
+check "geodex-query --info shows the accuracy table" grep -q "^                  3L-10L  *[0-9.<]*%  *[0-9.<]*%" "$work/info.txt"
+"$tools/geodex-query" "$work/one.gdx" --info --format json >"$work/info.json" 2>&1
+exits 0 "geodex-query --info --format json"
+# The text and the JSON show the same figures: each bin's p99, formatted as
+# the text formats it, is in the text's row of that bin.
+check "geodex-query --info text and JSON agree" python3 -c '
+import json, sys
+r = json.load(open(sys.argv[1])); text = open(sys.argv[2]).read()
+def pct(x):
+    v = 100 * x
+    if v == 0: return "0%"
+    if v < 0.001: return "<0.001%"
+    d = 0 if v >= 100 else 1 if v >= 10 else 2 if v >= 1 else 3 if v >= 0.1 else 4 if v >= 0.01 else 5
+    return "%.*f%%" % (d, v)
+for b in r["accuracy"]["bins"]:
+    row = [l for l in text.splitlines() if l.startswith(" " * 18 + b["label"] + " ")]
+    assert len(row) == 1, b["label"]
+    cells = row[0][18 + len(b["label"]):].split()
+    assert cells[:3] == [pct(b["rms"]), pct(b["p99"]), pct(b["p99_limit"])], (b, cells)
+assert "m = %d:" % r["samples"]["final"] in text
+' "$work/info.json" "$work/info.txt"
+"$tools/geodex-build" builtin:sphere -o "$work/charted.gdx" --samples 40 --threads 2 \
+  --report-png "$work/chart.png" >/dev/null 2>&1
+exits 0 "geodex-build --report-png"
+check "--report-png writes a PNG" sh -c "head -c 8 '$work/chart.png' | od -An -c | grep -q 'P   N   G'"
 "$tools/geodex-build" builtin:sphere -o "$work/plain.gdx" --samples 40 --threads 2 --no-calibration >/dev/null 2>&1
 exits 0 "geodex-build --no-calibration"
 "$tools/geodex-query" "$work/plain.gdx" --pairs "$work/pairs.txt" --error-bounds >/dev/null 2>"$work/err"
@@ -111,7 +135,7 @@ check "flat grid: Euclidean to 1e-12, unreferenced vertex inf" awk '
 "$tools/geodex-build" "$work/grid.obj" -o "$work/grid.gdx" --samples 60 --threads 2 \
   >"$work/grid_build.out" 2>&1
 exits 0 "geodex-build of the grid (refined)"
-check "refined build reports the midpoints" grep -q "mesh refinement  [0-9]* midpoints added" "$work/grid_build.out"
+check "refined build reports the midpoints" grep -q "refinement    [0-9]* midpoints" "$work/grid_build.out"
 "$tools/geodex-build" plan "$work/grid.obj" --samples 60 -o "$work/gwd" >/dev/null 2>&1
 exits 0 "geodex-build plan of the grid"
 for i in 0 1; do
@@ -131,11 +155,11 @@ check "refined: calibrate gives the one-process index" cmp -s "$work/grid.gdx" "
 "$tools/geodex-build" "$work/grid.obj" -o "$work/grid_noref.gdx" --samples 60 --no-refinement \
   >"$work/grid_noref.out" 2>&1
 exits 0 "geodex-build --no-refinement"
-check "--no-refinement adds no midpoint" grep -q "mesh refinement  none" "$work/grid_noref.out"
+check "--no-refinement adds no midpoint" grep -q "refinement    none" "$work/grid_noref.out"
 "$tools/geodex-query" "$work/grid.gdx" --info >"$work/grid_info.txt" 2>&1
 exits 0 "geodex-query --info of the grid"
 check "--info counts the grid's faces and shows the refinement" \
-  sh -c "grep -q '^faces = 128$' '$work/grid_info.txt' && grep -q '^mesh_refinement = ' '$work/grid_info.txt'"
+  sh -c "grep -q '^  mesh          [0-9]* vertices, 128 faces (answered on' '$work/grid_info.txt' && grep -q '^  refinement    [1-9][0-9]* midpoints' '$work/grid_info.txt'"
 printf '0 1 0 0 127 0 0 1
 5 0.2 0.3 0.5 100 0.3 0.3 0.4
 17 0.5 0.5 0 90 0.1 0.1 0.8

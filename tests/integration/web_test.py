@@ -3,7 +3,7 @@
 --browser) the viewer in headless Chromium.
 
   web_test.py --geodex G --server-bin S --build-bin B --query-bin Q --out DIR [--browser]
-              [--mesh MESH --samples M --screenshot PNG]
+              [--mesh MESH --samples M --screenshot PNG --panel-screenshot PNG]
 
 Without --browser: the HTTP/JSON API against geodex-query offline (distances,
 error bounds, field, path to 1e-9), the merged streams, and the error codes.
@@ -14,12 +14,18 @@ drew it), clicks a source and shift-clicks a target with real mouse events at
 canvas pixels, moves the mouse over a third point, toggles the geodesic
 triangulation, and checks the distances the page shows (data-distance, the
 exact number it received) against geodex-query for the surface points the page
-sent (read back from window.geodexViewer.state). Screenshots go to DIR.
+sent (read back from window.geodexViewer.state). The build report: the
+panel's report equals geodex-query --info --format json, its accuracy table
+shows the cells of geodex-query --info's text, its chart draws each bin's p99
+and RMS at the report's values (and `geodex info` prints the same text); at
+1000x700 and 1400x900 no word or number of the panel is broken across lines.
+Screenshots go to DIR.
 Exits 77 (ctest: skipped) when chromium, chromedriver or selenium is missing.
 """
 
 import argparse
 import json
+import math
 import os
 import random
 import shutil
@@ -313,7 +319,144 @@ return [out, c.width, c.height];
 """
 
 
-def test_browser(stack, out_dir, screenshot):
+# Every visible word of the panel laid out on one line: words whose text
+# ranges span more than one line, and whether the panel scrolls sideways
+# (test code run in the page).
+BROKEN_WORDS = """
+const panel = document.getElementById('panel'), broken = [];
+let words = 0;
+const walker = document.createTreeWalker(panel, NodeFilter.SHOW_TEXT);
+for (let n = walker.nextNode(); n; n = walker.nextNode()) {
+  const el = n.parentElement;
+  if (!el || el.closest('[hidden]') || el.getClientRects().length === 0) continue;  // not shown
+  for (const m of n.textContent.matchAll(/\\S+/g)) {
+    const range = document.createRange();
+    range.setStart(n, m.index);
+    range.setEnd(n, m.index + m[0].length);
+    const rects = Array.from(range.getClientRects()).filter((r) => r.width > 0 && r.height > 0);
+    if (rects.length === 0) continue;
+    ++words;
+    const lines = new Set(rects.map((r) => Math.round(r.top + r.height / 2)));
+    if (lines.size > 1) broken.push(m[0]);
+  }
+}
+const table = document.getElementById('accuracy-table').getBoundingClientRect();
+const box = panel.getBoundingClientRect();
+return {broken, words, overflow: panel.scrollWidth - panel.clientWidth,
+        tableInside: table.right <= box.right && table.left >= box.left,
+        chart: document.querySelectorAll('#accuracy-chart svg').length};
+"""
+
+# The chart as drawn: its frame and each figure's bin, value and position.
+CHART = """
+const svg = document.querySelector('#accuracy-chart svg');
+const frame = {};
+for (const k of ['error-max', 'plot-left', 'plot-right', 'plot-top', 'plot-bottom'])
+  frame[k] = Number(svg.getAttribute('data-' + k));
+const series = Array.from(svg.querySelectorAll('line[data-series]')).map((e) => ({
+  series: e.dataset.series, bin: e.dataset.bin, value: e.dataset.value,
+  x1: Number(e.getAttribute('x1')), x2: Number(e.getAttribute('x2')), y: Number(e.getAttribute('y1'))}));
+const limit = svg.querySelector('path[data-series=limit]');
+return {frame, series, limit: limit.dataset.values, limitPath: limit.getAttribute('d')};
+"""
+
+
+def chart_error_max(bins):
+    """The chart's top (core/index/report_chart.h ChartErrorMax), computed here apart."""
+    top = max([v for b in bins for v in (b["p99"], b["rms"], b["p99_limit"]) if v is not None] + [0])
+    top = 1.1 * top if top > 0 else 0.01
+    decade = 10 ** math.floor(math.log10(top / 7))
+    for f in (1, 2, 5, 10):
+        step = f * decade
+        if top / step <= 7:
+            break
+    return math.ceil(top / step - 1e-9) * step
+
+
+def check_report(driver, stack):
+    """The panel's report, its table and its chart show the figures of
+    geodex-query --info (text and JSON) for the served index, and `geodex
+    info` prints the same."""
+    from selenium.webdriver.common.by import By
+    wait_for(driver, "return window.geodexViewer.state.report", "the build report")
+    shown = driver.execute_script("return window.geodexViewer.state.report")
+    r = subprocess.run([stack.args.query_bin, stack.index, "--info", "--format", "json"],
+                       capture_output=True, text=True)
+    check(r.returncode == 0, f"geodex-query --info --format json: {r.stderr}")
+    report = json.loads(r.stdout)
+    check(shown == report, "the page's report differs from geodex-query --info --format json")
+    text = subprocess.run([stack.args.query_bin, stack.index, "--info"], capture_output=True,
+                          text=True).stdout
+    cli = subprocess.run([stack.args.geodex, "info", "--server", stack.grpc, "--model", stack.name],
+                         capture_output=True, text=True)
+    check(cli.returncode == 0 and cli.stdout.splitlines()[1:] == text.splitlines()[1:],
+          f"geodex info's text differs from geodex-query --info's:\n{cli.stdout}\n{text}")
+    cli_json = subprocess.run([stack.args.geodex, "info", "--server", stack.grpc, "--model", stack.name,
+                               "--format", "json"], capture_output=True, text=True)
+    check(json.loads(cli_json.stdout)["report"] == report, "geodex info --format json's report differs")
+    # The table: each bin's row shows the text report's cells.
+    bins = report["accuracy"]["bins"]
+    rows = [line for line in text.splitlines() if line.startswith(" " * 18)]
+    for b in bins:
+        row = next(line for line in rows if line[18:].startswith(b["label"] + " "))
+        want = row[18 + len(b["label"]):].split()[:3]
+        cells = driver.find_elements(By.CSS_SELECTOR, f"#accuracy-table tr[data-bin='{b['key']}'] td")
+        got = [c.text for c in cells[1:4]]
+        check(got == want, f"the panel's {b['label']} row shows {got}, geodex-query --info {want}")
+        check([float(c.get_attribute("data-value")) for c in cells[1:4]] == [b["rms"], b["p99"], b["p99_limit"]],
+              f"the panel's {b['label']} row holds other values than the report")
+    # The chart: every bin's p99 and RMS, at the value and place the frame gives.
+    chart = driver.execute_script(CHART)
+    frame = chart["frame"]
+    check(abs(frame["error-max"] - chart_error_max(bins)) < 1e-12,
+          f"the chart's error axis ends at {frame['error-max']}, not {chart_error_max(bins)}")
+
+    def x(l):
+        return frame["plot-left"] + (math.log10(l) + 1) / 3 * (frame["plot-right"] - frame["plot-left"])
+
+    def y(e):
+        return frame["plot-bottom"] - e / frame["error-max"] * (frame["plot-bottom"] - frame["plot-top"])
+
+    drawn = {(s["series"], s["bin"]): s for s in chart["series"]}
+    for b in bins:
+        lo, hi = max(b["from_L"], 0.1), min(b["to_L"] if b["to_L"] is not None else math.inf, 100)
+        for series in ("p99", "rms"):
+            s = drawn.get((series, b["key"]))
+            check(s is not None, f"the chart has no {series} of {b['label']}")
+            check(float(s["value"]) == b[series], f"the chart's {series} of {b['label']} is {s['value']}, "
+                  f"the report's {b[series]}")
+            check(abs(s["y"] - y(b[series])) < 0.01 and abs(s["x1"] - x(lo)) < 0.01 and abs(s["x2"] - x(hi)) < 0.01,
+                  f"the chart draws the {series} of {b['label']} at {s}, not at y {y(b[series])}")
+    check([float(v) for v in chart["limit"].split()] == [b["p99_limit"] for b in bins],
+          f"the chart's target line is {chart['limit']}")
+    start = [float(v) for v in chart["limitPath"].lstrip("M").split()[:2]]
+    check(abs(start[0] - x(0.1)) < 0.01 and abs(start[1] - y(bins[0]["p99_limit"])) < 0.01,
+          f"the target line starts at {start}")
+    print(f"web_test: the panel's table and chart show geodex-query --info's figures "
+          f"({len(chart['series'])} steps, axis to {frame['error-max']:.4g})")
+
+
+def check_layout(driver, out_dir, panel_screenshot):
+    """At 1000x700 and 1400x900 the panel breaks no word and no number."""
+    for width, height in ((1000, 700), (1400, 900)):
+        driver.execute_cdp_cmd("Emulation.setDeviceMetricsOverride",
+                               {"width": width, "height": height, "deviceScaleFactor": 1, "mobile": False})
+        time.sleep(0.5)  # the resize reflows the page and redraws the canvas
+        got = driver.execute_script(BROKEN_WORDS)
+        check(got["words"] > 50, f"{width}x{height}: only {got['words']} words in the panel")
+        check(not got["broken"], f"{width}x{height}: words broken across lines: {got['broken']}")
+        check(got["overflow"] <= 0, f"{width}x{height}: the panel scrolls sideways by {got['overflow']} px")
+        check(got["tableInside"] and got["chart"] == 1, f"{width}x{height}: accuracy table or chart missing: {got}")
+        driver.execute_script("document.getElementById('report').scrollIntoView()")
+        path = os.path.join(out_dir, f"web_viewer_{width}x{height}.png")
+        driver.save_screenshot(path)
+        if panel_screenshot and width == 1000:
+            driver.save_screenshot(panel_screenshot)
+        print(f"web_test: {width}x{height}: {got['words']} words, none broken; {path}")
+    driver.execute_cdp_cmd("Emulation.clearDeviceMetricsOverride", {})
+
+
+def test_browser(stack, out_dir, screenshot, panel_screenshot=None):
     driver = browser_or_skip()
     from selenium.webdriver.common.action_chains import ActionChains
     from selenium.webdriver.common.by import By
@@ -325,6 +468,7 @@ def test_browser(stack, out_dir, screenshot):
                          "window.geodexViewer.state.frames > 0", "the mesh to be drawn")
         drawn, colours = driver.execute_script(PIXELS)
         check(drawn > 0.05 and colours > 20, f"WebGL drew nothing visible: {drawn:.3f} of the canvas, {colours} colours")
+        check_report(driver, stack)
         candidates, width, height = driver.execute_script(CANDIDATES)
         check(len(candidates) >= 3, f"only {len(candidates)} vertices in view")
         candidates.sort(key=lambda c: c[1])
@@ -372,6 +516,7 @@ def test_browser(stack, out_dir, screenshot):
         s = driver.execute_script("return window.geodexViewer.state")
         check(s["numSamples"] == int(stack.info["numSamples"]), f"{s['numSamples']} samples drawn")
         driver.save_screenshot(os.path.join(out_dir, "web_viewer_triangulation.png"))
+        check_layout(driver, out_dir, panel_screenshot)
         print(f"web_test: browser ok in {time.time() - start:.1f} s; screenshots in {out_dir}")
     finally:
         driver.quit()
@@ -387,6 +532,7 @@ def main():
     parser.add_argument("--model-name", default="torus")
     parser.add_argument("--samples", type=int, default=100)
     parser.add_argument("--screenshot", help="also save the field screenshot here")
+    parser.add_argument("--panel-screenshot", help="also save the 1000x700 screenshot (the panel's layout) here")
     args = parser.parse_args()
     if args.browser:
         browser_or_skip(launch=False)  # skip before building anything
@@ -395,7 +541,7 @@ def main():
     stack = Stack(args, work, token=not args.browser)
     try:
         if args.browser:
-            test_browser(stack, args.out, args.screenshot)
+            test_browser(stack, args.out, args.screenshot, args.panel_screenshot)
         else:
             test_http(stack)
     finally:

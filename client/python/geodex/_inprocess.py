@@ -10,6 +10,7 @@ same ids (the mesh file's, also when the builder repaired the mesh).
 
 from __future__ import annotations
 
+import json
 import logging
 import os
 import sys
@@ -141,6 +142,14 @@ class Index:
             if eq and key.strip():
                 out[key.strip()] = value.strip()
         return out
+
+    def info(self) -> Dict[str, Any]:
+        """The build report as a dict: mesh, repairs, samples, size by
+        section, the error target (met, or why not) and the relative error by
+        distance (keys in core/README.md, "The build report"); relative
+        errors are fractions. Equal to ``Client.info`` of a server serving
+        this file."""
+        return json.loads(self._index.report_json)
 
     # --- queries ------------------------------------------------------------
 

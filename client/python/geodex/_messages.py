@@ -4,8 +4,9 @@ Internal to geodex.client."""
 
 from __future__ import annotations
 
+import json
 from dataclasses import dataclass, field
-from typing import Dict, NamedTuple, Optional, Tuple
+from typing import Any, Dict, NamedTuple, Optional, Tuple
 
 import grpc
 import numpy as np
@@ -46,7 +47,8 @@ class Model:
     ``state`` is "LOADING", "SERVING" or "FAILED" (then ``reason`` says
     why); vertex and face counts are those of the mesh file;
     ``build_report`` holds the builder's validation and accuracy figures
-    ("key" -> "value").
+    ("key" -> "value"); ``report`` the same report as a structured dict
+    (``Client.info``), empty when the server sends none.
     """
 
     name: str
@@ -67,6 +69,7 @@ class Model:
     build_report: Dict[str, str] = field(default_factory=dict)
     mapped_bytes: int = 0
     mesh_hash: int = 0
+    report: Dict[str, Any] = field(default_factory=dict)
 
 
 class Triangulation(NamedTuple):
@@ -137,6 +140,7 @@ def _model_of(info: pb.ModelInfo) -> Model:
         build_report=dict(info.build_report),
         mapped_bytes=info.mapped_bytes,
         mesh_hash=info.mesh_hash,
+        report=json.loads(info.report_json) if info.report_json else {},
     )
 
 

@@ -23,7 +23,7 @@ channels are thread-safe and a Client keeps no per-call state).
 from __future__ import annotations
 
 import json
-from typing import Any, Iterator, List, Optional, Sequence, Tuple, Union
+from typing import Any, Dict, Iterator, List, Optional, Sequence, Tuple, Union
 
 import grpc
 import numpy as np
@@ -48,7 +48,7 @@ from ._messages import (
     _path_of,
     _rpc_error,
 )
-from .errors import DataLoss, InvalidArgument, error_for_code
+from .errors import DataLoss, FailedPrecondition, InvalidArgument, error_for_code
 from .v1 import geodex_pb2 as pb
 from .v1 import geodex_pb2_grpc as pb_grpc
 
@@ -213,6 +213,24 @@ class Client:
         except grpc.RpcError as e:
             raise _rpc_error(e) from None
         return _model_of(info)
+
+    def info(self, name: str, version: int = 0) -> Dict[str, Any]:
+        """The build report of a model (its newest version, or ``version``)
+        as a dict: mesh, repairs, samples, size by section, the error target
+        (met, or why not) and the relative error by distance (keys in
+        core/README.md, "The build report"); relative errors are fractions.
+        Equal to ``geodex.Index(path).info()`` of the file served.
+
+        Raises NotFound for an unknown model or version, FailedPrecondition
+        when the model is not serving or the server sends no report (a
+        server older than ModelInfo.report_json)."""
+        model = self.model(name, version)
+        if not model.report:
+            raise FailedPrecondition(
+                f"model {name} version {model.version} has no build report "
+                f"(state {model.state}{': ' + model.reason if model.reason else ''})"
+            )
+        return model.report
 
     # --- distances ---------------------------------------------------------
 

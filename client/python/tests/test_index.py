@@ -34,6 +34,19 @@ def test_what_the_index_holds(index, client):
     assert "torus" in repr(index) or "index.gdx" in repr(index)
 
 
+def test_the_build_report_is_the_servers(index, client):
+    report = index.info()
+    assert report == client.info(MODEL) == client.model(MODEL).report
+    assert report["mesh"]["faces"] == index.num_faces
+    assert report["samples"]["final"] == index.num_samples
+    assert report["error_bounds"] is True
+    # The bins of the calibration, in order, with the stored figures.
+    assert [b["key"] for b in report["accuracy"]["bins"]] == ["below_L", "L_3L", "3L_10L", "beyond_10L"]
+    assert float(index.report["accuracy_p99_3L_10L"]) == pytest.approx(
+        report["accuracy"]["bins"][2]["p99"], rel=1e-5)
+    assert sum(s["bytes"] for s in report["size"]["sections"]) == report["size"]["bytes"]
+
+
 @pytest.mark.parametrize("options", [{}, {"bounds": True}, {"near_pairs": "unfold"},
                                      {"near_pairs": "exact"}, {"tolerance": 0.005}])
 def test_distances_equal_the_servers_to_the_bit(index, client, num_faces, options):

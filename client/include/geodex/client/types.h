@@ -98,6 +98,9 @@ struct ModelInfo {
   std::map<std::string, std::string> build_report;  // the builder's "key = value" figures
   int64_t mapped_bytes = 0;
   uint64_t mesh_hash = 0;
+  // The build report as one JSON object (keys: core/README.md, "The build
+  // report"); empty from a server that does not send it.
+  std::string report_json;
 };
 
 // "LOADING", "SERVING", ... as in the proto.

@@ -1,0 +1,198 @@
+#include "client/cli/model_report.h"
+
+#include <cmath>
+#include <vector>
+
+#include "absl/strings/str_cat.h"
+#include "absl/strings/str_format.h"
+#include "absl/strings/str_join.h"
+#include "absl/strings/str_split.h"
+#include "google/protobuf/struct.pb.h"
+#include "google/protobuf/util/json_util.h"
+
+namespace geodex::client::cli {
+namespace {
+
+using google::protobuf::Struct;
+using google::protobuf::Value;
+
+// Reads fields of the report's JSON; a missing or mistyped field sets `ok`
+// false (and reads as 0, "" or an empty object), so that one check at the
+// end refuses a malformed report.
+class Fields {
+ public:
+  const Value& Get(const Struct& s, const std::string& key) {
+    const auto it = s.fields().find(key);
+    if (it == s.fields().end()) {
+      ok = false;
+      return Value::default_instance();
+    }
+    return it->second;
+  }
+  double Num(const Struct& s, const std::string& key) {
+    const Value& v = Get(s, key);
+    if (v.kind_case() == Value::kNullValue) return NAN;
+    if (v.kind_case() != Value::kNumberValue) ok = false;
+    return v.number_value();
+  }
+  int64_t Int(const Struct& s, const std::string& key) {
+    return static_cast<int64_t>(std::llround(Num(s, key)));
+  }
+  std::string Str(const Struct& s, const std::string& key) {
+    const Value& v = Get(s, key);
+    if (v.kind_case() != Value::kStringValue) ok = false;
+    return v.string_value();
+  }
+  bool Bool(const Struct& s, const std::string& key) {
+    const Value& v = Get(s, key);
+    if (v.kind_case() != Value::kBoolValue) ok = false;
+    return v.bool_value();
+  }
+  const Struct& Obj(const Struct& s, const std::string& key) {
+    const Value& v = Get(s, key);
+    if (v.kind_case() != Value::kStructValue) ok = false;
+    return v.struct_value();
+  }
+  std::vector<const Struct*> List(const Struct& s, const std::string& key) {
+    const Value& v = Get(s, key);
+    if (v.kind_case() != Value::kListValue) ok = false;
+    std::vector<const Struct*> out;
+    for (const Value& e : v.list_value().values()) {
+      if (e.kind_case() != Value::kStructValue) ok = false;
+      out.push_back(&e.struct_value());
+    }
+    return out;
+  }
+  bool ok = true;
+};
+
+std::string FormatMiB(double bytes) {
+  const double mib = bytes / 1048576.0;
+  return absl::StrFormat(mib >= 0.1 || bytes == 0 ? "%.2f MiB" : "%.3f MiB", mib);
+}
+
+// `text` broken between words into lines of at most `width` columns, the
+// lines after the first indented by `indent`.
+std::string Wrap(const std::string& text, int indent, int width) {
+  std::string out;
+  int column = indent;
+  for (absl::string_view word : absl::StrSplit(text, ' ')) {
+    if (column > indent && column + 1 + static_cast<int>(word.size()) > width) {
+      absl::StrAppend(&out, "\n", std::string(indent, ' '));
+      column = indent;
+    } else if (column > indent) {
+      out += ' ';
+      ++column;
+    }
+    absl::StrAppend(&out, word);
+    column += static_cast<int>(word.size());
+  }
+  return out;
+}
+
+std::string Title(const ModelInfo& m) {
+  return absl::StrFormat("model %s, version %d (%s)", m.name, m.version, StateName(m.state));
+}
+
+// A model without the report's JSON: what ModelInfo has.
+std::string PlainReport(const ModelInfo& m) {
+  std::string out = absl::StrCat(Title(m), m.reason.empty() ? "" : ": " + m.reason, "\n");
+  if (m.state != ModelInfo::State::kServing) return out;
+  absl::StrAppendFormat(&out, "  mesh          %d vertices, %d faces\n", m.num_vertices,
+                        m.num_faces);
+  absl::StrAppendFormat(&out, "  samples       m = %d: %d requested\n", m.num_samples,
+                        m.requested_samples);
+  absl::StrAppendFormat(&out, "  triangles     %d geodesic triangles\n", m.num_triangles);
+  for (const auto& [key, value] : m.build_report) {
+    absl::StrAppendFormat(&out, "  %s = %s\n", key, value);
+  }
+  return out;
+}
+
+}  // namespace
+
+std::string FormatPercent(double fraction) {
+  if (std::isnan(fraction)) return "n/a";
+  const double v = 100 * fraction;
+  if (v == 0) return "0%";
+  if (v < 0.001) return "<0.001%";
+  const int decimals = v >= 100 ? 0 : v >= 10 ? 1 : v >= 1 ? 2 : v >= 0.1 ? 3 : v >= 0.01 ? 4 : 5;
+  return absl::StrFormat("%.*f%%", decimals, v);
+}
+
+absl::StatusOr<std::string> ModelReportText(const ModelInfo& m) {
+  if (m.report_json.empty()) return PlainReport(m);
+  Struct r;
+  if (!google::protobuf::util::JsonStringToMessage(m.report_json, &r).ok()) {
+    return absl::InvalidArgumentError("the server's build report is not a JSON object");
+  }
+  Fields f;
+  const Struct& mesh = f.Obj(r, "mesh");
+  const Struct& samples = f.Obj(r, "samples");
+  const Struct& size = f.Obj(r, "size");
+  const Struct& target = f.Obj(r, "target");
+  std::string out = absl::StrFormat("%s: geodex index, format %s, built by %s\n", Title(m),
+                                    f.Str(r, "format"), f.Str(r, "builder"));
+  const int64_t vertices = f.Int(mesh, "vertices"), faces = f.Int(mesh, "faces");
+  const int64_t index_vertices = f.Int(mesh, "index_vertices");
+  const int64_t index_faces = f.Int(mesh, "index_faces");
+  absl::StrAppendFormat(&out, "  mesh          %d vertices, %d faces", vertices, faces);
+  if (index_vertices != vertices || index_faces != faces) {
+    absl::StrAppendFormat(&out, " (answered on %d vertices, %d faces)", index_vertices,
+                          index_faces);
+  }
+  absl::StrAppendFormat(&out, "\n  repairs       %s\n", f.Str(mesh, "repairs"));
+  const int64_t midpoints = f.Int(mesh, "refinement_midpoints");
+  absl::StrAppendFormat(&out, "  refinement    %s\n",
+                        midpoints == 0
+                            ? std::string("none (no edge longer than L/2)")
+                            : absl::StrFormat("%d midpoints (long edges split flat)", midpoints));
+  absl::StrAppendFormat(&out,
+                        "  samples       m = %d: %d requested, %d added by the repair of the "
+                        "triangulation\n",
+                        f.Int(samples, "final"), f.Int(samples, "requested"),
+                        f.Int(samples, "added_by_repair"));
+  absl::StrAppendFormat(&out, "  triangles     %d geodesic triangles\n", f.Int(r, "triangles"));
+  const double bytes = f.Num(size, "bytes");
+  absl::StrAppendFormat(&out, "  size          %s\n", FormatMiB(bytes));
+  for (const Struct* s : f.List(size, "sections")) {
+    const double section = f.Num(*s, "bytes");
+    const double share = 100.0 * section / bytes;
+    absl::StrAppendFormat(&out, "                  %-24s %10s %6s\n", f.Str(*s, "label"),
+                          FormatMiB(section),
+                          share < 0.05 ? "<0.1%" : absl::StrFormat("%.1f%%", share));
+  }
+  absl::StrAppendFormat(
+      &out, "  error bounds  %s\n",
+      f.Bool(r, "error_bounds") ? "yes (calibrated)" : "no (geodex-build calibrate adds them)");
+  absl::StrAppendFormat(&out, "  error target  %s\n", Wrap(f.Str(target, "verdict"), 16, 100));
+  const Value& accuracy_value = f.Get(r, "accuracy");
+  if (accuracy_value.kind_case() == Value::kStructValue) {
+    const Struct& a = accuracy_value.struct_value();
+    absl::StrAppendFormat(&out,
+                          "  accuracy      relative error of the default answer over %d held-out "
+                          "pairs from %d sources; L = %.4g\n",
+                          f.Int(a, "pairs"), f.Int(a, "sources"), f.Num(a, "scale_length"));
+    absl::StrAppendFormat(&out, "                  %-10s %9s %9s %11s\n", "distance", "RMS", "p99",
+                          "p99 limit");
+    for (const Struct* b : f.List(a, "bins")) {
+      const double p99 = f.Num(*b, "p99"), limit = f.Num(*b, "p99_limit");
+      absl::StrAppendFormat(&out, "                  %-10s %9s %9s %11s%s\n", f.Str(*b, "label"),
+                            FormatPercent(f.Num(*b, "rms")), FormatPercent(p99),
+                            FormatPercent(limit), p99 > limit ? "  over" : "");
+    }
+    absl::StrAppendFormat(&out,
+                          "                  area-uniform pairs: RMS %s (limit %s), p99 beyond "
+                          "10L %s\n",
+                          FormatPercent(f.Num(a, "uniform_rms")),
+                          FormatPercent(f.Num(target, "error")),
+                          FormatPercent(f.Num(a, "uniform_far_p99")));
+  }
+  if (!f.ok) {
+    return absl::InvalidArgumentError(
+        "the server's build report lacks fields this client reads (core/README.md)");
+  }
+  return out;
+}
+
+}  // namespace geodex::client::cli

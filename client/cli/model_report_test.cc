@@ -1,0 +1,124 @@
+#include "client/cli/model_report.h"
+
+#include <string>
+
+#include "client/cli/outputs.h"
+#include "gmock/gmock.h"
+#include "gtest/gtest.h"
+
+namespace geodex::client::cli {
+namespace {
+
+using ::testing::HasSubstr;
+
+// A report as core/index/index_report.h writes it (abridged).
+// clang-format off
+constexpr char kReport[] = R"json({
+  "format": "2.1",
+  "builder": "geodex-build 0.1.0",
+  "mesh": {
+    "vertices": 250,
+    "faces": 500,
+    "index_vertices": 3305,
+    "index_faces": 6610,
+    "refinement_midpoints": 3055,
+    "repairs": "none",
+    "repair_counts": {"faces_reoriented": 0}
+  },
+  "samples": {"requested": 300, "final": 300, "added_by_repair": 0, "repair": "0 samples added in 0 rounds"},
+  "triangles": 600,
+  "size": {"bytes": 1150656, "sections": [
+    {"key": "distance_matrix", "label": "distance matrix", "bytes": 360000},
+    {"key": "calibration", "label": "calibration", "bytes": 376}]},
+  "error_bounds": true,
+  "target": {
+    "error": 0.005,
+    "asked": true,
+    "met": false,
+    "stop": "the cap of 300 samples",
+    "rounds": [300],
+    "closest_check": "vertex 3L-10L p99",
+    "closest_upper95": 0.064817,
+    "closest_limit": 0.02,
+    "verdict": "0.500% NOT met: m stopped at the cap of 300 samples after 1 round (m = 300)"
+  },
+  "accuracy": {
+    "sources": 128,
+    "pairs": 14765,
+    "scale_length": 0.14864576,
+    "uniform_rms": 0.012520552,
+    "uniform_far_p99": 0.047317427,
+    "bins": [
+      {"key": "below_L", "label": "d < L", "from_L": 0, "to_L": 1, "rms": 0.00017556928, "p99": 1.6596281e-15, "p99_limit": 0.01},
+      {"key": "beyond_10L", "label": ">= 10L", "from_L": 10, "to_L": null, "rms": 0.014184382, "p99": 0.04691552, "p99_limit": 0.02}
+    ]
+  },
+  "build_report": {
+    "samples": "300"
+  }
+}
+)json";
+// clang-format on
+
+ModelInfo Model() {
+  ModelInfo m;
+  m.name = "bob";
+  m.version = 3;
+  m.state = ModelInfo::State::kServing;
+  m.report_json = kReport;
+  return m;
+}
+
+TEST(ModelReportTest, LaysOutTheServersReport) {
+  const absl::StatusOr<std::string> text = ModelReportText(Model());
+  ASSERT_TRUE(text.ok()) << text.status();
+  EXPECT_THAT(*text, HasSubstr("model bob, version 3 (SERVING): geodex index, format 2.1, built "
+                               "by geodex-build 0.1.0\n"));
+  EXPECT_THAT(*text, HasSubstr("  mesh          250 vertices, 500 faces (answered on 3305 "
+                               "vertices, 6610 faces)\n"));
+  EXPECT_THAT(*text, HasSubstr("  refinement    3055 midpoints (long edges split flat)\n"));
+  EXPECT_THAT(*text, HasSubstr("                  distance matrix            0.34 MiB  31.3%\n"));
+  EXPECT_THAT(*text, HasSubstr("                  calibration               0.000 MiB  <0.1%\n"));
+  EXPECT_THAT(*text, HasSubstr("  error target  0.500% NOT met: m stopped at the cap"));
+  EXPECT_THAT(*text, HasSubstr("L = 0.1486\n"));
+  EXPECT_THAT(*text, HasSubstr("                  d < L        0.0176%   <0.001%       1.00%\n"));
+  EXPECT_THAT(*text,
+              HasSubstr("                  >= 10L         1.42%     4.69%       2.00%  over\n"));
+  EXPECT_THAT(*text,
+              HasSubstr("area-uniform pairs: RMS 1.25% (limit 0.500%), p99 beyond 10L 4.73%"));
+}
+
+TEST(ModelReportTest, RefusesAMalformedReport) {
+  ModelInfo m = Model();
+  m.report_json = "[1, 2]";
+  EXPECT_EQ(ModelReportText(m).status().code(), absl::StatusCode::kInvalidArgument);
+  m.report_json = R"({"format": "2.1"})";
+  EXPECT_EQ(ModelReportText(m).status().code(), absl::StatusCode::kInvalidArgument);
+}
+
+TEST(ModelReportTest, WithoutTheReportShowsTheKeyValues) {
+  ModelInfo m = Model();
+  m.report_json.clear();
+  m.num_faces = 500;
+  m.build_report["samples"] = "300";
+  const absl::StatusOr<std::string> text = ModelReportText(m);
+  ASSERT_TRUE(text.ok());
+  EXPECT_THAT(*text, HasSubstr("500 faces"));
+  EXPECT_THAT(*text, HasSubstr("  samples = 300\n"));
+}
+
+TEST(ModelReportTest, JsonCarriesTheReportAsAnObject) {
+  const std::string json = ModelToJson(Model());
+  EXPECT_THAT(json, HasSubstr("\n  \"report\": {\n    \"format\": \"2.1\",\n"));
+  EXPECT_THAT(json, HasSubstr("\"name\": \"bob\""));
+  EXPECT_EQ(json.substr(json.size() - 6), "  }\n}\n");
+}
+
+TEST(ModelReportTest, PercentagesAsTheCoreWritesThem) {
+  EXPECT_EQ(FormatPercent(6.42854), "643%");
+  EXPECT_EQ(FormatPercent(7.80335e-05), "0.00780%");
+  EXPECT_EQ(FormatPercent(1e-9), "<0.001%");
+}
+
+}  // namespace
+}  // namespace geodex::client::cli

@@ -1,0 +1,442 @@
+#include "core/index/index_report.h"
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <cstdlib>
+#include <cstring>
+#include <limits>
+#include <map>
+
+#include "absl/strings/ascii.h"
+#include "absl/strings/numbers.h"
+#include "absl/strings/str_cat.h"
+#include "absl/strings/str_format.h"
+#include "absl/strings/str_join.h"
+#include "absl/strings/str_split.h"
+#include "absl/strings/strip.h"
+
+namespace geodex::index {
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+// The calibration's bins (core/validation/pair_sampling.h, the report's
+// accuracy_*_<key> lines) and the target's p99 limit of each, in units of E
+// (core/validation/target_error.h: 2E below 3L, 4E from 3L).
+struct BinSpec {
+  const char* key;
+  const char* label;
+  double from_l, to_l, limit_factor;
+};
+constexpr BinSpec kBins[4] = {{"below_L", "d < L", 0, 1, 2},
+                              {"L_3L", "L-3L", 1, 3, 2},
+                              {"3L_10L", "3L-10L", 3, 10, 4},
+                              {"beyond_10L", ">= 10L", 10, kInf, 4}};
+
+// Groups of sections, as a person thinks of the index.
+struct SectionGroup {
+  const char* key;
+  const char* label;
+  std::vector<SectionId> ids;
+};
+const std::vector<SectionGroup>& Groups() {
+  static const auto* const groups = new std::vector<SectionGroup>{
+      {"distance_matrix",
+       "distance matrix",
+       {SectionId::kSampleDistances, SectionId::kSampleDistancesLower}},
+      {"mesh", "mesh", {SectionId::kPositions, SectionId::kFaces, SectionId::kTwins}},
+      {"vertex_records", "vertex records", {SectionId::kVertexRecords}},
+      {"triangles", "samples, triangles", {SectionId::kSamples, SectionId::kTriangles}},
+      {"face_bvh", "face BVH", {SectionId::kFaceBvh, SectionId::kBvhFaces}},
+      {"input_ids", "input ids", {SectionId::kInputFaces, SectionId::kVertexCopies}},
+      {"refinement", "refinement", {SectionId::kCoarseFaces, SectionId::kSplitFaces}},
+      {"calibration", "calibration", {SectionId::kAccuracy, SectionId::kSpreadBounds}},
+      {"report", "build report", {SectionId::kReport}},
+  };
+  return *groups;
+}
+
+// The shortest decimal of `x`, read back as a double: every form of the
+// report (this text, the JSON, the viewer reading the JSON) then starts from
+// the same number.
+double Tidy(float x) {
+  char buffer[32];
+  const auto end = std::to_chars(buffer, buffer + sizeof(buffer), x).ptr;
+  return std::strtod(std::string(buffer, end).c_str(), nullptr);
+}
+
+std::string JsonNumber(double x) {
+  if (!std::isfinite(x)) return "null";
+  char buffer[32];
+  const auto end = std::to_chars(buffer, buffer + sizeof(buffer), x).ptr;
+  return std::string(buffer, end);
+}
+
+std::string JsonString(std::string_view s) {
+  std::string out = "\"";
+  for (const char c : s) {
+    switch (c) {
+      case '"':
+        out += "\\\"";
+        break;
+      case '\\':
+        out += "\\\\";
+        break;
+      case '\n':
+        out += "\\n";
+        break;
+      case '\t':
+        out += "\\t";
+        break;
+      default:
+        if (static_cast<unsigned char>(c) < 0x20) {
+          absl::StrAppendFormat(&out, "\\u%04x", static_cast<int>(c));
+        } else {
+          out += c;
+        }
+    }
+  }
+  return out + "\"";
+}
+
+const std::string* Find(const IndexReport& r, std::string_view key) {
+  for (const auto& [k, v] : r.entries) {
+    if (k == key) return &v;
+  }
+  return nullptr;
+}
+
+// The repairs made, one phrase each: the builder's summary
+// ("0 non-manifold vertices split (0 copies), ..., 0 zero-area faces and 0
+// slivers kept") without the phrases that count nothing.
+std::string RepairsMade(const std::string* summary) {
+  if (summary == nullptr) return "none recorded";
+  std::vector<std::string> made;
+  for (absl::string_view part : absl::StrSplit(*summary, ", ")) {
+    for (absl::string_view phrase : absl::StrSplit(part, " and ")) {
+      if (!absl::StartsWith(phrase, "0 ")) made.emplace_back(phrase);
+    }
+  }
+  return made.empty() ? "none" : absl::StrJoin(made, ", ");
+}
+
+void ReadTarget(IndexReport& r) {
+  const std::string* error = Find(r, "target_error");
+  double target = 0;
+  if (error != nullptr && absl::SimpleAtod(*error, &target) && target > 0) {
+    r.target_asked = true;
+    r.target_error = target;
+    const std::string* reached = Find(r, "target_error_reached");
+    r.target_met = reached != nullptr && *reached == "yes";
+    if (reached != nullptr && absl::StartsWith(*reached, "no (") && absl::EndsWith(*reached, ")")) {
+      r.target_stop = reached->substr(4, reached->size() - 5);
+    }
+    for (int k = 1;; ++k) {
+      const std::string* round = Find(r, absl::StrCat("target_error_round_", k));
+      int64_t m = 0;
+      if (round == nullptr) break;
+      absl::string_view text = *round;
+      if (!absl::ConsumePrefix(&text, "m = ")) break;
+      if (!absl::SimpleAtoi(text.substr(0, text.find(':')), &m)) break;
+      r.target_rounds.push_back(m);
+    }
+    // "vertex 3L-10L p99 0.064817 of 0.02"
+    if (const std::string* worst = Find(r, "target_error_worst"); worst != nullptr) {
+      const size_t of = worst->rfind(" of ");
+      const size_t space = of == std::string::npos ? of : worst->rfind(' ', of - 1);
+      if (space != std::string::npos &&
+          absl::SimpleAtod(worst->substr(space + 1, of - space - 1), &r.closest_upper95) &&
+          absl::SimpleAtod(worst->substr(of + 4), &r.closest_limit)) {
+        r.closest_check = worst->substr(0, space);
+      }
+    }
+  }
+  for (int b = 0; b < 4; ++b) r.bins[b].p99_limit = kBins[b].limit_factor * r.target_error;
+}
+
+std::string Verdict(const IndexReport& r) {
+  if (r.target_asked) {
+    const std::string rounds = absl::StrFormat("%d round%s (m = %s)", r.target_rounds.size(),
+                                               r.target_rounds.size() == 1 ? "" : "s",
+                                               absl::StrJoin(r.target_rounds, ", "));
+    const std::string closest =
+        r.closest_check.empty()
+            ? ""
+            : absl::StrFormat("%s, %s, has a 95%% upper limit of %s against %s",
+                              r.target_met ? "; the closest check" : "; the furthest check",
+                              r.closest_check, FormatPercent(r.closest_upper95),
+                              FormatPercent(r.closest_limit));
+    if (r.target_met) {
+      return absl::StrFormat("%s met in %s%s", FormatPercent(r.target_error), rounds, closest);
+    }
+    return absl::StrFormat("%s NOT met: m stopped at %s after %s%s", FormatPercent(r.target_error),
+                           r.target_stop.empty() ? "the builder's limit" : r.target_stop, rounds,
+                           closest);
+  }
+  const std::string none =
+      absl::StrFormat("none asked (built with --samples %d)", r.requested_samples);
+  if (!r.has_accuracy) return none + "; no calibration to compare with";
+  std::vector<std::string> over;
+  if (r.uniform_rms > r.target_error) over.push_back("the uniform RMS");
+  for (const ReportBin& bin : r.bins) {
+    if (bin.p99 > bin.p99_limit) over.push_back(absl::StrCat("p99 at ", bin.label));
+  }
+  return absl::StrFormat("%s; measured against the default target %s: %s", none,
+                         FormatPercent(r.target_error),
+                         over.empty() ? "every figure within its limit"
+                                      : absl::StrCat(absl::StrJoin(over, ", "), " over the limit"));
+}
+
+// `text` broken between words into lines of at most `width` columns, the
+// lines after the first indented by `indent` (which the first line's label
+// takes).
+std::string Wrap(const std::string& text, int indent, int width) {
+  std::string out;
+  int column = indent;
+  for (absl::string_view word : absl::StrSplit(text, ' ')) {
+    if (column > indent && column + 1 + static_cast<int>(word.size()) > width) {
+      absl::StrAppend(&out, "\n", std::string(indent, ' '));
+      column = indent;
+    } else if (column > indent) {
+      out += ' ';
+      ++column;
+    }
+    absl::StrAppend(&out, word);
+    column += static_cast<int>(word.size());
+  }
+  return out;
+}
+
+void ReadSections(const Index& index, IndexReport& r) {
+  const FileHeader& h = index.header();
+  const std::span<const uint8_t> image = index.image();
+  std::map<uint32_t, uint64_t> by_id;
+  uint64_t in_sections = 0;
+  for (uint32_t i = 0; i < h.num_sections; ++i) {
+    SectionEntry e;
+    // Index::Open checked that the table lies inside the file.
+    std::memcpy(&e, image.data() + h.section_table_offset + i * sizeof(SectionEntry), sizeof(e));
+    by_id[e.id] += e.size;
+    in_sections += e.size;
+  }
+  for (const SectionGroup& g : Groups()) {
+    uint64_t bytes = 0;
+    for (const SectionId id : g.ids) bytes += by_id[static_cast<uint32_t>(id)];
+    if (bytes > 0) r.sections.push_back({g.key, g.label, bytes});
+  }
+  if (r.bytes > in_sections) {
+    r.sections.push_back({"header", "header, table, padding", r.bytes - in_sections});
+  }
+  std::stable_sort(
+      r.sections.begin(), r.sections.end(),
+      [](const ReportSection& a, const ReportSection& b) { return a.bytes > b.bytes; });
+}
+
+}  // namespace
+
+std::vector<std::pair<std::string, std::string>> ParseReportEntries(std::string_view text) {
+  std::vector<std::pair<std::string, std::string>> out;
+  std::map<std::string, size_t> at;
+  for (absl::string_view line : absl::StrSplit(absl::string_view(text.data(), text.size()), '\n')) {
+    const size_t eq = line.find('=');
+    if (eq == absl::string_view::npos) continue;
+    std::string key(absl::StripAsciiWhitespace(line.substr(0, eq)));
+    if (key.empty()) continue;
+    std::string value(absl::StripAsciiWhitespace(line.substr(eq + 1)));
+    const auto [it, inserted] = at.emplace(key, out.size());
+    if (inserted) {
+      out.emplace_back(std::move(key), std::move(value));
+    } else {
+      out[it->second].second = std::move(value);
+    }
+  }
+  return out;
+}
+
+IndexReport MakeIndexReport(const Index& index) {
+  IndexReport r;
+  const FileHeader& h = index.header();
+  r.format = absl::StrFormat("%d.%d", h.format_major, h.format_minor);
+  r.builder = index.builder_version();
+  r.entries = ParseReportEntries(index.report());
+  r.index_vertices = index.num_vertices();
+  r.index_faces = index.num_faces();
+  r.refinement_midpoints = index.split_vertices();
+  // The mesh file's counts, as core/query/internal/input_ids.h reads them: the
+  // midpoints and the copies of split vertices are the last vertices; faces
+  // are the input records, else the faces before refinement.
+  r.vertices = r.index_vertices - r.refinement_midpoints -
+               static_cast<int64_t>(index.vertex_copies().size());
+  r.faces = !index.input_faces().empty()     ? static_cast<int64_t>(index.input_faces().size())
+            : !index.split_faces().empty() ? static_cast<int64_t>(index.coarse_faces().size() / 3)
+                                             : r.index_faces;
+  r.repairs = RepairsMade(Find(r, "mesh_repairs"));
+  for (const auto& [key, value] : r.entries) {
+    double count = 0;
+    if (key != "mesh_repairs" && absl::StartsWith(key, "mesh_") && key != "mesh_refinement" &&
+        absl::SimpleAtod(value, &count)) {
+      r.repair_counts.emplace_back(key.substr(5), count);
+    }
+  }
+  r.requested_samples = h.params.requested_samples;
+  r.samples = index.num_samples();
+  r.samples_added_by_repair = h.params.samples_added_by_repair;
+  if (const std::string* repair = Find(r, "repair"); repair != nullptr) r.sample_repair = *repair;
+  r.triangles = index.num_triangles();
+  r.bytes = index.size_bytes();
+  ReadSections(index, r);
+  r.error_bounds = index.accuracy() != nullptr;
+  for (int b = 0; b < 4; ++b) {
+    r.bins[b].key = kBins[b].key;
+    r.bins[b].label = kBins[b].label;
+    r.bins[b].from_l = kBins[b].from_l;
+    r.bins[b].to_l = kBins[b].to_l;
+    r.bins[b].rms = r.bins[b].p99 = kNaN;
+  }
+  r.uniform_rms = r.uniform_far_p99 = kNaN;
+  if (const AccuracyRecord* a = index.accuracy(); a != nullptr) {
+    r.has_accuracy = true;
+    r.accuracy_sources = a->num_sources;
+    r.accuracy_pairs = a->num_pairs;
+    r.scale_length = Tidy(a->scale_length);
+    r.uniform_rms = Tidy(a->uniform_rms);
+    r.uniform_far_p99 = Tidy(a->uniform_far_p99);
+    for (int b = 0; b < 4; ++b) {
+      r.bins[b].rms = Tidy(a->rms[b]);
+      r.bins[b].p99 = Tidy(a->p99[b]);
+    }
+  }
+  ReadTarget(r);
+  r.target_verdict = Verdict(r);
+  return r;
+}
+
+std::string FormatPercent(double fraction) {
+  if (std::isnan(fraction)) return "n/a";
+  const double v = 100 * fraction;
+  if (v == 0) return "0%";
+  if (v < 0.001) return "<0.001%";
+  const int decimals = v >= 100 ? 0 : v >= 10 ? 1 : v >= 1 ? 2 : v >= 0.1 ? 3 : v >= 0.01 ? 4 : 5;
+  return absl::StrFormat("%.*f%%", decimals, v);
+}
+
+std::string FormatMiB(uint64_t bytes) {
+  const double mib = static_cast<double>(bytes) / 1048576.0;
+  return absl::StrFormat(mib >= 0.1 || bytes == 0 ? "%.2f MiB" : "%.3f MiB", mib);
+}
+
+std::string IndexReportText(const IndexReport& r, std::string_view title) {
+  std::string out =
+      absl::StrFormat("%s: geodex index, format %s, built by %s\n", title, r.format, r.builder);
+  absl::StrAppendFormat(&out, "  mesh          %d vertices, %d faces", r.vertices, r.faces);
+  if (r.index_vertices != r.vertices || r.index_faces != r.faces) {
+    absl::StrAppendFormat(&out, " (answered on %d vertices, %d faces)", r.index_vertices,
+                          r.index_faces);
+  }
+  absl::StrAppendFormat(&out, "\n  repairs       %s\n", r.repairs);
+  absl::StrAppendFormat(
+      &out, "  refinement    %s\n",
+      r.refinement_midpoints == 0
+          ? std::string("none (no edge longer than L/2)")
+          : absl::StrFormat("%d midpoints (long edges split flat)", r.refinement_midpoints));
+  absl::StrAppendFormat(&out,
+                        "  samples       m = %d: %d requested, %d added by the repair of the "
+                        "triangulation\n",
+                        r.samples, r.requested_samples, r.samples_added_by_repair);
+  absl::StrAppendFormat(&out, "  triangles     %d geodesic triangles\n", r.triangles);
+  absl::StrAppendFormat(&out, "  size          %s\n", FormatMiB(r.bytes));
+  for (const ReportSection& s : r.sections) {
+    const double share = 100.0 * static_cast<double>(s.bytes) / r.bytes;
+    absl::StrAppendFormat(&out, "                  %-24s %10s %6s\n", s.label, FormatMiB(s.bytes),
+                          share < 0.05 ? "<0.1%" : absl::StrFormat("%.1f%%", share));
+  }
+  absl::StrAppendFormat(
+      &out, "  error bounds  %s\n",
+      r.error_bounds ? "yes (calibrated)" : "no (geodex-build calibrate adds them)");
+  absl::StrAppendFormat(&out, "  error target  %s\n", Wrap(r.target_verdict, 16, 100));
+  if (!r.has_accuracy) return out;
+  absl::StrAppendFormat(&out,
+                        "  accuracy      relative error of the default answer over %d held-out "
+                        "pairs from %d sources; L = %.4g\n",
+                        r.accuracy_pairs, r.accuracy_sources, r.scale_length);
+  absl::StrAppendFormat(&out, "                  %-10s %9s %9s %11s\n", "distance", "RMS", "p99",
+                        "p99 limit");
+  for (const ReportBin& b : r.bins) {
+    absl::StrAppendFormat(&out, "                  %-10s %9s %9s %11s%s\n", b.label,
+                          FormatPercent(b.rms), FormatPercent(b.p99), FormatPercent(b.p99_limit),
+                          b.p99 > b.p99_limit ? "  over" : "");
+  }
+  absl::StrAppendFormat(
+      &out, "                  area-uniform pairs: RMS %s (limit %s), p99 beyond 10L %s\n",
+      FormatPercent(r.uniform_rms), FormatPercent(r.target_error),
+      FormatPercent(r.uniform_far_p99));
+  return out;
+}
+
+std::string IndexReportJson(const IndexReport& r) {
+  std::string out = "{\n";
+  absl::StrAppend(&out, "  \"format\": ", JsonString(r.format), ",\n");
+  absl::StrAppend(&out, "  \"builder\": ", JsonString(r.builder), ",\n");
+  absl::StrAppend(&out, "  \"mesh\": {\n    \"vertices\": ", r.vertices,
+                  ",\n    \"faces\": ", r.faces, ",\n    \"index_vertices\": ", r.index_vertices,
+                  ",\n    \"index_faces\": ", r.index_faces,
+                  ",\n    \"refinement_midpoints\": ", r.refinement_midpoints,
+                  ",\n    \"repairs\": ", JsonString(r.repairs), ",\n    \"repair_counts\": {");
+  for (size_t i = 0; i < r.repair_counts.size(); ++i) {
+    absl::StrAppend(&out, i ? ", " : "", JsonString(r.repair_counts[i].first), ": ",
+                    JsonNumber(r.repair_counts[i].second));
+  }
+  absl::StrAppend(&out, "}\n  },\n");
+  absl::StrAppend(&out, "  \"samples\": {\"requested\": ", r.requested_samples,
+                  ", \"final\": ", r.samples, ", \"added_by_repair\": ", r.samples_added_by_repair,
+                  ", \"repair\": ", JsonString(r.sample_repair), "},\n");
+  absl::StrAppend(&out, "  \"triangles\": ", r.triangles, ",\n");
+  absl::StrAppend(&out, "  \"size\": {\"bytes\": ", r.bytes, ", \"sections\": [");
+  for (size_t i = 0; i < r.sections.size(); ++i) {
+    absl::StrAppend(&out, i ? ",\n" : "\n", "    {\"key\": ", JsonString(r.sections[i].key),
+                    ", \"label\": ", JsonString(r.sections[i].label),
+                    ", \"bytes\": ", r.sections[i].bytes, "}");
+  }
+  absl::StrAppend(&out, "]},\n");
+  absl::StrAppend(&out, "  \"error_bounds\": ", r.error_bounds ? "true" : "false", ",\n");
+  absl::StrAppend(
+      &out, "  \"target\": {\n    \"error\": ", JsonNumber(r.target_error),
+      ",\n    \"asked\": ", r.target_asked ? "true" : "false",
+      ",\n    \"met\": ", r.target_asked ? (r.target_met ? "true" : "false") : "null",
+      ",\n    \"stop\": ", JsonString(r.target_stop), ",\n    \"rounds\": [",
+      absl::StrJoin(r.target_rounds, ", "),
+      "],\n    \"closest_check\": ", JsonString(r.closest_check), ",\n    \"closest_upper95\": ",
+      r.closest_check.empty() ? "null" : JsonNumber(r.closest_upper95),
+      ",\n    \"closest_limit\": ", r.closest_check.empty() ? "null" : JsonNumber(r.closest_limit),
+      ",\n    \"verdict\": ", JsonString(r.target_verdict), "\n  },\n");
+  if (r.has_accuracy) {
+    absl::StrAppend(&out, "  \"accuracy\": {\n    \"sources\": ", r.accuracy_sources,
+                    ",\n    \"pairs\": ", r.accuracy_pairs,
+                    ",\n    \"scale_length\": ", JsonNumber(r.scale_length),
+                    ",\n    \"uniform_rms\": ", JsonNumber(r.uniform_rms),
+                    ",\n    \"uniform_far_p99\": ", JsonNumber(r.uniform_far_p99),
+                    ",\n    \"bins\": [");
+    for (size_t b = 0; b < r.bins.size(); ++b) {
+      const ReportBin& bin = r.bins[b];
+      absl::StrAppend(
+          &out, b ? ",\n" : "\n", "      {\"key\": ", JsonString(bin.key),
+          ", \"label\": ", JsonString(bin.label), ", \"from_L\": ", JsonNumber(bin.from_l),
+          ", \"to_L\": ", JsonNumber(bin.to_l), ", \"rms\": ", JsonNumber(bin.rms),
+          ", \"p99\": ", JsonNumber(bin.p99), ", \"p99_limit\": ", JsonNumber(bin.p99_limit), "}");
+    }
+    absl::StrAppend(&out, "\n    ]\n  },\n");
+  } else {
+    absl::StrAppend(&out, "  \"accuracy\": null,\n");
+  }
+  absl::StrAppend(&out, "  \"build_report\": {");
+  for (size_t i = 0; i < r.entries.size(); ++i) {
+    absl::StrAppend(&out, i ? ",\n" : "\n", "    ", JsonString(r.entries[i].first), ": ",
+                    JsonString(r.entries[i].second));
+  }
+  absl::StrAppend(&out, r.entries.empty() ? "}\n" : "\n  }\n", "}\n");
+  return out;
+}
+
+}  // namespace geodex::index

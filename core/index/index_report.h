@@ -1,0 +1,139 @@
+#pragma once
+
+// The build report of an index, for people and for scripts.
+//
+// An index stores its builder's report as "key = value" lines
+// (SectionId::kReport) beside the header's counts and the accuracy
+// calibration. MakeIndexReport gathers them into one IndexReport: the mesh,
+// its repairs, the samples, the index size by section, whether the error
+// target was met (and why not), and the relative error by distance.
+// IndexReportText renders it as a few lines and a table with units (%, MiB);
+// IndexReportJson as one JSON object whose keys are documented in
+// core/README.md ("The build report"). geodex-query --info, geodex-build's
+// closing lines, the server's GetModel (ModelInfo.report_json), the viewer
+// and the Python package all show this one report.
+//
+//   absl::StatusOr<std::shared_ptr<const Index>> index = Index::Open("x.gdx");
+//   const IndexReport report = MakeIndexReport(**index);
+//   std::string text = IndexReportText(report, "x.gdx");
+//   std::string json = IndexReportJson(report);
+//
+// Relative errors are fractions (0.01 is 1%) everywhere but in the text,
+// which shows percentages. Every function is a pure function of its
+// arguments; thread-safe.
+
+#include <array>
+#include <cstdint>
+#include <string>
+#include <string_view>
+#include <utility>
+#include <vector>
+
+#include "core/index/index.h"
+
+namespace geodex::index {
+
+// The error target the builder builds to when not given a sample count
+// (core/validation/target_error.h's kDefaultTargetError): the report of an
+// index built with a fixed m compares its figures with this one's limits.
+inline constexpr double kReportDefaultTargetError = 0.005;
+
+// One bin of the calibration, by exact distance in units of the sample
+// spacing L.
+struct ReportBin {
+  std::string key;    // "below_L", "L_3L", "3L_10L", "beyond_10L"
+  std::string label;  // "d < L", "L-3L", "3L-10L", ">= 10L"
+  double from_l = 0;  // the bin's distances, in units of L: [from_l, to_l)
+  double to_l = 0;    // +infinity for the last bin
+  double rms = 0;     // relative error of the default answer: RMS
+  double p99 = 0;     // and 99th percentile
+  // The error target's limit on the p99 of this bin: 2E below 3L, 4E from
+  // 3L (the target's or, for a build with a fixed m, the default target's).
+  double p99_limit = 0;
+};
+
+// Bytes of one group of sections (the distance matrix, the mesh, ...).
+struct ReportSection {
+  std::string key;    // "distance_matrix", "mesh", ...
+  std::string label;  // "distance matrix", "mesh", ...
+  uint64_t bytes = 0;
+};
+
+struct IndexReport {
+  std::string format;  // "2.1"
+  std::string builder;
+  // The mesh file's counts, and those of the mesh the index answers on
+  // (repaired, refined).
+  int64_t vertices = 0;
+  int64_t faces = 0;
+  int64_t index_vertices = 0;
+  int64_t index_faces = 0;
+  int64_t refinement_midpoints = 0;
+  // The repairs of the input mesh: one phrase per repair made ("none" when
+  // none was), and every count the report has ("mesh_" keys without it).
+  std::string repairs;
+  std::vector<std::pair<std::string, double>> repair_counts;
+  int64_t requested_samples = 0;
+  int64_t samples = 0;
+  int64_t samples_added_by_repair = 0;
+  std::string sample_repair;  // the triangulation's repair, as the builder says it
+  int64_t triangles = 0;
+  uint64_t bytes = 0;                   // the whole file
+  std::vector<ReportSection> sections;  // non-empty groups, largest first
+  bool error_bounds = false;            // calibrated: per-answer bounds and tolerances
+  // The error target: `target_asked` when the index was built to one
+  // (--target-error, or no --samples); otherwise target_error is the default
+  // target, which the figures are compared with.
+  double target_error = kReportDefaultTargetError;
+  bool target_asked = false;
+  bool target_met = false;             // a target-error build only
+  std::string target_stop;             // why m stopped short of the target, when it did
+  std::vector<int64_t> target_rounds;  // m of each round
+  // The check closest to (or furthest over) its limit, with its 95% upper
+  // confidence limit and the limit (a target-error build only).
+  std::string closest_check;
+  double closest_upper95 = 0;
+  double closest_limit = 0;
+  // One sentence: met, or not and why (every build with a calibration).
+  std::string target_verdict;
+  // The calibration (has_accuracy), over held-out exact propagations.
+  bool has_accuracy = false;
+  int64_t accuracy_sources = 0;
+  int64_t accuracy_pairs = 0;
+  double scale_length = 0;  // L, in mesh units
+  double uniform_rms = 0;   // over area-uniform pairs
+  double uniform_far_p99 = 0;
+  std::array<ReportBin, 4> bins;
+  // Every "key = value" line of the stored report, in order (a key given
+  // twice keeps its last value, at its first place).
+  std::vector<std::pair<std::string, std::string>> entries;
+};
+
+// The "key = value" lines of a stored report; other lines are skipped, keys
+// and values trimmed; a key given twice keeps its last value at its first
+// place.
+std::vector<std::pair<std::string, std::string>> ParseReportEntries(std::string_view text);
+
+// The report of a loaded index: its header, section table, calibration and
+// stored report. Never fails: figures the index lacks (an older format, a
+// build without calibration) are absent (has_accuracy false, counts 0).
+IndexReport MakeIndexReport(const Index& index);
+
+// A few lines and a table for a person, headed by `title` (a file or model
+// name): relative errors in %, sizes in MiB. Ends with a newline.
+std::string IndexReportText(const IndexReport& report, std::string_view title);
+
+// One JSON object, pretty-printed with two-space indents (keys:
+// core/README.md). Numbers are the shortest decimals that read back to the
+// same double; a figure the index lacks is null.
+std::string IndexReportJson(const IndexReport& report);
+
+// `fraction` as a percentage with three significant digits and no exponent
+// ("1.31%", "0.00780%", "643%"; "<0.001%" below that, "0%" for 0, "n/a" for
+// NaN). The viewer and the client format the same way.
+std::string FormatPercent(double fraction);
+
+// `bytes` in MiB with two decimals ("1.54 MiB").
+std::string FormatMiB(uint64_t bytes);
+
+}  // namespace geodex::index
