@@ -68,7 +68,9 @@ class Fields {
 
 std::string FormatMiB(double bytes) {
   const double mib = bytes / 1048576.0;
-  return absl::StrFormat(mib >= 0.1 || bytes == 0 ? "%.2f MiB" : "%.3f MiB", mib);
+  // Two literal formats: StrFormat checks its format at compile time.
+  if (mib >= 0.1 || bytes == 0) return absl::StrFormat("%.2f MiB", mib);
+  return absl::StrFormat("%.3f MiB", mib);
 }
 
 // `text` broken between words into lines of at most `width` columns, the

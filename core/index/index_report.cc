@@ -324,7 +324,9 @@ std::string FormatPercent(double fraction) {
 
 std::string FormatMiB(uint64_t bytes) {
   const double mib = static_cast<double>(bytes) / 1048576.0;
-  return absl::StrFormat(mib >= 0.1 || bytes == 0 ? "%.2f MiB" : "%.3f MiB", mib);
+  // Two literal formats: StrFormat checks its format at compile time.
+  if (mib >= 0.1 || bytes == 0) return absl::StrFormat("%.2f MiB", mib);
+  return absl::StrFormat("%.3f MiB", mib);
 }
 
 std::string IndexReportText(const IndexReport& r, std::string_view title) {
