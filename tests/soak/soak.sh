@@ -125,7 +125,7 @@ kill -0 "$SERVER_PID" 2> /dev/null || fail "the server died"
 sleep 1
 MODELS="$("$CLIENT_BIN" models --server "$ADDR")"
 echo "$MODELS" | grep -q "SERVING" || fail "no version serving after the run: $MODELS"
-INFO="$("$CLIENT_BIN" info --server "$ADDR" --model torus)"
+INFO="$("$CLIENT_BIN" info --server "$ADDR" --model torus --format json)"
 echo "$INFO" | grep -q '"version": 4' || fail "version 4 is not the one serving: $INFO"
 
 # After warm-up (the samples from half the run on) the heap grows less than
