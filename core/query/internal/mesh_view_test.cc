@@ -3,6 +3,7 @@
 #include <array>
 #include <vector>
 
+#include "core/query/internal/mesh_view_testing.h"
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
 
@@ -12,17 +13,7 @@ namespace {
 using ::testing::ElementsAre;
 using ::testing::UnorderedElementsAre;
 
-// Twins of the half-edges 3 f + i (corner i -> i+1): the reversed edge, or -1.
-std::vector<int32_t> Twins(const std::vector<int32_t>& faces) {
-  std::vector<int32_t> twins(faces.size(), -1);
-  for (size_t h = 0; h < faces.size(); ++h) {
-    const int32_t a = faces[h], b = faces[h - h % 3 + (h % 3 + 1) % 3];
-    for (size_t g = 0; g < faces.size(); ++g) {
-      if (faces[g] == b && faces[g - g % 3 + (g % 3 + 1) % 3] == a) twins[h] = g;
-    }
-  }
-  return twins;
-}
+using testing::Twins;
 
 TEST(MeshViewTest, FanAtABoundaryVertexWalksBothWays) {
   // A unit square split along its diagonal 0-2.

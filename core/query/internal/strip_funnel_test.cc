@@ -4,6 +4,7 @@
 #include <numbers>
 #include <vector>
 
+#include "core/query/internal/mesh_view_testing.h"
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
 
@@ -13,17 +14,7 @@ namespace {
 using geometry::Vec2;
 using ::testing::ElementsAre;
 
-// Twins of the half-edges 3 f + i (corner i -> i+1): the reversed edge, or -1.
-std::vector<int32_t> Twins(const std::vector<int32_t>& faces) {
-  std::vector<int32_t> twins(faces.size(), -1);
-  for (size_t h = 0; h < faces.size(); ++h) {
-    const int32_t a = faces[h], b = faces[h - h % 3 + (h % 3 + 1) % 3];
-    for (size_t g = 0; g < faces.size(); ++g) {
-      if (faces[g] == b && faces[g - g % 3 + (g % 3 + 1) % 3] == a) twins[h] = g;
-    }
-  }
-  return twins;
-}
+using testing::Twins;
 
 // A mesh held by its arrays, with its view.
 struct TestMesh {
