@@ -306,8 +306,9 @@ HttpResponse ErrorResponse(const absl::Status& status, int http_status) {
 }
 
 const std::vector<std::string>& WebAssetNames() {
-  static const std::vector<std::string> kNames = {"index.html", "viewer.js", "viewer.css",
-                                                  "three.min.js", "OrbitControls.js"};
+  static const std::vector<std::string> kNames = {
+      "index.html", "viewer.js", "report_chart.js", "viewer.css", "three.min.js",
+      "OrbitControls.js"};
   return kNames;
 }
 
