@@ -1,8 +1,8 @@
 #pragma once
 
 // Per-thread working memory of the queries that are not O(1): the exact
-// solver that refinements and exact neighbourhoods run (its arrays grow with
-// the mesh, so a thread keeps one and reuses it). Optional wherever a query
+// solvers that refinements and exact neighbourhoods run (their arrays grow
+// with the mesh, so a thread keeps them and reuses them). Optional wherever a query
 // takes it: without one, a query makes its own for the call.
 //
 // Thread safety: one QueryScratch per thread; it is not shared.
@@ -17,6 +17,7 @@ class Mesh;
 }  // namespace geodex::mesh
 namespace geodex::geodesic {
 class ExactGeodesicSolver;
+class ConfinedGeodesicSolver;
 }  // namespace geodex::geodesic
 
 namespace geodex::query {
@@ -33,7 +34,8 @@ class QueryScratch {
  private:
   friend class LocalExact;
   std::unique_ptr<geodesic::ExactGeodesicSolver> solver_;
-  const mesh::Mesh* mesh_ = nullptr;  // the mesh solver_ was made for
+  const mesh::Mesh* mesh_ = nullptr;                            // the mesh solver_ was made for
+  std::unique_ptr<geodesic::ConfinedGeodesicSolver> confined_;  // over confined_->mesh()
 };
 
 }  // namespace geodex::query

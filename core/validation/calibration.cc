@@ -195,7 +195,7 @@ absl::StatusOr<Calibration> Calibrate(const mesh::Mesh& mesh,
   for (const ExactPair& pair : pairs) {
     const absl::StatusOr<double> u = engine->Distance(pair.p, pair.q, pure);
     bool wraps = false;
-    const absl::StatusOr<double> t = engine->TracedDistance(pair.p, pair.q, &wraps);
+    const absl::StatusOr<double> t = engine->WalkedDistance(pair.p, pair.q, &wraps);
     if (!u.ok()) continue;
     if (std::isfinite(*u)) largest_answer = std::max(largest_answer, *u);
     if (t.ok() && std::isfinite(*t)) largest_answer = std::max(largest_answer, *t);

@@ -250,9 +250,8 @@ std::optional<double> AngleSum(const MeshView& view, int32_t face, int32_t v) {
 
 }  // namespace
 
-std::optional<NearPath> NearPathLength(const MeshView& view, const GradientPaths& paths,
-                                       const SurfacePoint& from, const SurfacePoint& to,
-                                       bool walk_chord, double plausible) {
+NearWalk WalkNearPair(const MeshView& view, const SurfacePoint& from, const SurfacePoint& to,
+                      double plausible) {
   // First the corridors of the chord, from either end, unfolded into the
   // plane. A straight segment through the corridor is a local geodesic, as
   // the straightened trace would be, found without evaluating the distance
@@ -262,7 +261,8 @@ std::optional<NearPath> NearPathLength(const MeshView& view, const GradientPaths
   // or at one saddle by no more than its angle excess, is a local geodesic
   // too. Paths bending at several saddles were often in a wrong corridor,
   // and so, rarely, is a straight one longer than `plausible` (across a
-  // sharp feature); then the trace decides. Every candidate is a surface
+  // sharp feature); then the caller decides (NearPathLength: the trace; the
+  // refinement: an exact propagation round the pair). Every candidate is a surface
   // path, so the shortest is kept (figures: tests/bench/README.md).
   constexpr int kMaxWalkSteps = 256;
   // A release shortens the path; a near path passes few vertices.
@@ -273,7 +273,7 @@ std::optional<NearPath> NearPathLength(const MeshView& view, const GradientPaths
   std::optional<NearPath> found;
   Corridor corridor;
   Corridor::Bends bends;
-  for (int start = 0; start < (walk_chord ? 2 : 0); ++start) {
+  for (int start = 0; start < 2; ++start) {
     const SurfacePoint& a = ends[start].point;
     const SurfacePoint& b = ends[1 - start].point;
     if (!WalkCorridor(view, ends[start], ends[1 - start], kMaxWalkSteps, &corridor.faces()) ||
@@ -281,7 +281,7 @@ std::optional<NearPath> NearPathLength(const MeshView& view, const GradientPaths
       continue;
     }
     if (const std::optional<double> length = corridor.StraightLength()) {
-      if (*length <= plausible) return NearPath{*length, false};
+      if (*length <= plausible) return {NearPath{*length, false}, std::nullopt};
       doubt(*length);
       continue;
     }
@@ -305,7 +305,7 @@ std::optional<NearPath> NearPathLength(const MeshView& view, const GradientPaths
       if (shortcut == nullptr) {
         if (length <= plausible && bends.size() <= 1) {
           // Straight in the walk's own corridor: as sure as a straight walk.
-          if (release == 0 && bends.empty()) return NearPath{length, false};
+          if (release == 0 && bends.empty()) return {NearPath{length, false}, std::nullopt};
           // Else a local geodesic in a corridor the walk did not find by
           // itself: kept, but the other walk may find a shorter one.
           if (!found || length < found->length) found = NearPath{length, !bends.empty()};
@@ -319,8 +319,20 @@ std::optional<NearPath> NearPathLength(const MeshView& view, const GradientPaths
   }
   // Every candidate is a surface path: the shortest is the closest.
   if (found) {
-    if (doubted && *doubted < found->length) return NearPath{*doubted, true};
-    return found;
+    if (doubted && *doubted < found->length) return {NearPath{*doubted, true}, std::nullopt};
+    return {found, std::nullopt};
+  }
+  return {std::nullopt, doubted};
+}
+
+std::optional<NearPath> NearPathLength(const MeshView& view, const GradientPaths& paths,
+                                       const SurfacePoint& from, const SurfacePoint& to,
+                                       bool walk_chord, double plausible) {
+  std::optional<double> doubted;
+  if (walk_chord) {
+    const NearWalk walk = WalkNearPair(view, from, to, plausible);
+    if (walk.path) return walk.path;
+    doubted = walk.doubted;
   }
   // Without Path's restarts, which double the cost of a near pair for a
   // small gain (tests/bench/README.md).

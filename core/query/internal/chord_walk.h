@@ -31,11 +31,28 @@ struct NearPath {
   bool wraps;
 };
 
+// What the chord's walks found between near points.
+struct NearWalk {
+  // The shortest path the walks vouch for: a local geodesic in a corridor
+  // (straight, or bending round one saddle by no more than its angle
+  // excess), or a shorter doubted one beside it.
+  std::optional<NearPath> path;
+  // Without such a path: the shortest candidate the walks doubted (bending
+  // at several saddles, or straight but longer than `plausible`), if any.
+  std::optional<double> doubted;
+};
+
+// The chord's walks from either end between valid canonical points `from`
+// and `to` (from the smaller point, for symmetry). A straight walk longer
+// than `plausible` is doubted (it may run in a wrong corridor).
+NearWalk WalkNearPair(const MeshView& view, const SurfacePoint& from, const SurfacePoint& to,
+                      double plausible = std::numeric_limits<double>::infinity());
+
 // The shortest path found between valid canonical points `from` and `to`
-// (from the smaller point, for symmetry); nullopt when neither a walk nor a
-// trace reaches. `walk_chord`: try the chord's corridors first (off: the trace
-// only, for benchmarks). A straight walk longer than `plausible` is doubted
-// (it may run in a wrong corridor) and kept only if nothing shorter is found.
+// (from the smaller point, for symmetry): the walks' (WalkNearPair), else
+// the gradient trace, else the shortest doubted walk; nullopt when neither a
+// walk nor a trace reaches. `walk_chord`: try the chord's corridors first
+// (off: the trace only, for benchmarks).
 std::optional<NearPath> NearPathLength(const MeshView& view, const GradientPaths& paths,
                                        const SurfacePoint& from, const SurfacePoint& to,
                                        bool walk_chord,

@@ -13,7 +13,8 @@ ErrorBounds::ErrorBounds(const index::Index& index)
 
 double ErrorBounds::Of(AnswerKind kind, bool vertex_pair, double d, double spread) const {
   if (accuracy_ == nullptr) return std::numeric_limits<double>::quiet_NaN();
-  if (kind == AnswerKind::kExact || !(d < std::numeric_limits<double>::infinity())) return 0;
+  if (!(d < std::numeric_limits<double>::infinity())) return 0;
+  if (kind == AnswerKind::kExact) return kExactRelativeBound * d;
   const double x = d / accuracy_->scale_length;
   int b = 0;
   while (b + 1 < index::kAccuracyBins && x >= index::kAccuracyBinUpper[b]) ++b;

@@ -4,7 +4,7 @@
 // index built with its accuracy calibration (index::AccuracyRecord) gives
 // every answer an absolute error bound, the error its kind of answer (O(1),
 // traced, exact) at its distance stayed within on all but a small share of
-// held-out exact pairs; 0 for exact answers. With the spread bounds
+// held-out exact pairs; rounding for exact answers. With the spread bounds
 // (index::SpreadBoundRecord), an O(1) answer's bound also grows with its
 // unfolding spread (LiftedUnfolding::Spread), which flags the pairs it errs most on.
 //
@@ -19,6 +19,13 @@ namespace geodex::query {
 // How an answer was obtained, for its bound.
 enum class AnswerKind { kUnfold, kTrace, kWrappedTrace, kExact };
 
+// The bound of an exact answer, relative to it: window propagations agree
+// with each other to ~1e-15 relative (a confined one with the whole mesh's,
+// the index's mesh with its long edges split with the input mesh); a
+// rounding-sized bound, not 0, so that coverage measured against another
+// exact solver is honest.
+inline constexpr double kExactRelativeBound = 1e-9;
+
 class ErrorBounds {
  public:
   // Over `index`'s calibration (none: no bounds), which must outlive this.
@@ -30,9 +37,9 @@ class ErrorBounds {
   bool has_spread() const { return spread_ != nullptr; }
 
   // The bound of an answer of `kind` at distance d between two vertices
-  // (`vertex_pair`) or other points; NaN without calibration, 0 for exact
-  // answers and unreachable pairs. `spread` scales an O(1) answer's bound
-  // when the index has spread bounds.
+  // (`vertex_pair`) or other points; NaN without calibration,
+  // kExactRelativeBound x d for exact answers, 0 for unreachable pairs. `spread` scales an O(1)
+  // answer's bound when the index has spread bounds.
   double Of(AnswerKind kind, bool vertex_pair, double d, double spread = 0) const;
 
   // How far beyond 3L an O(1) answer may lie while the pair is closer: the

@@ -59,7 +59,7 @@ TEST(ErrorBoundsTest, BoundsComeFromTheBinOfTheDistance) {
   EXPECT_EQ(bounds.Of(AnswerKind::kWrappedTrace, false, 0.1), 200);
   EXPECT_EQ(bounds.Of(AnswerKind::kTrace, true, 0.1), 300);
   EXPECT_EQ(bounds.Of(AnswerKind::kWrappedTrace, true, 0.1), 400);
-  EXPECT_EQ(bounds.Of(AnswerKind::kExact, true, 0.1), 0);
+  EXPECT_EQ(bounds.Of(AnswerKind::kExact, true, 0.1), kExactRelativeBound * 0.1);
   EXPECT_EQ(bounds.Of(AnswerKind::kUnfold, true, INFINITY), 0);  // unreachable: exact
   // The margin beyond 3L: the larger O(1) bound of bin [3L, 5L).
   EXPECT_EQ(bounds.RefineMargin(), 50);

@@ -63,6 +63,19 @@ std::optional<double> LocalExact::NearDistance(const SurfacePoint& from, const S
   return solver->DistanceAt(to);
 }
 
+std::optional<double> LocalExact::ConfinedDistance(const SurfacePoint& from, const SurfacePoint& to,
+                                                   std::span<const int32_t> seed_faces,
+                                                   QueryScratch& scratch) const {
+  const mesh::Mesh* m = ExactMesh();
+  if (m == nullptr) return std::nullopt;
+  if (scratch.confined_ == nullptr || &scratch.confined_->mesh() != m) {
+    scratch.confined_ = std::make_unique<geodesic::ConfinedGeodesicSolver>(*m);
+  }
+  const absl::StatusOr<double> d = scratch.confined_->Distance(from, to, seed_faces);
+  if (!d.ok()) return std::nullopt;
+  return *d;
+}
+
 absl::StatusOr<std::span<const double>> LocalExact::Distances(const SurfacePoint& p, double radius,
                                                               QueryScratch& scratch) const {
   if (!(radius >= 0)) {

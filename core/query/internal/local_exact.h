@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "absl/status/statusor.h"
+#include "core/geodesic/confined_geodesic.h"
 #include "core/geodesic/exact_geodesic.h"
 #include "core/index/index.h"
 #include "core/mesh/mesh.h"
@@ -39,6 +40,16 @@ class LocalExact {
   // keeps the solver between calls.
   std::optional<double> NearDistance(const SurfacePoint& from, const SurfacePoint& to,
                                      QueryScratch* scratch) const;
+
+  // The exact distance between valid canonical points, by a propagation
+  // confined to a region of faces round them that grows until it certifies
+  // its answer (core/geodesic/confined_geodesic.h): its cost follows the
+  // region, not the mesh. `seed_faces`: the faces the region starts
+  // from (e.g. a path's; empty: a shortest chain of faces between the
+  // points'). nullopt as NearDistance. `scratch` keeps the solver between calls.
+  std::optional<double> ConfinedDistance(const SurfacePoint& from, const SurfacePoint& to,
+                                         std::span<const int32_t> seed_faces,
+                                         QueryScratch& scratch) const;
 
   // Exact distances from a valid canonical point to every vertex within
   // `radius` (larger values or +inf beyond). The span lives in `scratch`

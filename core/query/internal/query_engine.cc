@@ -78,6 +78,9 @@ absl::Status QueryEngine::DistanceBatch(std::span<const SurfacePoint> a,
   }
   const bool want_bounds = !bounds.empty();
   GEODEX_RETURN_IF_ERROR(bounds_.CheckOptions(options, want_bounds));
+  // One solver for the batch's exact refinements when the caller keeps none.
+  QueryScratch own;
+  if (scratch == nullptr) scratch = &own;
   auto refine = [&](size_t k, const LiftedPoint& p, const LiftedPoint& q) {
     const bool near = unfolding_.AreNear(p, q);
     if (refiner_.Needs(options, want_bounds, near, out[k])) {
@@ -143,6 +146,19 @@ absl::StatusOr<double> QueryEngine::TracedDistance(const SurfacePoint& p, const 
   if (!t) return absl::NotFoundError("no trace between the points");
   if (wraps != nullptr) *wraps = t->wraps;
   return t->length;
+}
+
+absl::StatusOr<double> QueryEngine::WalkedDistance(const SurfacePoint& p, const SurfacePoint& q,
+                                                   bool* wraps) const {
+  if (!knobs_.walk_near_pairs) return TracedDistance(p, q, wraps);
+  const SurfacePoint a = view_.InLowestFaceIfVertex(view_.Canonical(p)),
+                     b = view_.InLowestFaceIfVertex(view_.Canonical(q));
+  const bool swap = std::tie(b.face, b.w) < std::tie(a.face, a.w);
+  const NearWalk walk = WalkNearPair(view_, swap ? b : a, swap ? a : b);
+  if (!walk.path)
+    return absl::NotFoundError("the walks found no local geodesic between the points");
+  if (wraps != nullptr) *wraps = walk.path->wraps;
+  return walk.path->length;
 }
 
 absl::StatusOr<std::span<const double>> QueryEngine::LocalExactDistances(

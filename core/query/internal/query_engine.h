@@ -81,11 +81,19 @@ class QueryEngine {
                              std::span<double> out, const DistanceOptions& options = {},
                              QueryScratch* scratch = nullptr, std::span<double> bounds = {}) const;
 
-  // The length of a near pair's surface path as the default refinement finds
-  // it (chord_walk.h; symmetric, never below the geodesic distance); with
-  // `wraps`, whether it bends round a mesh vertex. Errors:
-  // NotFound between components or when no path reaches the other point.
+  // The length of a near pair's surface path (chord_walk.h's
+  // NearPathLength: the chord's walks, else the gradient trace; symmetric,
+  // never below the geodesic distance); with `wraps`, whether it bends round
+  // a mesh vertex. Errors: NotFound between components or when no path
+  // reaches the other point.
   absl::StatusOr<double> TracedDistance(const SurfacePoint& p, const SurfacePoint& q,
+                                        bool* wraps = nullptr) const;
+
+  // The surface path the default refinement answers a near pair with, as
+  // TracedDistance: the walks' local geodesic (the trace when the walks are
+  // off); NotFound when the walks vouch for none, for the default mode then
+  // answers exactly. What the trace bounds are calibrated on.
+  absl::StatusOr<double> WalkedDistance(const SurfacePoint& p, const SurfacePoint& q,
                                         bool* wraps = nullptr) const;
 
   // Exact distances from p to every vertex within `radius` (local_exact.h;

@@ -283,6 +283,49 @@ TEST(QueryEngineTest, NearPairsAreThePathLengthByDefault) {
   for (size_t i = 0; i < a.size(); ++i) EXPECT_EQ(out[i], *engine->Distance(a[i], b[i]));
 }
 
+// Near pairs the chord's walks vouch for no local geodesic between are
+// answered exactly (a propagation confined round the pair), with a bound of
+// rounding size: here pairs across a hole, where the chord leaves the
+// surface and the geodesic bends round the hole's corner.
+TEST(QueryEngineTest, NearPairsTheWalksCannotSettleAreExact) {
+  const Mesh m = gen::SquareWithHole(24, 1.0);
+  auto engine = geodex::testing::TestEngineOrThrow(m, 20, /*calibrate=*/true);
+  QueryScratch scratch;
+  std::vector<SurfacePoint> left, right;
+  for (const SurfacePoint& p : RandomPoints(m, 3000, 33)) {
+    const mesh::Vec3 x = mesh::PositionOf(m, p);
+    if (std::abs(x.y() - 0.5) > 0.12) continue;
+    if (x.x() < 0.3) left.push_back(p);
+    if (x.x() > 0.7) right.push_back(p);
+  }
+  int near = 0, unsettled = 0;
+  for (size_t i = 0; i < std::min(left.size(), right.size()); ++i) {
+    const SurfacePoint& p = left[i];
+    const SurfacePoint& q = right[i];
+    const double o1 = *engine->Distance(p, q, {.near_pairs = NearPairs::kUnfold});
+    if (!engine->IsNearPair(p, q) && o1 >= engine->refine_below()) continue;
+    ++near;
+    double bound = 0;
+    const double d = *engine->Distance(p, q, {}, &scratch, &bound);
+    const double exact = Exact(m, p, q);
+    if (engine->WalkedDistance(p, q).ok()) {
+      EXPECT_GE(d, exact * (1 - 1e-9));  // a surface path
+      continue;
+    }
+    ++unsettled;
+    EXPECT_NEAR(d, exact, 1e-9 * exact);
+    EXPECT_LE(bound, kExactRelativeBound * d);
+    EXPECT_GE(bound, std::abs(d - exact));
+    // Symmetric, and the same in a batch.
+    EXPECT_EQ(*engine->Distance(q, p, {}, &scratch), d);
+    double out = 0;
+    ASSERT_TRUE(engine->DistanceBatch({&p, 1}, {&q, 1}, {&out, 1}).ok());
+    EXPECT_EQ(out, d);
+  }
+  EXPECT_GT(near, 10);
+  EXPECT_GT(unsettled, 10);
+}
+
 // An O(1) answer that overestimates puts a pair closer than 3L above 3L; a
 // calibrated index also refines the pairs its bound says may be closer.
 TEST(QueryEngineTest, CalibratedIndexesRefinePairsThatMayBeCloserThan3L) {
@@ -302,12 +345,16 @@ TEST(QueryEngineTest, CalibratedIndexesRefinePairsThatMayBeCloserThan3L) {
     if (plain->IsNearPair(p, q)) continue;
     const double o1 = *plain->Distance(p, q, unfold);
     ASSERT_EQ(o1, *calibrated->Distance(p, q, unfold));  // the same index otherwise
-    const auto traced = calibrated->TracedDistance(p, q);
-    if (!traced.ok()) continue;
     if (o1 >= three_l && o1 < calibrated->refine_below()) {
       ++in_margin;
       EXPECT_EQ(*plain->Distance(p, q), o1);
-      EXPECT_EQ(*calibrated->Distance(p, q), *traced);
+      // Refined: the walks' local geodesic, or the exact distance where the
+      // walks vouch for none (or ran longer than is plausible).
+      const auto walked = calibrated->WalkedDistance(p, q);
+      const double exact = *calibrated->Distance(p, q, {.near_pairs = NearPairs::kExact});
+      const double refined = *calibrated->Distance(p, q);
+      EXPECT_TRUE((walked.ok() && refined == *walked) || refined == exact)
+          << refined << " walked " << (walked.ok() ? *walked : -1) << " exact " << exact;
     } else if (o1 >= calibrated->refine_below()) {
       EXPECT_EQ(*calibrated->Distance(p, q), o1);
     }

@@ -4,11 +4,12 @@
 // error is about the same at every distance, so its relative error grows as
 // the points get closer: pairs that may be closer than kRefineScale
 // geodesic-triangle edges, and pairs in the same or adjacent geodesic
-// triangles, are answered by default by the length of a surface path between
-// them (chord_walk.h), or by a local exact propagation (local_exact.h), as
-// DistanceOptions::near_pairs says. A caller's tolerance refines every pair
-// whose error bound (error_bounds.h) exceeds tolerance x distance, by the
-// path and then exactly.
+// triangles, are answered by default by a local geodesic the chord's walks
+// find (chord_walk.h), else exactly by a propagation confined to a region
+// round the pair (local_exact.h, core/geodesic/confined_geodesic.h); or all
+// exactly, as DistanceOptions::near_pairs says. A caller's tolerance
+// answers exactly every pair whose error bound (error_bounds.h) exceeds
+// tolerance x distance.
 //
 // Thread safety: immutable; every method is const and thread-safe, with one
 // QueryScratch per thread.
