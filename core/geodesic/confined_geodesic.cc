@@ -108,6 +108,43 @@ void ConfinedGeodesicSolver::AddFaceChain(int32_t from, int32_t to) {
   chain_reached_.clear();
 }
 
+void ConfinedGeodesicSolver::AddEllipsoid(int32_t start, const Vec3& p, const Vec3& q,
+                                          double length) {
+  // Faces some point x of which may have |x - p| + |x - q| <= length, by a
+  // lower bound on that sum over the face: its value at the centroid less
+  // twice the face's radius about it.
+  auto inside = [&](int32_t f) {
+    const auto& [a, b, c] = mesh_.face(f);
+    const Vec3 centroid = (mesh_.position(a) + mesh_.position(b) + mesh_.position(c)) / 3;
+    const double radius =
+        std::max({(mesh_.position(a) - centroid).norm(), (mesh_.position(b) - centroid).norm(),
+                  (mesh_.position(c) - centroid).norm()});
+    return (centroid - p).norm() + (centroid - q).norm() - 2 * radius <= length;
+  };
+  // chain_parent_ marks the faces tested (-1), chain_reached_ lists them;
+  // the ones inside are queued.
+  std::vector<int32_t>& queue = ellipsoid_queue_;
+  queue.clear();
+  chain_parent_[start] = -1;
+  chain_reached_.push_back(start);
+  queue.push_back(start);
+  for (size_t i = 0; i < queue.size(); ++i) {
+    const int32_t f = queue[i];
+    AddFace(f);
+    for (int k = 0; k < 3; ++k) {
+      const int32_t t = mesh_.Twin(3 * f + k);
+      if (t == kNone) continue;
+      const int32_t g = Mesh::FaceOf(t);
+      if (chain_parent_[g] != -2) continue;
+      chain_parent_[g] = -1;
+      chain_reached_.push_back(g);
+      if (inside(g)) queue.push_back(g);
+    }
+  }
+  for (const int32_t f : chain_reached_) chain_parent_[f] = -2;
+  chain_reached_.clear();
+}
+
 void ConfinedGeodesicSolver::FindViolations(const Vec3& q, double distance,
                                             std::vector<int32_t>& violating_vertices) {
   border_.clear();
@@ -157,7 +194,8 @@ void ConfinedGeodesicSolver::FindViolations(const Vec3& q, double distance,
 
 absl::StatusOr<double> ConfinedGeodesicSolver::Distance(const SurfacePoint& p,
                                                         const SurfacePoint& q,
-                                                        std::span<const int32_t> seed_faces) {
+                                                        std::span<const int32_t> seed_faces,
+                                                        double upper_bound) {
   stats_ = {};
   GEODEX_RETURN_IF_ERROR(mesh::ValidateSurfacePoint(mesh_, p));
   GEODEX_RETURN_IF_ERROR(mesh::ValidateSurfacePoint(mesh_, q));
@@ -180,7 +218,14 @@ absl::StatusOr<double> ConfinedGeodesicSolver::Distance(const SurfacePoint& p,
 
   GeodesicOptions options;
   options.stop_points = {q};
-  const Vec3 qx = mesh::PositionOf(mesh_, q);
+  const Vec3 px = mesh::PositionOf(mesh_, p), qx = mesh::PositionOf(mesh_, q);
+  bool ellipsoid_added = false;
+  if (upper_bound < kInfinity) {
+    ellipsoid_added = true;
+    AddEllipsoid(p.face, px, qx, upper_bound);
+    options.prune_length = upper_bound;
+    options.prune_point = qx;
+  }
   for (int32_t rings = 1;; rings *= 2) {
     options.face_region = in_region_;
     ++stats_.rounds;
@@ -194,9 +239,25 @@ absl::StatusOr<double> ConfinedGeodesicSolver::Distance(const SurfacePoint& p,
       stats_.border_edges = static_cast<int32_t>(border_.size());
       return d;
     }
-    // Each round adds at least the faces beyond the violating edges, so the
-    // region reaches a whole component at the latest.
-    GrowRings(vertices_, rings);
+    // A path from p to q no longer than d_R(q) lies inside the ellipsoid
+    // |x - p| + |x - q| <= d_R(q), so it crosses only faces that meet the
+    // ellipsoid, and those faces are connected along it: the faces reached
+    // from p's face through such faces hold every shortest path, and the
+    // next round certifies (every border point b then has
+    // d_R(b) + |b - q| >= |b - p| + |b - q| > d_R(q)). Growing rings round
+    // the violating edges instead took 3-4 rounds round thin features,
+    // where the straight line to q is far shorter than the way round.
+    if (d < kInfinity && !ellipsoid_added) {
+      ellipsoid_added = true;
+      AddEllipsoid(p.face, px, qx, d);
+      // And inside it, only what may lead to q within d_R(q).
+      options.prune_length = d;
+      options.prune_point = qx;
+    } else {
+      // Each round adds at least the faces beyond the violating edges, so
+      // the region reaches a whole component at the latest.
+      GrowRings(vertices_, rings);
+    }
   }
 }
 

@@ -80,8 +80,12 @@ class ConfinedGeodesicSolver {
   // `seed_faces` (may be empty; duplicates allowed). Errors: InvalidArgument
   // for a malformed point, OutOfRange for a face id past the end (a point's
   // or a seed's); ResourceExhausted from the engine's window limit.
+  // `upper_bound`, if finite, must be no shorter than the distance (e.g. the
+  // length of a surface path from p to q): the first region is then the
+  // faces that may meet the ellipsoid it bounds (see Distance's rounds).
   absl::StatusOr<double> Distance(const SurfacePoint& p, const SurfacePoint& q,
-                                  std::span<const int32_t> seed_faces = {});
+                                  std::span<const int32_t> seed_faces = {},
+                                  double upper_bound = kInfinity);
 
   // The exact geodesic from p to q as surface points (p first, then every
   // edge crossing and vertex, q last), of length Distance(p, q, seed_faces).
@@ -103,6 +107,9 @@ class ConfinedGeodesicSolver {
   // Adds a shortest chain of edge-adjacent faces from face `from` to `to`
   // (nothing when they are not connected).
   void AddFaceChain(int32_t from, int32_t to);
+  // Adds the faces reached from face `start` through faces that may meet
+  // the ellipsoid |x - p| + |x - q| <= length.
+  void AddEllipsoid(int32_t start, const mesh::Vec3& p, const mesh::Vec3& q, double length);
   // After a propagation that gave d_R(q) = `distance`: the border edges whose
   // bound falls short of it; appends their ends to `violating_vertices`.
   void FindViolations(const mesh::Vec3& q, double distance,
@@ -123,6 +130,7 @@ class ConfinedGeodesicSolver {
   // (-2 unreached), and the reached faces to clear.
   std::vector<int32_t> chain_parent_;
   std::vector<int32_t> chain_reached_;
+  std::vector<int32_t> ellipsoid_queue_;
   std::vector<int32_t> vertices_;
   ConfinedStats stats_;
 };

@@ -28,9 +28,8 @@ ExactGeodesicSolver::ExactGeodesicSolver(const Mesh& mesh)
   pinched_.resize(mesh.num_vertices());
   for (int32_t v = 0; v < mesh.num_vertices(); ++v) {
     pinched_[v] = mesh::TouchesZeroLengthEdge(mesh, v);
-    emits_[v] = mesh.IsReferenced(v) &&
-                (mesh.IsBoundaryVertex(v) || pinched_[v] ||
-                 mesh.AngleSum(v) >= 2 * std::numbers::pi - kSaddleSlack);
+    emits_[v] = mesh.IsReferenced(v) && (mesh.IsBoundaryVertex(v) || pinched_[v] ||
+                                         mesh.AngleSum(v) >= 2 * std::numbers::pi - kSaddleSlack);
   }
 }
 
@@ -111,6 +110,11 @@ absl::Status ExactGeodesicSolver::Propagate(std::span<const SurfacePoint> source
   }
   region_ = options.face_region;
   stop_radius_ = options.stop_radius;
+  // With slack for rounding: where the way on to the point is straight (a
+  // flat surface, a saddle seen straight from it), the straight-line bound
+  // equals the distance, and rounding must not prune that way.
+  prune_length_ = options.prune_length * (1 + 1e-9);
+  prune_point_ = options.prune_point;
   stop_vertices_ = options.stop_vertices;
   stop_points_ = options.stop_points;
   max_windows_ = options.max_windows > 0 ? options.max_windows
@@ -355,7 +359,8 @@ void ExactGeodesicSolver::UpdateVertex(int32_t v, double d, int32_t source, Via 
   dist_[v] = d;
   nearest_[v] = source;
   origin_[v] = {via, id};
-  if ((emits_[v] || RegionBorderState(v) == kReflexBorder) && d <= stop_radius_) {
+  if ((emits_[v] || RegionBorderState(v) == kReflexBorder) && d <= stop_radius_ &&
+      !(d + (mesh_.position(v) - prune_point_).norm() > prune_length_)) {
     queue_.Push(d, ~v);
   }
 }
@@ -363,6 +368,23 @@ void ExactGeodesicSolver::UpdateVertex(int32_t v, double d, int32_t source, Via 
 double ExactGeodesicSolver::MinDistance(const Window& w) const {
   const double dx = w.sx < w.b0 ? w.b0 - w.sx : (w.sx > w.b1 ? w.sx - w.b1 : 0.0);
   return w.sigma + Hypot(dx, w.sy);
+}
+
+bool ExactGeodesicSolver::MayReachPrunePoint(const Window& w) const {
+  // The prune point's coordinates about the edge's line: u along it from
+  // its origin, r from the line (turned into the plane of the window).
+  const mesh::Vec3& o = mesh_.position(mesh_.Origin(w.h));
+  const double length = frame_[w.h].length;
+  if (!(length > 0)) return true;
+  const mesh::Vec3 axis = (mesh_.position(mesh_.Dest(w.h)) - o) / length;
+  const mesh::Vec3 rel = prune_point_ - o;
+  const double u = rel.dot(axis), r = rel.cross(axis).norm();
+  // min over x in [b0, b1] of |S - x| + |x - Q|: convex in x; on the whole
+  // line the minimum is where the segment from S to Q unfolded across the
+  // line meets it.
+  const double sr = std::abs(w.sy), total = sr + r;
+  const double x = std::clamp(total > 0 ? w.sx + (u - w.sx) * (sr / total) : w.sx, w.b0, w.b1);
+  return w.sigma + Hypot(x - w.sx, sr) + Hypot(u - x, r) <= prune_length_;
 }
 
 bool ExactGeodesicSolver::IsUseless(const Window& w) const {
@@ -380,6 +402,7 @@ void ExactGeodesicSolver::PushWindow(const Window& w) {
   if (!(w.b1 - w.b0 > 1e-14 * frame_[w.h].length)) return;
   const double key = MinDistance(w);
   if (key > stop_radius_) return;
+  if (prune_length_ < kInfinity && !MayReachPrunePoint(w)) return;
   if (IsUseless(w)) return;
   const int32_t index = static_cast<int32_t>(windows_.size());
   windows_.push_back(w);
@@ -431,8 +454,7 @@ void ExactGeodesicSolver::PropagateWindow(int32_t index) {
   if (w.b0 < left_end) {
     const int32_t t = mesh_.Twin(Mesh::Prev(h));
     if (t != kNone) {
-      const ChildWindow c =
-          ChildAcrossAC(f, frame_[t].length, w.sx, w.sy, xc, w.b0, left_end);
+      const ChildWindow c = ChildAcrossAC(f, frame_[t].length, w.sx, w.sy, xc, w.b0, left_end);
       child.b0 = c.b0, child.b1 = c.b1, child.sx = c.sx, child.sy = c.sy, child.h = t;
       PushWindow(child);
     }
@@ -440,8 +462,7 @@ void ExactGeodesicSolver::PropagateWindow(int32_t index) {
   if (right_begin < w.b1) {
     const int32_t t = mesh_.Twin(Mesh::Next(h));
     if (t != kNone) {
-      const ChildWindow c =
-          ChildAcrossCB(f, frame_[t].length, w.sx, w.sy, xc, right_begin, w.b1);
+      const ChildWindow c = ChildAcrossCB(f, frame_[t].length, w.sx, w.sy, xc, right_begin, w.b1);
       child.b0 = c.b0, child.b1 = c.b1, child.sx = c.sx, child.sy = c.sy, child.h = t;
       PushWindow(child);
     }

@@ -74,6 +74,15 @@ struct GeodesicOptions {
   // edge of R whose other face lies outside R stop there and are kept as
   // BorderWindows(). Read during Propagate only.
   std::span<const uint8_t> face_region;
+  // If finite: an upper bound on the distance to the point `prune_point`
+  // (e.g. the length of a path to it). Windows and vertices every path
+  // through which to that point is longer than this, by the straight line
+  // from them to it, are not propagated: the point's distance stays exact
+  // (and so does every distance d(x) with d(x) + |x - prune_point| below
+  // the bound), others may be left larger. Focuses a propagation between two
+  // points on the ellipsoid round them.
+  double prune_length = kInfinity;
+  mesh::Vec3 prune_point = mesh::Vec3::Zero();
 };
 
 struct GeodesicStats {
@@ -263,6 +272,10 @@ class ExactGeodesicSolver {
   std::vector<SourceInFace> face_sources_;
   std::vector<SurfacePoint> sources_;
   double stop_radius_ = kInfinity;
+  double prune_length_ = kInfinity;
+  mesh::Vec3 prune_point_ = mesh::Vec3::Zero();
+  // Whether a window's paths may reach prune_point_ within prune_length_.
+  bool MayReachPrunePoint(const Window& w) const;
   std::vector<int32_t> stop_vertices_;
   std::vector<SurfacePoint> stop_points_;
   int64_t max_windows_ = 0;

@@ -15,9 +15,8 @@ namespace geodex::geodesic {
 namespace {
 
 using Heap = RadixHeap<int32_t>;
-using Reference =
-    std::priority_queue<std::pair<double, int32_t>, std::vector<std::pair<double, int32_t>>,
-                        std::greater<>>;
+using Reference = std::priority_queue<std::pair<double, int32_t>,
+                                      std::vector<std::pair<double, int32_t>>, std::greater<>>;
 
 // Drives a RadixHeap and a std::priority_queue with the same Dijkstra-like
 // (monotone) sequence: each pop pushes a few keys at or above the popped one.

@@ -26,7 +26,6 @@ constexpr double kSaddleSlack = 1e-9;
 // same point for the "two sides" rule, which then keeps both sides.
 constexpr double kSideSlack = 1e-8;
 
-
 // Whether the segments from the pseudo-sources p and q to the points (a,0) and
 // (b,0) of the edge cross (touching counts) below it. By orientation tests:
 // no division, and exact in sign up to rounding.
@@ -51,9 +50,9 @@ VertexGeodesicSolver::VertexGeodesicSolver(const Mesh& mesh)
   for (int32_t v = 0; v < mesh.num_vertices(); ++v) {
     // A pinch (an end of an edge of length 0, kept by mesh repair) is a
     // cone point of unknown angle: a pseudo-source, to be safe.
-    emits_[v] = mesh.IsReferenced(v) &&
-                (mesh.IsBoundaryVertex(v) || mesh::TouchesZeroLengthEdge(mesh, v) ||
-                 mesh.AngleSum(v) > 2 * std::numbers::pi + kSaddleSlack);
+    emits_[v] =
+        mesh.IsReferenced(v) && (mesh.IsBoundaryVertex(v) || mesh::TouchesZeroLengthEdge(mesh, v) ||
+                                 mesh.AngleSum(v) > 2 * std::numbers::pi + kSaddleSlack);
   }
   head_.assign(nh, kNone);
   queued_.assign(nh, 0);
@@ -89,12 +88,11 @@ absl::Status VertexGeodesicSolver::Propagate(std::span<const int32_t> sources,
   if (sources.empty()) return absl::InvalidArgumentError("no sources given");
   for (const int32_t v : sources) {
     if (v < 0 || v >= mesh_.num_vertices()) {
-      return absl::OutOfRangeError(absl::StrFormat("source vertex %d out of range [0, %d)", v,
-                                                   mesh_.num_vertices()));
+      return absl::OutOfRangeError(
+          absl::StrFormat("source vertex %d out of range [0, %d)", v, mesh_.num_vertices()));
     }
     if (!mesh_.IsReferenced(v)) {
-      return absl::InvalidArgumentError(
-          absl::StrFormat("source vertex %d belongs to no face", v));
+      return absl::InvalidArgumentError(absl::StrFormat("source vertex %d belongs to no face", v));
     }
   }
   GEODEX_RETURN_IF_ERROR(Start(options));
@@ -358,8 +356,7 @@ void VertexGeodesicSolver::WakeEnd(int32_t v) {
   // never be queued, yet the window may still improve vertices beyond it
   // (the region a new source improves is star-shaped along geodesics, but
   // its vertices need not be): queue such an end at its initial distance.
-  if (state_[v] != kInside && state_[v] != kWoken && nearest_[v] == kNone &&
-      dist_[v] < kInfinity) {
+  if (state_[v] != kInside && state_[v] != kWoken && nearest_[v] == kNone && dist_[v] < kInfinity) {
     state_[v] = kWoken;
     vertex_queue_.Push(dist_[v], v);
   }
@@ -405,8 +402,7 @@ void VertexGeodesicSolver::PropagateList(int32_t h) {
     p.crossing = std::clamp(p.xc, w.b0, w.b1);
     // Straight to C when the ray through C crosses the interval, else
     // round its nearer end: either way the length of a path to C.
-    const double dc =
-        w.sigma + Hypot(p.crossing - w.sx, w.sy) + Hypot(f.cx - p.crossing, f.cy);
+    const double dc = w.sigma + Hypot(p.crossing - w.sx, w.sy) + Hypot(f.cx - p.crossing, f.cy);
     if (dc < best) {
       best = dc;
       best_source = w.source;
@@ -439,14 +435,14 @@ void VertexGeodesicSolver::PropagateList(int32_t h) {
     // through C->B.
     if (left && w.b0 < std::min(w.b1, p.xc)) {
       if (const int32_t t = mesh_.Twin(Mesh::Prev(h)); t != kNone) {
-        PropagateChild(t, ChildAcrossAC(f, frame_[t].length, w.sx, w.sy, p.xc, w.b0,
-                                        std::min(w.b1, p.xc)), w);
+        PropagateChild(
+            t, ChildAcrossAC(f, frame_[t].length, w.sx, w.sy, p.xc, w.b0, std::min(w.b1, p.xc)), w);
       }
     }
     if (right && std::max(w.b0, p.xc) < w.b1) {
       if (const int32_t t = mesh_.Twin(Mesh::Next(h)); t != kNone) {
-        PropagateChild(t, ChildAcrossCB(f, frame_[t].length, w.sx, w.sy, p.xc,
-                                        std::max(w.b0, p.xc), w.b1), w);
+        PropagateChild(
+            t, ChildAcrossCB(f, frame_[t].length, w.sx, w.sy, p.xc, std::max(w.b0, p.xc), w.b1), w);
       }
     }
   }
@@ -503,8 +499,7 @@ void VertexGeodesicSolver::PruneNeighbours() {
   for (size_t i = 0; i < pending_.size(); ++i) {
     pending_[kept++] = pending_[i];
     while (kept >= 2) {
-      const PairVerdict verdict =
-          ComparePair(pending_[kept - 2].window, pending_[kept - 1].window);
+      const PairVerdict verdict = ComparePair(pending_[kept - 2].window, pending_[kept - 1].window);
       if (verdict == PairVerdict::kBoth) break;
       if (verdict == PairVerdict::kFirstDominated) pending_[kept - 2] = pending_[kept - 1];
       --kept;

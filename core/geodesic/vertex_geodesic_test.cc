@@ -191,8 +191,7 @@ TEST(VertexGeodesicTest, FlatConvexDomainGivesEuclideanDistances) {
   const int32_t source = 317;
   ASSERT_TRUE(solver.Propagate({source}).ok());
   for (int32_t v = 0; v < grid.num_vertices(); ++v) {
-    EXPECT_NEAR(solver.VertexDistance(v), (grid.position(v) - grid.position(source)).norm(),
-                1e-12);
+    EXPECT_NEAR(solver.VertexDistance(v), (grid.position(v) - grid.position(source)).norm(), 1e-12);
   }
 }
 
@@ -267,7 +266,8 @@ TEST(VertexGeodesicTest, InitialDistancesGiveTheMinimumAndOnlyImproveLocally) {
           EXPECT_EQ(solver.NearestSource(v), mesh::kNone) << v;
         }
       }
-      for (int32_t v = 0; v < m.num_vertices(); ++v) reference[v] = std::min(reference[v], alone[v]);
+      for (int32_t v = 0; v < m.num_vertices(); ++v)
+        reference[v] = std::min(reference[v], alone[v]);
       field = solver.VertexDistances();
     }
     // Later sources only explore their own cells and a ring around them.
@@ -290,9 +290,8 @@ TEST(VertexGeodesicTest, InitialDistancesGiveTheMinimumAndOnlyImproveLocally) {
 // The new source improves x across the edge (u,w) while u and w keep their
 // (shorter) initial distances: the window must not wait forever for u or w.
 TEST(VertexGeodesicTest, InitialDistancesDoNotStopTheFrontAtUnimprovedEdges) {
-  const Mesh kite = *Mesh::Create(
-      {Vec3(-10, 0, 0), Vec3(10, 0, 0), Vec3(0, -1, 0), Vec3(0, 1, 0)}, {{0, 2, 1}, {1, 3, 0}},
-      "kite");
+  const Mesh kite = *Mesh::Create({Vec3(-10, 0, 0), Vec3(10, 0, 0), Vec3(0, -1, 0), Vec3(0, 1, 0)},
+                                  {{0, 2, 1}, {1, 3, 0}}, "kite");
   const double far = std::sqrt(101.0);
   const std::vector<double> initial = {0, 0, far, far};
   VertexGeodesicOptions options;

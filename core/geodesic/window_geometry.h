@@ -80,8 +80,8 @@ inline double RayThroughC(const HalfEdgeFrame& f, double sx, double sy) {
 
 // The rays through [b0,b1] (b1 <= xc, see RayThroughC) leave the face through
 // its edge A->C (A = Origin(h)); `child_length` is that edge's length.
-inline ChildWindow ChildAcrossAC(const HalfEdgeFrame& f, double child_length, double sx,
-                                 double sy, double xc, double b0, double b1) {
+inline ChildWindow ChildAcrossAC(const HalfEdgeFrame& f, double child_length, double sx, double sy,
+                                 double xc, double b0, double b1) {
   auto hit = [&](double b) {  // fraction along A->C hit by the ray through (b,0)
     if (b >= xc) return 1.0;
     const double den = f.cy * (b - sx) + f.cx * sy;
@@ -94,8 +94,8 @@ inline ChildWindow ChildAcrossAC(const HalfEdgeFrame& f, double child_length, do
 }
 
 // The rays through [b0,b1] (b0 >= xc) leave the face through its edge C->B.
-inline ChildWindow ChildAcrossCB(const HalfEdgeFrame& f, double child_length, double sx,
-                                 double sy, double xc, double b0, double b1) {
+inline ChildWindow ChildAcrossCB(const HalfEdgeFrame& f, double child_length, double sx, double sy,
+                                 double xc, double b0, double b1) {
   const double bx = f.length - f.cx, by = -f.cy;  // B - C
   auto hit = [&](double b) {                      // fraction along C->B
     if (b <= xc) return 0.0;
@@ -118,8 +118,8 @@ inline ChildWindow ChildAcrossCB(const HalfEdgeFrame& f, double child_length, do
 // checking the far end b1 suffices (B alike at b0). Where d(C) >= sigma the
 // set of points that C reaches sooner is convex (bounded by a hyperbola
 // branch round C), so both ends inside it put the whole interval inside.
-inline bool CornersReachSooner(const HalfEdgeFrame& f, double da, double db, double dc,
-                               double b0, double b1, double sx, double sy, double sigma) {
+inline bool CornersReachSooner(const HalfEdgeFrame& f, double da, double db, double dc, double b0,
+                               double b1, double sx, double sy, double sigma) {
   const double d0 = sigma + Hypot(b0 - sx, sy);
   const double d1 = sigma + Hypot(b1 - sx, sy);
   const double slack = kFilterSlack * std::max(d0, d1);

@@ -11,11 +11,16 @@
 // near pairs drawn on purpose. So is the time of one Path between random
 // interior points, traced (O(k)) and with an exact corridor of 8 steps.
 //
-//   query_bench [--index FILE.gdx]... [--pairs N]
+//   query_bench [--index FILE.gdx]... [--pairs N] [--accuracy-pairs N]
 //
 // Then, per index with its accuracy calibration, the refinement table: the
 // default mode, the pure O(1) mode, the default with error bounds and with
 // a tolerance of 0.005, on uniform pairs and on pairs at each scale.
+//
+// Then, per index with its calibration, the refined answers against the
+// exact engine (refinement_accuracy.h): per scale bin, vertex and interior
+// pairs, rate, error quantiles, bound coverage and the share answered
+// exactly; tolerances 0.005 and 0.001 on area-uniform pairs.
 //
 // Then the exponential map (core/query/internal/exp_map.h): the time of one map round
 // an interior point for radii of 3 L, 10 L and the whole mesh, in the default

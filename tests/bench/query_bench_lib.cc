@@ -16,6 +16,7 @@
 #include "core/query/internal/unfold_kernel.h"
 #include "tests/bench/bench_table.h"
 #include "tests/bench/bench_timing.h"
+#include "tests/bench/refinement_accuracy.h"
 
 namespace geodex::bench {
 namespace {
@@ -266,6 +267,8 @@ std::unique_ptr<CLI::App> QueryBenchFlags(QueryBenchOptions* options) {
   app->add_option("--index", options->indexes, "Index files to measure");
   app->add_option("--pairs", options->pairs, "Pairs per measurement");
   app->add_flag("--expmap-only", options->expmap_only, "Only the exponential map table");
+  app->add_option("--accuracy-pairs", options->accuracy_pairs,
+                  "Pairs per row of the table against the exact engine");
   return app;
 }
 
@@ -459,6 +462,12 @@ int RunQueryBench(const QueryBenchOptions& options) {
   std::printf("%s", RefinementHeader().c_str());
   for (size_t i = 0; i < loaded.size() && !options.expmap_only; ++i) {
     BenchRefinement(options.indexes[i], loaded[i], std::min(options.pairs, 200'000));
+  }
+  std::printf("%s", AccuracyHeader().c_str());
+  for (size_t i = 0; i < loaded.size() && !options.expmap_only; ++i) {
+    for (const AccuracyRow& row : MeasureRefinementAccuracy(loaded[i], options.accuracy_pairs)) {
+      std::printf("%s\n", AccuracyRowText(options.indexes[i], row).c_str());
+    }
   }
   std::printf("\nExponential map (5 interior centres)\n%s", ExpMapHeader().c_str());
   for (size_t i = 0; i < loaded.size(); ++i) BenchExpMap(options.indexes[i], loaded[i]);

@@ -22,6 +22,7 @@ struct QueryBenchOptions {
   std::vector<std::string> indexes;  // empty: a generated sphere
   int pairs = 1'000'000;             // pairs per measurement
   bool expmap_only = false;          // only the exponential map table
+  int accuracy_pairs = 1000;         // per row of the table against the exact engine
 };
 
 // The command line of query_bench, writing into `options` when parsed.

@@ -65,13 +65,14 @@ std::optional<double> LocalExact::NearDistance(const SurfacePoint& from, const S
 
 std::optional<double> LocalExact::ConfinedDistance(const SurfacePoint& from, const SurfacePoint& to,
                                                    std::span<const int32_t> seed_faces,
-                                                   QueryScratch& scratch) const {
+                                                   QueryScratch& scratch,
+                                                   double upper_bound) const {
   const mesh::Mesh* m = ExactMesh();
   if (m == nullptr) return std::nullopt;
   if (scratch.confined_ == nullptr || &scratch.confined_->mesh() != m) {
     scratch.confined_ = std::make_unique<geodesic::ConfinedGeodesicSolver>(*m);
   }
-  const absl::StatusOr<double> d = scratch.confined_->Distance(from, to, seed_faces);
+  const absl::StatusOr<double> d = scratch.confined_->Distance(from, to, seed_faces, upper_bound);
   if (!d.ok()) return std::nullopt;
   return *d;
 }

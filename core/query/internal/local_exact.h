@@ -46,10 +46,12 @@ class LocalExact {
   // its answer (core/geodesic/confined_geodesic.h): its cost follows the
   // region, not the mesh. `seed_faces`: the faces the region starts
   // from (e.g. a path's; empty: a shortest chain of faces between the
-  // points'). nullopt as NearDistance. `scratch` keeps the solver between calls.
+  // points'). `upper_bound`: the length of a surface path between them, if
+  // one is known (it focuses the propagation). nullopt as NearDistance. `scratch` keeps the solver
+  // between calls.
   std::optional<double> ConfinedDistance(const SurfacePoint& from, const SurfacePoint& to,
-                                         std::span<const int32_t> seed_faces,
-                                         QueryScratch& scratch) const;
+                                         std::span<const int32_t> seed_faces, QueryScratch& scratch,
+                                         double upper_bound = kInf) const;
 
   // Exact distances from a valid canonical point to every vertex within
   // `radius` (larger values or +inf beyond). The span lives in `scratch`

@@ -46,8 +46,9 @@ double Refiner::Refine(const SurfacePoint& p_in, const SurfacePoint& q_in, const
   // that stops at `to`.
   QueryScratch own;
   QueryScratch& solvers = scratch != nullptr ? *scratch : own;
-  auto exact = [&] {
-    std::optional<double> e = exact_.ConfinedDistance(from, to, {}, solvers);
+  // `path_length`: the length of a surface path between the points, if known.
+  auto exact = [&](double path_length = kInf) {
+    std::optional<double> e = exact_.ConfinedDistance(from, to, {}, solvers, path_length);
     if (!e) e = exact_.NearDistance(from, to, &solvers);
     if (!e) return false;
     d = *e;
@@ -75,7 +76,7 @@ double Refiner::Refine(const SurfacePoint& p_in, const SurfacePoint& q_in, const
     if (walk_) {
       const NearWalk walk = WalkNearPair(view_, from, to, plausible());
       if (walk.path) return take(*walk.path);
-      if (exact()) return true;
+      if (exact(walk.doubted.value_or(kInf))) return true;
     }
     const std::optional<NearPath> t = NearPathLength(view_, paths_, from, to, walk_, plausible());
     return t && take(*t);
