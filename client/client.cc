@@ -607,9 +607,9 @@ absl::StatusOr<VertexDistancesWithin> Client::DistanceFieldWithin(
     field.version = chunk.version();
   }
   if (std::ssize(field.vertices) != n) {
-    return absl::DataLossError(absl::StrFormat(
-        "the server sent %d of the field's %d vertices within the radius", field.vertices.size(),
-        n));
+    return absl::DataLossError(
+        absl::StrFormat("the server sent %d of the field's %d vertices within the radius",
+                        field.vertices.size(), n));
   }
   return field;
 }

@@ -565,18 +565,19 @@ TEST(ClientDistanceFieldWithin, BadRadiiAreRefusedBeforeAnyCall) {
 
 TEST(ClientDistanceFieldWithin, InconsistentChunksAreDataLoss) {
   const std::vector<std::vector<v1::DistanceFieldChunk>> bad = {
-      {SparseChunk(0, 3, {{2, 0.5, 0}, {7, 2.5, 1}})},                                // short
+      {SparseChunk(0, 3, {{2, 0.5, 0}, {7, 2.5, 1}})},                                  // short
       {SparseChunk(0, 3, {{2, 0.5, 0}, {7, 2.5, 1}}), SparseChunk(1, 3, {{9, 1, 0}})},  // overlap
-      {SparseChunk(0, 2, {{7, 0.5, 0}, {2, 2.5, 1}})},                                // order
+      {SparseChunk(0, 2, {{7, 0.5, 0}, {2, 2.5, 1}})},                                  // order
       {SparseChunk(0, 2, {{2, 0.5, 0}}), SparseChunk(1, 3, {{7, 1, 0}})},               // totals
   };
   for (const auto& chunks : bad) {
     auto mock = std::make_shared<MockGeodexConnection>();
     EXPECT_CALL(*mock, DistanceField).WillOnce(Return(chunks));
     Client client(mock);
-    EXPECT_EQ(
-        client.DistanceFieldWithin("torus", std::vector<SurfacePoint>(1), {.radius = 3}).status().code(),
-        absl::StatusCode::kDataLoss);
+    EXPECT_EQ(client.DistanceFieldWithin("torus", std::vector<SurfacePoint>(1), {.radius = 3})
+                  .status()
+                  .code(),
+              absl::StatusCode::kDataLoss);
   }
   // A server older than radius fields answers with the whole field.
   v1::DistanceFieldChunk whole;

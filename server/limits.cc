@@ -26,8 +26,8 @@ absl::Status CheckFieldSources(const ServiceLimits& limits, int64_t sources) {
 }
 
 absl::Status FieldVerticesExceeded(const ServiceLimits& limits, const absl::Status& status) {
-  return absl::ResourceExhaustedError(absl::StrFormat(
-      "%s, the limit (max_field_vertices)", status.message()));
+  return absl::ResourceExhaustedError(
+      absl::StrFormat("%s, the limit (max_field_vertices)", status.message()));
 }
 
 absl::Status CheckPathPairs(const ServiceLimits& limits, int64_t pairs) {

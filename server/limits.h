@@ -22,9 +22,9 @@ struct ServiceLimits {
   // propagation stops past them (a cost cap; the answer lists those within
   // the radius).
   int64_t max_field_vertices = 1'000'000;
-  int64_t max_path_pairs = 10'000;            // pairs of one Path call
-  int64_t max_locate_positions = 1'000'000;   // positions of one Locate call
-  int64_t max_message_bytes = 64 << 20;       // any received message (gRPC enforces it)
+  int64_t max_path_pairs = 10'000;           // pairs of one Path call
+  int64_t max_locate_positions = 1'000'000;  // positions of one Locate call
+  int64_t max_message_bytes = 64 << 20;      // any received message (gRPC enforces it)
   // Streaming calls running at once: StreamDistances, Matrix, DistanceField, GetMesh.
   int32_t max_concurrent_streams = 64;
   // Batches of one StreamDistances call read ahead of the answers written:

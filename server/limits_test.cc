@@ -44,8 +44,9 @@ TEST(LimitChecksTest, FieldVerticesNamesTheLimitAndModelsLowerIt) {
   ServiceLimits limits;
   limits.max_field_vertices = 1000;
   ExpectExhausted(
-      FieldVerticesExceeded(limits, absl::ResourceExhaustedError(
-                                        "the field within radius 2 reaches more than 1000 vertices")),
+      FieldVerticesExceeded(limits,
+                            absl::ResourceExhaustedError(
+                                "the field within radius 2 reaches more than 1000 vertices")),
       "the field within radius 2 reaches more than 1000 vertices, the limit (max_field_vertices)");
   ModelLimits model;
   model.set_max_field_vertices(10);

@@ -308,8 +308,8 @@ TEST_P(RpcTest, DistanceFieldWithinARadiusMatchesTheEngine) {
   }
   // Bad radii are refused with the value; a tiny one inside a face answers
   // one empty chunk that still carries the version.
-  for (const double radius : {-1.0, std::numeric_limits<double>::quiet_NaN(),
-                              std::numeric_limits<double>::infinity()}) {
+  for (const double radius :
+       {-1.0, std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::infinity()}) {
     v1::DistanceFieldRequest request;
     *request.mutable_model() = Ref("sphere");
     *request.mutable_sources() = ToProto(sources);

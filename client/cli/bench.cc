@@ -23,7 +23,9 @@ std::array<double, 3> UniformWeights(std::mt19937_64& rng) {
   return {1 - u - v, u, v};
 }
 
-Position Minus(const Position& a, const Position& b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
+Position Minus(const Position& a, const Position& b) {
+  return {a[0] - b[0], a[1] - b[1], a[2] - b[2]};
+}
 double Norm(const Position& a) { return std::sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]); }
 
 Position PointOf(const Mesh& mesh, const SurfacePoint& p) {
@@ -82,8 +84,8 @@ double ScaleLength(const Mesh& mesh, int64_t num_samples) {
   for (const auto& f : mesh.faces) {
     const Position u = Minus(mesh.positions[f[1]], mesh.positions[f[0]]);
     const Position v = Minus(mesh.positions[f[2]], mesh.positions[f[0]]);
-    area += 0.5 * Norm({u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2],
-                        u[0] * v[1] - u[1] * v[0]});
+    area += 0.5 *
+            Norm({u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]});
   }
   return area > 0 ? std::sqrt(2 * area / (std::sqrt(3.0) * num_samples)) : 0;
 }
@@ -261,23 +263,22 @@ absl::StatusOr<BenchReport> RunBench(const Client& client, const BenchOptions& o
     report.scale_length = ScaleLength(*mesh, info->num_samples);
     // Drawing walks the faces round each point: fewer pairs than the uniform
     // pool, used in turn.
-    pool = DrawNearPairs(*mesh, options.near_from * report.scale_length,
-                         options.near_to * report.scale_length,
-                         std::max<size_t>(4096, 4 * static_cast<size_t>(options.batch)),
-                         options.seed);
+    pool = DrawNearPairs(
+        *mesh, options.near_from * report.scale_length, options.near_to * report.scale_length,
+        std::max<size_t>(4096, 4 * static_cast<size_t>(options.batch)), options.seed);
     if (pool.empty()) {
-      return absl::FailedPreconditionError(absl::StrFormat(
-          "model %s: no pairs %gL to %gL apart (L = %g)", info->name, options.near_from,
-          options.near_to, report.scale_length));
+      return absl::FailedPreconditionError(
+          absl::StrFormat("model %s: no pairs %gL to %gL apart (L = %g)", info->name,
+                          options.near_from, options.near_to, report.scale_length));
     }
     // Every batch is a slice of the pool.
     for (size_t i = 0; pool.size() < static_cast<size_t>(options.batch); ++i) {
       pool.push_back(pool[i]);
     }
   } else {
-    pool = RandomPairs(info->num_faces,
-                       std::max<size_t>(65536, 4 * static_cast<size_t>(options.batch)),
-                       options.seed);
+    pool =
+        RandomPairs(info->num_faces,
+                    std::max<size_t>(65536, 4 * static_cast<size_t>(options.batch)), options.seed);
   }
 
   std::vector<WorkerStats> stats(options.concurrency);

@@ -506,8 +506,7 @@ TEST(InputQueriesTest, FieldWithinIsTheExactFieldInsideTheRadius) {
       previous = field->vertices.size();
       if (radius < 2 * L) EXPECT_LT(field->vertices.size(), torus.num_vertices() / 4u);
       if (sources.size() == 2) {
-        EXPECT_NE(std::find(field->nearest.begin(), field->nearest.end(), 1),
-                  field->nearest.end());
+        EXPECT_NE(std::find(field->nearest.begin(), field->nearest.end(), 1), field->nearest.end());
       }
     }
     EXPECT_EQ(previous, static_cast<size_t>(torus.num_vertices()));  // r = 100: all of it

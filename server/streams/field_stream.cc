@@ -61,9 +61,8 @@ class FieldStream final : public ChunkedWriteStream<v1::DistanceFieldChunk> {
   const v1::DistanceFieldChunk* TakeNextLocked() override {
     const int64_t count = std::min(chunk_vertices_, size() - next_vertex_);
     if (within_radius()) {
-      RadiusFieldChunkToProto(radius_field_, next_vertex_, count,
-                              request_->with_nearest_source(), model_.version->version(),
-                              &chunk_);
+      RadiusFieldChunkToProto(radius_field_, next_vertex_, count, request_->with_nearest_source(),
+                              model_.version->version(), &chunk_);
     } else {
       FieldChunkToProto(field_, next_vertex_, count, request_->with_nearest_source(),
                         model_.version->version(), &chunk_);

@@ -513,8 +513,7 @@ int RunQueryBench(const QueryBenchOptions& options) {
     for (size_t i = 0; i < loaded.size(); ++i) BenchExpMap(options.indexes[i], loaded[i]);
   }
   if (!options.expmap_only) {
-    std::printf("\nDistance fields (5 interior sources, one at a time)\n%s",
-                FieldHeader().c_str());
+    std::printf("\nDistance fields (5 interior sources, one at a time)\n%s", FieldHeader().c_str());
     for (size_t i = 0; i < loaded.size(); ++i) BenchField(options.indexes[i], loaded[i]);
   }
   return 0;

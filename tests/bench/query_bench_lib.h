@@ -112,9 +112,9 @@ std::string ExpMapRow(const std::string& label, const ExpMapFigures& f);
 
 // One row of the distance field table: one radius.
 struct FieldFigures {
-  std::string field;      // "3 L", "10 L", "whole mesh, O(1)", "whole mesh, exact"
-  double per_field = 0;   // vertices in the field, mean over the sources
-  double us = 0;          // one field, microseconds
+  std::string field;     // "3 L", "10 L", "whole mesh, O(1)", "whole mesh, exact"
+  double per_field = 0;  // vertices in the field, mean over the sources
+  double us = 0;         // one field, microseconds
 };
 
 // Measures and prints the distance field rows of `ix`: fields of one source

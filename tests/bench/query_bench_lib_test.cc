@@ -199,8 +199,8 @@ TEST(QueryBenchRunTest, PrintsFourTables) {
   }
   // Header and rule, one row; header and rule, uniform and four bins;
   // header and rule, three radii; header and rule, four fields.
-  EXPECT_EQ(widths, (std::vector<int>{14, 14, 14, 11, 11, 11, 11, 11, 11, 11, 6, 6, 6, 6, 6, 5, 5,
-                                      5, 5, 5, 5}));
+  EXPECT_EQ(widths, (std::vector<int>{14, 14, 14, 11, 11, 11, 11, 11, 11, 11, 6,
+                                      6,  6,  6,  6,  5,  5,  5,  5,  5,  5}));
   EXPECT_THAT(out, HasSubstr("\nExponential map (5 interior centres)\n"));
   EXPECT_THAT(out, HasSubstr("\nDistance fields (5 interior sources, one at a time)\n"));
   EXPECT_THAT(out, HasSubstr("| whole mesh, exact | 642 |"));

@@ -34,7 +34,8 @@ absl::Status Bench(BenchFlags flags) {
   flags.options.duration = absl::Seconds(flags.duration_s);
   flags.options.warmup = absl::Seconds(flags.warmup_s);
   std::string out;
-  for (const BenchOptions::Pairs kind : {BenchOptions::Pairs::kUniform, BenchOptions::Pairs::kNear}) {
+  for (const BenchOptions::Pairs kind :
+       {BenchOptions::Pairs::kUniform, BenchOptions::Pairs::kNear}) {
     if (flags.pairs != "both" && (flags.pairs == "near") != (kind == BenchOptions::Pairs::kNear)) {
       continue;
     }

@@ -41,8 +41,7 @@ struct FieldFlags {
 // version that answered the field, so that a model reloaded between the two
 // calls cannot pair one version's distances with another's mesh.
 absl::StatusOr<Mesh> MeshOfField(const Client& client, const ModelFlags& model,
-                                 int64_t field_version, size_t field_vertices,
-                                 bool within_radius) {
+                                 int64_t field_version, size_t field_vertices, bool within_radius) {
   const int64_t version = field_version != 0 ? field_version : model.version;
   absl::StatusOr<Mesh> mesh = client.GetMesh(ModelRef(model.name, version));
   if (!mesh.ok()) {
@@ -85,9 +84,9 @@ absl::Status Field(const FieldFlags& flags) {
       return InputError(absl::InvalidArgumentError(
           absl::StrFormat("--radius must be finite and > 0, got %g", flags.radius)));
     }
-    absl::StatusOr<VertexDistancesWithin> field = client->DistanceFieldWithin(
-        flags.model.ref(), *sources,
-        {.radius = flags.radius, .with_nearest_source = flags.nearest});
+    absl::StatusOr<VertexDistancesWithin> field =
+        client->DistanceFieldWithin(flags.model.ref(), *sources,
+                                    {.radius = flags.radius, .with_nearest_source = flags.nearest});
     if (!field.ok()) return field.status();
     if (!ply) return WriteFileOrStdout(flags.out, FieldWithinToText(*field));
     const size_t reached = field->vertices.empty() ? 0 : field->vertices.back() + size_t{1};
