@@ -61,9 +61,10 @@ absl::Status CheckPairsPerMessage(const ServiceLimits& limits, int64_t pairs);
 absl::Status CheckMatrixCells(const ServiceLimits& limits, int64_t sources, int64_t targets);
 // `sources` of one DistanceField call.
 absl::Status CheckFieldSources(const ServiceLimits& limits, int64_t sources);
-// The error of a DistanceField call whose field within `radius` reached
+// The error of a DistanceField call whose field within a radius reached
 // more vertices than max_field_vertices (the query stops there and says so
-// with ResourceExhausted, `status`): its message with the limit's name
+// with ResourceExhausted, `status`, its only use of that code): its message
+// with the limit's name
 // ("the field within radius 2 reaches more than 1000 vertices, the limit
 // (max_field_vertices)").
 absl::Status FieldVerticesExceeded(const ServiceLimits& limits, const absl::Status& status);

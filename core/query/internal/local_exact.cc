@@ -101,6 +101,9 @@ absl::StatusOr<RadiusField> LocalExact::DistancesWithin(std::span<const SurfaceP
       return absl::ResourceExhaustedError(absl::StrFormat(
           "the field within radius %g reaches more than %d vertices", radius, max_vertices));
     }
+    // The solver's window budget: a safety net against pathological meshes,
+    // not a limit of the request (ResourceExhausted stays the vertex cap's).
+    if (absl::IsResourceExhausted(status)) return absl::InternalError(status.message());
     return status;
   }
   // Vertices past the radius were reached too, with upper bounds: within it,

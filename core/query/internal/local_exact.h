@@ -55,7 +55,9 @@ class LocalExact {
   // are read from the list of those it reached. Errors: InvalidArgument for a
   // radius that is not finite and > 0 or no source; ResourceExhausted when
   // `max_vertices` > 0 and the propagation reaches more vertices (it stops
-  // there); Internal when the index's mesh cannot be rebuilt.
+  // there); Internal when the index's mesh cannot be rebuilt or the
+  // propagation exceeds the solver's window budget (GeodesicOptions::
+  // max_windows, a safety net against pathological meshes).
   absl::StatusOr<RadiusField> DistancesWithin(std::span<const SurfacePoint> sources, double radius,
                                               int64_t max_vertices, QueryScratch& scratch) const;
 
