@@ -554,6 +554,66 @@ absl::StatusOr<VertexDistances> Client::DistanceField(const ModelRef& model,
   return field;
 }
 
+absl::StatusOr<VertexDistancesWithin> Client::DistanceFieldWithin(
+    const ModelRef& model, absl::Span<const SurfacePoint> sources,
+    const FieldWithinQuery& query) const {
+  if (absl::Status s = CheckModel(model); !s.ok()) return s;
+  if (!(std::isfinite(query.radius) && query.radius > 0)) {
+    return absl::InvalidArgumentError(
+        absl::StrFormat("the radius must be finite and > 0, got %g", query.radius));
+  }
+  v1::DistanceFieldRequest request;
+  *request.mutable_model() = ToProto(model);
+  *request.mutable_sources() = ToProto(sources);
+  request.set_with_nearest_source(query.with_nearest_source);
+  request.set_radius(query.radius);
+  absl::StatusOr<std::vector<v1::DistanceFieldChunk>> chunks = connection_->DistanceField(request);
+  if (!chunks.ok()) return chunks.status();
+
+  VertexDistancesWithin field;
+  const int64_t n = chunks->empty() ? 0 : chunks->front().num_vertices();
+  for (const v1::DistanceFieldChunk& chunk : *chunks) {
+    const int size = chunk.distances_size();
+    if (chunk.vertices_size() != size) {
+      return absl::DataLossError(absl::StrFormat(
+          "the server sent a distance field chunk of %d distances for %d vertices%s", size,
+          chunk.vertices_size(),
+          chunk.vertices_size() == 0 ? " (a whole-mesh field: the server predates radius fields)"
+                                     : ""));
+    }
+    if (chunk.num_vertices() != n || chunk.vertex_offset() != std::ssize(field.vertices) ||
+        std::ssize(field.vertices) + size > n ||
+        (query.with_nearest_source && chunk.nearest_source_size() != size)) {
+      return absl::DataLossError(absl::StrFormat(
+          "the server sent a chunk of entries [%d, %d) of %d (%d nearest sources), after %d, for a "
+          "field of %d vertices within the radius",
+          chunk.vertex_offset(), chunk.vertex_offset() + size, chunk.num_vertices(),
+          chunk.nearest_source_size(), field.vertices.size(), n));
+    }
+    for (int i = 0; i < size; ++i) {
+      if (!field.vertices.empty() && chunk.vertices(i) <= field.vertices.back()) {
+        return absl::DataLossError(
+            absl::StrFormat("the server sent field vertices out of order (%d after %d)",
+                            chunk.vertices(i), field.vertices.back()));
+      }
+      field.vertices.push_back(chunk.vertices(i));
+    }
+    field.distances.insert(field.distances.end(), chunk.distances().begin(),
+                           chunk.distances().end());
+    if (query.with_nearest_source) {
+      field.nearest_source.insert(field.nearest_source.end(), chunk.nearest_source().begin(),
+                                  chunk.nearest_source().end());
+    }
+    field.version = chunk.version();
+  }
+  if (std::ssize(field.vertices) != n) {
+    return absl::DataLossError(
+        absl::StrFormat("the server sent %d of the field's %d vertices within the radius",
+                        field.vertices.size(), n));
+  }
+  return field;
+}
+
 absl::StatusOr<client::ExpMap> Client::ExpMap(const ModelRef& model, const SurfacePoint& center,
                                               const ExpMapQuery& query) const {
   if (absl::Status s = CheckModel(model); !s.ok()) return s;

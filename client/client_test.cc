@@ -1,8 +1,10 @@
 #include "geodex/client/client.h"
 
+#include <array>
 #include <atomic>
 #include <deque>
 #include <functional>
+#include <limits>
 #include <thread>
 
 #include "absl/synchronization/mutex.h"
@@ -510,6 +512,85 @@ TEST(ClientDistanceField, GapIsDataLoss) {
   Client client(mock);
   EXPECT_EQ(client.DistanceField("torus", std::vector<SurfacePoint>(1)).status().code(),
             absl::StatusCode::kDataLoss);
+}
+
+// A chunk of a field within a radius: entries (vertex, distance, nearest
+// source) from `offset` of an answer of `total` entries.
+v1::DistanceFieldChunk SparseChunk(int64_t offset, int64_t total,
+                                   std::vector<std::array<double, 3>> entries) {
+  v1::DistanceFieldChunk chunk;
+  chunk.set_vertex_offset(offset);
+  chunk.set_num_vertices(total);
+  chunk.set_version(4);
+  for (const auto& [vertex, distance, nearest] : entries) {
+    chunk.add_vertices(static_cast<int32_t>(vertex));
+    chunk.add_distances(distance);
+    chunk.add_nearest_source(static_cast<int32_t>(nearest));
+  }
+  return chunk;
+}
+
+TEST(ClientDistanceFieldWithin, SendsTheRadiusAndAssemblesTheChunks) {
+  auto mock = std::make_shared<MockGeodexConnection>();
+  EXPECT_CALL(*mock, DistanceField).WillOnce([](const v1::DistanceFieldRequest& r) {
+    EXPECT_EQ(r.radius(), 2.5);
+    EXPECT_TRUE(r.with_nearest_source());
+    EXPECT_EQ(r.sources().faces_size(), 2);
+    return std::vector<v1::DistanceFieldChunk>{SparseChunk(0, 3, {{2, 0.5, 0}, {7, 2.5, 1}}),
+                                               SparseChunk(2, 3, {{11, 1, 1}})};
+  });
+  Client client(mock);
+  absl::StatusOr<VertexDistancesWithin> field = client.DistanceFieldWithin(
+      "torus", std::vector<SurfacePoint>(2), {.radius = 2.5, .with_nearest_source = true});
+  ASSERT_TRUE(field.ok()) << field.status();
+  EXPECT_THAT(field->vertices, ElementsAre(2, 7, 11));
+  EXPECT_THAT(field->distances, ElementsAre(0.5, 2.5, 1));
+  EXPECT_THAT(field->nearest_source, ElementsAre(0, 1, 1));
+  EXPECT_EQ(field->version, 4);
+}
+
+TEST(ClientDistanceFieldWithin, BadRadiiAreRefusedBeforeAnyCall) {
+  auto mock = std::make_shared<MockGeodexConnection>();
+  EXPECT_CALL(*mock, DistanceField).Times(0);
+  Client client(mock);
+  for (double radius : {0.0, -1.0, std::numeric_limits<double>::quiet_NaN(),
+                        std::numeric_limits<double>::infinity()}) {
+    const absl::Status s =
+        client.DistanceFieldWithin("torus", std::vector<SurfacePoint>(1), {.radius = radius})
+            .status();
+    EXPECT_EQ(s.code(), absl::StatusCode::kInvalidArgument) << radius;
+    EXPECT_THAT(s.message(), HasSubstr("radius must be finite and > 0"));
+  }
+}
+
+TEST(ClientDistanceFieldWithin, InconsistentChunksAreDataLoss) {
+  const std::vector<std::vector<v1::DistanceFieldChunk>> bad = {
+      {SparseChunk(0, 3, {{2, 0.5, 0}, {7, 2.5, 1}})},                                  // short
+      {SparseChunk(0, 3, {{2, 0.5, 0}, {7, 2.5, 1}}), SparseChunk(1, 3, {{9, 1, 0}})},  // overlap
+      {SparseChunk(0, 2, {{7, 0.5, 0}, {2, 2.5, 1}})},                                  // order
+      {SparseChunk(0, 2, {{2, 0.5, 0}}), SparseChunk(1, 3, {{7, 1, 0}})},               // totals
+  };
+  for (const auto& chunks : bad) {
+    auto mock = std::make_shared<MockGeodexConnection>();
+    EXPECT_CALL(*mock, DistanceField).WillOnce(Return(chunks));
+    Client client(mock);
+    EXPECT_EQ(client.DistanceFieldWithin("torus", std::vector<SurfacePoint>(1), {.radius = 3})
+                  .status()
+                  .code(),
+              absl::StatusCode::kDataLoss);
+  }
+  // A server older than radius fields answers with the whole field.
+  v1::DistanceFieldChunk whole;
+  whole.set_num_vertices(2);
+  whole.add_distances(0);
+  whole.add_distances(1);
+  auto mock = std::make_shared<MockGeodexConnection>();
+  EXPECT_CALL(*mock, DistanceField).WillOnce(Return(std::vector<v1::DistanceFieldChunk>{whole}));
+  Client client(mock);
+  const absl::Status s =
+      client.DistanceFieldWithin("torus", std::vector<SurfacePoint>(1), {.radius = 3}).status();
+  EXPECT_EQ(s.code(), absl::StatusCode::kDataLoss);
+  EXPECT_THAT(s.message(), HasSubstr("predates radius fields"));
 }
 
 // A mesh of 4 vertices (vertex v at (v, 10 v, 100 v)) and 3 faces in two

@@ -126,6 +126,24 @@ void FieldChunkToProto(const query::DistanceField& field, int64_t offset, int64_
   }
 }
 
+void RadiusFieldChunkToProto(const query::RadiusField& field, int64_t offset, int64_t count,
+                             bool with_nearest_source, int64_t version,
+                             v1::DistanceFieldChunk* chunk) {
+  chunk->set_vertex_offset(offset);
+  chunk->set_num_vertices(static_cast<int64_t>(field.vertices.size()));
+  chunk->set_version(version);
+  chunk->mutable_vertices()->Assign(field.vertices.begin() + offset,
+                                    field.vertices.begin() + offset + count);
+  chunk->mutable_distances()->Assign(field.distance.begin() + offset,
+                                     field.distance.begin() + offset + count);
+  if (with_nearest_source) {
+    chunk->mutable_nearest_source()->Assign(field.nearest.begin() + offset,
+                                            field.nearest.begin() + offset + count);
+  } else {
+    chunk->clear_nearest_source();
+  }
+}
+
 void ExpMapChunkToProto(std::span<const query::ExpMapVertex> map, int64_t offset, int64_t count,
                         int64_t version, v1::ExpMapChunk* chunk) {
   chunk->Clear();

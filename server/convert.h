@@ -88,6 +88,13 @@ void MatrixBlockToProto(int64_t row_offset, int64_t rows, int64_t num_targets,
 void FieldChunkToProto(const query::DistanceField& field, int64_t offset, int64_t count,
                        bool with_nearest_source, int64_t version, v1::DistanceFieldChunk* chunk);
 
+// Entries [offset, offset + count) of a field within a radius (in input ids:
+// InputQueries::FieldWithin), in the sparse form: vertices aligned with
+// distances, vertex_offset = offset, num_vertices the answer's entries.
+void RadiusFieldChunkToProto(const query::RadiusField& field, int64_t offset, int64_t count,
+                             bool with_nearest_source, int64_t version,
+                             v1::DistanceFieldChunk* chunk);
+
 // Entries [offset, offset + count) of an exponential map (in input ids:
 // InputQueries::ExpMap).
 void ExpMapChunkToProto(std::span<const query::ExpMapVertex> map, int64_t offset, int64_t count,

@@ -25,6 +25,11 @@ absl::Status CheckFieldSources(const ServiceLimits& limits, int64_t sources) {
       "%d sources exceed the limit of %d (max_field_sources)", sources, limits.max_field_sources));
 }
 
+absl::Status FieldVerticesExceeded(const ServiceLimits& limits, const absl::Status& status) {
+  return absl::ResourceExhaustedError(
+      absl::StrFormat("%s, the limit (max_field_vertices)", status.message()));
+}
+
 absl::Status CheckPathPairs(const ServiceLimits& limits, int64_t pairs) {
   if (pairs <= limits.max_path_pairs) return absl::OkStatus();
   return absl::ResourceExhaustedError(

@@ -18,9 +18,13 @@ struct ServiceLimits {
   int64_t max_pairs_per_message = 1'000'000;  // Distance, each StreamDistances batch
   int64_t max_matrix_cells = 50'000'000;      // sources x targets of one Matrix call
   int64_t max_field_sources = 10'000;         // sources of one DistanceField call
-  int64_t max_path_pairs = 10'000;            // pairs of one Path call
-  int64_t max_locate_positions = 1'000'000;   // positions of one Locate call
-  int64_t max_message_bytes = 64 << 20;       // any received message (gRPC enforces it)
+  // Vertices one DistanceField call with a radius may reach: its exact
+  // propagation stops past them (a cost cap; the answer lists those within
+  // the radius).
+  int64_t max_field_vertices = 1'000'000;
+  int64_t max_path_pairs = 10'000;           // pairs of one Path call
+  int64_t max_locate_positions = 1'000'000;  // positions of one Locate call
+  int64_t max_message_bytes = 64 << 20;      // any received message (gRPC enforces it)
   // Streaming calls running at once: StreamDistances, Matrix, DistanceField, GetMesh.
   int32_t max_concurrent_streams = 64;
   // Batches of one StreamDistances call read ahead of the answers written:
@@ -41,6 +45,7 @@ inline ServiceLimits WithModelLimits(ServiceLimits server, const ModelLimits& mo
   lower(&server.max_pairs_per_message, model.max_pairs_per_message());
   lower(&server.max_matrix_cells, model.max_matrix_cells());
   lower(&server.max_field_sources, model.max_field_sources());
+  lower(&server.max_field_vertices, model.max_field_vertices());
   lower(&server.max_path_pairs, model.max_path_pairs());
   lower(&server.max_locate_positions, model.max_locate_positions());
   return server;
@@ -56,6 +61,13 @@ absl::Status CheckPairsPerMessage(const ServiceLimits& limits, int64_t pairs);
 absl::Status CheckMatrixCells(const ServiceLimits& limits, int64_t sources, int64_t targets);
 // `sources` of one DistanceField call.
 absl::Status CheckFieldSources(const ServiceLimits& limits, int64_t sources);
+// The error of a DistanceField call whose field within a radius reached
+// more vertices than max_field_vertices (the query stops there and says so
+// with ResourceExhausted, `status`, its only use of that code): its message
+// with the limit's name
+// ("the field within radius 2 reaches more than 1000 vertices, the limit
+// (max_field_vertices)").
+absl::Status FieldVerticesExceeded(const ServiceLimits& limits, const absl::Status& status);
 // `pairs` of one Path call.
 absl::Status CheckPathPairs(const ServiceLimits& limits, int64_t pairs);
 // `positions` of one Locate call.

@@ -40,6 +40,21 @@ TEST(LimitChecksTest, EachLimitHoldsAtItsValueAndFailsOneBeyond) {
                   "2 streaming calls already running (max_concurrent_streams)");
 }
 
+TEST(LimitChecksTest, FieldVerticesNamesTheLimitAndModelsLowerIt) {
+  ServiceLimits limits;
+  limits.max_field_vertices = 1000;
+  ExpectExhausted(
+      FieldVerticesExceeded(limits,
+                            absl::ResourceExhaustedError(
+                                "the field within radius 2 reaches more than 1000 vertices")),
+      "the field within radius 2 reaches more than 1000 vertices, the limit (max_field_vertices)");
+  ModelLimits model;
+  model.set_max_field_vertices(10);
+  EXPECT_EQ(WithModelLimits(limits, model).max_field_vertices, 10);
+  model.set_max_field_vertices(5000);  // a model only lowers the server's
+  EXPECT_EQ(WithModelLimits(limits, model).max_field_vertices, 1000);
+}
+
 TEST(LimitChecksTest, MatrixCellsWithoutOverflow) {
   ServiceLimits limits;
   limits.max_matrix_cells = 100;

@@ -79,6 +79,7 @@ absl::StatusOr<ModelConfig> ParseModelConfig(std::string_view text, std::string_
       {"limits.max_field_sources", l.max_field_sources()},
       {"limits.max_path_pairs", l.max_path_pairs()},
       {"limits.max_locate_positions", l.max_locate_positions()},
+      {"limits.max_field_vertices", l.max_field_vertices()},
   };
   for (const auto& [field, value] : checks) {
     if (value < 0) {

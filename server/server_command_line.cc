@@ -64,6 +64,9 @@ void ServerCommandLine::AddLimitOptions() {
       ->check(kPositive);
   app_.add_option("--max-field-sources", limits.max_field_sources, "Sources per DistanceField call")
       ->check(kPositive);
+  app_.add_option("--max-field-vertices", limits.max_field_vertices,
+                  "Vertices a DistanceField call with a radius may reach")
+      ->check(kPositive);
   app_.add_option("--max-path-pairs", limits.max_path_pairs, "Pairs per Path call")
       ->check(kPositive);
   app_.add_option("--max-locate", limits.max_locate_positions, "Positions per Locate call")

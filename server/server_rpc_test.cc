@@ -325,6 +325,20 @@ TEST_P(RpcTest, OversizedRequestsAreResourceExhausted) {
     EXPECT_EQ(s.error_code(), grpc::StatusCode::RESOURCE_EXHAUSTED);
     EXPECT_THAT(s.error_message(), HasSubstr("max_field_sources"));
   }
+  {  // vertices a field within a radius reaches: the whole sphere > 300
+    v1::DistanceFieldRequest request;
+    *request.mutable_model() = Ref("sphere");
+    *request.mutable_sources() = ToProto(testing::RandomPoints(faces, 2, 1));
+    request.set_radius(10);
+    auto context = Context();
+    auto reader = stub_->DistanceField(context.get(), request);
+    v1::DistanceFieldChunk chunk;
+    EXPECT_FALSE(reader->Read(&chunk));
+    s = reader->Finish();
+    EXPECT_EQ(s.error_code(), grpc::StatusCode::RESOURCE_EXHAUSTED);
+    EXPECT_THAT(s.error_message(), HasSubstr("more than 300 vertices"));
+    EXPECT_THAT(s.error_message(), HasSubstr("max_field_vertices"));
+  }
   {  // path pairs
     v1::PathRequest request;
     *request.mutable_model() = Ref("sphere");

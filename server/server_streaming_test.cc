@@ -6,6 +6,7 @@
 #include <atomic>
 #include <chrono>
 #include <cstdio>
+#include <limits>
 #include <string>
 #include <thread>
 #include <vector>
@@ -263,6 +264,78 @@ TEST_P(RpcTest, DistanceFieldMatchesTheEngine) {
   }
   ASSERT_TRUE(reader->Finish().ok());
   EXPECT_EQ(next, sphere_->index().num_vertices());
+}
+
+// With a radius: the sparse form, the engine's exact field within it (the
+// sphere's index needed no repair: input ids are internal ids).
+TEST_P(RpcTest, DistanceFieldWithinARadiusMatchesTheEngine) {
+  const int32_t faces = sphere_->index().num_faces();
+  const auto sources = testing::RandomPoints(faces, 2, 22);
+  for (const bool nearest : {false, true}) {
+    v1::DistanceFieldRequest request;
+    *request.mutable_model() = Ref("sphere");
+    *request.mutable_sources() = ToProto(sources);
+    request.set_with_nearest_source(nearest);
+    request.set_radius(0.6);
+    auto context = Context();
+    auto reader = stub_->DistanceField(context.get(), request);
+    query::QueryScratch scratch;
+    auto field = sphere_->FieldWithin(sources, {.radius = 0.6}, scratch);
+    ASSERT_TRUE(field.ok()) << field.status();
+    ASSERT_FALSE(field->vertices.empty());
+    ASSERT_LT(field->vertices.size(), 300u);  // under the test server's max_field_vertices
+    v1::DistanceFieldChunk chunk;
+    int64_t next = 0;
+    int chunks = 0;
+    while (reader->Read(&chunk)) {
+      ++chunks;
+      EXPECT_EQ(chunk.vertex_offset(), next);
+      EXPECT_EQ(chunk.num_vertices(), static_cast<int64_t>(field->vertices.size()));
+      EXPECT_EQ(chunk.version(), 1);
+      ASSERT_EQ(chunk.vertices_size(), chunk.distances_size());
+      ASSERT_EQ(chunk.nearest_source_size(), nearest ? chunk.distances_size() : 0);
+      for (int i = 0; i < chunk.distances_size(); ++i) {
+        EXPECT_EQ(chunk.vertices(i), field->vertices[next + i]);
+        EXPECT_EQ(chunk.distances(i), field->distance[next + i]);
+        EXPECT_LE(chunk.distances(i), 0.6);
+        if (nearest) EXPECT_EQ(chunk.nearest_source(i), field->nearest[next + i]);
+      }
+      next += chunk.distances_size();
+    }
+    ASSERT_TRUE(reader->Finish().ok());
+    EXPECT_EQ(chunks, 1);
+    EXPECT_EQ(next, static_cast<int64_t>(field->vertices.size()));
+  }
+  // Bad radii are refused with the value; a tiny one inside a face answers
+  // one empty chunk that still carries the version.
+  for (const double radius :
+       {-1.0, std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::infinity()}) {
+    v1::DistanceFieldRequest request;
+    *request.mutable_model() = Ref("sphere");
+    *request.mutable_sources() = ToProto(sources);
+    request.set_radius(radius);
+    auto context = Context();
+    auto reader = stub_->DistanceField(context.get(), request);
+    v1::DistanceFieldChunk chunk;
+    EXPECT_FALSE(reader->Read(&chunk));
+    const grpc::Status s = reader->Finish();
+    EXPECT_EQ(s.error_code(), grpc::StatusCode::INVALID_ARGUMENT) << radius;
+    EXPECT_THAT(s.error_message(), HasSubstr("radius must be finite and > 0, got"));
+  }
+  v1::DistanceFieldRequest request;
+  *request.mutable_model() = Ref("sphere");
+  *request.mutable_sources() = ToProto(std::vector<mesh::SurfacePoint>{{0, {0.3, 0.3, 0.4}}});
+  request.set_radius(1e-6);
+  auto context = Context();
+  auto reader = stub_->DistanceField(context.get(), request);
+  std::vector<v1::DistanceFieldChunk> chunks;
+  v1::DistanceFieldChunk chunk;
+  while (reader->Read(&chunk)) chunks.push_back(chunk);
+  ASSERT_TRUE(reader->Finish().ok());
+  ASSERT_EQ(chunks.size(), 1u);
+  EXPECT_EQ(chunks[0].num_vertices(), 0);
+  EXPECT_EQ(chunks[0].distances_size(), 0);
+  EXPECT_EQ(chunks[0].version(), 1);
 }
 
 TEST_P(RpcTest, GetMeshIsTheIndexMesh) {

@@ -125,6 +125,7 @@ void RpcTest::SetUp() {
     o.limits.max_pairs_per_message = 5000;
     o.limits.max_matrix_cells = 100000;
     o.limits.max_field_sources = 16;
+    o.limits.max_field_vertices = 300;
     o.limits.max_path_pairs = 50;
     o.limits.max_locate_positions = 100;
     o.limits.max_message_bytes = 1 << 20;

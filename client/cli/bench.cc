@@ -1,7 +1,9 @@
 #include "client/cli/bench.h"
 
 #include <algorithm>
+#include <array>
 #include <atomic>
+#include <cmath>
 #include <random>
 #include <thread>
 #include <vector>
@@ -13,20 +15,135 @@
 namespace geodex::client::cli {
 namespace {
 
-// Uniformly random points: a random face, weights uniform on the triangle.
+// Weights uniform on the triangle.
+std::array<double, 3> UniformWeights(std::mt19937_64& rng) {
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  double u = unit(rng), v = unit(rng);
+  if (u + v > 1) u = 1 - u, v = 1 - v;
+  return {1 - u - v, u, v};
+}
+
+Position Minus(const Position& a, const Position& b) {
+  return {a[0] - b[0], a[1] - b[1], a[2] - b[2]};
+}
+double Norm(const Position& a) { return std::sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]); }
+
+Position PointOf(const Mesh& mesh, const SurfacePoint& p) {
+  Position x = {0, 0, 0};
+  for (int k = 0; k < 3; ++k) {
+    const Position& v = mesh.positions[mesh.faces[p.face][k]];
+    for (int c = 0; c < 3; ++c) x[c] += p.w[k] * v[c];
+  }
+  return x;
+}
+
+// Faces sharing an edge with each face (any number round an edge).
+std::vector<std::vector<int32_t>> FaceNeighbours(const Mesh& mesh) {
+  std::vector<std::pair<uint64_t, int32_t>> edges;
+  edges.reserve(3 * mesh.faces.size());
+  for (size_t f = 0; f < mesh.faces.size(); ++f) {
+    for (int k = 0; k < 3; ++k) {
+      const uint64_t a = mesh.faces[f][k], b = mesh.faces[f][(k + 1) % 3];
+      edges.push_back({std::min(a, b) << 32 | std::max(a, b), static_cast<int32_t>(f)});
+    }
+  }
+  std::sort(edges.begin(), edges.end());
+  std::vector<std::vector<int32_t>> neighbours(mesh.faces.size());
+  for (size_t i = 0; i < edges.size();) {
+    size_t j = i;
+    while (j < edges.size() && edges[j].first == edges[i].first) ++j;
+    for (size_t x = i; x < j; ++x) {
+      for (size_t y = i; y < j; ++y) {
+        if (edges[x].second != edges[y].second) {
+          neighbours[edges[x].second].push_back(edges[y].second);
+        }
+      }
+    }
+    i = j;
+  }
+  return neighbours;
+}
+
+}  // namespace
+
 std::vector<PointPair> RandomPairs(int64_t num_faces, size_t count, uint64_t seed) {
   std::mt19937_64 rng(seed);
   std::uniform_int_distribution<int32_t> face(0, static_cast<int32_t>(num_faces - 1));
-  std::uniform_real_distribution<double> unit(0.0, 1.0);
   auto point = [&] {
-    double u = unit(rng), v = unit(rng);
-    if (u + v > 1) u = 1 - u, v = 1 - v;
-    return SurfacePoint{face(rng), {1 - u - v, u, v}};
+    const int32_t f = face(rng);
+    return SurfacePoint{f, UniformWeights(rng)};
   };
   std::vector<PointPair> pairs(count);
   for (PointPair& p : pairs) p = {point(), point()};
   return pairs;
 }
+
+double ScaleLength(const Mesh& mesh, int64_t num_samples) {
+  if (num_samples <= 0) return 0;
+  double area = 0;
+  for (const auto& f : mesh.faces) {
+    const Position u = Minus(mesh.positions[f[1]], mesh.positions[f[0]]);
+    const Position v = Minus(mesh.positions[f[2]], mesh.positions[f[0]]);
+    area += 0.5 *
+            Norm({u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]});
+  }
+  return area > 0 ? std::sqrt(2 * area / (std::sqrt(3.0) * num_samples)) : 0;
+}
+
+std::vector<PointPair> DrawNearPairs(const Mesh& mesh, double lo, double hi, size_t count,
+                                     uint64_t seed) {
+  std::vector<PointPair> pairs;
+  const int32_t num_faces = static_cast<int32_t>(mesh.faces.size());
+  if (num_faces == 0 || !(hi >= lo) || !(lo >= 0)) return pairs;
+  const std::vector<std::vector<int32_t>> neighbours = FaceNeighbours(mesh);
+  // Each face's bounding sphere, to test whether it reaches into a ball.
+  std::vector<Position> centre(num_faces);
+  std::vector<double> radius(num_faces);
+  for (int32_t f = 0; f < num_faces; ++f) {
+    centre[f] = PointOf(mesh, {f, {1.0 / 3, 1.0 / 3, 1.0 / 3}});
+    radius[f] = 0;
+    for (int k = 0; k < 3; ++k) {
+      radius[f] = std::max(radius[f], Norm(Minus(mesh.positions[mesh.faces[f][k]], centre[f])));
+    }
+  }
+  std::mt19937_64 rng(seed);
+  std::uniform_int_distribution<int32_t> any_face(0, num_faces - 1);
+  std::vector<uint32_t> seen(num_faces, 0);  // the attempt that last reached a face
+  std::vector<int32_t> ball;
+  // A point whose ball holds no partner is skipped; give up after many in a
+  // row (no pair exists at this scale).
+  constexpr int kAttemptsPerPair = 64, kPartnerTries = 16;
+  uint32_t attempt = 0;
+  for (int misses = 0; pairs.size() < count && misses < kAttemptsPerPair;) {
+    ++attempt;
+    const SurfacePoint p{any_face(rng), UniformWeights(rng)};
+    const Position x = PointOf(mesh, p);
+    // The faces reached from p's across edges, each reaching into the ball.
+    ball.assign(1, p.face);
+    seen[p.face] = attempt;
+    for (size_t i = 0; i < ball.size(); ++i) {
+      for (const int32_t g : neighbours[ball[i]]) {
+        if (seen[g] == attempt || Norm(Minus(centre[g], x)) - radius[g] > hi) continue;
+        seen[g] = attempt;
+        ball.push_back(g);
+      }
+    }
+    std::uniform_int_distribution<size_t> pick(0, ball.size() - 1);
+    bool found = false;
+    for (int t = 0; t < kPartnerTries && !found; ++t) {
+      const SurfacePoint q{ball[pick(rng)], UniformWeights(rng)};
+      const double d = Norm(Minus(PointOf(mesh, q), x));
+      if (d >= lo && d <= hi) {
+        pairs.push_back({p, q});
+        found = true;
+      }
+    }
+    misses = found ? 0 : misses + 1;
+  }
+  return pairs;
+}
+
+namespace {
 
 // What one worker measured.
 struct WorkerStats {
@@ -137,9 +254,32 @@ absl::StatusOr<BenchReport> RunBench(const Client& client, const BenchOptions& o
     return absl::FailedPreconditionError(
         absl::StrFormat("model %s has no faces (state %s)", info->name, StateName(info->state)));
   }
-  const std::vector<PointPair> pool =
-      RandomPairs(info->num_faces, std::max<size_t>(65536, 4 * static_cast<size_t>(options.batch)),
-                  options.seed);
+  BenchReport report;
+  std::vector<PointPair> pool;
+  if (options.pairs == BenchOptions::Pairs::kNear) {
+    // The mesh of the version described, for L and the draw.
+    absl::StatusOr<Mesh> mesh = client.GetMesh(ModelRef(options.model.name, info->version));
+    if (!mesh.ok()) return mesh.status();
+    report.scale_length = ScaleLength(*mesh, info->num_samples);
+    // Drawing walks the faces round each point: fewer pairs than the uniform
+    // pool, used in turn.
+    pool = DrawNearPairs(
+        *mesh, options.near_from * report.scale_length, options.near_to * report.scale_length,
+        std::max<size_t>(4096, 4 * static_cast<size_t>(options.batch)), options.seed);
+    if (pool.empty()) {
+      return absl::FailedPreconditionError(
+          absl::StrFormat("model %s: no pairs %gL to %gL apart (L = %g)", info->name,
+                          options.near_from, options.near_to, report.scale_length));
+    }
+    // Every batch is a slice of the pool.
+    for (size_t i = 0; pool.size() < static_cast<size_t>(options.batch); ++i) {
+      pool.push_back(pool[i]);
+    }
+  } else {
+    pool =
+        RandomPairs(info->num_faces,
+                    std::max<size_t>(65536, 4 * static_cast<size_t>(options.batch)), options.seed);
+  }
 
   std::vector<WorkerStats> stats(options.concurrency);
   const absl::Time begin = absl::Now();
@@ -157,7 +297,6 @@ absl::StatusOr<BenchReport> RunBench(const Client& client, const BenchOptions& o
   }
   for (std::thread& t : workers) t.join();
 
-  BenchReport report;
   report.elapsed = options.duration;
   std::vector<double> latencies;
   absl::Status first_error;
@@ -183,10 +322,15 @@ absl::StatusOr<BenchReport> RunBench(const Client& client, const BenchOptions& o
 
 std::string FormatBenchReport(const BenchOptions& options, const BenchReport& report) {
   const double seconds = absl::ToDoubleSeconds(report.elapsed);
+  const std::string pairs =
+      options.pairs == BenchOptions::Pairs::kNear
+          ? absl::StrFormat("near pairs %gL-%gL apart (L = %.4g)", options.near_from,
+                            options.near_to, report.scale_length)
+          : std::string("uniform pairs");
   std::string out = absl::StrFormat(
-      "model %s, mode %s, concurrency %d, batch %d pairs%s, %.1f s measured (after %.1f s "
+      "model %s, %s, mode %s, concurrency %d, batch %d pairs%s, %.1f s measured (after %.1f s "
       "warm-up)\n",
-      options.model.name, options.mode, options.concurrency, options.batch,
+      options.model.name, pairs, options.mode, options.concurrency, options.batch,
       options.mode == "stream" ? absl::StrFormat(", window %d", options.window) : "", seconds,
       absl::ToDoubleSeconds(options.warmup));
   absl::StrAppendFormat(&out, "calls       %d ok", report.calls);

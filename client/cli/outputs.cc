@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <limits>
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
@@ -107,6 +108,30 @@ std::string FieldToText(const VertexDistances& field) {
     out += '\n';
   }
   return out;
+}
+
+std::string FieldWithinToText(const VertexDistancesWithin& field) {
+  std::string out;
+  out.reserve(field.distances.size() * 28);
+  const bool nearest = !field.nearest_source.empty();
+  char buffer[64];
+  for (size_t i = 0; i < field.vertices.size(); ++i) {
+    absl::StrAppend(&out, field.vertices[i], " ");
+    const auto [ptr, ec] = std::to_chars(buffer, buffer + sizeof(buffer), field.distances[i]);
+    out.append(buffer, ptr);
+    if (nearest) absl::StrAppend(&out, " ", field.nearest_source[i]);
+    out += '\n';
+  }
+  return out;
+}
+
+std::vector<double> DenseDistances(const VertexDistancesWithin& field, size_t num_vertices) {
+  std::vector<double> dense(num_vertices, std::numeric_limits<double>::infinity());
+  for (size_t i = 0; i < field.vertices.size(); ++i) {
+    const int32_t v = field.vertices[i];
+    if (v >= 0 && static_cast<size_t>(v) < num_vertices) dense[v] = field.distances[i];
+  }
+  return dense;
 }
 
 std::array<uint8_t, 3> RampColor(double t) {

@@ -26,6 +26,16 @@ std::string PathsToJson(const std::vector<GeodesicPath>& paths);
 // nearest sources, "distance nearest_source".
 std::string FieldToText(const VertexDistances& field);
 
+// A distance field within a radius as text: one line per vertex within it,
+// ascending, "vertex distance" or, with nearest sources, "vertex distance
+// nearest_source".
+std::string FieldWithinToText(const VertexDistancesWithin& field);
+
+// The field within a radius over every one of `num_vertices` vertices:
+// +infinity beyond the radius (what FieldToPly draws gray). Vertices past
+// the end are ignored.
+std::vector<double> DenseDistances(const VertexDistancesWithin& field, size_t num_vertices);
+
 // An ASCII PLY of `mesh` (vertices x y z, triangles) colored by a distance
 // field, for MeshLab and the like. Each vertex has the color RampColor(d /
 // largest finite distance), dark purple at the sources to yellow at the

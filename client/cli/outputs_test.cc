@@ -57,6 +57,22 @@ TEST(FieldToText, OneLinePerVertex) {
   EXPECT_EQ(FieldToText(field), "0 0\n1.5 1\ninf -1\n");
 }
 
+TEST(FieldWithinToText, OneLinePerVertexWithinTheRadius) {
+  VertexDistancesWithin field;
+  field.vertices = {3, 8};
+  field.distances = {0.25, 1.5};
+  EXPECT_EQ(FieldWithinToText(field), "3 0.25\n8 1.5\n");
+  field.nearest_source = {1, 0};
+  EXPECT_EQ(FieldWithinToText(field), "3 0.25 1\n8 1.5 0\n");
+  EXPECT_EQ(FieldWithinToText({}), "");
+  const std::vector<double> dense = DenseDistances(field, 9);
+  ASSERT_EQ(dense.size(), 9u);
+  EXPECT_EQ(dense[3], 0.25);
+  EXPECT_EQ(dense[8], 1.5);
+  EXPECT_EQ(dense[0], std::numeric_limits<double>::infinity());
+  EXPECT_EQ(DenseDistances(field, 4)[3], 0.25);  // vertex 8 past the end: left out
+}
+
 TEST(FieldToPly, ColoredMeshWithQuality) {
   Mesh mesh;
   mesh.positions = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {5, 5, 5}};

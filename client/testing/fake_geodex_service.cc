@@ -235,6 +235,50 @@ grpc::Status FakeGeodexService::Path(grpc::ServerContext* context, const v1::Pat
   return grpc::Status::OK;
 }
 
+namespace {
+
+// The field within request.radius(), in the sparse form of the real server.
+grpc::Status SparseField(const v1::DistanceFieldRequest& request, const std::vector<Point>& sources,
+                         grpc::ServerWriter<v1::DistanceFieldChunk>* writer) {
+  const double radius = request.radius();
+  if (!(std::isfinite(radius) && radius > 0)) {
+    return grpc::Status(grpc::StatusCode::INVALID_ARGUMENT,
+                        absl::StrFormat("the radius must be finite and > 0, got %g", radius));
+  }
+  std::vector<int32_t> vertices, nearest;
+  std::vector<double> distances;
+  for (int32_t v = 0; v < FakeGeodexService::kNumVertices; ++v) {
+    double best = std::numeric_limits<double>::infinity();
+    int32_t near = -1;
+    for (size_t s = 0; s < sources.size(); ++s) {
+      const double d = std::abs(static_cast<double>(v - sources[s].face));
+      if (d < best) best = d, near = static_cast<int32_t>(s);
+    }
+    if (!(best <= radius)) continue;
+    vertices.push_back(v);
+    distances.push_back(best);
+    nearest.push_back(near);
+  }
+  const int64_t n = static_cast<int64_t>(vertices.size());
+  constexpr int64_t kChunk = 7;
+  // At least one chunk, which carries the version of an empty answer.
+  for (int64_t begin = 0; begin == 0 || begin < n; begin += kChunk) {
+    v1::DistanceFieldChunk chunk;
+    chunk.set_vertex_offset(begin);
+    chunk.set_num_vertices(n);
+    chunk.set_version(1);
+    for (int64_t i = begin; i < std::min(n, begin + kChunk); ++i) {
+      chunk.add_vertices(vertices[i]);
+      chunk.add_distances(distances[i]);
+      if (request.with_nearest_source()) chunk.add_nearest_source(nearest[i]);
+    }
+    if (!writer->Write(chunk)) break;
+  }
+  return grpc::Status::OK;
+}
+
+}  // namespace
+
 grpc::Status FakeGeodexService::DistanceField(grpc::ServerContext* context,
                                               const v1::DistanceFieldRequest* request,
                                               grpc::ServerWriter<v1::DistanceFieldChunk>* writer) {
@@ -246,6 +290,7 @@ grpc::Status FakeGeodexService::DistanceField(grpc::ServerContext* context,
     return grpc::Status(grpc::StatusCode::INVALID_ARGUMENT, "sources: none given");
   }
   constexpr int64_t kChunk = 7;
+  if (request->radius() != 0) return SparseField(*request, sources, writer);
   for (int64_t begin = 0; begin < kNumVertices; begin += kChunk) {
     v1::DistanceFieldChunk chunk;
     chunk.set_vertex_offset(begin);

@@ -6,7 +6,9 @@
 //
 //   distance(a, b)   = |a.face - b.face| + sum_i |a.w[i] - b.w[i]|
 //   path(a, b)       = [a, b] at positions (face, w1, w2), length = distance
-//   field(v)         = min over sources s of |v - s.face|   (num_vertices = 60)
+//   field(v)         = min over sources s of |v - s.face|   (num_vertices = 60);
+//                      with a radius r, the sparse form: the vertices with
+//                      field(v) <= r, 7 entries a chunk
 //   locate(x, y, z)  = face clamp(floor(x)), weights (1, 0, 0), distance |y|
 //   mesh             = vertex v at (v, v % 2, 0), face f = (f % 60, (f + 1) % 60,
 //                      (f + 2) % 60); chunk k holds vertices [7k, 7k + 7) and

@@ -119,6 +119,7 @@ absl::Status ExactGeodesicSolver::Propagate(std::span<const SurfacePoint> source
   stop_points_ = options.stop_points;
   max_windows_ = options.max_windows > 0 ? options.max_windows
                                          : 400 * int64_t{mesh_.num_halfedges()} + 1'000'000;
+  max_vertices_ = options.max_vertices;
 
   sources_.assign(sources.begin(), sources.end());
   for (int32_t s = 0; s < static_cast<int32_t>(sources.size()); ++s) {
@@ -154,6 +155,10 @@ absl::Status ExactGeodesicSolver::Propagate(std::span<const SurfacePoint> source
     if (static_cast<int64_t>(windows_.size()) > max_windows_) {
       return absl::ResourceExhaustedError(absl::StrFormat(
           "geodesic propagation on %s exceeded %d windows", mesh_.name(), max_windows_));
+    }
+    if (max_vertices_ > 0 && static_cast<int64_t>(touched_vertices_.size()) > max_vertices_) {
+      return absl::ResourceExhaustedError(absl::StrFormat(
+          "geodesic propagation on %s reached more than %d vertices", mesh_.name(), max_vertices_));
     }
   }
   queue_.Clear();

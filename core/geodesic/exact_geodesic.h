@@ -65,6 +65,10 @@ struct GeodesicOptions {
   // Safety net against pathological inputs: ResourceExhausted past this many
   // windows. 0 means 400 per half-edge plus 10^6.
   int64_t max_windows = 0;
+  // When > 0: ResourceExhausted as soon as more than this many vertices have
+  // a distance (ReachedVertices()), so that a caller answering a bounded
+  // request stops paying once it is over its budget.
+  int64_t max_vertices = 0;
   // If non-empty (one entry per face), the propagation is confined to the
   // region R of faces f with face_region[f] != 0, as if the other faces did
   // not exist: distances are those along paths inside R, and a vertex of R
@@ -116,7 +120,8 @@ class ExactGeodesicSolver {
   // Runs a propagation from `sources` (at least one). Each source is a surface
   // point; sources that coincide are allowed. Errors: InvalidArgument /
   // OutOfRange for an invalid source (see mesh::ValidateSurfacePoint) or an
-  // initial_distance of the wrong size; ResourceExhausted past max_windows.
+  // initial_distance of the wrong size; ResourceExhausted past max_windows or
+  // max_vertices.
   // Results of an earlier propagation are discarded.
   absl::Status Propagate(std::span<const SurfacePoint> sources,
                          const GeodesicOptions& options = {});
@@ -133,6 +138,12 @@ class ExactGeodesicSolver {
   // or mesh::kNone when unreachable: the geodesic Voronoi diagram at vertices.
   int32_t NearestSource(int32_t v) const { return nearest_[v]; }
   const std::vector<int32_t>& NearestSources() const { return nearest_; }
+  // The vertices the last propagation gave a distance, in the order it
+  // reached them, each once: without initial_distance, exactly those whose
+  // distance is finite. With a stop radius they are the vertices within it
+  // and a ring beyond (upper bounds there); reading them costs what the
+  // propagation reached, not O(n).
+  std::span<const int32_t> ReachedVertices() const { return touched_vertices_; }
 
   // Exact distance at any surface point (the point must be valid). +inf when
   // unreachable.
@@ -279,6 +290,7 @@ class ExactGeodesicSolver {
   std::vector<int32_t> stop_vertices_;
   std::vector<SurfacePoint> stop_points_;
   int64_t max_windows_ = 0;
+  int64_t max_vertices_ = 0;
   GeodesicStats stats_;
 };
 

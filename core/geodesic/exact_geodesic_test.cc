@@ -1,5 +1,6 @@
 #include "core/geodesic/exact_geodesic.h"
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <random>
@@ -299,6 +300,46 @@ TEST(ExactGeodesicTest, StopRadiusLeavesFarVerticesUnreached) {
   }
   ASSERT_TRUE(solver.Propagate({AtVertex(m, s)}).ok());
   EXPECT_LT(limited * 4, solver.stats().windows_created);
+}
+
+// A bounded propagation lists what it reached, so that a caller reads the
+// vertices within the radius without scanning the mesh; a reused solver
+// lists the second run's vertices only.
+TEST(ExactGeodesicTest, ReachedVerticesAreTheFiniteOnes) {
+  const Mesh m = gen::Torus(40, 16, 1.0, 0.35);
+  ExactGeodesicSolver solver(m);
+  GeodesicOptions options;
+  options.stop_radius = 0.5;
+  for (const SurfacePoint& source : {AtVertex(m, 7), InFace(300, 0.2, 0.3)}) {
+    ASSERT_TRUE(solver.Propagate({source}, options).ok());
+    std::vector<int32_t> reached(solver.ReachedVertices().begin(), solver.ReachedVertices().end());
+    std::sort(reached.begin(), reached.end());
+    EXPECT_EQ(std::adjacent_find(reached.begin(), reached.end()), reached.end());
+    std::vector<int32_t> finite;
+    for (int32_t v = 0; v < m.num_vertices(); ++v) {
+      if (solver.VertexDistance(v) < kInfinity) finite.push_back(v);
+    }
+    EXPECT_EQ(reached, finite);
+    EXPECT_GT(finite.size(), 10u);
+    EXPECT_LT(finite.size(), static_cast<size_t>(m.num_vertices() / 2));
+  }
+}
+
+TEST(ExactGeodesicTest, MaxVerticesStopsAPropagationOverItsBudget) {
+  const Mesh m = gen::Torus(40, 16, 1.0, 0.35);
+  ExactGeodesicSolver solver(m);
+  GeodesicOptions options;
+  options.max_vertices = 50;
+  const absl::Status status = solver.Propagate({AtVertex(m, 7)}, options);
+  EXPECT_EQ(status.code(), absl::StatusCode::kResourceExhausted);
+  EXPECT_THAT(std::string(status.message()), HasSubstr("more than 50 vertices"));
+  EXPECT_LE(solver.ReachedVertices().size(), 60u);  // stopped at once, not at the end
+  // Within the budget it answers as without one.
+  options.max_vertices = m.num_vertices();
+  ASSERT_TRUE(solver.Propagate({AtVertex(m, 7)}, options).ok());
+  const std::vector<double> bounded = solver.VertexDistances();
+  ASSERT_TRUE(solver.Propagate({AtVertex(m, 7)}).ok());
+  EXPECT_EQ(bounded, solver.VertexDistances());
 }
 
 TEST(ExactGeodesicTest, StopTargetsSettlesThemEarly) {

@@ -280,6 +280,29 @@ class Index {
     return py::make_tuple(distances, nearest);
   }
 
+  // (vertices (k,), distances (k,), nearest source (k,)) of the vertices of
+  // the mesh file within `radius` of the sources (InputQueries::FieldWithin).
+  py::tuple FieldWithin(const Faces& faces, const Weights& weights, double radius) const {
+    query::RadiusField field;
+    {
+      py::gil_scoped_release release;
+      query::EnginePoints sources;
+      ThrowIfError(
+          queries_->Read(SpanOf(faces), SpanOf(weights), query::Named("sources"), &sources));
+      query::FieldWithinOptions options;
+      options.radius = radius;
+      query::QueryScratch scratch;
+      field = ValueOrThrow(queries_->FieldWithin(sources, options, &scratch));
+    }
+    const int64_t k = static_cast<int64_t>(field.vertices.size());
+    py::array_t<int32_t> vertices(k), nearest(k);
+    py::array_t<double> distances(k);
+    std::copy(field.vertices.begin(), field.vertices.end(), vertices.mutable_data());
+    std::copy(field.distance.begin(), field.distance.end(), distances.mutable_data());
+    std::copy(field.nearest.begin(), field.nearest.end(), nearest.mutable_data());
+    return py::make_tuple(vertices, distances, nearest);
+  }
+
   // (vertices, r, theta, u, v) of the exponential map round one point.
   py::tuple ExpMap(int32_t face, const Weights& weights, double radius,
                    std::optional<Weights> direction, int near_pairs, double tolerance) const {
@@ -394,6 +417,7 @@ void BindIndex(py::module_& m) {
       .def("matrix", &Index::Matrix)
       .def("path", &Index::Path)
       .def("field", &Index::Field)
+      .def("field_within", &Index::FieldWithin)
       .def("expmap", &Index::ExpMap)
       .def("locate", &Index::Locate)
       .def("mesh", &Index::Mesh);

@@ -123,6 +123,40 @@ absl::StatusOr<DistanceField> InputQueries::Field(const EnginePoints& sources) c
   return ids_.FieldToInput(std::move(field));
 }
 
+absl::StatusOr<RadiusField> InputQueries::FieldWithin(const EnginePoints& sources,
+                                                      const FieldWithinOptions& options,
+                                                      QueryScratch* scratch) const {
+  QueryScratch local;
+  GEODEX_ASSIGN_OR_RETURN(
+      RadiusField field,
+      engine_->FieldWithin(sources.points_, options, scratch != nullptr ? *scratch : local));
+  if (ids_.identity()) return field;
+  // Each reached internal vertex as its input vertex (none for a midpoint),
+  // then one entry per input vertex: the copy nearest its source.
+  struct Entry {
+    int32_t vertex;
+    double distance;
+    int32_t nearest;
+  };
+  std::vector<Entry> entries;
+  entries.reserve(field.vertices.size());
+  for (size_t i = 0; i < field.vertices.size(); ++i) {
+    const int32_t v = ids_.InputVertex(field.vertices[i]);
+    if (v != mesh::kNone) entries.push_back({v, field.distance[i], field.nearest[i]});
+  }
+  std::sort(entries.begin(), entries.end(), [](const Entry& a, const Entry& b) {
+    return a.vertex != b.vertex ? a.vertex < b.vertex : a.distance < b.distance;
+  });
+  RadiusField out;
+  for (const Entry& e : entries) {
+    if (!out.vertices.empty() && out.vertices.back() == e.vertex) continue;
+    out.vertices.push_back(e.vertex);
+    out.distance.push_back(e.distance);
+    out.nearest.push_back(e.nearest);
+  }
+  return out;
+}
+
 absl::StatusOr<std::vector<ExpMapVertex>> InputQueries::ExpMap(const EnginePoints& centres,
                                                                size_t i, ExpMapOptions options,
                                                                QueryScratch* scratch) const {

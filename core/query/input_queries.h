@@ -144,6 +144,21 @@ class InputQueries {
   // copy's nearest source.
   absl::StatusOr<DistanceField> Field(const EnginePoints& sources) const;
 
+  // The exact distance field of `sources` within options.radius
+  // (QueryEngine::FieldWithin): only the input vertices within the radius,
+  // ascending, each with its exact distance from its nearest source and that
+  // source's index (at a vertex the repair split, the nearest of its copies
+  // within the radius; midpoints of split long edges are no input vertices
+  // and are left out). It costs what the propagation reaches, not O(n), and
+  // is exact where Field is O(1) per vertex. `scratch` (optional) keeps the
+  // exact solver between calls. Errors: InvalidArgument for no source or a
+  // radius that is not finite and > 0 (the message gives the value);
+  // ResourceExhausted when options.max_vertices > 0 and the propagation
+  // reaches more vertices.
+  absl::StatusOr<RadiusField> FieldWithin(const EnginePoints& sources,
+                                          const FieldWithinOptions& options,
+                                          QueryScratch* scratch = nullptr) const;
+
   // The exponential map round centres[i] (§6.4, internal/exp_map.h):
   // vertices are input vertices, ascending (a split vertex: its copy of
   // smallest r); θ counter-clockwise about the normal of the centre's input

@@ -3,12 +3,14 @@
 
 #include "core/query/input_queries.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <memory>
 #include <string>
 
+#include "absl/strings/str_format.h"
 #include "core/builder/builder.h"
 #include "core/builder/mesh_arrays.h"
 #include "core/geodesic/exact_geodesic.h"
@@ -450,6 +452,156 @@ TEST(InputQueriesTest, PointsAreCheckedWhereTheyEnter) {
             absl::StatusCode::kInvalidArgument);
   EnginePoints none;
   EXPECT_EQ((*queries)->Field(none).status().code(), absl::StatusCode::kInvalidArgument);
+}
+
+// The field within a radius against the exact whole-mesh field (the
+// window engine on the same mesh, no radius): equal to 1e-9 relative at
+// every vertex within r, and exactly those vertices listed.
+void ExpectExactWithin(const RadiusField& field, const geodesic::ExactGeodesicSolver& exact,
+                       int32_t num_vertices, double radius) {
+  ASSERT_EQ(field.vertices.size(), field.distance.size());
+  ASSERT_EQ(field.vertices.size(), field.nearest.size());
+  EXPECT_TRUE(std::is_sorted(field.vertices.begin(), field.vertices.end()));
+  size_t k = 0;
+  for (int32_t v = 0; v < num_vertices; ++v) {
+    const double truth = exact.VertexDistance(v);
+    const bool listed = k < field.vertices.size() && field.vertices[k] == v;
+    // A vertex on the circle itself may fall either side by rounding.
+    if (std::abs(truth - radius) > 1e-9 * radius) {
+      EXPECT_EQ(listed, truth <= radius) << "vertex " << v << " at " << truth;
+    }
+    if (!listed) continue;
+    EXPECT_LE(field.distance[k], radius);
+    EXPECT_NEAR(field.distance[k], truth, 1e-9 * truth) << "vertex " << v;
+    if (truth <= radius) EXPECT_EQ(field.nearest[k], exact.NearestSource(v)) << "vertex " << v;
+    ++k;
+  }
+  EXPECT_EQ(k, field.vertices.size()) << "vertices past the mesh's";
+}
+
+TEST(InputQueriesTest, FieldWithinIsTheExactFieldInsideTheRadius) {
+  const mesh::Mesh torus = mesh::gen::Torus(40, 16, 1.0, 0.4);
+  Built b = Build(RawOf(torus, "torus"), 60);
+  auto queries = InputQueries::Create(b.engine);
+  ASSERT_TRUE(queries.ok()) << queries.status();
+  const double L = (*queries)->scale_length();
+  geodesic::ExactGeodesicSolver exact(torus);
+  QueryScratch scratch;
+  // One source in a face, then two (a vertex and a point on an edge).
+  const std::vector<std::vector<SurfacePoint>> source_sets = {
+      {{17, {0.2, 0.3, 0.5}}}, {{300, {1, 0, 0}}, {900, {0.5, 0.5, 0}}}};
+  for (const std::vector<SurfacePoint>& sources : source_sets) {
+    EnginePoints read;
+    ASSERT_TRUE((*queries)->Read(sources, Named("sources"), &read).ok());
+    ASSERT_TRUE(exact.Propagate(sources).ok());
+    size_t previous = 0;
+    for (const double radius : {L, 3 * L, 100.0}) {
+      SCOPED_TRACE(::testing::Message() << sources.size() << " sources, radius " << radius);
+      FieldWithinOptions options;
+      options.radius = radius;
+      absl::StatusOr<RadiusField> field = (*queries)->FieldWithin(read, options, &scratch);
+      ASSERT_TRUE(field.ok()) << field.status();
+      ExpectExactWithin(*field, exact, torus.num_vertices(), radius);
+      EXPECT_GT(field->vertices.size(), previous);
+      previous = field->vertices.size();
+      if (radius < 2 * L) EXPECT_LT(field->vertices.size(), torus.num_vertices() / 4u);
+      if (sources.size() == 2) {
+        EXPECT_NE(std::find(field->nearest.begin(), field->nearest.end(), 1), field->nearest.end());
+      }
+    }
+    EXPECT_EQ(previous, static_cast<size_t>(torus.num_vertices()));  // r = 100: all of it
+  }
+  // Without a scratch of the caller's, the same answer.
+  EnginePoints read;
+  ASSERT_TRUE((*queries)->Read(source_sets[0], Named("sources"), &read).ok());
+  FieldWithinOptions options;
+  options.radius = 2 * L;
+  absl::StatusOr<RadiusField> with = (*queries)->FieldWithin(read, options, &scratch);
+  absl::StatusOr<RadiusField> without = (*queries)->FieldWithin(read, options);
+  ASSERT_TRUE(with.ok() && without.ok());
+  EXPECT_EQ(with->vertices, without->vertices);
+  EXPECT_EQ(with->distance, without->distance);
+}
+
+TEST(InputQueriesTest, FieldWithinRefusesBadRadiiAndTooManyVertices) {
+  const mesh::Mesh sphere = mesh::gen::Sphere(2, 1.0);
+  Built b = Build(RawOf(sphere, "sphere"), 40);
+  auto queries = InputQueries::Create(b.engine);
+  ASSERT_TRUE(queries.ok()) << queries.status();
+  const SurfacePoint source{5, {0.2, 0.3, 0.5}};
+  EnginePoints read;
+  ASSERT_TRUE((*queries)->Read(std::span(&source, 1), Named("sources"), &read).ok());
+  for (const auto& [radius, shown] : std::vector<std::pair<double, std::string>>{
+           {NAN, "nan"}, {INFINITY, "inf"}, {-1.0, "-1"}, {0.0, "0"}}) {
+    FieldWithinOptions options;
+    options.radius = radius;
+    const absl::Status status = (*queries)->FieldWithin(read, options).status();
+    EXPECT_EQ(status.code(), absl::StatusCode::kInvalidArgument) << shown;
+    EXPECT_THAT(std::string(status.message()), ::testing::EndsWith("got " + shown));
+  }
+  FieldWithinOptions options;
+  options.radius = 1.0;
+  EnginePoints none;
+  EXPECT_EQ((*queries)->FieldWithin(none, options).status().code(),
+            absl::StatusCode::kInvalidArgument);
+  absl::StatusOr<RadiusField> all = (*queries)->FieldWithin(read, options);
+  ASSERT_TRUE(all.ok()) << all.status();
+  options.max_vertices = static_cast<int64_t>(all->vertices.size()) / 2;
+  const absl::Status over = (*queries)->FieldWithin(read, options).status();
+  EXPECT_EQ(over.code(), absl::StatusCode::kResourceExhausted);
+  EXPECT_THAT(std::string(over.message()),
+              ::testing::HasSubstr(absl::StrFormat("more than %d vertices", options.max_vertices)));
+  options.max_vertices = sphere.num_vertices();
+  EXPECT_TRUE((*queries)->FieldWithin(read, options).ok());
+}
+
+// Over a split index the field lists input vertices only, with the coarse
+// mesh's exact distances (the split is flat); over a repaired one, a split
+// vertex once, at its nearest copy.
+TEST(InputQueriesTest, FieldWithinAnswersInTheInputIds) {
+  const mesh::Mesh coarse = mesh::gen::Sphere(1, 1.0);
+  Built b = Build(RawOf(coarse, "sphere"), 120, /*refine=*/true);
+  ASSERT_GT(b.engine->index().num_vertices(), coarse.num_vertices());
+  auto queries = InputQueries::Create(b.engine);
+  ASSERT_TRUE(queries.ok()) << queries.status();
+  const std::vector<SurfacePoint> sources = {{3, {0.2, 0.3, 0.5}}, {60, {0, 1, 0}}};
+  EnginePoints read;
+  ASSERT_TRUE((*queries)->Read(sources, Named("sources"), &read).ok());
+  geodesic::ExactGeodesicSolver exact(coarse);
+  ASSERT_TRUE(exact.Propagate(sources).ok());
+  for (const double radius : {0.5, 1.2}) {
+    FieldWithinOptions options;
+    options.radius = radius;
+    absl::StatusOr<RadiusField> field = (*queries)->FieldWithin(read, options);
+    ASSERT_TRUE(field.ok()) << field.status();
+    ASSERT_FALSE(field->vertices.empty());
+    ExpectExactWithin(*field, exact, coarse.num_vertices(), radius);
+  }
+
+  Built pyramids = Build(mesh::testing::TwoPyramidsApexToApex(), 10);
+  auto apart = InputQueries::Create(pyramids.engine);
+  ASSERT_TRUE(apart.ok());
+  ASSERT_EQ(pyramids.engine->index().vertex_copies().size(), 1u);
+  const SurfacePoint on_first{0, {0.2, 0.3, 0.5}};
+  ASSERT_TRUE((*apart)->Read(std::span(&on_first, 1), Named("sources"), &read).ok());
+  FieldWithinOptions options;
+  options.radius = 100;
+  absl::StatusOr<RadiusField> field = (*apart)->FieldWithin(read, options);
+  ASSERT_TRUE(field.ok()) << field.status();
+  absl::StatusOr<DistanceField> whole = (*apart)->Field(read);
+  ASSERT_TRUE(whole.ok());
+  // The reachable input vertices, each once; the whole field's at the apex
+  // (vertex 0, reached through its copy on the first pyramid) is O(1), so
+  // only listed vertices are compared, loosely.
+  std::vector<int32_t> reachable;
+  for (int32_t v = 0; v < 9; ++v) {
+    if (std::isfinite(whole->distance[v])) reachable.push_back(v);
+  }
+  EXPECT_EQ(field->vertices, reachable);
+  for (size_t i = 0; i < field->vertices.size(); ++i) {
+    EXPECT_NEAR(field->distance[i], whole->distance[field->vertices[i]],
+                0.05 + 0.05 * field->distance[i]);
+  }
 }
 
 }  // namespace

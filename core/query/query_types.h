@@ -2,8 +2,9 @@
 
 // The value types of geodex's queries: how a distance is asked for
 // (DistanceOptions, NearPairs), how the queries of an index are set up
-// (QueryOptions), an exponential map's options, and what comes back
-// (PathPoint, DistanceField, ExpMapVertex, LocatedPoint). Plain data: the
+// (QueryOptions), the options of an exponential map and of a field within a
+// radius, and what comes back (PathPoint, DistanceField, RadiusField,
+// ExpMapVertex, LocatedPoint). Plain data: the
 // public face of core/query with input_queries.h and query_scratch.h.
 
 #include <array>
@@ -76,6 +77,26 @@ struct PathPoint {
 struct DistanceField {
   std::vector<double> distance;  // per vertex; +inf when unreachable or unreferenced
   std::vector<int32_t> nearest;  // per vertex: index of the nearest source (-1 if none)
+};
+
+// How a distance field within a radius is asked for (InputQueries::
+// FieldWithin).
+struct FieldWithinOptions {
+  // Vertices farther than this from every source are left out; finite, > 0.
+  double radius = 0;
+  // When > 0, the most vertices the propagation may reach (those within the
+  // radius and a ring beyond): more is ResourceExhausted, and the work stops
+  // there. 0: no limit.
+  int64_t max_vertices = 0;
+};
+
+// The exact distance field within a radius: entry i is vertex vertices[i]
+// (ascending), at geodesic distance distance[i] <= radius from its nearest
+// source, the nearest[i]-th. Only vertices within the radius are listed.
+struct RadiusField {
+  std::vector<int32_t> vertices;
+  std::vector<double> distance;
+  std::vector<int32_t> nearest;
 };
 
 struct LocatedPoint {

@@ -83,7 +83,9 @@ void QueryCommandLine::AddQueryOptions() {
   auto* expmap = app_.add_option("--expmap", a.expmap,
                                  "Exponential map round the point \"F W0 W1 W2\": 'vertex u v' "
                                  "for every vertex within --radius");
-  app_.add_option("--radius", a.radius, "With --expmap: the geodesic radius")->needs(expmap);
+  app_.add_option("--radius", a.radius,
+                  "With --expmap: the geodesic radius; with --field: only the vertices within it, "
+                  "exact, one line 'vertex distance' each (ascending)");
   app_.add_option("--direction", a.direction,
                   "With --expmap: the reference direction X Y Z (theta = 0), projected into "
                   "the centre's face; default its first edge")
@@ -199,8 +201,19 @@ absl::StatusOr<std::string> FieldText(const query::InputQueries& queries,
   }
   query::EnginePoints sources;
   GEODEX_RETURN_IF_ERROR(queries.Read(points, nullptr, &sources));
-  GEODEX_ASSIGN_OR_RETURN(const query::DistanceField field, queries.Field(sources));
   std::string out;
+  if (args.radius != 0) {
+    query::FieldWithinOptions options;
+    options.radius = args.radius;
+    GEODEX_ASSIGN_OR_RETURN(const query::RadiusField field, queries.FieldWithin(sources, options));
+    for (size_t i = 0; i < field.vertices.size(); ++i) {
+      absl::StrAppend(&out, field.vertices[i], " ", mesh::FormatDistance(field.distance[i]));
+      if (args.nearest) out += absl::StrFormat(" %d", field.nearest[i]);
+      out += "\n";
+    }
+    return out;
+  }
+  GEODEX_ASSIGN_OR_RETURN(const query::DistanceField field, queries.Field(sources));
   for (size_t v = 0; v < field.distance.size(); ++v) {
     out += mesh::FormatDistance(field.distance[v]);
     if (args.nearest) out += absl::StrFormat(" %d", field.nearest[v]);
@@ -254,6 +267,9 @@ absl::StatusOr<std::string> AnswerQueryTool(const QueryToolArgs& args) {
   options.exact_path_corridor = args.exact_path_corridor;
   GEODEX_ASSIGN_OR_RETURN(const auto queries, query::InputQueries::Open(args.index, options));
   const query::DistanceOptions distance_options = DistanceOptionsOf(args);
+  if (args.radius != 0 && args.field.empty() && args.expmap.empty()) {
+    return absl::InvalidArgumentError("--radius needs --field or --expmap");
+  }
   if (args.info) return IndexInfoText(*queries, args);
   if (!args.pairs.empty()) return PairDistancesText(*queries, args, distance_options);
   if (!args.paths.empty()) return PathsText(*queries, args);

@@ -35,7 +35,7 @@ struct QueryToolArgs {
   std::string pairs, paths, field, locate, expmap;
   bool info = false;
   // --expmap: the geodesic radius and the reference direction (empty or
-  // three numbers).
+  // three numbers). --field with a radius: the field within it.
   double radius = 0;
   std::vector<double> direction;
   std::string format = "xyz";       // --paths: "xyz" or "json"
@@ -88,7 +88,10 @@ absl::StatusOr<std::string> PathsText(const query::InputQueries& queries,
                                       const QueryToolArgs& args);
 
 // --field: a distance per vertex from the sources of the file args.field
-// ("distance nearest_source" with nearest). Errors: the file's, bad points.
+// ("distance nearest_source" with nearest); with args.radius, "vertex
+// distance [nearest_source]" for the vertices within it only, exact
+// (InputQueries::FieldWithin). Errors: the file's, bad points, a radius that
+// is not finite and > 0.
 absl::StatusOr<std::string> FieldText(const query::InputQueries& queries,
                                       const QueryToolArgs& args);
 

@@ -75,7 +75,6 @@ TEST(QueryCommandLineTest, RefusesWhatCli11Checks) {
   EXPECT_THROW(Parse("x.gdx --pairs a --paths b"), CLI::ExcludesError);
   EXPECT_THROW(Parse("x.gdx --field a --locate b"), CLI::ExcludesError);
   EXPECT_THROW(Parse("x.gdx --pairs a --info"), CLI::ExcludesError);
-  EXPECT_THROW(Parse("x.gdx --pairs a --radius 1"), CLI::RequiresError);
   EXPECT_THROW(Parse("x.gdx --pairs a --near-pairs fast"), CLI::ValidationError);
   EXPECT_THROW(Parse("x.gdx --paths a --exact-path-corridor 65"), CLI::ValidationError);
   EXPECT_THROW(Parse("x.gdx --pairs a --tolerance -1"), CLI::ValidationError);
@@ -244,6 +243,31 @@ TEST_F(QueryToolIndexTest, FieldHasALinePerVertex) {
   const std::vector<std::string> lines = Lines(*out);
   ASSERT_EQ(lines.size(), static_cast<size_t>(mesh_->num_vertices()));
   for (const std::string& line : lines) EXPECT_THAT(line, EndsWith(" 0"));
+}
+
+TEST_F(QueryToolIndexTest, FieldWithinARadiusListsTheVerticesWithinIt) {
+  QueryToolArgs args = Args();
+  args.field = WriteTestFile("sources.txt", "0 1 0 0\n");
+  args.radius = 0.5;
+  const absl::StatusOr<std::string> out = AnswerQueryTool(args);
+  ASSERT_TRUE(out.ok()) << out.status();
+  const std::vector<std::string> lines = Lines(*out);
+  ASSERT_FALSE(lines.empty());
+  ASSERT_LT(lines.size(), static_cast<size_t>(mesh_->num_vertices()));
+  int previous = -1;
+  for (const std::string& line : lines) {
+    const std::vector<std::string> fields = absl::StrSplit(line, ' ');
+    ASSERT_EQ(fields.size(), 2u) << line;
+    EXPECT_GT(std::stoi(fields[0]), previous);
+    previous = std::stoi(fields[0]);
+    EXPECT_LE(std::stod(fields[1]), 0.5);
+  }
+  args.radius = -1;
+  EXPECT_EQ(AnswerQueryTool(args).status().code(), absl::StatusCode::kInvalidArgument);
+  args.field.clear();
+  args.locate = args.index;
+  args.radius = 1;
+  EXPECT_EQ(AnswerQueryTool(args).status().code(), absl::StatusCode::kInvalidArgument);
 }
 
 TEST_F(QueryToolIndexTest, LocateFindsAVertex) {

@@ -1,8 +1,10 @@
 #pragma once
 
 // DistanceField: the distance of every vertex of the input mesh from its
-// nearest source. One job on the worker pool computes the whole field; its
-// chunks of at most 1 MiB are then written one at a time.
+// nearest source, or, with a radius, the exact distances of the vertices
+// within it (sparse chunks: vertices with their distances). One job on the
+// worker pool computes the whole field; its chunks of at most 1 MiB are then
+// written one at a time.
 
 #include "geodex/v1/geodex.pb.h"
 #include "grpcpp/server_context.h"

@@ -10,6 +10,7 @@
 #include "absl/strings/str_format.h"
 #include "core/builder/builder.h"
 #include "core/mesh/generators.h"
+#include "core/query/input_queries.h"
 #include "core/query/internal/exp_map.h"
 #include "core/query/internal/query_engine.h"
 #include "core/query/internal/query_knobs.h"
@@ -257,6 +258,8 @@ int RunOnGeneratedSphere(int pairs) {
   std::printf("%s\n", ThroughputRow("sphere(5)", MeasureThroughput(*ix, pairs)).c_str());
   std::printf("\n%s", ExpMapHeader().c_str());
   BenchExpMap("sphere(5)", *ix);
+  std::printf("\nDistance fields (5 interior sources, one at a time)\n%s", FieldHeader().c_str());
+  BenchField("sphere(5)", *ix);
   return 0;
 }
 
@@ -267,6 +270,7 @@ std::unique_ptr<CLI::App> QueryBenchFlags(QueryBenchOptions* options) {
   app->add_option("--index", options->indexes, "Index files to measure");
   app->add_option("--pairs", options->pairs, "Pairs per measurement");
   app->add_flag("--expmap-only", options->expmap_only, "Only the exponential map table");
+  app->add_flag("--field-only", options->field_only, "Only the distance field table");
   app->add_option("--accuracy-pairs", options->accuracy_pairs,
                   "Pairs per row of the table against the exact engine");
   return app;
@@ -429,6 +433,48 @@ void BenchExpMap(const std::string& label, std::shared_ptr<const index::Index> i
   }
 }
 
+void BenchField(const std::string& label, std::shared_ptr<const index::Index> ix) {
+  auto queries = *query::InputQueries::Create(ix);
+  const auto sources = InteriorPoints(*ix, 5, 8);
+  std::vector<query::EnginePoints> read(sources.size());
+  for (size_t i = 0; i < sources.size(); ++i) {
+    (void)queries->Read(std::span(&sources[i], 1), query::Named("source"), &read[i]);
+  }
+  const double l = queries->scale_length();
+  query::QueryScratch scratch;
+  // The lazy exact mesh and the scratch's solver, made before the clock runs.
+  (void)queries->FieldWithin(read[0], {.radius = l}, &scratch);
+  const double kWhole = std::numeric_limits<double>::max();
+  for (const double radius : {3 * l, 10 * l, 0.0, kWhole}) {
+    size_t vertices = 0;
+    const double t0 = ThreadCpuSeconds();
+    for (const query::EnginePoints& source : read) {
+      if (radius == 0) {
+        vertices += queries->Field(source)->distance.size();
+      } else {
+        vertices += queries->FieldWithin(source, {.radius = radius}, &scratch)->vertices.size();
+      }
+    }
+    FieldFigures f;
+    f.us = 1e6 * (ThreadCpuSeconds() - t0) / read.size();
+    f.field = radius == 0        ? "whole mesh, O(1)"
+              : radius == kWhole ? "whole mesh, exact"
+                                 : absl::StrFormat("%.0f L", radius / l);
+    f.per_field = static_cast<double>(vertices) / read.size();
+    std::printf("%s\n", FieldRow(label, f).c_str());
+  }
+}
+
+std::string FieldHeader() {
+  return MarkdownHeader({"index", "field", "vertices", "one field", "vertices/s"});
+}
+
+std::string FieldRow(const std::string& label, const FieldFigures& f) {
+  return MarkdownRow({label, f.field, absl::StrFormat("%.0f", f.per_field),
+                      absl::StrFormat("%.0f us", f.us),
+                      absl::StrFormat("%.3gM", f.us > 0 ? f.per_field / f.us : 0)});
+}
+
 std::string ExpMapHeader() {
   return MarkdownHeader({"index", "radius", "vertices mapped", "one map, default",
                          "one map, pure O(1)", "per vertex, default"});
@@ -455,22 +501,30 @@ int RunQueryBench(const QueryBenchOptions& options) {
       return 1;
     }
     loaded.push_back(*ix);
-    if (!options.expmap_only) {
+    if (!options.expmap_only && !options.field_only) {
       std::printf("%s\n", ThroughputRow(path, MeasureThroughput(*ix, options.pairs)).c_str());
     }
   }
-  std::printf("%s", RefinementHeader().c_str());
-  for (size_t i = 0; i < loaded.size() && !options.expmap_only; ++i) {
-    BenchRefinement(options.indexes[i], loaded[i], std::min(options.pairs, 200'000));
-  }
-  std::printf("%s", AccuracyHeader().c_str());
-  for (size_t i = 0; i < loaded.size() && !options.expmap_only; ++i) {
-    for (const AccuracyRow& row : MeasureRefinementAccuracy(loaded[i], options.accuracy_pairs)) {
-      std::printf("%s\n", AccuracyRowText(options.indexes[i], row).c_str());
+  if (!options.expmap_only && !options.field_only) {
+    std::printf("%s", RefinementHeader().c_str());
+    for (size_t i = 0; i < loaded.size(); ++i) {
+      BenchRefinement(options.indexes[i], loaded[i], std::min(options.pairs, 200'000));
+    }
+    std::printf("%s", AccuracyHeader().c_str());
+    for (size_t i = 0; i < loaded.size(); ++i) {
+      for (const AccuracyRow& row : MeasureRefinementAccuracy(loaded[i], options.accuracy_pairs)) {
+        std::printf("%s\n", AccuracyRowText(options.indexes[i], row).c_str());
+      }
     }
   }
-  std::printf("\nExponential map (5 interior centres)\n%s", ExpMapHeader().c_str());
-  for (size_t i = 0; i < loaded.size(); ++i) BenchExpMap(options.indexes[i], loaded[i]);
+  if (!options.field_only) {
+    std::printf("\nExponential map (5 interior centres)\n%s", ExpMapHeader().c_str());
+    for (size_t i = 0; i < loaded.size(); ++i) BenchExpMap(options.indexes[i], loaded[i]);
+  }
+  if (!options.expmap_only) {
+    std::printf("\nDistance fields (5 interior sources, one at a time)\n%s", FieldHeader().c_str());
+    for (size_t i = 0; i < loaded.size(); ++i) BenchField(options.indexes[i], loaded[i]);
+  }
   return 0;
 }
 

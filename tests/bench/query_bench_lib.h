@@ -1,7 +1,7 @@
 #pragma once
 
 // The pieces of query_bench (query_bench.cc): its flags, the pairs it draws,
-// the measurements, and the rows of its three tables.
+// the measurements, and the rows of its four tables.
 //
 // Rates are single-thread and per CPU-second of the measuring thread
 // (ThreadCpuSeconds). Not thread-safe.
@@ -22,6 +22,7 @@ struct QueryBenchOptions {
   std::vector<std::string> indexes;  // empty: a generated sphere
   int pairs = 1'000'000;             // pairs per measurement
   bool expmap_only = false;          // only the exponential map table
+  bool field_only = false;           // only the distance field table
   int accuracy_pairs = 1000;         // per row of the table against the exact engine
 };
 
@@ -109,6 +110,23 @@ void BenchExpMap(const std::string& label, std::shared_ptr<const index::Index> i
 // The exponential map table's header, and one row of it (no newline).
 std::string ExpMapHeader();
 std::string ExpMapRow(const std::string& label, const ExpMapFigures& f);
+
+// One row of the distance field table: one radius.
+struct FieldFigures {
+  std::string field;     // "3 L", "10 L", "whole mesh, O(1)", "whole mesh, exact"
+  double per_field = 0;  // vertices in the field, mean over the sources
+  double us = 0;         // one field, microseconds
+};
+
+// Measures and prints the distance field rows of `ix`: fields of one source
+// at a time (5 interior points) within 3 L and 10 L (exact, FieldWithin),
+// against the whole-mesh field (O(1) per vertex, Field) and the exact one
+// (FieldWithin with an unbounded radius).
+void BenchField(const std::string& label, std::shared_ptr<const index::Index> ix);
+
+// The distance field table's header, and one row of it (no newline).
+std::string FieldHeader();
+std::string FieldRow(const std::string& label, const FieldFigures& f);
 
 // Runs the whole benchmark as the command line asks and returns the exit
 // code: 1 when an index cannot be opened.

@@ -159,6 +159,13 @@ TEST(QueryBenchTablesTest, ExpMapRowLayout) {
   ExpectTable(ExpMapHeader(), 0, row);
 }
 
+TEST(QueryBenchTablesTest, FieldRowLayout) {
+  const FieldFigures f{.field = "3 L", .per_field = 900, .us = 450};
+  const std::string row = FieldRow("t.gdx", f);
+  EXPECT_EQ(row, "| t.gdx | 3 L | 900 | 450 us | 2M |");
+  ExpectTable(FieldHeader(), 0, row);
+}
+
 TEST(QueryBenchRunTest, MeasuresASmallIndex) {
   const auto ix = SmallIndex(false);
   const ThroughputFigures f = MeasureThroughput(ix, 50);
@@ -172,7 +179,7 @@ TEST(QueryBenchRunTest, MeasuresASmallIndex) {
 
 // The whole run on a calibrated index in a file: its three tables, each row
 // as wide as its header.
-TEST(QueryBenchRunTest, PrintsThreeTables) {
+TEST(QueryBenchRunTest, PrintsFourTables) {
   const auto path = std::filesystem::temp_directory_path() /
                     ("query_bench_lib_test_" + std::to_string(getpid()) + ".gdx");
   {
@@ -191,9 +198,12 @@ TEST(QueryBenchRunTest, PrintsThreeTables) {
     if (line[0] == '|') widths.push_back(Columns(line));
   }
   // Header and rule, one row; header and rule, uniform and four bins;
-  // header and rule, three radii.
-  EXPECT_EQ(widths, (std::vector<int>{14, 14, 14, 11, 11, 11, 11, 11, 11, 11, 6, 6, 6, 6, 6}));
+  // header and rule, three radii; header and rule, four fields.
+  EXPECT_EQ(widths, (std::vector<int>{14, 14, 14, 11, 11, 11, 11, 11, 11, 11, 6,
+                                      6,  6,  6,  6,  5,  5,  5,  5,  5,  5}));
   EXPECT_THAT(out, HasSubstr("\nExponential map (5 interior centres)\n"));
+  EXPECT_THAT(out, HasSubstr("\nDistance fields (5 interior sources, one at a time)\n"));
+  EXPECT_THAT(out, HasSubstr("| whole mesh, exact | 642 |"));
 }
 
 TEST(QueryBenchRunTest, AnIndexThatCannotBeOpenedExitsOne) {

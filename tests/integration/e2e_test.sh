@@ -324,6 +324,27 @@ if [ $FAKE -eq 0 ]; then
     fail "field.ply: not exactly one vertex at distance 0" ply_quality.txt
 fi
 
+# The field within a radius: 'vertex distance' lines, vertices ascending, every
+# distance within the radius; the fake's closed form exactly (sources on faces
+# 0 and 1: |v - 0| and |v - 1|).
+"$GEODEX" field "${S[@]}" --model "$MODEL" --sources sources.txt --radius 2.5 --out near.txt \
+  2> err.txt || fail "field --radius" err.txt
+if [ $FAKE -eq 1 ]; then
+  [ "$(cat near.txt)" = "$(printf '0 0\n1 0\n2 1\n3 2')" ] &&
+    pass "field --radius: the vertices within it, the fake's distances" ||
+    fail "field --radius: not the fake's vertices within 2.5" near.txt
+else
+  awk -v r=2.5 -v nv="$NUM_VERTICES" 'NF != 2 || $1 !~ /^[0-9]+$/ || $1 >= nv || $2 > r ||
+       (NR > 1 && $1 <= last) { exit 1 } { last = $1 } END { exit NR == 0 }' near.txt &&
+    [ "$(wc -l < near.txt)" -lt "$NUM_VERTICES" ] &&
+    pass "field --radius: $(wc -l < near.txt) vertices within it, ascending" ||
+    fail "field --radius: lines not 'vertex distance' within 2.5, ascending" near.txt
+fi
+"$GEODEX" field "${S[@]}" --model "$MODEL" --sources sources.txt --radius -1 > /dev/null 2> err.txt
+code=$?
+[ $code -eq 2 ] && grep -q "radius must be finite and > 0, got -1" err.txt &&
+  pass "field --radius -1: exit 2" || fail "field --radius -1: exit $code" err.txt
+
 # The exponential map: lines as geodex-query prints them offline, the decal
 # as a textured OBJ + MTL + PNG, and a rendered picture.
 if [ $FAKE -eq 0 ]; then

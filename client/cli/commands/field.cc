@@ -1,4 +1,6 @@
-// `geodex field`: the distance from the nearest source to every mesh vertex.
+// `geodex field`: the distance from the nearest source to every mesh vertex,
+// or with --radius R the exact distance of every vertex within R (one exact
+// propagation on the server, whose cost follows the vertices it reaches).
 //
 // `field --out X.ply` asks for the distance field, then for the mesh of the
 // version that answered it (GetMesh pinned to that version, so that both
@@ -7,6 +9,7 @@
 // quality; unreachable vertices are gray with quality -1 (FieldToPly in
 // client/cli/outputs.h).
 
+#include <cmath>
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -31,14 +34,15 @@ struct FieldFlags {
   ModelFlags model;
   std::string sources, out = "-";
   bool nearest = false;
+  double radius = 0;  // 0: every vertex
 };
 
 // The mesh the distance field `field` was computed on: GetMesh pinned to the
 // version that answered the field, so that a model reloaded between the two
 // calls cannot pair one version's distances with another's mesh.
 absl::StatusOr<Mesh> MeshOfField(const Client& client, const ModelFlags& model,
-                                 const VertexDistances& field) {
-  const int64_t version = field.version != 0 ? field.version : model.version;
+                                 int64_t field_version, size_t field_vertices, bool within_radius) {
+  const int64_t version = field_version != 0 ? field_version : model.version;
   absl::StatusOr<Mesh> mesh = client.GetMesh(ModelRef(model.name, version));
   if (!mesh.ok()) {
     return absl::Status(mesh.status().code(),
@@ -51,10 +55,11 @@ absl::StatusOr<Mesh> MeshOfField(const Client& client, const ModelFlags& model,
         "the server sent the mesh of version %d for the distance field of version %d",
         mesh->version, version));
   }
-  if (mesh->positions.size() != field.distances.size()) {
+  if (within_radius ? field_vertices > mesh->positions.size()
+                    : field_vertices != mesh->positions.size()) {
     return absl::DataLossError(
         absl::StrFormat("the distance field has %d vertices but the mesh of version %d has %d",
-                        field.distances.size(), mesh->version, mesh->positions.size()));
+                        field_vertices, mesh->version, mesh->positions.size()));
   }
   return mesh;
 }
@@ -74,11 +79,28 @@ absl::Status Field(const FieldFlags& flags) {
     return InputError(absl::InvalidArgumentError(
         absl::StrCat(flags.sources, ": no source points (lines 'f w0 w1 w2')")));
   }
+  if (flags.radius != 0) {
+    if (!(std::isfinite(flags.radius) && flags.radius > 0)) {
+      return InputError(absl::InvalidArgumentError(
+          absl::StrFormat("--radius must be finite and > 0, got %g", flags.radius)));
+    }
+    absl::StatusOr<VertexDistancesWithin> field =
+        client->DistanceFieldWithin(flags.model.ref(), *sources,
+                                    {.radius = flags.radius, .with_nearest_source = flags.nearest});
+    if (!field.ok()) return field.status();
+    if (!ply) return WriteFileOrStdout(flags.out, FieldWithinToText(*field));
+    const size_t reached = field->vertices.empty() ? 0 : field->vertices.back() + size_t{1};
+    absl::StatusOr<Mesh> mesh = MeshOfField(*client, flags.model, field->version, reached, true);
+    if (!mesh.ok()) return mesh.status();
+    return WriteFileOrStdout(flags.out,
+                             FieldToPly(*mesh, DenseDistances(*field, mesh->positions.size())));
+  }
   absl::StatusOr<VertexDistances> field =
       client->DistanceField(flags.model.ref(), *sources, flags.nearest);
   if (!field.ok()) return field.status();
   if (!ply) return WriteFileOrStdout(flags.out, FieldToText(*field));
-  absl::StatusOr<Mesh> mesh = MeshOfField(*client, flags.model, *field);
+  absl::StatusOr<Mesh> mesh =
+      MeshOfField(*client, flags.model, field->version, field->distances.size(), false);
   if (!mesh.ok()) return mesh.status();
   return WriteFileOrStdout(flags.out, FieldToPly(*mesh, field->distances));
 }
@@ -90,10 +112,18 @@ void AddFieldCommand(CLI::App* app, absl::Status* status) {
   CLI::App* field = app->add_subcommand(
       "field",
       "Distance from the nearest source to every mesh vertex: one line per vertex, or with "
-      "--out X.ply the model's mesh colored by distance");
+      "--out X.ply the model's mesh colored by distance. With --radius R, the exact distance "
+      "of every vertex within R only: one line 'vertex distance' per such vertex, ascending");
   AddConnectionFlags(field, &flags->conn);
   AddModelFlags(field, &flags->model);
   field->add_option("--sources", flags->sources, "File of lines 'f w0 w1 w2'")->required();
+  field
+      ->add_option("--radius", flags->radius,
+                   "Only the vertices within this geodesic distance of the sources (mesh units; "
+                   "finite, > 0), with exact distances: text lines 'vertex distance' (with "
+                   "--nearest 'vertex distance source'), vertices ascending, none beyond R; a .ply "
+                   "draws the vertices beyond R gray with quality -1. 0 (default): every vertex")
+      ->capture_default_str();
   field->add_flag("--nearest", flags->nearest,
                   "Also print the index of the nearest source on each line (text output only)");
   field

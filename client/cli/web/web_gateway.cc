@@ -107,8 +107,10 @@ namespace {
 
 // --- merging the chunks of a server stream into one message --------------------
 
+// Both forms of the field: per vertex, or (with a radius) the sparse one,
+// whose offsets and total count entries instead of vertices.
 absl::StatusOr<v1::DistanceFieldChunk> MergeField(const std::vector<v1::DistanceFieldChunk>& in,
-                                                  bool with_nearest_source) {
+                                                  bool with_nearest_source, bool within_radius) {
   v1::DistanceFieldChunk out;
   if (in.empty()) return out;
   out.set_num_vertices(in[0].num_vertices());
@@ -123,8 +125,12 @@ absl::StatusOr<v1::DistanceFieldChunk> MergeField(const std::vector<v1::Distance
     if (with_nearest_source && c.nearest_source_size() != c.distances_size()) {
       return DataLoss("distance field", "lack nearest sources");
     }
+    if (c.vertices_size() != (within_radius ? c.distances_size() : 0)) {
+      return DataLoss("distance field", "do not give one vertex per distance");
+    }
     out.mutable_distances()->MergeFrom(c.distances());
     out.mutable_nearest_source()->MergeFrom(c.nearest_source());
+    out.mutable_vertices()->MergeFrom(c.vertices());
   }
   if (out.distances_size() != out.num_vertices()) {
     return DataLoss("distance field", "do not cover every vertex");
@@ -448,7 +454,7 @@ HttpResponse WebGateway::HandleApi(const HttpRequest& request) const {
     if (!r.ok()) return ErrorResponse(r.status());
     auto chunks = connection_->DistanceField(*r);
     if (!chunks.ok()) return ErrorResponse(chunks.status());
-    return Answer(MergeField(*chunks, r->with_nearest_source()));
+    return Answer(MergeField(*chunks, r->with_nearest_source(), r->radius() != 0));
   }
   if (verb == "matrix") {
     auto r = PostRequest<v1::MatrixRequest>(name, request);

@@ -263,6 +263,42 @@ TEST_F(WebGatewayTest, FieldChunksAreMergedAndChecked) {
               "every vertex");
 }
 
+// With a radius the JSON body carries it, and the sparse chunks merge into
+// one: vertices aligned with distances.
+TEST_F(WebGatewayTest, FieldWithinARadiusPassesTheRadiusAndMergesVertices) {
+  v1::DistanceFieldChunk c0, c1;
+  for (auto* c : {&c0, &c1}) {
+    c->set_num_vertices(3);
+    c->set_version(2);
+  }
+  c0.add_vertices(4);
+  c0.add_distances(0.5);
+  c0.add_vertices(9);
+  c0.add_distances(1.25);
+  c1.set_vertex_offset(2);
+  c1.add_vertices(17);
+  c1.add_distances(0.75);
+  v1::DistanceFieldChunk no_vertices = c1;
+  no_vertices.clear_vertices();
+  EXPECT_CALL(*mock_, DistanceField)
+      .WillOnce([&](const v1::DistanceFieldRequest& request) {
+        EXPECT_EQ(request.radius(), 1.5);
+        EXPECT_EQ(request.model().name(), "torus");
+        return std::vector<v1::DistanceFieldChunk>{c0, c1};
+      })
+      .WillOnce(Return(std::vector<v1::DistanceFieldChunk>{c0, no_vertices}));
+  const std::string body = R"({"sources": {"faces": [0], "weights": [1, 0, 0]}, "radius": 1.5})";
+  const HttpResponse r = Post("/v1/models/torus:field", body);
+  ASSERT_EQ(r.status, 200) << r.body;
+  EXPECT_THAT(r.body, HasSubstr(R"("vertices":[4,9,17])"));
+  const auto merged = Parse<v1::DistanceFieldChunk>(r);
+  EXPECT_EQ(merged.num_vertices(), 3);
+  ASSERT_EQ(merged.distances_size(), 3);
+  EXPECT_EQ(merged.distances(2), 0.75);
+  ExpectError(Post("/v1/models/torus:field", body), 500, absl::StatusCode::kDataLoss,
+              "one vertex per distance");
+}
+
 TEST_F(WebGatewayTest, MeshChunksAreMerged) {
   v1::MeshChunk c0, c1;
   for (auto* c : {&c0, &c1}) {

@@ -228,12 +228,20 @@ class Index:
         return [Path(*path) for path in raw]  # (positions, faces, weights, length)
 
     def field(
-        self, sources: Any, *, nearest: bool = False, xyz: bool = False
-    ) -> Union[np.ndarray, Tuple[np.ndarray, np.ndarray]]:
+        self, sources: Any, *, radius: float = 0.0, nearest: bool = False, xyz: bool = False
+    ) -> Union[np.ndarray, Tuple[np.ndarray, ...]]:
         """The distance from the nearest source to every vertex of the mesh
         file, (n,) float64; with ``nearest``, also the (n,) int32 index of
-        each vertex's nearest source (-1 if none)."""
+        each vertex's nearest source (-1 if none). With ``radius`` > 0, as
+        :meth:`geodex.Client.field`: the exact distances of the vertices
+        within it only, as (k,) int32 vertices (ascending) and (k,) float64
+        distances (and (k,) int32 nearest sources with ``nearest``); a
+        radius that is negative, NaN or infinite is InvalidArgument."""
         src = self._points(sources, "sources", xyz)
+        radius = float(radius)
+        if radius != 0:
+            ids, d, near = self._index.field_within(src.faces, src.weights, radius)
+            return (ids, d, near) if nearest else (ids, d)
         d, near = self._index.field(src.faces, src.weights)
         return (d, near) if nearest else d
 

@@ -23,6 +23,7 @@ channels are thread-safe and a Client keeps no per-call state).
 from __future__ import annotations
 
 import json
+import math
 from typing import Any, Dict, Iterator, List, Optional, Sequence, Tuple, Union
 
 import grpc
@@ -533,26 +534,53 @@ class Client:
         model: str,
         sources: Any,
         *,
+        radius: float = 0.0,
         nearest: bool = False,
         xyz: bool = False,
         version: int = 0,
-    ) -> Union[np.ndarray, Tuple[np.ndarray, np.ndarray]]:
-        """The distance from the nearest of ``sources`` to every vertex.
+    ) -> Union[np.ndarray, Tuple[np.ndarray, ...]]:
+        """The distance from the nearest of ``sources`` to every vertex, or
+        to the vertices within ``radius``.
+
+        Parameters
+        ----------
+        radius : float
+            0 (the default): every vertex, O(1) per vertex per source.
+            > 0 and finite: only the vertices within this geodesic distance
+            of the sources, with exact distances (one exact propagation on
+            the server, whose cost follows the vertices it reaches: for many
+            targets round a few sources).
 
         Returns
         -------
-        numpy.ndarray or (numpy.ndarray, numpy.ndarray)
-            (n,) float64 per vertex of the mesh file (``inf`` for vertices
-            no face uses or on other components); with ``nearest``, also (n,)
-            int32 the index of each vertex's nearest source (-1 if none).
+        numpy.ndarray or tuple of numpy.ndarray
+            Without a radius: (n,) float64 per vertex of the mesh file
+            (``inf`` for vertices no face uses or on other components); with
+            ``nearest``, also (n,) int32 the index of each vertex's nearest
+            source (-1 if none). With a radius: (k,) int32 the vertices
+            within it, ascending, and (k,) float64 their distances; with
+            ``nearest``, also (k,) int32 their nearest sources.
+
+        Raises
+        ------
+        InvalidArgument
+            For a radius that is negative, NaN or infinite.
+        ResourceExhausted
+            When the field within the radius reaches more vertices than the
+            server allows (max_field_vertices).
         """
+        radius = float(radius)
+        if radius != 0 and not (math.isfinite(radius) and radius > 0):
+            raise InvalidArgument(f"the radius must be finite and > 0, got {radius:g}")
         (src,), version = self._points_list(model, [sources], ("sources",), xyz, version)
         request = (
             pb.DistanceFieldRequest(
-                model=_model_ref(model, version), with_nearest_source=bool(nearest)
+                model=_model_ref(model, version), with_nearest_source=bool(nearest), radius=radius
             ).SerializeToString()
             + _wire.length_delimited(2, _wire.surface_points(src.faces, src.weights))
         )
+        if radius > 0:
+            return self._field_within(request, nearest)
         out: Optional[np.ndarray] = None
         near: Optional[np.ndarray] = None
         filled = 0
@@ -582,6 +610,49 @@ class Client:
         if filled != out.shape[0]:
             raise DataLoss(f"the field stream sent {filled} of {out.shape[0]} vertices")
         return out if not nearest else (out, near)
+
+    def _field_within(self, request: bytes, nearest: bool) -> Tuple[np.ndarray, ...]:
+        """The sparse chunks of a field within a radius, assembled."""
+        vertices: List[np.ndarray] = []
+        distances: List[np.ndarray] = []
+        sources: List[np.ndarray] = []
+        total: Optional[int] = None
+        filled = 0
+        try:
+            for data in self._field(request, metadata=self._metadata):
+                fields = _wire.read_fields(data)
+                n, offset = _wire.scalar(fields, 4), _wire.scalar(fields, 1)
+                d = _wire.packed_doubles(fields, 2)
+                v = _wire.packed_varints(fields, 6)
+                if v.shape[0] != d.shape[0]:
+                    raise DataLoss(
+                        f"field chunk of {d.shape[0]} distances for {v.shape[0]} vertices"
+                        + (" (a whole-mesh field: the server predates radius fields)"
+                           if v.shape[0] == 0 else "")
+                    )
+                total = n if total is None else total
+                if n != total or offset != filled or offset + d.shape[0] > total:
+                    raise DataLoss(f"field chunk at {offset} ({d.shape[0]} of {n}) after {filled}")
+                vertices.append(v)
+                distances.append(np.array(d))
+                if nearest:
+                    sources.append(self._sized(_wire.packed_varints(fields, 3), d.shape[0],
+                                               "nearest sources"))
+                filled += d.shape[0]
+        except grpc.RpcError as e:
+            raise _rpc_error(e) from None
+        if total is None:
+            raise DataLoss("the field stream sent no chunk")
+        if filled != total:
+            raise DataLoss(f"the field stream sent {filled} of {total} vertices within the radius")
+        ids = np.concatenate(vertices).astype(np.int32) if vertices else np.zeros(0, np.int32)
+        if ids.shape[0] > 1 and not (np.diff(ids) > 0).all():
+            raise DataLoss("the server sent the field's vertices out of order")
+        out = np.concatenate(distances) if distances else np.zeros(0)
+        if not nearest:
+            return ids, out
+        near = np.concatenate(sources).astype(np.int32) if sources else np.zeros(0, np.int32)
+        return ids, out, near
 
     def expmap(
         self,

@@ -127,6 +127,41 @@ def test_paths_equal_geodex_query(client, torus_index, tmp_path, num_faces, toru
     np.testing.assert_allclose([p.positions[-1] for p in paths], ends, atol=1e-9)
 
 
+def test_field_within_a_radius_is_exact(client, num_faces, torus_mesh):
+    # The reference: each vertex's distance as an exact near pair (a local
+    # exact propagation), for vertices near enough to be refined.
+    vertices, faces = torus_mesh
+    model = client.model(MODEL)
+    area = 0.5 * np.linalg.norm(np.cross(vertices[faces[:, 1]] - vertices[faces[:, 0]],
+                                         vertices[faces[:, 2]] - vertices[faces[:, 0]]), axis=1).sum()
+    scale = np.sqrt(2 * area / (np.sqrt(3) * model.num_samples))  # L
+    sources = random_points(num_faces, 2, 16)
+    radius = 1.5 * scale
+    ids, d, nearest = client.field(MODEL, sources, radius=radius, nearest=True)
+    assert ids.dtype == np.int32 and d.dtype == np.float64 and nearest.dtype == np.int32
+    assert (np.diff(ids) > 0).all() and (d <= radius).all() and set(nearest.tolist()) <= {0, 1}
+    assert 0 < ids.shape[0] < vertices.shape[0] // 4
+    # Every vertex: its face and the corner it is in that face.
+    face_of = np.zeros(vertices.shape[0], np.int32)
+    corner_of = np.zeros(vertices.shape[0], np.int64)
+    for k in range(3):
+        face_of[faces[:, k]] = np.arange(faces.shape[0])
+        corner_of[faces[:, k]] = k
+    at = geodex.SurfacePoints(face_of, np.eye(3)[corner_of])
+    exact = np.full(vertices.shape[0], np.inf)
+    for s in range(2):
+        source = sources.take(slice(s, s + 1))
+        repeated = geodex.SurfacePoints(np.repeat(source.faces, vertices.shape[0]),
+                                        np.repeat(source.weights, vertices.shape[0], axis=0))
+        exact = np.minimum(exact, client.distance(MODEL, repeated, at, near_pairs="exact"))
+    assert max_relative_difference(d, exact[ids]) <= 1e-9
+    off = np.abs(exact - radius) > 1e-9 * radius  # vertices on the circle may go either way
+    assert np.array_equal(np.isin(np.arange(vertices.shape[0]), ids)[off], (exact <= radius)[off])
+    # Without nearest sources: the same vertices and distances.
+    ids2, d2 = client.field(MODEL, sources, radius=radius)
+    assert np.array_equal(ids2, ids) and np.array_equal(d2, d)
+
+
 def test_field_equals_geodex_query(client, torus_index, tmp_path, num_faces):
     sources = random_points(num_faces, 5, 15)
     out = run_query(torus_index, tmp_path, "--nearest", stdin_lines=query_points_lines(sources),

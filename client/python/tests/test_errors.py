@@ -116,6 +116,11 @@ def test_bad_points_of_the_other_methods(client, num_faces):
         client.expmap(MODEL, past, 1.0)
     with pytest.raises(geodex.InvalidArgument, match="radius"):
         client.expmap(MODEL, (3, (1.0, 0.0, 0.0)), -1.0)
+    for radius, shown in [(-1.0, "-1"), (np.nan, "nan"), (np.inf, "inf")]:
+        with pytest.raises(geodex.InvalidArgument, match=f"radius must be finite and > 0, got {shown}"):
+            client.field(MODEL, g, radius=radius)
+    with pytest.raises(geodex.OutOfRange, match=r"sources\[0\]"):
+        client.field(MODEL, past, radius=1.0)
     with pytest.raises(geodex.InvalidArgument, match="one point"):
         client.expmap(MODEL, (g.faces[:2], g.weights[:2]), 1.0)
     with pytest.raises(geodex.InvalidArgument, match=r"xyz\[1\]"):

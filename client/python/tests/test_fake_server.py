@@ -63,6 +63,15 @@ def test_field_matrix_path_locate(fake):
         expected = np.minimum(np.abs(v - 10), np.abs(v - 40))
         assert np.array_equal(d, expected)
         assert nearest.dtype == np.int32 and nearest.shape == (NUM_VERTICES,)
+        # Within a radius: the vertices of the closed form within it (30, in
+        # chunks of 7), ascending, with their distances and nearest sources.
+        ids, dr, near = client.field("fake", sources, radius=7, nearest=True)
+        within = v[expected <= 7]
+        assert ids.dtype == np.int32 and ids.tolist() == within.tolist() and len(within) == 30
+        assert np.array_equal(dr, expected[within]) and dr.dtype == np.float64
+        assert np.array_equal(near, (within > 25).astype(np.int32))
+        ids, dr = client.field("fake", sources, radius=0.5)
+        assert ids.tolist() == [10, 40] and dr.tolist() == [0.0, 0.0]
         a, b = random_points(NUM_FACES, 5, 5), random_points(NUM_FACES, 7, 6)
         m = client.matrix("fake", a, b)
         rows = np.stack([fake_distance(geodex.SurfacePoints(np.repeat(a.faces[i], 7),

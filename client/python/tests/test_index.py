@@ -81,6 +81,15 @@ def test_every_other_method_equals_the_server(index, client, num_faces, torus_me
         assert ours.length == theirs.length
     for ours, theirs in zip(index.field(s, nearest=True), client.field(MODEL, s, nearest=True)):
         assert np.array_equal(ours, theirs)
+    for ours, theirs in zip(index.field(s, radius=0.8, nearest=True),
+                            client.field(MODEL, s, radius=0.8, nearest=True)):
+        assert np.array_equal(ours, theirs) and ours.dtype == theirs.dtype
+    for radius in (-1.0, np.nan, np.inf):
+        with pytest.raises(geodex.InvalidArgument, match="radius must be finite and > 0") as ours:
+            index.field(s, radius=radius)
+        with pytest.raises(geodex.InvalidArgument) as theirs:
+            client.field(MODEL, s, radius=radius)
+        assert str(ours.value).endswith(str(theirs.value).split("got ")[-1])
     for ours, theirs in zip(index.expmap((5, (0.1, 0.1, 0.8)), 1.2, direction=(1, 2, 3)),
                             client.expmap(MODEL, (5, (0.1, 0.1, 0.8)), 1.2, direction=(1, 2, 3))):
         assert np.array_equal(ours, theirs)

@@ -1,5 +1,7 @@
 #include "core/query/internal/local_exact.h"
 
+#include <algorithm>
+#include <cmath>
 #include <memory>
 #include <optional>
 #include <span>
@@ -90,6 +92,50 @@ absl::StatusOr<std::span<const double>> LocalExact::Distances(const SurfacePoint
   options.stop_radius = radius;
   GEODEX_RETURN_IF_ERROR(solver->Propagate({p}, options));
   return std::span<const double>(solver->VertexDistances());
+}
+
+absl::StatusOr<RadiusField> LocalExact::DistancesWithin(std::span<const SurfacePoint> sources,
+                                                        double radius, int64_t max_vertices,
+                                                        QueryScratch& scratch) const {
+  if (!(std::isfinite(radius) && radius > 0)) {
+    return absl::InvalidArgumentError(
+        absl::StrFormat("the radius must be finite and > 0, got %g", radius));
+  }
+  if (sources.empty()) return absl::InvalidArgumentError("no sources given");
+  geodesic::ExactGeodesicSolver* solver = ExactSolver(scratch);
+  if (solver == nullptr) {
+    return absl::InternalError("the index's mesh cannot be rebuilt for exact propagation");
+  }
+  geodesic::GeodesicOptions options;
+  options.stop_radius = radius;
+  options.max_vertices = max_vertices;
+  if (absl::Status status = solver->Propagate(sources, options); !status.ok()) {
+    if (max_vertices > 0 && absl::IsResourceExhausted(status) &&
+        static_cast<int64_t>(solver->ReachedVertices().size()) > max_vertices) {
+      return absl::ResourceExhaustedError(absl::StrFormat(
+          "the field within radius %g reaches more than %d vertices", radius, max_vertices));
+    }
+    // The solver's window budget: a safety net against pathological meshes,
+    // not a limit of the request (ResourceExhausted stays the vertex cap's).
+    if (absl::IsResourceExhausted(status)) return absl::InternalError(status.message());
+    return status;
+  }
+  // Vertices past the radius were reached too, with upper bounds: within it,
+  // every distance is final (all the work closer than the radius was done).
+  std::vector<int32_t> within;
+  for (const int32_t v : solver->ReachedVertices()) {
+    if (solver->VertexDistance(v) <= radius) within.push_back(v);
+  }
+  std::sort(within.begin(), within.end());
+  RadiusField field;
+  field.vertices = std::move(within);
+  field.distance.reserve(field.vertices.size());
+  field.nearest.reserve(field.vertices.size());
+  for (const int32_t v : field.vertices) {
+    field.distance.push_back(solver->VertexDistance(v));
+    field.nearest.push_back(solver->NearestSource(v));
+  }
+  return field;
 }
 
 absl::StatusOr<std::vector<PathPoint>> LocalExact::CorridorPath(const std::vector<PathPoint>& path,

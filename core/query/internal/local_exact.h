@@ -60,6 +60,20 @@ class LocalExact {
   absl::StatusOr<std::span<const double>> Distances(const SurfacePoint& p, double radius,
                                                     QueryScratch& scratch) const;
 
+  // Exact distances from the nearest of valid canonical `sources` to every
+  // vertex within `radius`, by one propagation from all of them: the vertices
+  // ascending, each with its distance and the index (into `sources`) of its
+  // nearest source. The cost follows the faces reached, not the mesh: the
+  // solver resets only what its last propagation touched, and the vertices
+  // are read from the list of those it reached. Errors: InvalidArgument for a
+  // radius that is not finite and > 0 or no source; ResourceExhausted when
+  // `max_vertices` > 0 and the propagation reaches more vertices (it stops
+  // there); Internal when the index's mesh cannot be rebuilt or the
+  // propagation exceeds the solver's window budget (GeodesicOptions::
+  // max_windows, a safety net against pathological meshes).
+  absl::StatusOr<RadiusField> DistancesWithin(std::span<const SurfacePoint> sources, double radius,
+                                              int64_t max_vertices, QueryScratch& scratch) const;
+
   // The exact shortest path from the first point of `path` to its last
   // among the faces within `steps` edge steps of the faces `path` crosses,
   // or an error (e.g. when that corridor is not a manifold mesh).

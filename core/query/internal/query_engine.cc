@@ -199,6 +199,16 @@ absl::StatusOr<DistanceField> QueryEngine::Field(std::span<const SurfacePoint> s
   return ApproximateField(view_, lifting_, unfolding_, canonical);
 }
 
+absl::StatusOr<RadiusField> QueryEngine::FieldWithin(std::span<const SurfacePoint> sources,
+                                                     const FieldWithinOptions& options,
+                                                     QueryScratch& scratch) const {
+  if (sources.empty()) return absl::InvalidArgumentError("no sources given");
+  std::vector<SurfacePoint> canonical;
+  canonical.reserve(sources.size());
+  for (const SurfacePoint& source : sources) canonical.push_back(view_.Canonical(source));
+  return exact_.DistancesWithin(canonical, options.radius, options.max_vertices, scratch);
+}
+
 absl::StatusOr<std::vector<ExpMapVertex>> QueryEngine::ExpMap(const SurfacePoint& centre,
                                                               const ExpMapOptions& options,
                                                               QueryScratch* scratch) const {

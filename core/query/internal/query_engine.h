@@ -128,6 +128,16 @@ class QueryEngine {
   // (distance_field.h). Errors: InvalidArgument if empty.
   absl::StatusOr<DistanceField> Field(std::span<const SurfacePoint> sources) const;
 
+  // The exact distance from the nearest of `sources` to every vertex within
+  // options.radius, by one exact propagation from all of them
+  // (LocalExact::DistancesWithin): its cost follows the vertices reached,
+  // not the mesh, and is not O(1) per vertex. `scratch` keeps the solver
+  // between calls. Errors: InvalidArgument if empty or for a radius that is
+  // not finite and > 0; ResourceExhausted past options.max_vertices.
+  absl::StatusOr<RadiusField> FieldWithin(std::span<const SurfacePoint> sources,
+                                          const FieldWithinOptions& options,
+                                          QueryScratch& scratch) const;
+
   // The exponential map round `centre` (exp_map.h, §6.4). Errors: those of
   // query::ExpMap.
   absl::StatusOr<std::vector<ExpMapVertex>> ExpMap(const SurfacePoint& centre,

@@ -152,6 +152,19 @@ class Client {
                                                 absl::Span<const SurfacePoint> sources,
                                                 bool with_nearest_source = false) const;
 
+  // The exact distance from the nearest source to every mesh vertex within
+  // query.radius, and only those (geodex.v1.DistanceFieldRequest.radius):
+  // one exact propagation on the server whose cost follows the vertices it
+  // reaches, for many targets round few sources (local descriptors,
+  // learning on meshes). Entries ascend by vertex. Errors: INVALID_ARGUMENT
+  // for a radius that is not finite and > 0 (checked here) or bad sources;
+  // RESOURCE_EXHAUSTED past the server's max_field_vertices; DATA_LOSS if
+  // the chunks are not one consistent answer, or the server answered with
+  // a whole-mesh field (one older than radius fields).
+  absl::StatusOr<VertexDistancesWithin> DistanceFieldWithin(const ModelRef& model,
+                                                            absl::Span<const SurfacePoint> sources,
+                                                            const FieldWithinQuery& query) const;
+
   // The exponential map round `center` (geodesic polar coordinates of every
   // vertex within query.radius), assembled from the streamed chunks; entries
   // ascend by vertex. Errors: INVALID_ARGUMENT for a bad centre, radius or

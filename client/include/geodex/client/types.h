@@ -133,6 +133,25 @@ struct VertexDistances {
   int64_t version = 0;
 };
 
+// What one DistanceFieldWithin call asks for.
+struct FieldWithinQuery {
+  // Vertices farther than this from every source are left out; finite, > 0.
+  double radius = 0;
+  // Also the index of each vertex's nearest source.
+  bool with_nearest_source = false;
+};
+
+// A distance field within a radius: entry i is mesh vertex vertices[i]
+// (ascending), at exact geodesic distance distances[i] <= radius from its
+// nearest source, whose index is nearest_source[i] (empty unless asked
+// for). Vertices beyond the radius are left out.
+struct VertexDistancesWithin {
+  std::vector<int32_t> vertices;
+  std::vector<double> distances;
+  std::vector<int32_t> nearest_source;
+  int64_t version = 0;  // the model version that answered
+};
+
 // A model's triangle mesh as its index holds it: vertex v is positions[v]
 // (unreferenced vertices included), face f is faces[f], three vertex ids in
 // the order of the source file. The ids are those of SurfacePoint::face and
