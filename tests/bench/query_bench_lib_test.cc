@@ -177,9 +177,9 @@ TEST(QueryBenchRunTest, MeasuresASmallIndex) {
   EXPECT_LE(f.near_pairs, 1000u);
 }
 
-// The whole run on a calibrated index in a file: its three tables, each row
+// The whole run on a calibrated index in a file: its five tables, each row
 // as wide as its header.
-TEST(QueryBenchRunTest, PrintsFourTables) {
+TEST(QueryBenchRunTest, PrintsFiveTables) {
   const auto path = std::filesystem::temp_directory_path() /
                     ("query_bench_lib_test_" + std::to_string(getpid()) + ".gdx");
   {
@@ -198,9 +198,13 @@ TEST(QueryBenchRunTest, PrintsFourTables) {
     if (line[0] == '|') widths.push_back(Columns(line));
   }
   // Header and rule, one row; header and rule, uniform and four bins;
-  // header and rule, three radii; header and rule, four fields.
-  EXPECT_EQ(widths, (std::vector<int>{14, 14, 14, 11, 11, 11, 11, 11, 11, 11, 6,
-                                      6,  6,  6,  6,  5,  5,  5,  5,  5,  5}));
+  // header and rule, vertex and interior points in four bins, uniform pairs
+  // and two tolerances; header and rule, three radii; header and rule, four
+  // fields.
+  EXPECT_EQ(widths, (std::vector<int>{14, 14, 14, 11, 11, 11, 11, 11, 11, 11, 9, 9, 9, 9,
+                                      9,  9,  9,  9,  9,  9,  9,  9,  9,  6,  6,  6, 6, 6,
+                                      5,  5,  5,  5,  5,  5}));
+  EXPECT_THAT(out, HasSubstr("\nRefined answers against the exact engine"));
   EXPECT_THAT(out, HasSubstr("\nExponential map (5 interior centres)\n"));
   EXPECT_THAT(out, HasSubstr("\nDistance fields (5 interior sources, one at a time)\n"));
   EXPECT_THAT(out, HasSubstr("| whole mesh, exact | 642 |"));
