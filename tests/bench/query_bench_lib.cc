@@ -7,8 +7,10 @@
 #include <span>
 #include <utility>
 
+#include "absl/status/status.h"
 #include "absl/strings/str_format.h"
 #include "core/builder/builder.h"
+#include "core/common/status_macros.h"
 #include "core/mesh/generators.h"
 #include "core/query/input_queries.h"
 #include "core/query/internal/exp_map.h"
@@ -259,7 +261,10 @@ int RunOnGeneratedSphere(int pairs) {
   std::printf("\n%s", ExpMapHeader().c_str());
   BenchExpMap("sphere(5)", *ix);
   std::printf("\nDistance fields (5 interior sources, one at a time)\n%s", FieldHeader().c_str());
-  BenchField("sphere(5)", *ix);
+  if (const absl::Status status = BenchField("sphere(5)", *ix); !status.ok()) {
+    std::fprintf(stderr, "sphere(5): %s\n", status.ToString().c_str());
+    return 1;
+  }
   return 0;
 }
 
@@ -277,11 +282,15 @@ std::unique_ptr<CLI::App> QueryBenchFlags(QueryBenchOptions* options) {
 }
 
 std::vector<mesh::SurfacePoint> InteriorPoints(const index::Index& ix, int n, uint64_t seed) {
+  return InteriorPoints(ix.num_faces(), n, seed);
+}
+
+std::vector<mesh::SurfacePoint> InteriorPoints(int32_t num_faces, int n, uint64_t seed) {
   std::mt19937_64 rng(seed);
   std::uniform_real_distribution<double> u(0, 1);
   std::vector<mesh::SurfacePoint> out;
   while (static_cast<int>(out.size()) < n) {
-    const int32_t f = static_cast<int32_t>(rng() % ix.num_faces());
+    const int32_t f = static_cast<int32_t>(rng() % num_faces);
     double a = u(rng), b = u(rng);
     if (a + b > 1) a = 1 - a, b = 1 - b;
     out.push_back({f, {1 - a - b, a, b}});
@@ -433,26 +442,31 @@ void BenchExpMap(const std::string& label, std::shared_ptr<const index::Index> i
   }
 }
 
-void BenchField(const std::string& label, std::shared_ptr<const index::Index> ix) {
-  auto queries = *query::InputQueries::Create(ix);
-  const auto sources = InteriorPoints(*ix, 5, 8);
+absl::Status BenchField(const std::string& label, std::shared_ptr<const index::Index> ix) {
+  GEODEX_ASSIGN_OR_RETURN(auto queries, query::InputQueries::Create(ix));
+  // Points of the mesh file's faces: the facade's ids, which differ from the
+  // index's where the builder split long edges or repaired the mesh.
+  const auto sources = InteriorPoints(queries->num_faces(), 5, 8);
   std::vector<query::EnginePoints> read(sources.size());
   for (size_t i = 0; i < sources.size(); ++i) {
-    (void)queries->Read(std::span(&sources[i], 1), query::Named("source"), &read[i]);
+    GEODEX_RETURN_IF_ERROR(queries->Read(std::span(&sources[i], 1), query::Named("source"), &read[i]));
   }
   const double l = queries->scale_length();
   query::QueryScratch scratch;
   // The lazy exact mesh and the scratch's solver, made before the clock runs.
-  (void)queries->FieldWithin(read[0], {.radius = l}, &scratch);
+  GEODEX_RETURN_IF_ERROR(queries->FieldWithin(read[0], {.radius = l}, &scratch).status());
   const double kWhole = std::numeric_limits<double>::max();
   for (const double radius : {3 * l, 10 * l, 0.0, kWhole}) {
     size_t vertices = 0;
     const double t0 = ThreadCpuSeconds();
     for (const query::EnginePoints& source : read) {
       if (radius == 0) {
-        vertices += queries->Field(source)->distance.size();
+        GEODEX_ASSIGN_OR_RETURN(const query::DistanceField field, queries->Field(source));
+        vertices += field.distance.size();
       } else {
-        vertices += queries->FieldWithin(source, {.radius = radius}, &scratch)->vertices.size();
+        GEODEX_ASSIGN_OR_RETURN(const query::RadiusField field,
+                                queries->FieldWithin(source, {.radius = radius}, &scratch));
+        vertices += field.vertices.size();
       }
     }
     FieldFigures f;
@@ -463,6 +477,7 @@ void BenchField(const std::string& label, std::shared_ptr<const index::Index> ix
     f.per_field = static_cast<double>(vertices) / read.size();
     std::printf("%s\n", FieldRow(label, f).c_str());
   }
+  return absl::OkStatus();
 }
 
 std::string FieldHeader() {
@@ -523,7 +538,12 @@ int RunQueryBench(const QueryBenchOptions& options) {
   }
   if (!options.expmap_only) {
     std::printf("\nDistance fields (5 interior sources, one at a time)\n%s", FieldHeader().c_str());
-    for (size_t i = 0; i < loaded.size(); ++i) BenchField(options.indexes[i], loaded[i]);
+    for (size_t i = 0; i < loaded.size(); ++i) {
+      if (const absl::Status status = BenchField(options.indexes[i], loaded[i]); !status.ok()) {
+        std::fprintf(stderr, "%s: %s\n", options.indexes[i].c_str(), status.ToString().c_str());
+        return 1;
+      }
+    }
   }
   return 0;
 }

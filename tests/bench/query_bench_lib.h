@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "CLI/CLI.hpp"
+#include "absl/status/status.h"
 #include "core/index/index.h"
 #include "core/mesh/mesh.h"
 
@@ -32,6 +33,7 @@ std::unique_ptr<CLI::App> QueryBenchFlags(QueryBenchOptions* options);
 // `n` area-uniform interior points (fixed `seed`): a random face, random
 // barycentric weights.
 std::vector<mesh::SurfacePoint> InteriorPoints(const index::Index& ix, int n, uint64_t seed);
+std::vector<mesh::SurfacePoint> InteriorPoints(int32_t num_faces, int n, uint64_t seed);
 
 // `n` points at a random corner of a random face (fixed `seed`).
 std::vector<mesh::SurfacePoint> VertexPoints(const index::Index& ix, int n, uint64_t seed);
@@ -121,8 +123,8 @@ struct FieldFigures {
 // Measures and prints the distance field rows of `ix`: fields of one source
 // at a time (5 interior points) within 3 L and 10 L (exact, FieldWithin),
 // against the whole-mesh field (O(1) per vertex, Field) and the exact one
-// (FieldWithin with an unbounded radius).
-void BenchField(const std::string& label, std::shared_ptr<const index::Index> ix);
+// (FieldWithin with an unbounded radius). Errors: those of the queries.
+absl::Status BenchField(const std::string& label, std::shared_ptr<const index::Index> ix);
 
 // The distance field table's header, and one row of it (no newline).
 std::string FieldHeader();

@@ -11,6 +11,8 @@
 #include <vector>
 
 #include "absl/strings/str_split.h"
+#include "core/builder/builder.h"
+#include "core/builder/mesh_arrays.h"
 #include "core/mesh/generators.h"
 #include "core/validation/test_index.h"
 #include "gmock/gmock.h"
@@ -208,6 +210,30 @@ TEST(QueryBenchRunTest, PrintsFiveTables) {
   EXPECT_THAT(out, HasSubstr("\nExponential map (5 interior centres)\n"));
   EXPECT_THAT(out, HasSubstr("\nDistance fields (5 interior sources, one at a time)\n"));
   EXPECT_THAT(out, HasSubstr("| whole mesh, exact | 642 |"));
+}
+
+// The field rows read their sources in the mesh file's ids: on an index
+// whose builder split long edges (a coarse sphere sampled more finely than it
+// has vertices) those are not the index's own faces.
+TEST(QueryBenchRunTest, FieldsOfASplitIndex) {
+  const mesh::Mesh coarse = mesh::gen::Sphere(1, 1.0);
+  auto prepared = builder::PrepareMesh(coarse, {}, 120, /*refine=*/true);
+  ASSERT_TRUE(prepared.ok()) << prepared.status();
+  builder::BuildOptions options;
+  options.num_samples = 120;
+  builder::BuildSummary summary;
+  auto data = builder::BuildPreparedIndex(*prepared, options, &summary);
+  ASSERT_TRUE(data.ok()) << data.status();
+  auto bytes = index::SerializeIndex(*data);
+  ASSERT_TRUE(bytes.ok()) << bytes.status();
+  auto ix = index::Index::FromBytes(*std::move(bytes));
+  ASSERT_TRUE(ix.ok()) << ix.status();
+  ASSERT_GT((*ix)->split_vertices(), 0);
+  ::testing::internal::CaptureStdout();
+  const absl::Status status = BenchField("split", *ix);
+  const std::string out = ::testing::internal::GetCapturedStdout();
+  ASSERT_TRUE(status.ok()) << status;
+  EXPECT_THAT(out, HasSubstr("| split | whole mesh, exact | 42 |"));
 }
 
 TEST(QueryBenchRunTest, AnIndexThatCannotBeOpenedExitsOne) {
