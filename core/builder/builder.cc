@@ -9,6 +9,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
+#include "absl/strings/str_join.h"
 #include "core/builder/mesh_arrays.h"
 #include "core/builder/vertex_assignment.h"
 #include "core/common/status_macros.h"
@@ -181,6 +182,7 @@ void Summarize(const Mesh& mesh, const Plan& plan, const SampleDistances& sample
   summary->requested_samples = plan.requested_samples;
   summary->num_samples = plan.num_samples();
   summary->repair = plan.repair.Summary();
+  summary->euler_samples = plan.repair.euler_samples;
   summary->num_triangles = static_cast<int32_t>(plan.triangles.size());
   summary->referenced_vertices = counts.referenced;
   summary->unassigned_vertices = counts.unassigned;
@@ -291,7 +293,7 @@ absl::Status RepairIntoPlan(const Mesh& mesh, sampling::SampleSet set, const Bui
 }  // namespace
 
 std::string BuildSummary::ToText() const {
-  return absl::StrFormat(
+  std::string out = absl::StrFormat(
       "requested_samples = %d\nsamples = %d\nrepair = %s\ntriangles = %d\n"
       "referenced_vertices = %d\nunassigned_vertices = %d\nshare_outside_triangle = %.6g\n"
       "longest_edge = %.9g\nbbox_diagonal = %.9g\ngeodesic_edges = %d\n"
@@ -300,6 +302,12 @@ std::string BuildSummary::ToText() const {
       requested_samples, num_samples, repair, num_triangles, referenced_vertices,
       unassigned_vertices, share_outside, longest_edge, bbox_diagonal, geodesic_edges,
       edge_crossings_found, edge_length_total, edge_length_max, edge_length_error);
+  // Only when there are any, so that an index of a mesh whose samples saw its
+  // topology keeps its bytes.
+  if (!euler_samples.empty()) {
+    absl::StrAppend(&out, "repair_euler_samples = ", absl::StrJoin(euler_samples, " "), "\n");
+  }
+  return out;
 }
 
 absl::StatusOr<Plan> MakePlan(const Mesh& mesh, const BuildOptions& options) {

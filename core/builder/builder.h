@@ -81,6 +81,9 @@ struct BuildSummary {
   int32_t requested_samples = 0;
   int32_t num_samples = 0;
   std::string repair;
+  // The samples added for a wrong Euler characteristic (indices into the
+  // samples, in the order added; triangulation::RepairReport::euler_samples).
+  std::vector<int32_t> euler_samples;
   int32_t num_triangles = 0;
   int64_t referenced_vertices = 0;
   int64_t unassigned_vertices = 0;
@@ -97,7 +100,8 @@ struct BuildSummary {
   double bbox_diagonal = 0;
   uint64_t index_bytes = 0;
   // "key = value" lines without the timings (the index stores them, and the
-  // same input must give the same bytes).
+  // same input must give the same bytes); repair_euler_samples only when
+  // there are any.
   std::string ToText() const;
 };
 

@@ -2,10 +2,11 @@
 // tiny handles, a tube pinched almost shut, pinched vertices, crossing
 // sheets, duplicate and zero-area faces, many tiny components, a decimated
 // shape), each through the whole build as geodex-build runs it: repaired,
-// refined, sampled, triangulated, its rows computed and merged. Each either
-// builds and answers (distances finite within a component, close to the
-// exact geodesic on a few pairs) or is refused in one short line that names
-// the place. And every refusal the build can end with keeps to that length.
+// refined, sampled, triangulated, its rows computed and merged. Each has a
+// valid triangulation, so each must build and answer (distances finite
+// within a component, close to the exact geodesic on a few pairs); a refusal
+// fails the test, and must still be one short line that names the place. And
+// every refusal the build can end with keeps to that length.
 
 #include <chrono>
 #include <cmath>
@@ -22,9 +23,11 @@
 #include "core/builder/build_pipeline.h"
 #include "core/builder/builder.h"
 #include "core/builder/mesh_arrays.h"
+#include "core/builder/workdir.h"
 #include "core/common/file_util.h"
 #include "core/geodesic/exact_geodesic.h"
 #include "core/index/index.h"
+#include "core/index/index_report.h"
 #include "core/mesh/broken_meshes_testing.h"
 #include "core/mesh/generators.h"
 #include "core/mesh/mesh_io.h"
@@ -188,7 +191,12 @@ std::vector<ScanCase> ScanCases() {
   return cases;
 }
 
-TEST(ScanBuildTest, EveryScanBuildsAndAnswersOrIsRefusedReadably) {
+// Every case's surface can be triangulated: the repair keeps its zero-area
+// faces and pressed-flat folds, but the triangulation traces its edges along
+// the mesh edges there (geodesic_edges.h) and compares them in degenerate
+// faces by their combinatorics. The inputs the build legitimately refuses
+// are in EveryRefusalOfTheBuildFitsOneShortLine.
+TEST(ScanBuildTest, EveryScanBuildsAndAnswers) {
   for (const ScanCase& c : ScanCases()) {
     SCOPED_TRACE(c.name);
     const auto start = std::chrono::steady_clock::now();
@@ -204,6 +212,7 @@ TEST(ScanBuildTest, EveryScanBuildsAndAnswersOrIsRefusedReadably) {
       EXPECT_LT(out.worst, 0.25);
     } else {
       std::printf("%-30s refused in %.1f s: %s\n", c.name, seconds, out.refusal.c_str());
+      ADD_FAILURE() << c.name << " can be triangulated but was refused: " << out.refusal;
     }
   }
 }
@@ -298,6 +307,71 @@ TEST(ScanBuildTest, ATunnelTheSamplesMissIsLocatedAndSampled) {
     EXPECT_NE(message.find(" L long at vertex "), std::string::npos) << message;
   }
   EXPECT_TRUE(named);
+}
+
+// The build report says where the samples added for the topology went, and
+// a distributed build's plan file keeps them.
+TEST(ScanBuildTest, TheReportPlacesTheSamplesAddedForATunnel) {
+  const RawMesh raw = mt::ClusterVertices(mt::RawOf(gen::Torus(96, 48, 1.0, 0.9), "torus"), 0.03);
+  absl::StatusOr<mesh::RepairedMesh> repaired = mesh::RepairMesh(raw);
+  ASSERT_TRUE(repaired.ok()) << repaired.status();
+  const Mesh& mesh = repaired->mesh;
+  builder::BuildOptions options;
+  options.num_samples = 30;
+  options.threads = 2;
+  absl::StatusOr<builder::Plan> plan = builder::MakePlan(mesh, options);
+  ASSERT_TRUE(plan.ok()) << plan.status();
+  const std::vector<int32_t>& euler = plan->repair.euler_samples;
+  EXPECT_EQ(
+      static_cast<int32_t>(euler.size()),
+      plan->repair.added_for[static_cast<int>(triangulation::ViolationKind::kEulerCharacteristic)]);
+  ASSERT_FALSE(euler.empty());
+  for (int32_t a : euler) {
+    EXPECT_GE(a, options.num_samples);  // added by the repair
+    EXPECT_LT(a, plan->num_samples());
+  }
+
+  const std::string dir =
+      (std::filesystem::temp_directory_path() / "geodex_euler_samples_plan").string();
+  ASSERT_TRUE(builder::SavePlan(mesh, *plan, dir).ok());
+  auto loaded = builder::LoadPlan(dir);
+  ASSERT_TRUE(loaded.ok()) << loaded.status();
+  EXPECT_EQ(loaded->second.repair.euler_samples, euler);
+  std::filesystem::remove_all(dir);
+
+  builder::BuildSummary summary;
+  absl::StatusOr<index::IndexData> data =
+      builder::BuildIndexFromPlan(mesh, *plan, options, &summary);
+  ASSERT_TRUE(data.ok()) << data.status();
+  absl::StatusOr<std::string> bytes = index::SerializeIndex(*data);
+  ASSERT_TRUE(bytes.ok()) << bytes.status();
+  auto index = index::Index::FromBytes(*std::move(bytes));
+  ASSERT_TRUE(index.ok()) << index.status();
+  const index::IndexReport report = index::MakeIndexReport(**index);
+  EXPECT_EQ(report.euler_samples, static_cast<int64_t>(euler.size()));
+  ASSERT_EQ(report.euler_sample_places.size(),
+            std::min<size_t>(euler.size(), index::kReportedEulerSamples));
+  for (size_t i = 0; i < report.euler_sample_places.size(); ++i) {
+    const index::PlacedSample& place = report.euler_sample_places[i];
+    const int32_t v = plan->samples[euler[i]];
+    EXPECT_EQ(place.sample, euler[i]);
+    EXPECT_EQ(place.position[0], mesh.position(v).x());
+    EXPECT_EQ(place.position[1], mesh.position(v).y());
+    EXPECT_EQ(place.position[2], mesh.position(v).z());
+    if (v < report.vertices) {
+      EXPECT_EQ(place.vertex, v);
+      EXPECT_FALSE(place.copy || place.midpoint);
+    }
+  }
+  const std::string text = index::IndexReportText(report, "tunnel.gdx");
+  std::printf("%s", text.c_str());
+  EXPECT_NE(text.find(absl::StrFormat("%d of them for the topology the samples missed, at ",
+                                      euler.size())),
+            std::string::npos)
+      << text;
+  EXPECT_NE(index::IndexReportJson(report).find(
+                absl::StrFormat("\"added_for_topology\": %d", euler.size())),
+            std::string::npos);
 }
 
 // Refusals name the place: stop the repair before it is done.

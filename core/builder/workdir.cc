@@ -20,8 +20,10 @@ namespace {
 // The last byte of a magic is the format version. Plan versions: 1 initial;
 // 2 adds kEdgesCross to the repair report (9 counters), the crossings found
 // and the figures of the traced geodesic edges; 3 adds the cell radii (2 is
-// still read, without them).
-constexpr char kPlanMagic[8] = {'G', 'D', 'X', 'P', 'L', 'A', 'N', '3'};
+// still read, without them); 4 adds the samples added for a wrong Euler
+// characteristic (3 is still read, without them).
+constexpr char kPlanMagic[8] = {'G', 'D', 'X', 'P', 'L', 'A', 'N', '4'};
+constexpr char kPlanMagicV3[8] = {'G', 'D', 'X', 'P', 'L', 'A', 'N', '3'};
 constexpr char kPlanMagicV2[8] = {'G', 'D', 'X', 'P', 'L', 'A', 'N', '2'};
 constexpr char kRowsMagic[8] = {'G', 'D', 'X', 'R', 'O', 'W', 'S', '1'};
 // 2 adds the long-edge split (coarse faces, pieces, midpoint count); 1 is
@@ -121,6 +123,7 @@ absl::Status SavePlan(const mesh::Mesh& mesh, const Plan& plan, const std::strin
   w.Put(plan.edge_stats.max_relative_error);
   w.Put(plan.sampling_seconds);
   w.Put(plan.triangulation_seconds);
+  w.PutVector(plan.repair.euler_samples);
   Seal(w);
   return AtomicWriteFile(PlanPath(workdir), w.bytes());
 }
@@ -129,10 +132,14 @@ absl::StatusOr<std::pair<mesh::Mesh, Plan>> LoadPlan(const std::string& workdir)
   GEODEX_ASSIGN_OR_RETURN(mesh::Mesh mesh, LoadWorkMesh(PlanMeshPath(workdir)));
   const std::string path = PlanPath(workdir);
   GEODEX_ASSIGN_OR_RETURN(const std::string bytes, ReadWholeFile(path));
-  const bool v2 = bytes.size() >= sizeof(kPlanMagicV2) &&
-                  std::memcmp(bytes.data(), kPlanMagicV2, sizeof(kPlanMagicV2)) == 0;
-  GEODEX_ASSIGN_OR_RETURN(const std::string_view payload,
-                          Unseal(bytes, v2 ? kPlanMagicV2 : kPlanMagic, path));
+  auto is = [&](const char(&magic)[8]) {
+    return bytes.size() >= sizeof(magic) && std::memcmp(bytes.data(), magic, sizeof(magic)) == 0;
+  };
+  const bool v2 = is(kPlanMagicV2);
+  const bool v3 = is(kPlanMagicV3);
+  GEODEX_ASSIGN_OR_RETURN(
+      const std::string_view payload,
+      Unseal(bytes, v2 ? kPlanMagicV2 : (v3 ? kPlanMagicV3 : kPlanMagic), path));
   ByteReader r(payload, path);
   Plan plan;
   GEODEX_RETURN_IF_ERROR(r.Get(&plan.mesh_hash));
@@ -153,6 +160,7 @@ absl::StatusOr<std::pair<mesh::Mesh, Plan>> LoadPlan(const std::string& workdir)
   GEODEX_RETURN_IF_ERROR(r.Get(&plan.edge_stats.max_relative_error));
   GEODEX_RETURN_IF_ERROR(r.Get(&plan.sampling_seconds));
   GEODEX_RETURN_IF_ERROR(r.Get(&plan.triangulation_seconds));
+  if (!v2 && !v3) GEODEX_RETURN_IF_ERROR(r.GetVector(&plan.repair.euler_samples));
   if (!r.AtEnd()) return absl::DataLossError(absl::StrFormat("%s has trailing bytes", path));
   if (index::MeshHash(FlatPositions(mesh), FlatFaces(mesh)) != plan.mesh_hash) {
     return absl::FailedPreconditionError(
@@ -164,6 +172,7 @@ absl::StatusOr<std::pair<mesh::Mesh, Plan>> LoadPlan(const std::string& workdir)
                (plan.cell_radius.empty() || static_cast<int32_t>(plan.cell_radius.size()) == m);
   for (double r : plan.cell_radius) valid &= r >= 0 && std::isfinite(r);
   for (int32_t v : plan.samples) valid &= v >= 0 && v < mesh.num_vertices();
+  for (int32_t a : plan.repair.euler_samples) valid &= a >= 0 && a < m;
   for (int32_t a : plan.nearest) valid &= a >= mesh::kNone && a < m;
   for (const auto& t : plan.triangles) {
     for (int32_t a : t) valid &= a >= 0 && a < m;

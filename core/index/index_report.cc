@@ -122,6 +122,46 @@ std::string RepairsMade(const std::string* summary) {
   return made.empty() ? "none" : absl::StrJoin(made, ", ");
 }
 
+// The builder's repair_euler_samples (sample indices), placed on the mesh.
+// The index's vertices are the file's, then the repair's copies, then the
+// refinement's midpoints (r.vertices counts the file's).
+void ReadEulerSamples(const Index& index, IndexReport& r) {
+  const std::string* list = Find(r, "repair_euler_samples");
+  if (list == nullptr) return;
+  const std::span<const int32_t> samples = index.samples();
+  const std::span<const double> positions = index.positions();
+  const std::span<const int32_t> copies = index.vertex_copies();
+  for (absl::string_view word : absl::StrSplit(*list, ' ', absl::SkipEmpty())) {
+    int64_t a = 0;
+    if (!absl::SimpleAtoi(word, &a) || a < 0 || a >= static_cast<int64_t>(samples.size())) continue;
+    ++r.euler_samples;
+    if (r.euler_sample_places.size() >= kReportedEulerSamples) continue;
+    const int64_t v = samples[a];
+    if (v < 0 || 3 * v + 2 >= static_cast<int64_t>(positions.size())) continue;
+    PlacedSample p;
+    p.sample = a;
+    p.position = {positions[3 * v], positions[3 * v + 1], positions[3 * v + 2]};
+    if (v < r.vertices) {
+      p.vertex = v;
+    } else if (v - r.vertices < static_cast<int64_t>(copies.size())) {
+      p.copy = true;
+      p.vertex = copies[v - r.vertices];
+    } else {
+      p.midpoint = true;
+      p.vertex = -1;
+    }
+    r.euler_sample_places.push_back(p);
+  }
+}
+
+// "vertex 12 (0.1, 0.2, 0.3)", "a copy of vertex 12 (...)", "a midpoint (...)".
+std::string DescribePlace(const PlacedSample& p) {
+  const std::string at =
+      absl::StrFormat("(%.4g, %.4g, %.4g)", p.position[0], p.position[1], p.position[2]);
+  if (p.midpoint) return absl::StrCat("a midpoint ", at);
+  return absl::StrCat(p.copy ? "a copy of vertex " : "vertex ", p.vertex, " ", at);
+}
+
 void ReadTarget(IndexReport& r) {
   const std::string* error = Find(r, "target_error");
   double target = 0;
@@ -269,9 +309,9 @@ IndexReport MakeIndexReport(const Index& index) {
   // are the input records, else the faces before refinement.
   r.vertices = r.index_vertices - r.refinement_midpoints -
                static_cast<int64_t>(index.vertex_copies().size());
-  r.faces = !index.input_faces().empty()     ? static_cast<int64_t>(index.input_faces().size())
+  r.faces = !index.input_faces().empty()   ? static_cast<int64_t>(index.input_faces().size())
             : !index.split_faces().empty() ? static_cast<int64_t>(index.coarse_faces().size() / 3)
-                                             : r.index_faces;
+                                           : r.index_faces;
   r.repairs = RepairsMade(Find(r, "mesh_repairs"));
   for (const auto& [key, value] : r.entries) {
     double count = 0;
@@ -284,6 +324,7 @@ IndexReport MakeIndexReport(const Index& index) {
   r.samples = index.num_samples();
   r.samples_added_by_repair = h.params.samples_added_by_repair;
   if (const std::string* repair = Find(r, "repair"); repair != nullptr) r.sample_repair = *repair;
+  ReadEulerSamples(index, r);
   r.triangles = index.num_triangles();
   r.bytes = index.size_bytes();
   ReadSections(index, r);
@@ -347,6 +388,14 @@ std::string IndexReportText(const IndexReport& r, std::string_view title) {
                         "  samples       m = %d: %d requested, %d added by the repair of the "
                         "triangulation\n",
                         r.samples, r.requested_samples, r.samples_added_by_repair);
+  if (r.euler_samples > 0) {
+    std::vector<std::string> places;
+    for (const PlacedSample& p : r.euler_sample_places) places.push_back(DescribePlace(p));
+    if (r.euler_samples > static_cast<int64_t>(places.size())) places.push_back("...");
+    absl::StrAppendFormat(&out,
+                          "                %d of them for the topology the samples missed, at %s\n",
+                          r.euler_samples, absl::StrJoin(places, ", "));
+  }
   absl::StrAppendFormat(&out, "  triangles     %d geodesic triangles\n", r.triangles);
   absl::StrAppendFormat(&out, "  size          %s\n", FormatMiB(r.bytes));
   for (const ReportSection& s : r.sections) {
@@ -393,7 +442,17 @@ std::string IndexReportJson(const IndexReport& r) {
   absl::StrAppend(&out, "}\n  },\n");
   absl::StrAppend(&out, "  \"samples\": {\"requested\": ", r.requested_samples,
                   ", \"final\": ", r.samples, ", \"added_by_repair\": ", r.samples_added_by_repair,
-                  ", \"repair\": ", JsonString(r.sample_repair), "},\n");
+                  ", \"repair\": ", JsonString(r.sample_repair),
+                  ", \"added_for_topology\": ", r.euler_samples, ", \"topology_places\": [");
+  for (size_t i = 0; i < r.euler_sample_places.size(); ++i) {
+    const PlacedSample& p = r.euler_sample_places[i];
+    absl::StrAppend(&out, i ? ", " : "", "{\"sample\": ", p.sample,
+                    ", \"vertex\": ", p.midpoint ? std::string("null") : absl::StrCat(p.vertex),
+                    ", \"copy\": ", p.copy ? "true" : "false", ", \"position\": [",
+                    JsonNumber(p.position[0]), ", ", JsonNumber(p.position[1]), ", ",
+                    JsonNumber(p.position[2]), "]}");
+  }
+  absl::StrAppend(&out, "]},\n");
   absl::StrAppend(&out, "  \"triangles\": ", r.triangles, ",\n");
   absl::StrAppend(&out, "  \"size\": {\"bytes\": ", r.bytes, ", \"sections\": [");
   for (size_t i = 0; i < r.sections.size(); ++i) {

@@ -59,6 +59,18 @@ struct ReportSection {
   uint64_t bytes = 0;
 };
 
+// A sample's place: its vertex in the mesh file's ids (`copy_of` for a copy
+// the repair made of a non-manifold vertex, `midpoint` for a refinement's
+// midpoint, which the file does not have) and its position.
+struct PlacedSample {
+  int64_t sample = 0;
+  int64_t vertex = 0;  // the file's id; for a copy, the vertex it copies; -1 for a midpoint
+  bool copy = false;
+  bool midpoint = false;
+  std::array<double, 3> position = {0, 0, 0};
+};
+inline constexpr int kReportedEulerSamples = 5;
+
 struct IndexReport {
   std::string format;  // "2.1"
   std::string builder;
@@ -77,6 +89,11 @@ struct IndexReport {
   int64_t samples = 0;
   int64_t samples_added_by_repair = 0;
   std::string sample_repair;  // the triangulation's repair, as the builder says it
+  // The samples the repair added for a wrong Euler characteristic: how many,
+  // and where the first kReportedEulerSamples lie (the handles, tunnels and
+  // pinches the requested samples missed).
+  int64_t euler_samples = 0;
+  std::vector<PlacedSample> euler_sample_places;
   int64_t triangles = 0;
   uint64_t bytes = 0;                   // the whole file
   std::vector<ReportSection> sections;  // non-empty groups, largest first

@@ -133,6 +133,11 @@ std::array<double, 3> WeightsIn(const Mesh& mesh, const Location& at, int32_t f)
 
 using geometry::Vec2;
 
+// A face whose doubled area is below this fraction of its longest side
+// squared is degenerate for FindCrossings: the bound by which mesh repair
+// counts sliver faces.
+constexpr double kDegenerateArea = 1e-6;
+
 // A face in its own planar frame: corner 0 at the origin, corner 1 at (l, 0),
 // corner 2 at (cx, cy) with cy > 0.
 struct FaceFrame {
@@ -147,6 +152,17 @@ struct FaceFrame {
     cx = e1.dot(e2) / l;
     cy = e1.cross(e2).norm() / l;
     size = std::max({l, e2.norm(), (e2 - e1).norm()});
+    if (!(cy * l >= kDegenerateArea * size * size)) {
+      // A zero-area or needle face flattens to a segment (or a point), where
+      // every two pieces would touch: a path along one side and the opposite
+      // corner, or two paths that cross the face apart. Which pieces cross is
+      // a matter of the face's combinatorics, the same in any affine image,
+      // so compare them in an equilateral triangle of the same size instead.
+      size = size > 0 ? size : 1;
+      l = size;
+      cx = size / 2;
+      cy = size * std::sqrt(3.0) / 2;
+    }
   }
   Vec2 Map(const std::array<double, 3>& w) const { return {w[1] * l + w[2] * cx, w[2] * cy}; }
   SurfacePoint Unmap(int32_t f, const Vec2& p) const {
@@ -212,6 +228,41 @@ struct Piece {
   std::array<double, 3> p, q;  // barycentric in `face`
   int32_t vp, vq;              // mesh vertex at p / q, or kNone
 };
+
+// When a mesh edge joins vertices u and v and is no longer than their
+// geodesic `distance`, it is a shortest geodesic between them: sets `edge`'s
+// path to it and returns true. Among shortest paths of equal length the
+// propagation's backtracking picks one by rounding, and on a degenerate
+// surface it may pick one that leaves the edge: through the apex of a
+// zero-area face lying on the edge (a cap, which scans and their repair keep)
+// or across the other layer where a fold is pressed flat and its two sides
+// share vertices (decimation by clustering). Such a path meets the Delaunay
+// edges of the neighbouring samples although the mesh edge meets none, and no
+// added sample can change it: the samples there are adjacent vertices
+// already. The mesh edge is the choice that does not depend on rounding.
+bool MeshEdgePath(const Mesh& mesh, int32_t u, int32_t v, double distance, GeodesicEdge* edge) {
+  for (const int32_t h : mesh.Outgoing(u)) {
+    const int32_t f = Mesh::FaceOf(h);
+    const int32_t prev = 3 * f + (h % 3 + 2) % 3;  // the half-edge into u in face f
+    int32_t corner_v;
+    if (mesh.Dest(h) == v) {
+      corner_v = (h % 3 + 1) % 3;
+    } else if (mesh.Origin(prev) == v) {
+      corner_v = prev % 3;
+    } else {
+      continue;
+    }
+    const double length = (mesh.position(v) - mesh.position(u)).norm();
+    if (length > distance * (1 + kSnap)) return false;
+    SurfacePoint from{f, {0, 0, 0}}, to{f, {0, 0, 0}};
+    from.w[h % 3] = 1;
+    to.w[corner_v] = 1;
+    edge->path = {from, to};
+    edge->length = length;
+    return true;
+  }
+  return false;
+}
 
 }  // namespace
 
@@ -282,6 +333,7 @@ absl::StatusOr<std::vector<GeodesicEdge>> TraceEdges(
             return absl::NotFoundError(absl::StrFormat(
                 "adjacent samples %d and %d are not connected on the surface", a, b));
           }
+          if (MeshEdgePath(mesh, samples[a], samples[b], edge.distance, &edge)) continue;
           GEODEX_ASSIGN_OR_RETURN(const SurfacePoint target, mesh::VertexPoint(mesh, samples[b]));
           GEODEX_ASSIGN_OR_RETURN(std::vector<SurfacePoint> back, solver.PathTo(target));
           // PathTo runs from b back to a and may give one place twice (a

@@ -46,8 +46,11 @@ std::vector<std::pair<int32_t, int32_t>> DelaunayEdges(
 // exact propagation per sample a that has a neighbour b > a, stopped as soon
 // as the distances to all those neighbours are final (so each is local), then
 // follows the path back from each b; the samples are shared among `threads`
-// worker threads (0: all hardware threads). The result is sorted by (a, b)
-// and identical for every thread count.
+// worker threads (0: all hardware threads). Samples joined by a mesh edge no
+// longer than their distance are joined by that edge, whichever equally short
+// path the propagation would take (through the apex of a zero-area face on
+// the edge, or across the other layer of a fold pressed flat). The result is
+// sorted by (a, b) and identical for every thread count.
 // Errors: InvalidArgument for a sample id or vertex out of range; NotFound when
 // two adjacent samples are not connected on the surface; errors of the
 // geodesic engine.
@@ -69,11 +72,12 @@ inline constexpr double kTouchTolerance = 1e-9;
 // sample that both end at (`samples[i]` is the vertex of sample i), once per
 // pair, sorted by (first, second). Paths are cut into per-face pieces and
 // compared face by face in that face's own planar frame, within
-// kTouchTolerance. A path point on a mesh edge or vertex belongs to every face
-// around it, so two paths that pass through the same mesh vertex touch; so does
-// a path passing through the vertex of a sample it does not end at. Two edges
-// ending at the same sample touch there only if they leave it in the same
-// direction.
+// kTouchTolerance; a zero-area or sliver face, whose frame is a segment, by
+// the pieces' barycentric coordinates (in an equilateral triangle). A path
+// point on a mesh edge or vertex belongs to every face around it, so two
+// paths that pass through the same mesh vertex touch; so does a path passing
+// through the vertex of a sample it does not end at. Two edges ending at the
+// same sample touch there only if they leave it in the same direction.
 // Errors: InvalidArgument for an invalid path point, a sample id out of range,
 // or two consecutive points with no face in common.
 absl::StatusOr<std::vector<EdgeCrossing>> FindCrossings(const mesh::Mesh& mesh,

@@ -1,8 +1,11 @@
 #include "core/triangulation/geodesic_edges.h"
 
 #include <cmath>
+#include <optional>
 
+#include "absl/strings/str_cat.h"
 #include "core/geodesic/exact_geodesic.h"
+#include "core/mesh/broken_meshes_testing.h"
 #include "core/mesh/generators.h"
 #include "core/triangulation/geodesic_triangulation.h"
 #include "core/triangulation/test_shapes.h"
@@ -287,6 +290,81 @@ TEST_F(CrossingTest, RejectsPathsThatJump) {
   std::vector<GeodesicEdge> edges(1);
   edges[0] = {0, 1, 4, 4, VertexPath(grid_, kN, {{0, 0}, {4, 0}})};
   EXPECT_EQ(Find(samples, edges).status().code(), absl::StatusCode::kInvalidArgument);
+}
+
+// A 4 x 4 grid of unit cells with a zero-area cap: an inner face (a, c, d)
+// split at the midpoint b of its side (a, c) into (a, b, d) and (b, c, d),
+// with the zero-area face (a, c, b) between them and the face (c, a, e)
+// across the side, as scans and their repair leave them.
+class ZeroAreaCapTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    mesh::RawMesh raw = mesh::testing::RawOf(gen::Grid(4, 4, 4.0, 4.0), "grid");
+    const mesh::Mesh grid = gen::Grid(4, 4, 4.0, 4.0);
+    // An inner face whose first side has a face on its other side.
+    int32_t face = 0;
+    while (grid.Twin(3 * face) == mesh::kNone) ++face;
+    a_ = raw.triangles[face][0];
+    c_ = raw.triangles[face][1];
+    d_ = raw.triangles[face][2];
+    const int32_t twin = grid.Twin(3 * face);
+    e_ = grid.face(mesh::Mesh::FaceOf(twin))[(twin % 3 + 2) % 3];
+    split_ = face;
+    cap_ = mesh::testing::AddZeroAreaFace(&raw, face);
+    b_ = static_cast<int32_t>(raw.positions.size()) - 1;
+    auto m = mesh::Mesh::Create(raw.positions, raw.triangles, "capped grid",
+                                {.allow_zero_area_faces = true});
+    ASSERT_TRUE(m.ok()) << m.status();
+    mesh_.emplace(*std::move(m));
+  }
+
+  std::optional<mesh::Mesh> mesh_;
+  int32_t a_ = 0, b_ = 0, c_ = 0, d_ = 0, e_ = 0, split_ = 0, cap_ = 0;
+};
+
+// In the cap, b lies on the side (a, c) in space: flattened, every piece in
+// it would touch every other. It is told apart by its corners: the path along
+// the side meets neither b nor the paths leaving b away from the side, but a
+// path from b across the side into the face beyond crosses it.
+TEST_F(ZeroAreaCapTest, CrossingsInTheCapGoByItsCorners) {
+  const std::vector<int32_t> samples = {a_, c_, b_, d_, e_};
+  auto at = [](int32_t face, double wa, double wb, double wc) {
+    return SurfacePoint{face, {wa, wb, wc}};
+  };
+  // The cap is (a, c, b), the split face (a, b, d).
+  const GeodesicEdge side = {0, 1, 1, 1, {at(cap_, 1, 0, 0), at(cap_, 0, 1, 0)}};
+  const GeodesicEdge to_a = {0, 2, 0.5, 0.5, {at(cap_, 1, 0, 0), at(cap_, 0, 0, 1)}};
+  const GeodesicEdge to_c = {1, 2, 0.5, 0.5, {at(cap_, 0, 1, 0), at(cap_, 0, 0, 1)}};
+  const GeodesicEdge away = {2, 3, 1, 1, {at(split_, 0, 1, 0), at(split_, 0, 0, 1)}};
+  auto found = FindCrossings(*mesh_, samples, std::vector<GeodesicEdge>{side, to_a, to_c, away});
+  ASSERT_TRUE(found.ok()) << found.status();
+  EXPECT_TRUE(found->empty()) << "edges " << (*found)[0].first << ", " << (*found)[0].second;
+  const GeodesicEdge across = {
+      2, 4, 1, 1, {at(cap_, 0, 0, 1), at(cap_, 0.5, 0.5, 0), *mesh::VertexPoint(*mesh_, e_)}};
+  found = FindCrossings(*mesh_, samples, std::vector<GeodesicEdge>{side, across});
+  ASSERT_TRUE(found.ok()) << found.status();
+  EXPECT_EQ(found->size(), 1u);
+}
+
+// Samples joined by a mesh edge as long as their distance are joined by that
+// edge: a and c not through the cap's apex b, as the propagation's path
+// between them goes, at zero extra length. The triangles round b then embed.
+TEST_F(ZeroAreaCapTest, AdjacentSamplesAreJoinedByTheirMeshEdge) {
+  const std::vector<int32_t> samples = {a_, c_, b_, d_, e_};
+  const std::vector<std::array<int32_t, 3>> triangles = {
+      {0, 1, 2}, {0, 2, 3}, {2, 1, 3}, {1, 0, 4}};
+  auto edges = TraceEdges(*mesh_, samples, triangles);
+  ASSERT_TRUE(edges.ok()) << edges.status();
+  for (const GeodesicEdge& edge : *edges) {
+    SCOPED_TRACE(absl::StrCat(edge.a, "-", edge.b));
+    EXPECT_EQ(edge.path.size(), 2u);
+    EXPECT_NEAR(edge.length, edge.distance, 1e-12);
+    EXPECT_EQ(mesh::PositionOf(*mesh_, edge.path.front()), mesh_->position(samples[edge.a]));
+    EXPECT_EQ(mesh::PositionOf(*mesh_, edge.path.back()), mesh_->position(samples[edge.b]));
+  }
+  auto found = FindCrossings(*mesh_, samples, *edges);
+  ASSERT_TRUE(found.ok()) << found.status();
+  EXPECT_TRUE(found->empty());
 }
 
 TEST(GeodesicEdgesTest, ObjHasAVertexPerPointAndALinePerEdge) {

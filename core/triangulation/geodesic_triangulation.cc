@@ -671,6 +671,9 @@ absl::StatusOr<DualComplex> RepairTriangulation(const Mesh& mesh, sampling::Samp
     }
     for (const auto& [vertex, kind] : insert) {
       if (set->distance[vertex] == 0) continue;
+      if (kind == ViolationKind::kEulerCharacteristic) {
+        report->euler_samples.push_back(static_cast<int32_t>(set->samples.size()));
+      }
       GEODEX_RETURN_IF_ERROR(sampling::AddSample(solver, vertex, set));
       ++report->samples_added;
       ++report->added_for[static_cast<int>(kind)];

@@ -80,6 +80,10 @@ struct RepairReport {
   std::array<int32_t, kNumViolationKinds> added_for = {};
   // Pairs of crossing geodesic edges found, summed over the rounds.
   int32_t crossings_found = 0;
+  // The samples (indices into SampleSet::samples) added for a wrong Euler
+  // characteristic, in the order added: where the handles, tunnels and
+  // pinches the first samples missed lie.
+  std::vector<int32_t> euler_samples;
   std::string Summary() const;
 };
 
