@@ -111,10 +111,16 @@ void MatrixBlockToProto(int64_t row_offset, int64_t rows, int64_t num_targets,
   block->mutable_bounds()->Assign(bounds.begin(), bounds.end());
 }
 
-void FieldChunkToProto(const query::DistanceField& field, int64_t offset, int64_t count,
+namespace {
+
+// The part of a chunk both kinds of field share: where it starts, how many
+// vertices the field has, the version, and the slice of distances (and
+// nearest sources, if asked for).
+template <typename Field>
+void FieldSliceToProto(const Field& field, size_t num_vertices, int64_t offset, int64_t count,
                        bool with_nearest_source, int64_t version, v1::DistanceFieldChunk* chunk) {
   chunk->set_vertex_offset(offset);
-  chunk->set_num_vertices(static_cast<int64_t>(field.distance.size()));
+  chunk->set_num_vertices(static_cast<int64_t>(num_vertices));
   chunk->set_version(version);
   chunk->mutable_distances()->Assign(field.distance.begin() + offset,
                                      field.distance.begin() + offset + count);
@@ -126,22 +132,21 @@ void FieldChunkToProto(const query::DistanceField& field, int64_t offset, int64_
   }
 }
 
+}  // namespace
+
+void FieldChunkToProto(const query::DistanceField& field, int64_t offset, int64_t count,
+                       bool with_nearest_source, int64_t version, v1::DistanceFieldChunk* chunk) {
+  FieldSliceToProto(field, field.distance.size(), offset, count, with_nearest_source, version,
+                    chunk);
+}
+
 void RadiusFieldChunkToProto(const query::RadiusField& field, int64_t offset, int64_t count,
                              bool with_nearest_source, int64_t version,
                              v1::DistanceFieldChunk* chunk) {
-  chunk->set_vertex_offset(offset);
-  chunk->set_num_vertices(static_cast<int64_t>(field.vertices.size()));
-  chunk->set_version(version);
+  FieldSliceToProto(field, field.vertices.size(), offset, count, with_nearest_source, version,
+                    chunk);
   chunk->mutable_vertices()->Assign(field.vertices.begin() + offset,
                                     field.vertices.begin() + offset + count);
-  chunk->mutable_distances()->Assign(field.distance.begin() + offset,
-                                     field.distance.begin() + offset + count);
-  if (with_nearest_source) {
-    chunk->mutable_nearest_source()->Assign(field.nearest.begin() + offset,
-                                            field.nearest.begin() + offset + count);
-  } else {
-    chunk->clear_nearest_source();
-  }
 }
 
 void ExpMapChunkToProto(std::span<const query::ExpMapVertex> map, int64_t offset, int64_t count,
