@@ -13,7 +13,6 @@
 #include "core/common/status_macros.h"
 #include "core/mesh/generators.h"
 #include "core/query/input_queries.h"
-#include "core/query/internal/exp_map.h"
 #include "core/query/internal/query_engine.h"
 #include "core/query/internal/query_knobs.h"
 #include "core/query/internal/unfold_kernel.h"
@@ -424,11 +423,11 @@ void BenchExpMap(const std::string& label, std::shared_ptr<const index::Index> i
       options.radius = radius;
       if (mode == 1) options.distance.near_pairs = query::NearPairs::kUnfold;
       query::QueryScratch scratch;
-      (void)query::ExpMap(*engine, centres[0], options, &scratch);  // the lazy exact mesh
+      (void)engine->ExpMap(centres[0], options, &scratch);  // the lazy exact mesh
       mapped = 0;
       const double t0 = ThreadCpuSeconds();
       for (const mesh::SurfacePoint& c : centres) {
-        mapped += query::ExpMap(*engine, c, options, &scratch)->size();
+        mapped += engine->ExpMap(c, options, &scratch)->size();
       }
       ms[mode] = 1e3 * (ThreadCpuSeconds() - t0) / centres.size();
     }

@@ -7,7 +7,7 @@
 
 #include "absl/strings/str_format.h"
 #include "core/index/index.h"
-#include "core/query/internal/exp_map.h"
+#include "core/query/internal/query_engine.h"
 
 namespace geodex::soak {
 
@@ -319,7 +319,7 @@ void Soak::ExpMap(std::mt19937& rng) {
   if (answered.engine == nullptr) return;
   query::ExpMapOptions options;
   options.radius = radius;
-  auto map = query::ExpMap(*answered.engine, centre[0], options);
+  auto map = answered.engine->ExpMap(centre[0], options);
   bool same = map.ok() && map->size() == vertices.size();
   for (size_t i = 0; same && i < vertices.size(); ++i) {
     same = (*map)[i].vertex == vertices[i] && (*map)[i].theta == theta[i];

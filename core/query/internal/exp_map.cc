@@ -63,13 +63,9 @@ struct Node {
 // whose distance is known but whose angle is not.
 class ExpMapper {
  public:
-  ExpMapper(const QueryEngine& engine, const mesh::SurfacePoint& centre,
-            const ExpMapOptions& options, QueryScratch* scratch)
-      : engine_(engine),
-        view_{engine.index().positions(), engine.index().faces(), engine.index().twins()},
-        centre_(centre),
-        options_(options),
-        scratch_(scratch) {}
+  ExpMapper(const ExpMapSurface& surface, const mesh::SurfacePoint& centre,
+            const ExpMapOptions& options)
+      : surface_(surface), view_(surface.view), centre_(centre), options_(options) {}
 
   absl::StatusOr<std::vector<ExpMapVertex>> Run();
 
@@ -105,13 +101,12 @@ class ExpMapper {
   }
   double Edge(int32_t a, int32_t b) const { return (view_.Position(a) - view_.Position(b)).norm(); }
 
-  const QueryEngine& engine_;
+  const ExpMapSurface& surface_;
   const MeshView view_;
   mesh::SurfacePoint centre_;
   const ExpMapOptions& options_;
-  QueryScratch* scratch_;
   // Exact distances of the vertices within exact_radius_ of the centre
-  // (QueryEngine::LocalExactDistances), when the distance options refine.
+  // (ExpMapSurface::exact_within), when the distance options refine.
   std::span<const double> exact_;
   double exact_radius_ = -1;
   Vec3 origin_, normal_, e1_, e2_;
@@ -345,7 +340,7 @@ absl::Status ExpMapper::Expand(int32_t v) {
       if (!(r <= exact_radius_)) {
         mesh::SurfacePoint p{g, {0, 0, 0}};
         p.w[i] = 1;
-        GEODEX_ASSIGN_OR_RETURN(r, engine_.Distance(centre_, p, options_.distance, scratch_));
+        GEODEX_ASSIGN_OR_RETURN(r, surface_.distance(centre_, p));
       }
       Node& met = nodes_[u];
       met.face = g;
@@ -374,8 +369,8 @@ absl::StatusOr<std::vector<ExpMapVertex>> ExpMapper::Run() {
   // engine would refine vertex after vertex by traces, one local exact
   // propagation gives every r at once, exactly.
   if (options_.distance.near_pairs != NearPairs::kUnfold) {
-    exact_radius_ = std::min(options_.radius, kRefineScale * engine_.scale_length());
-    GEODEX_ASSIGN_OR_RETURN(exact_, engine_.LocalExactDistances(centre_, exact_radius_, *scratch_));
+    exact_radius_ = std::min(options_.radius, kRefineScale * surface_.scale_length);
+    GEODEX_ASSIGN_OR_RETURN(exact_, surface_.exact_within(centre_, exact_radius_));
   }
   if (at_vertex >= 0) {
     SeedFromVertex(at_vertex);
@@ -408,12 +403,10 @@ absl::StatusOr<std::vector<ExpMapVertex>> ExpMapper::Run() {
 
 }  // namespace
 
-absl::StatusOr<std::vector<ExpMapVertex>> ExpMap(const QueryEngine& engine,
+absl::StatusOr<std::vector<ExpMapVertex>> ExpMap(const ExpMapSurface& surface,
                                                  const mesh::SurfacePoint& centre,
-                                                 const ExpMapOptions& options,
-                                                 QueryScratch* scratch) {
-  QueryScratch local;
-  return ExpMapper(engine, centre, options, scratch != nullptr ? scratch : &local).Run();
+                                                 const ExpMapOptions& options) {
+  return ExpMapper(surface, centre, options).Run();
 }
 
 }  // namespace geodex::query

@@ -19,26 +19,50 @@
 // Only the vertices within the radius and one ring round them are visited:
 // the cost grows with the vertices inside the radius, not with the mesh.
 //
-// Thread safety: a pure function of an immutable engine; pass one
-// QueryScratch per thread.
+// The map takes its distances from the caller (QueryEngine::ExpMap passes
+// its own Distance and LocalExactDistances), so that it depends on the parts
+// it reads and not on the engine that composes them.
+//
+// Thread safety: a pure function of its inputs; the distance functions are
+// called on the calling thread only.
 
 #include <cstdint>
 #include <optional>
+#include <span>
 #include <vector>
 
+#include "absl/functional/function_ref.h"
 #include "absl/status/statusor.h"
 #include "core/mesh/mesh.h"
-#include "core/query/internal/query_engine.h"
+#include "core/query/internal/mesh_view.h"
+#include "core/query/query_types.h"
 
 namespace geodex::query {
 
+// What the map reads of the surface and of the distances from its centre.
+struct ExpMapSurface {
+  MeshView view;
+  // L of the index (QueryEngine::scale_length): distances below
+  // kRefineScale * L are taken from one exact propagation.
+  double scale_length;
+  // The distance from `centre` to `p`, refined as options.distance says.
+  absl::FunctionRef<absl::StatusOr<double>(const mesh::SurfacePoint& centre,
+                                           const mesh::SurfacePoint& p)>
+      distance;
+  // Exact distances from `centre` to the vertices within `radius`, indexed by
+  // vertex (QueryEngine::LocalExactDistances).
+  absl::FunctionRef<absl::StatusOr<std::span<const double>>(const mesh::SurfacePoint& centre,
+                                                            double radius)>
+      exact_within;
+};
+
 // The map of every vertex within options.radius of `centre`, ascending by
-// vertex id. `centre` is valid, in the engine's ids. Errors: InvalidArgument
+// vertex id. `centre` is valid, in the surface's ids. Errors: InvalidArgument
 // for a radius that is not finite and > 0, and for a reference direction that
-// is not finite or is perpendicular to the centre's face.
-absl::StatusOr<std::vector<ExpMapVertex>> ExpMap(const QueryEngine& engine,
+// is not finite or is perpendicular to the centre's face; those of the
+// surface's distance functions.
+absl::StatusOr<std::vector<ExpMapVertex>> ExpMap(const ExpMapSurface& surface,
                                                  const mesh::SurfacePoint& centre,
-                                                 const ExpMapOptions& options,
-                                                 QueryScratch* scratch = nullptr);
+                                                 const ExpMapOptions& options);
 
 }  // namespace geodex::query

@@ -8,6 +8,7 @@
 
 #include "absl/container/flat_hash_map.h"
 #include "core/mesh/generators.h"
+#include "core/query/internal/query_engine.h"
 #include "core/validation/test_index.h"
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
@@ -36,7 +37,7 @@ std::vector<ExpMapVertex> MapOrDie(const QueryEngine& engine, const SurfacePoint
   ExpMapOptions options;
   options.radius = radius;
   options.reference_direction = direction;
-  absl::StatusOr<std::vector<ExpMapVertex>> map = ExpMap(engine, centre, options);
+  absl::StatusOr<std::vector<ExpMapVertex>> map = engine.ExpMap(centre, options);
   if (!map.ok()) throw std::runtime_error(std::string(map.status().message()));
   return *std::move(map);
 }
@@ -324,20 +325,20 @@ TEST(ExpMapTest, RejectsBadArguments) {
   const auto engine = MakeEngine(mesh, 8);
   ExpMapOptions options;
   options.radius = 0;
-  EXPECT_THAT(ExpMap(*engine, {0, {1, 0, 0}}, options).status().message(), HasSubstr("radius"));
+  EXPECT_THAT(engine->ExpMap({0, {1, 0, 0}}, options).status().message(), HasSubstr("radius"));
   options.radius = std::numeric_limits<double>::quiet_NaN();
-  EXPECT_FALSE(ExpMap(*engine, {0, {1, 0, 0}}, options).ok());
+  EXPECT_FALSE(engine->ExpMap({0, {1, 0, 0}}, options).ok());
   options.radius = 0.5;
   options.reference_direction = Vec3(0, 0, 1);  // the grid's normal
-  EXPECT_THAT(ExpMap(*engine, {0, {1, 0, 0}}, options).status().message(),
+  EXPECT_THAT(engine->ExpMap({0, {1, 0, 0}}, options).status().message(),
               HasSubstr("perpendicular"));
   options.reference_direction = Vec3(std::nan(""), 0, 0);
-  EXPECT_THAT(ExpMap(*engine, {0, {1, 0, 0}}, options).status().message(), HasSubstr("finite"));
+  EXPECT_THAT(engine->ExpMap({0, {1, 0, 0}}, options).status().message(), HasSubstr("finite"));
   // Along the reference direction theta is 0; the grid faces +z, so +v
   // points along +z x +y = -x.
   options.reference_direction = Vec3(0, 1, 0);
   const SurfacePoint centre{5, {0.2, 0.3, 0.5}};
-  const absl::StatusOr<std::vector<ExpMapVertex>> map = ExpMap(*engine, centre, options);
+  const absl::StatusOr<std::vector<ExpMapVertex>> map = engine->ExpMap(centre, options);
   ASSERT_TRUE(map.ok()) << map.status();
   ASSERT_FALSE(map->empty());
   const Vec3 c = mesh::PositionOf(mesh, centre);

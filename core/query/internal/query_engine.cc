@@ -212,7 +212,15 @@ absl::StatusOr<RadiusField> QueryEngine::FieldWithin(std::span<const SurfacePoin
 absl::StatusOr<std::vector<ExpMapVertex>> QueryEngine::ExpMap(const SurfacePoint& centre,
                                                               const ExpMapOptions& options,
                                                               QueryScratch* scratch) const {
-  return query::ExpMap(*this, centre, options, scratch);
+  QueryScratch local;
+  QueryScratch& s = scratch != nullptr ? *scratch : local;
+  auto distance = [&](const SurfacePoint& from, const SurfacePoint& p) {
+    return Distance(from, p, options.distance, &s);
+  };
+  auto exact_within = [&](const SurfacePoint& from, double radius) {
+    return LocalExactDistances(from, radius, s);
+  };
+  return query::ExpMap({view_, scale_length_, distance, exact_within}, centre, options);
 }
 
 absl::StatusOr<LocatedPoint> QueryEngine::Locate(const mesh::Vec3& x) const {
