@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Fails if the project's files include each other in a loop. A header and
+# Fails if the project's files include each other in a loop (ctest: include_loops). A header and
 # its source (x.h, x.cc) count as one unit, since x.cc is where x.h's
 # promises are kept: x.h -> y.h together with y.cc -> x.h is a loop between
 # the units x and y, even though no header includes itself. Tests, mains and
@@ -11,26 +11,32 @@
 set -uo pipefail
 root="$(cd "${1:-$(dirname "$0")/..}" && pwd)"
 
+cd "$root" || exit 1
+files="$(find core server client tests proto -type f \( -name '*.h' -o -name '*.cc' \) \
+           -not -path '*/build*' 2>/dev/null | sort)"
+# One awk over every file: the list of files first (to resolve paths), then
+# their lines. Prints "unit included-unit" per include, and "unit unit" so
+# that every unit is a node.
 edges="$(
-  cd "$root" &&
-  find core server client tests proto -type f \( -name '*.h' -o -name '*.cc' \) \
-       -not -path '*/build*' 2>/dev/null | sort |
-  while IFS= read -r file; do
-    unit="${file%.*}"
-    # Every unit is a node, with or without includes.
-    echo "$unit $unit"
-    sed -nE 's/^[[:space:]]*#[[:space:]]*include[[:space:]]*"([^"]+)".*/\1/p' "$file" |
-    while IFS= read -r inc; do
-      if [ -f "$inc" ]; then
-        target="$inc"
-      elif [ -f "$(dirname "$file")/$inc" ]; then
-        target="$(realpath --relative-to=. "$(dirname "$file")/$inc")"
-      else
-        continue  # a generated or third-party header
-      fi
-      [ "${target%.*}" = "$unit" ] || echo "$unit ${target%.*}"
-    done
-  done
+  { echo "$files"; echo "--"; } | awk '
+    NR == FNR || !listed {
+      if ($0 == "--") { listed = 1; next }
+      exists[$0] = 1
+      next
+    }
+    FNR == 1 {
+      unit = FILENAME; sub(/\.[^.\/]*$/, "", unit)
+      dir = FILENAME; sub(/\/[^\/]*$/, "", dir)
+      print unit, unit
+    }
+    /^[ \t]*#[ \t]*include[ \t]*"/ {
+      inc = $0; sub(/^[^"]*"/, "", inc); sub(/".*$/, "", inc)
+      if (inc in exists) target = inc
+      else if ((dir "/" inc) in exists) target = dir "/" inc
+      else next  # a generated or third-party header
+      sub(/\.[^.\/]*$/, "", target)
+      if (target != unit) print unit, target
+    }' - $files
 )"
 
 if ! loops="$(tsort <<<"$edges" 2>&1 >/dev/null)" || [ -n "$loops" ]; then
