@@ -25,7 +25,10 @@ absl::Status CheckFieldSources(const ServiceLimits& limits, int64_t sources) {
       "%d sources exceed the limit of %d (max_field_sources)", sources, limits.max_field_sources));
 }
 
-absl::Status FieldVerticesExceeded(const ServiceLimits& limits, const absl::Status& status) {
+// `limits` keeps the signature of the other checks; the propagation's message
+// already names the count it stopped at.
+absl::Status FieldVerticesExceeded([[maybe_unused]] const ServiceLimits& limits,
+                                   const absl::Status& status) {
   return absl::ResourceExhaustedError(
       absl::StrFormat("%s, the limit (max_field_vertices)", status.message()));
 }

@@ -98,7 +98,7 @@ TEST_P(ServerRepairTest, ModelCountsAndMeshAreTheInputs) {
   EXPECT_EQ(info.num_vertices(), 162);
   EXPECT_EQ(info.build_report().at("mesh_duplicate_faces_dropped"), "1");
   EXPECT_EQ(info.build_report().at("mesh_faces_reoriented"), "2");
-  EXPECT_EQ(info.build_report().contains("mesh_refinement"), GetParam());
+  EXPECT_EQ(info.build_report().contains("mesh_split"), GetParam());
 
   v1::GetMeshRequest mesh_request;
   *mesh_request.mutable_model() = Ref("repaired");

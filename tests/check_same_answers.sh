@@ -11,7 +11,10 @@
 # checkouts, or a copy of one). Meshes: the generated torus, sphere and
 # double torus, and, when ../shared/meshes is present, cow_nonmanifold_3k
 # (repaired: exercises the input ids) and max_planck_5k. Exit 0 when every
-# output is identical, 1 otherwise (naming the first difference).
+# output is identical, 1 otherwise (naming the first difference). Where two
+# outputs differ, the largest difference between numbers in the same place
+# is printed (absolute and relative to the larger of the two), and the
+# largest over all outputs at the end: what a change of rounding moved.
 set -euo pipefail
 
 if [ "$#" -lt 2 ]; then sed -n '2,13p' "$0" | sed 's/^# \{0,1\}//'; exit 2; fi
@@ -44,12 +47,42 @@ else
 fi
 
 failures=0
+largest_rel=0
+largest_where="none"
+# largest_difference A B -> "ABS REL LINE", the largest relative difference
+# between numbers at the same place (line, word) of A and B; words that are
+# not both numbers count when they differ, as an infinite difference.
+largest_difference() {
+  awk 'function num(s) { return s ~ /^[-+]?([0-9]+\.?[0-9]*|\.[0-9]+)([eE][-+]?[0-9]+)?[,\]]*$/ }
+    function strip(s) { sub(/[,\]]+$/, "", s); return s }
+    NR == FNR { before[FNR] = $0; next }
+    {
+      n = split(before[FNR], a, /[ \t:\[]+/); m = split($0, b, /[ \t:\[]+/)
+      if (n != m) { if (worst_rel < 1e300) { worst_abs = "inf"; worst_rel = 1e300; at = FNR }; next }
+      for (i = 1; i <= n; ++i) {
+        if (a[i] == b[i]) continue
+        if (num(a[i]) && num(b[i])) {
+          x = strip(a[i]) + 0; y = strip(b[i]) + 0; d = x - y; if (d < 0) d = -d
+          s = (x < 0 ? -x : x); t = (y < 0 ? -y : y); s = (s > t ? s : t)
+          r = s > 0 ? d / s : 0
+          if (r > worst_rel) { worst_rel = r; worst_abs = d; at = FNR }
+        } else if (worst_rel < 1e300) { worst_abs = "inf"; worst_rel = 1e300; at = FNR }
+      }
+    }
+    END { if (FNR != length(before) && worst_rel < 1e300) { worst_abs = "inf"; worst_rel = 1e300 }
+          printf "%s %g %d\n", worst_abs == "" ? 0 : worst_abs, worst_rel, at }' "$1" "$2"
+}
 compare() {  # compare NAME: $work/before.NAME vs $work/after.NAME
   if cmp -s "$work/before.$1" "$work/after.$1"; then
     echo "  same   $1 ($(wc -c <"$work/after.$1") bytes)"
   else
-    echo "  DIFFER $1"
+    read -r abs rel line < <(largest_difference "$work/before.$1" "$work/after.$1")
+    echo "  DIFFER $1: largest difference $abs (relative $rel, line $line)"
     diff <(head -c 2000 "$work/before.$1") <(head -c 2000 "$work/after.$1") | head -5 || true
+    if awk -v r="$rel" -v w="$largest_rel" 'BEGIN { exit !(r > w) }'; then
+      largest_rel=$rel
+      largest_where="$1 (absolute $abs, line $line)"
+    fi
     failures=$((failures + 1))
   fi
 }
@@ -120,7 +153,7 @@ for mesh in "${meshes[@]}"; do
 done
 
 if [ "$failures" -gt 0 ]; then
-  echo "check_same_answers: $failures outputs differ"
+  echo "check_same_answers: $failures outputs differ; the largest relative difference: $largest_rel in $largest_where"
   exit 1
 fi
 echo "check_same_answers: every output identical"

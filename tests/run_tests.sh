@@ -7,6 +7,9 @@ cd "$(dirname "$0")/.."
 
 bash deploy/install-deps.sh
 BUILD_DIR="${GEODEX_BUILD_DIR:-build}"
-cmake -S . -B "$BUILD_DIR" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo
+# Warnings fail the build here (and in the fuzz and sanitizer trees that
+# ctest builds: they read GEODEX_WERROR from the environment).
+export GEODEX_WERROR=ON
+cmake -S . -B "$BUILD_DIR" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DGEODEX_WERROR=ON
 cmake --build "$BUILD_DIR" -j"$(nproc)"
 ctest --test-dir "$BUILD_DIR" --output-on-failure -j"$(nproc)" --timeout 900

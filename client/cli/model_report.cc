@@ -144,8 +144,8 @@ absl::StatusOr<std::string> ModelReportText(const ModelInfo& m) {
                           index_faces);
   }
   absl::StrAppendFormat(&out, "\n  repairs       %s\n", f.Str(mesh, "repairs"));
-  const int64_t midpoints = f.Int(mesh, "refinement_midpoints");
-  absl::StrAppendFormat(&out, "  refinement    %s\n",
+  const int64_t midpoints = f.Int(mesh, "split_midpoints");
+  absl::StrAppendFormat(&out, "  split         %s\n",
                         midpoints == 0
                             ? std::string("none (no edge longer than L/2)")
                             : absl::StrFormat("%d midpoints (long edges split flat)", midpoints));

@@ -21,7 +21,7 @@ constexpr char kReport[] = R"json({
     "faces": 500,
     "index_vertices": 3305,
     "index_faces": 6610,
-    "refinement_midpoints": 3055,
+    "split_midpoints": 3055,
     "repairs": "none",
     "repair_counts": {"faces_reoriented": 0}
   },
@@ -76,7 +76,7 @@ TEST(ModelReportTest, LaysOutTheServersReport) {
                                "by geodex-build 0.1.0\n"));
   EXPECT_THAT(*text, HasSubstr("  mesh          250 vertices, 500 faces (answered on 3305 "
                                "vertices, 6610 faces)\n"));
-  EXPECT_THAT(*text, HasSubstr("  refinement    3055 midpoints (long edges split flat)\n"));
+  EXPECT_THAT(*text, HasSubstr("  split         3055 midpoints (long edges split flat)\n"));
   EXPECT_THAT(*text, HasSubstr("                  distance matrix            0.34 MiB  31.3%\n"));
   EXPECT_THAT(*text, HasSubstr("                  calibration               0.000 MiB  <0.1%\n"));
   EXPECT_THAT(*text, HasSubstr("  error target  0.500% NOT met: m stopped at the cap"));

@@ -73,7 +73,7 @@ void AddSplitFaces(const mesh::Mesh& coarse, const mesh::LongEdgeSplit& split,
   }
   record->split_vertices = split.new_vertices;
   record->report += absl::StrFormat(
-      "mesh_refinement = %d midpoints added, %d faces became %d (long edges split flat)\n",
+      "mesh_split = %d midpoints added, %d faces became %d (long edges split flat)\n",
       split.new_vertices, coarse.num_faces(), split.mesh.num_faces());
 }
 

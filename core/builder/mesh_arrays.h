@@ -22,7 +22,7 @@ std::vector<int32_t> FlatFaces(const mesh::Mesh& mesh);
 // What the repair of an index's mesh did (core/mesh/mesh_repair.h), and the
 // long-edge split after it, as the index records them: its input-id sections
 // (format 1.2: input faces and vertex copies, empty for identity maps; 2.0:
-// the coarse faces and the pieces, empty without refinement) and the
+// the coarse faces and the pieces, empty without the split) and the
 // report's mesh_* lines.
 struct RepairRecord {
   std::vector<index::InputFaceRecord> input_faces;
@@ -46,16 +46,16 @@ void AddRepair(const RepairRecord& record, index::IndexData* data);
 // point and farthest-point sampling can place samples L apart anywhere.
 inline constexpr double kMaxEdgeOverScaleLength = 0.5;
 
-// The refinement the builder applies before sampling `num_samples` samples:
+// The long-edge split the builder applies before sampling `num_samples` samples:
 // SplitLongEdges at kMaxEdgeOverScaleLength * L(num_samples), adding at most
 // 4 vertices per input vertex plus 16 per sample. A mesh with no longer edge
 // comes back unchanged (new_vertices == 0). Errors: SplitLongEdges's.
 absl::StatusOr<mesh::LongEdgeSplit> SplitForSamples(const mesh::Mesh& mesh, int32_t num_samples);
 
-// Records `refinement` of `coarse` (the mesh RecordRepair's record is of)
-// into `record`: the sections and a mesh_refinement report line. Nothing for
-// a refinement that added no vertex.
-void AddSplitFaces(const mesh::Mesh& coarse, const mesh::LongEdgeSplit& refinement,
+// Records `split` of `coarse` (the mesh RecordRepair's record is of)
+// into `record`: the sections and a mesh_split report line. Nothing for
+// a split that added no vertex.
+void AddSplitFaces(const mesh::Mesh& coarse, const mesh::LongEdgeSplit& split,
                    RepairRecord* record);
 
 // The mesh the builder samples for `num_samples` samples and the record of
@@ -71,7 +71,7 @@ absl::StatusOr<PreparedMesh> PrepareMesh(const mesh::Mesh& coarse, RepairRecord 
 
 // The input file's id of each vertex of `prepared.mesh`: its own below the
 // repair's copies, the vertex a copy stands for, mesh::kNone for a midpoint
-// of the refinement (BuildOptions::input_vertex_ids, for refusal messages).
+// of the split (BuildOptions::input_vertex_ids, for refusal messages).
 std::vector<int32_t> InputVertexIds(const PreparedMesh& prepared);
 
 }  // namespace geodex::builder

@@ -49,12 +49,24 @@ double MinSumOnSegment(LineCoords x, LineCoords y, double lo, double hi) {
 }  // namespace
 
 ConfinedGeodesicSolver::ConfinedGeodesicSolver(const Mesh& mesh, const ConfinedOptions& options)
-    : mesh_(mesh),
+    : ConfinedGeodesicSolver(std::make_unique<ExactGeodesicSolver>(mesh), nullptr, options) {}
+
+ConfinedGeodesicSolver::ConfinedGeodesicSolver(ExactGeodesicSolver& engine,
+                                               const ConfinedOptions& options)
+    : ConfinedGeodesicSolver(nullptr, &engine, options) {}
+
+// mesh_ is read off the engine before own_engine_ takes it (members are made
+// in their order of declaration).
+ConfinedGeodesicSolver::ConfinedGeodesicSolver(std::unique_ptr<ExactGeodesicSolver> own,
+                                               ExactGeodesicSolver* borrowed,
+                                               const ConfinedOptions& options)
+    : mesh_((borrowed != nullptr ? *borrowed : *own).mesh()),
       options_(options),
-      engine_(mesh),
-      in_region_(mesh.num_faces(), 0),
-      slot_(mesh.num_halfedges(), -1),
-      chain_parent_(mesh.num_faces(), -2) {
+      own_engine_(std::move(own)),
+      engine_(borrowed != nullptr ? *borrowed : *own_engine_),
+      in_region_(mesh_.num_faces(), 0),
+      slot_(mesh_.num_halfedges(), -1),
+      chain_parent_(mesh_.num_faces(), -2) {
   // The points' stars must lie inside the region: the certificate has no
   // term for paths that leave it at a source.
   options_.seed_rings = std::max(options_.seed_rings, 1);

@@ -44,6 +44,7 @@
 // share one const Mesh.
 
 #include <cstdint>
+#include <memory>
 #include <span>
 #include <vector>
 
@@ -74,6 +75,12 @@ class ConfinedGeodesicSolver {
  public:
   // `mesh` must outlive the solver.
   explicit ConfinedGeodesicSolver(const Mesh& mesh, const ConfinedOptions& options = {});
+  // Runs its propagations on `engine` (over the mesh to confine to), which
+  // must outlive the solver: a caller that also propagates over the whole
+  // mesh keeps one engine's arrays, not two. The engine keeps no state
+  // between propagations that the other's would see.
+  explicit ConfinedGeodesicSolver(ExactGeodesicSolver& engine,
+                                  const ConfinedOptions& options = {});
 
   // The exact geodesic distance between p and q on the whole mesh (+inf when
   // they lie in different components), computed inside a region grown from
@@ -99,6 +106,9 @@ class ConfinedGeodesicSolver {
   const Mesh& mesh() const { return mesh_; }
 
  private:
+  // One of `own` (then owned) and `borrowed` is the engine.
+  ConfinedGeodesicSolver(std::unique_ptr<ExactGeodesicSolver> own, ExactGeodesicSolver* borrowed,
+                         const ConfinedOptions& options);
   void ClearRegion();
   void AddFace(int32_t f);
   // Adds the faces round the vertices in `vertices` (consumed), then round
@@ -117,7 +127,8 @@ class ConfinedGeodesicSolver {
 
   const Mesh& mesh_;
   ConfinedOptions options_;
-  ExactGeodesicSolver engine_;
+  std::unique_ptr<ExactGeodesicSolver> own_engine_;  // null when borrowed
+  ExactGeodesicSolver& engine_;
   // The region: a flag per face and the list of flagged faces.
   std::vector<uint8_t> in_region_;
   std::vector<int32_t> region_faces_;

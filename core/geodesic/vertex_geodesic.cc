@@ -19,7 +19,7 @@ using mesh::Vec3;
 // both sides, so nothing is lost. Treating them as saddles (as VTP and the
 // window engine do, against rounding) costs dearly where they abound: on a
 // mesh subdivided flat, three vertices in four are flat, and every one would
-// emit windows all round (tests/bench/README.md, the wavefront engine).
+// emit windows all round (tests/bench/exact_geodesics.md, the wavefront engine).
 // A true saddle within this of flat hides a shadow of relative size ~1e-9.
 constexpr double kSaddleSlack = 1e-9;
 // Two crossings of an edge closer than this fraction of its length are the

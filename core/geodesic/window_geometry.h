@@ -17,6 +17,7 @@
 
 #include "absl/status/status.h"
 #include "absl/strings/str_format.h"
+#include "core/geometry/face_frame.h"
 #include "core/mesh/mesh.h"
 
 namespace geodex::geodesic {
@@ -34,25 +35,20 @@ inline double Hypot(double x, double y) { return std::sqrt(x * x + y * y); }
 
 // Position of the opposite vertex of a half-edge in that half-edge's frame:
 // origin at (0,0), destination at (length,0), face at y > 0.
-struct HalfEdgeFrame {
-  double length;
-  double cx;
-  double cy;
-};
+using HalfEdgeFrame = geometry::FaceFrame;
 
-// Every half-edge's frame. From positions rather than edge lengths: the law
-// of cosines loses half the digits of cy on sliver triangles, the cross
-// product does not. An edge of length 0 (two corners at one position, kept by
-// mesh repair) carries no window; its frame only has to be free of NaN.
+// Every half-edge's frame (geometry::FrameOfTriangle, from positions). An
+// edge of length 0 (two corners at one position, kept by mesh repair)
+// carries no window; its frame only has to be free of NaN. cy is kept above
+// 0 so that the window formulas never divide by it as 0.
 inline std::vector<HalfEdgeFrame> HalfEdgeFrames(const mesh::Mesh& mesh) {
   std::vector<HalfEdgeFrame> frames(mesh.num_halfedges());
   for (int32_t h = 0; h < mesh.num_halfedges(); ++h) {
-    const mesh::Vec3& a = mesh.position(mesh.Origin(h));
-    const mesh::Vec3 ab = mesh.position(mesh.Dest(h)) - a;
-    const mesh::Vec3 ac = mesh.position(mesh.Opposite(h)) - a;
-    const double l = mesh.Length(h);
-    frames[h] = l > 0 ? HalfEdgeFrame{l, ab.dot(ac) / l, std::max(ab.cross(ac).norm() / l, 1e-300)}
-                      : HalfEdgeFrame{0, 0, 1e-300};
+    const HalfEdgeFrame f =
+        geometry::FrameOfTriangle(mesh.position(mesh.Origin(h)), mesh.position(mesh.Dest(h)),
+                                  mesh.position(mesh.Opposite(h)));
+    frames[h] = f.length > 0 ? HalfEdgeFrame{f.length, f.cx, std::max(f.cy, 1e-300)}
+                             : HalfEdgeFrame{0, 0, 1e-300};
   }
   return frames;
 }

@@ -60,7 +60,7 @@ struct ReportSection {
 };
 
 // A sample's place: its vertex in the mesh file's ids (`copy_of` for a copy
-// the repair made of a non-manifold vertex, `midpoint` for a refinement's
+// the repair made of a non-manifold vertex, `midpoint` for a split's
 // midpoint, which the file does not have) and its position.
 struct PlacedSample {
   int64_t sample = 0;
@@ -80,7 +80,7 @@ struct IndexReport {
   int64_t faces = 0;
   int64_t index_vertices = 0;
   int64_t index_faces = 0;
-  int64_t refinement_midpoints = 0;
+  int64_t split_midpoints = 0;
   // The repairs of the input mesh: one phrase per repair made ("none" when
   // none was), and every count the report has ("mesh_" keys without it).
   std::string repairs;

@@ -8,6 +8,7 @@
 
 #include "absl/strings/str_format.h"
 #include "core/common/status_macros.h"
+#include "core/query/internal/input_ids.h"
 #include "core/query/internal/query_engine.h"
 
 namespace geodex::query {
@@ -36,7 +37,17 @@ absl::StatusOr<std::shared_ptr<const InputQueries>> InputQueries::Create(
 }
 
 InputQueries::InputQueries(std::shared_ptr<const QueryEngine> engine)
-    : engine_(std::move(engine)), ids_(engine_->index()) {}
+    : engine_(std::move(engine)), ids_(std::make_unique<const InputIds>(engine_->index())) {}
+
+InputQueries::~InputQueries() = default;
+
+int32_t InputQueries::num_vertices() const { return ids_->num_input_vertices(); }
+int32_t InputQueries::num_faces() const { return ids_->num_input_faces(); }
+bool InputQueries::identity() const { return ids_->identity(); }
+mesh::Triangle InputQueries::InputFace(int32_t f) const { return ids_->InputFace(f); }
+int32_t InputQueries::InputVertex(int32_t internal_vertex) const {
+  return ids_->InputVertex(internal_vertex);
+}
 
 const index::Index& InputQueries::index() const { return engine_->index(); }
 const QueryOptions& InputQueries::options() const { return engine_->options(); }
@@ -60,7 +71,7 @@ absl::Status InputQueries::Read(std::span<const SurfacePoint> input, const Point
   out->input_faces_.resize(input.size());
   const double tolerance = engine_->options().weight_tolerance;
   for (size_t i = 0; i < input.size(); ++i) {
-    absl::StatusOr<SurfacePoint> internal = ids_.ToInternal(input[i], tolerance);
+    absl::StatusOr<SurfacePoint> internal = ids_->ToInternal(input[i], tolerance);
     if (!internal.ok()) return Prefixed(internal.status(), name, i);
     out->points_[i] = *internal;
     out->input_faces_[i] = input[i].face;
@@ -78,7 +89,7 @@ absl::Status InputQueries::Read(std::span<const int32_t> faces, std::span<const 
   out->input_faces_.assign(faces.begin(), faces.end());
   const double tolerance = engine_->options().weight_tolerance;
   for (size_t i = 0; i < faces.size(); ++i) {
-    absl::StatusOr<SurfacePoint> internal = ids_.ToInternal(
+    absl::StatusOr<SurfacePoint> internal = ids_->ToInternal(
         {faces[i], {weights[3 * i], weights[3 * i + 1], weights[3 * i + 2]}}, tolerance);
     if (!internal.ok()) return Prefixed(internal.status(), name, i);
     out->points_[i] = *internal;
@@ -114,13 +125,13 @@ absl::StatusOr<std::vector<PathPoint>> InputQueries::Path(const EnginePoints& a,
                                                           int32_t exact_corridor) const {
   GEODEX_ASSIGN_OR_RETURN(std::vector<PathPoint> path,
                           engine_->Path(a.points_.at(i), b.points_.at(j), exact_corridor));
-  ids_.PathToInput(path);
+  ids_->PathToInput(path);
   return path;
 }
 
 absl::StatusOr<DistanceField> InputQueries::Field(const EnginePoints& sources) const {
   GEODEX_ASSIGN_OR_RETURN(DistanceField field, engine_->Field(sources.points_));
-  return ids_.FieldToInput(std::move(field));
+  return ids_->FieldToInput(std::move(field));
 }
 
 absl::StatusOr<RadiusField> InputQueries::FieldWithin(const EnginePoints& sources,
@@ -130,7 +141,7 @@ absl::StatusOr<RadiusField> InputQueries::FieldWithin(const EnginePoints& source
   GEODEX_ASSIGN_OR_RETURN(
       RadiusField field,
       engine_->FieldWithin(sources.points_, options, scratch != nullptr ? *scratch : local));
-  if (ids_.identity()) return field;
+  if (ids_->identity()) return field;
   // Each reached internal vertex as its input vertex (none for a midpoint),
   // then one entry per input vertex: the copy nearest its source.
   struct Entry {
@@ -141,7 +152,7 @@ absl::StatusOr<RadiusField> InputQueries::FieldWithin(const EnginePoints& source
   std::vector<Entry> entries;
   entries.reserve(field.vertices.size());
   for (size_t i = 0; i < field.vertices.size(); ++i) {
-    const int32_t v = ids_.InputVertex(field.vertices[i]);
+    const int32_t v = ids_->InputVertex(field.vertices[i]);
     if (v != mesh::kNone) entries.push_back({v, field.distance[i], field.nearest[i]});
   }
   std::sort(entries.begin(), entries.end(), [](const Entry& a, const Entry& b) {
@@ -165,21 +176,21 @@ absl::StatusOr<std::vector<ExpMapVertex>> InputQueries::ExpMap(const EnginePoint
   // A re-oriented face's normal is the input face's reversed, and its first
   // edge another edge: give the input's first edge, and mirror θ. A piece of
   // a split face has other edges too.
-  const bool mirrored = ids_.Reoriented(input_face);
-  if ((mirrored || ids_.split()) && !options.reference_direction.has_value()) {
-    const mesh::Triangle t = ids_.InputFace(input_face);
+  const bool mirrored = ids_->Reoriented(input_face);
+  if ((mirrored || ids_->split()) && !options.reference_direction.has_value()) {
+    const mesh::Triangle t = ids_->InputFace(input_face);
     const std::span<const double> p = index().positions();
     options.reference_direction = mesh::Vec3(p[3 * t[1]], p[3 * t[1] + 1], p[3 * t[1] + 2]) -
                                   mesh::Vec3(p[3 * t[0]], p[3 * t[0] + 1], p[3 * t[0] + 2]);
   }
   GEODEX_ASSIGN_OR_RETURN(std::vector<ExpMapVertex> map,
                           engine_->ExpMap(internal, options, scratch));
-  if (ids_.identity()) return map;
-  // Midpoints of a refinement are no input vertices.
+  if (ids_->identity()) return map;
+  // Midpoints of the long-edge split are no input vertices.
   std::erase_if(
-      map, [this](const ExpMapVertex& e) { return ids_.InputVertex(e.vertex) == mesh::kNone; });
+      map, [this](const ExpMapVertex& e) { return ids_->InputVertex(e.vertex) == mesh::kNone; });
   for (ExpMapVertex& e : map) {
-    e.vertex = ids_.InputVertex(e.vertex);
+    e.vertex = ids_->InputVertex(e.vertex);
     if (mirrored) {
       e.theta = e.theta == 0 || e.theta == std::numbers::pi ? e.theta : -e.theta;
       e.v = -e.v;
@@ -198,7 +209,7 @@ absl::StatusOr<std::vector<ExpMapVertex>> InputQueries::ExpMap(const EnginePoint
 
 absl::StatusOr<LocatedPoint> InputQueries::Locate(const mesh::Vec3& x) const {
   GEODEX_ASSIGN_OR_RETURN(LocatedPoint located, engine_->Locate(x));
-  located.point = ids_.ToInput(located.point);
+  located.point = ids_->ToInput(located.point);
   return located;
 }
 
@@ -227,7 +238,7 @@ std::vector<SurfacePoint> InputQueries::SamplePoints() const {
   }
   std::vector<SurfacePoint> out(samples.size(), SurfacePoint{-1, {0, 0, 0}});
   for (size_t i = 0; i < samples.size(); ++i) {
-    if (face_of_sample[i] >= 0) out[i] = ids_.ToInput({face_of_sample[i], weights[i]});
+    if (face_of_sample[i] >= 0) out[i] = ids_->ToInput({face_of_sample[i], weights[i]});
   }
   return out;
 }
@@ -237,8 +248,8 @@ std::vector<int32_t> InputQueries::VertexTriangles() const {
   const std::span<const index::VertexRecord> records = index().vertices();
   std::vector<int32_t> out(num_vertices());
   for (int32_t v = 0; v < num_vertices(); ++v) out[v] = records[v].triangle;
-  for (int32_t copy = num_vertices(); copy < num_vertices() + ids_.num_vertex_copies(); ++copy) {
-    int32_t& t = out[ids_.InputVertex(copy)];
+  for (int32_t copy = num_vertices(); copy < num_vertices() + ids_->num_vertex_copies(); ++copy) {
+    int32_t& t = out[ids_->InputVertex(copy)];
     const int32_t c = records[copy].triangle;
     if (c >= 0 && (t < 0 || c < t)) t = c;
   }

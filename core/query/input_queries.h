@@ -38,13 +38,13 @@
 #include "absl/status/statusor.h"
 #include "core/index/index.h"
 #include "core/mesh/mesh.h"
-#include "core/query/internal/input_ids.h"
 #include "core/query/query_scratch.h"
 #include "core/query/query_types.h"
 
 namespace geodex::query {
 
 class QueryEngine;
+class InputIds;  // internal/input_ids.h: kept out of this public header
 
 // Points read by InputQueries::Read: validated, in the engine's ids. Only
 // InputQueries looks inside; callers keep them between calls (reusing one
@@ -72,6 +72,10 @@ PointName Named(std::string_view name);
 
 class InputQueries {
  public:
+  ~InputQueries();
+  InputQueries(const InputQueries&) = delete;
+  InputQueries& operator=(const InputQueries&) = delete;
+
   // Opens the index file at `path` and makes its queries. Errors: those of
   // index::Index::Open; InvalidArgument for a null index; FailedPrecondition
   // for an index without geodesic triangles or samples.
@@ -96,13 +100,13 @@ class InputQueries {
   double scale_length() const;
 
   // The input mesh's counts: what face and vertex ids are checked against.
-  int32_t num_vertices() const { return ids_.num_input_vertices(); }
-  int32_t num_faces() const { return ids_.num_input_faces(); }
+  int32_t num_vertices() const;
+  int32_t num_faces() const;
   // True when the index answers on the file's own mesh (no repair, no
-  // refinement): input ids are internal ids.
-  bool identity() const { return ids_.identity(); }
+  // split): input ids are internal ids.
+  bool identity() const;
   // The vertices of input face `f` (in [0, num_faces())), in the file's order.
-  mesh::Triangle InputFace(int32_t f) const { return ids_.InputFace(f); }
+  mesh::Triangle InputFace(int32_t f) const;
 
   // Validates `input` (in input ids) against the input's face count and the
   // engine's weight tolerance and keeps it in `out`. Errors: OutOfRange for
@@ -178,8 +182,8 @@ class InputQueries {
   // vertex, weight 1 on that vertex (face -1 and zero weights for a sample
   // on no face, which the builder never makes).
   std::vector<SurfacePoint> SamplePoints() const;
-  // The input vertex each sample is (mesh::kNone for a refinement's midpoint).
-  int32_t InputVertex(int32_t internal_vertex) const { return ids_.InputVertex(internal_vertex); }
+  // The input vertex each sample is (mesh::kNone for a midpoint of the split).
+  int32_t InputVertex(int32_t internal_vertex) const;
   // Per input vertex, its geodesic triangle; for a split vertex, the
   // smallest triangle id of its copies.
   std::vector<int32_t> VertexTriangles() const;
@@ -188,7 +192,7 @@ class InputQueries {
   explicit InputQueries(std::shared_ptr<const QueryEngine> engine);
 
   std::shared_ptr<const QueryEngine> engine_;
-  InputIds ids_;
+  std::unique_ptr<const InputIds> ids_;  // never null
 };
 
 }  // namespace geodex::query

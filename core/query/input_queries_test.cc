@@ -18,7 +18,7 @@
 #include "core/mesh/broken_meshes_testing.h"
 #include "core/mesh/generators.h"
 #include "core/mesh/mesh_repair.h"
-#include "core/query/internal/exp_map.h"
+#include "core/query/internal/expmap/exp_map.h"
 #include "core/query/internal/input_ids.h"
 #include "core/query/internal/query_engine.h"
 #include "gmock/gmock.h"
@@ -292,7 +292,7 @@ TEST(InputIdsTest, SplitIndexAnswersInTheInputIds) {
   EXPECT_EQ(ids.num_input_faces(), 80);
   EXPECT_EQ(ids.num_input_vertices(), 42);
   EXPECT_EQ(ids.ToInternal({80, {1, 0, 0}}).status().code(), absl::StatusCode::kOutOfRange);
-  EXPECT_THAT(std::string(e.index().report()), ::testing::HasSubstr("mesh_refinement = "));
+  EXPECT_THAT(std::string(e.index().report()), ::testing::HasSubstr("mesh_split = "));
 
   const std::span<const double> x = e.index().positions();
   const std::span<const int32_t> faces = e.index().faces();

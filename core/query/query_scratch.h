@@ -1,8 +1,8 @@
 #pragma once
 
 // Per-thread working memory of the queries that are not O(1): the exact
-// solvers that refinements and exact neighbourhoods run (their arrays grow
-// with the mesh, so a thread keeps them and reuses them). Optional wherever a query
+// solver that refinements and exact neighbourhoods run (its arrays grow with
+// the mesh, so a thread keeps it and reuses it). Optional wherever a query
 // takes it: without one, a query makes its own for the call.
 //
 // Thread safety: one QueryScratch per thread; it is not shared.
@@ -12,17 +12,7 @@
 
 #include <memory>
 
-namespace geodex::mesh {
-class Mesh;
-}  // namespace geodex::mesh
-namespace geodex::geodesic {
-class ExactGeodesicSolver;
-class ConfinedGeodesicSolver;
-}  // namespace geodex::geodesic
-
 namespace geodex::query {
-
-class LocalExact;
 
 class QueryScratch {
  public:
@@ -31,11 +21,17 @@ class QueryScratch {
   QueryScratch(QueryScratch&&) noexcept;
   QueryScratch& operator=(QueryScratch&&) noexcept;
 
+  // What the scratch holds: one exact solver over one mesh (and the state of
+  // propagations confined to parts of it, which run on that solver). Its
+  // definition is the query engine's own (internal/exact/local_exact.h);
+  // callers only pass the scratch along.
+  struct Solvers;
+  // The solvers, made (empty) on first use: a scratch that no query needs
+  // allocates nothing.
+  Solvers& solvers();
+
  private:
-  friend class LocalExact;
-  std::unique_ptr<geodesic::ExactGeodesicSolver> solver_;
-  const mesh::Mesh* mesh_ = nullptr;                            // the mesh solver_ was made for
-  std::unique_ptr<geodesic::ConfinedGeodesicSolver> confined_;  // over confined_->mesh()
+  std::unique_ptr<Solvers> solvers_;
 };
 
 }  // namespace geodex::query

@@ -49,14 +49,16 @@ void BuildCommandLine::AddSamplingOptions(CLI::App* cmd) {
                   "and interior pairs, by 95% upper limits on held-out sources")
       ->check(CLI::PositiveNumber);
   cmd->add_option("--max-samples", o.max_samples,
-                  "With an error target: the cap on m (default 8000; with --no-refinement, "
+                  "With an error target: the cap on m (default 8000; with --no-split, "
                   "half the vertices)")
       ->check(CLI::PositiveNumber);
   cmd->add_option("--seed", o.build.seed, "Sampling seed");
   cmd->add_option("--edges-obj", o.edges_obj, "Also write the geodesic edges as OBJ polylines");
-  cmd->add_flag("--no-refinement", args_.no_refinement,
+  cmd->add_flag("--no-split", args_.no_split,
                 "Sample the mesh's own vertices only: do not split edges longer than half the "
                 "sample spacing (coarse meshes then stop improving with more samples)");
+  // The flag's name before the split was called so; kept for scripts, not listed.
+  cmd->add_flag("--no-refinement", args_.no_split)->group("");
   AddMeshOptions(cmd);
   AddThreadsOption(cmd);
 }
@@ -97,7 +99,7 @@ BuildJob BuildCommandLine::job() const {
 
 builder::PipelineOptions BuildCommandLine::Options() const {
   builder::PipelineOptions o = args_.pipeline;
-  o.build.refine_long_edges = !args_.no_refinement;
+  o.build.refine_long_edges = !args_.no_split;
   o.calibrate = !args_.no_calibration;
   const CLI::App* sampled = *plan_ ? plan_ : &app_;
   if (sampled->count("--samples") == 0) {

@@ -24,7 +24,7 @@ struct BuildToolArgs {
   // Samples, target error, seed, threads, repair, edges file; completed by
   // BuildCommandLine::Options.
   builder::PipelineOptions pipeline;
-  bool no_refinement = false;   // --no-refinement
+  bool no_split = false;        // --no-split (hidden alias: --no-refinement)
   bool no_calibration = false;  // --no-calibration
   std::string mesh_path;        // a whole build, plan, calibrate
   std::string out;              // the index a whole build, merge or calibrate writes
@@ -51,7 +51,7 @@ class BuildCommandLine {
 
   // After parsing: the job given.
   BuildJob job() const;
-  // After parsing: the pipeline options of args(), with the refinement and
+  // After parsing: the pipeline options of args(), with the split and
   // calibration switches applied and, when --samples was not given (to a
   // whole build or plan), a build to the default error target from
   // builder::kDefaultFirstRoundSamples (--target-error E keeps E). Progress

@@ -55,7 +55,7 @@ TEST(BuildCommandLineTest, SamplesAndTargetError) {
 
 TEST(BuildCommandLineTest, WholeBuildFlags) {
   const auto cli = Parsed(
-      "m.stl -o x.gdx --samples 40 --seed 9 --threads 3 --edges-obj e.obj --no-refinement "
+      "m.stl -o x.gdx --samples 40 --seed 9 --threads 3 --edges-obj e.obj --no-split "
       "--no-calibration --strict --weld 1e-6");
   const builder::PipelineOptions o = cli->Options();
   EXPECT_EQ(o.build.seed, 9u);
@@ -73,7 +73,7 @@ TEST(BuildCommandLineTest, Subcommands) {
   EXPECT_EQ(cli->args().workdir, "wd");
   EXPECT_EQ(cli->Options().build.num_samples, 30);
   EXPECT_EQ(cli->Options().target_error, 0);
-  EXPECT_FALSE(cli->Options().build.refine_long_edges);
+  EXPECT_FALSE(cli->Options().build.refine_long_edges);  // --no-refinement: --no-split's old name
   EXPECT_EQ(Parsed("plan m.obj -o wd")->Options().target_error, validation::kDefaultTargetError);
 
   cli = Parsed("rows wd --shard 1/3 --threads 2");

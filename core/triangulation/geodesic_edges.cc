@@ -12,6 +12,7 @@
 #include "core/common/status_macros.h"
 #include "core/common/threads.h"
 #include "core/geodesic/exact_geodesic.h"
+#include "core/geometry/face_frame.h"
 #include "core/geometry/vec2.h"
 
 namespace geodex::triangulation {
@@ -146,11 +147,13 @@ struct FaceFrame {
 
   FaceFrame(const Mesh& mesh, int32_t f) {
     const Vec3& p0 = mesh.position(mesh.face(f)[0]);
-    const Vec3 e1 = mesh.position(mesh.face(f)[1]) - p0;
-    const Vec3 e2 = mesh.position(mesh.face(f)[2]) - p0;
-    l = e1.norm();
-    cx = e1.dot(e2) / l;
-    cy = e1.cross(e2).norm() / l;
+    const Vec3& p1 = mesh.position(mesh.face(f)[1]);
+    const Vec3& p2 = mesh.position(mesh.face(f)[2]);
+    const geometry::FaceFrame frame = geometry::FrameOfTriangle(p0, p1, p2);
+    l = frame.length;
+    cx = frame.cx;
+    cy = frame.cy;
+    const Vec3 e1 = p1 - p0, e2 = p2 - p0;
     size = std::max({l, e2.norm(), (e2 - e1).norm()});
     if (!(cy * l >= kDegenerateArea * size * size)) {
       // A zero-area or needle face flattens to a segment (or a point), where
@@ -175,12 +178,6 @@ struct FaceFrame {
   }
 };
 
-double Cross(const Vec2& o, const Vec2& a, const Vec2& b) {
-  return (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0]);
-}
-
-double Distance(const Vec2& a, const Vec2& b) { return std::hypot(a[0] - b[0], a[1] - b[1]); }
-
 // The point of segment [a, b] nearest to p.
 Vec2 Nearest(const Vec2& p, const Vec2& a, const Vec2& b) {
   const double dx = b[0] - a[0], dy = b[1] - a[1];
@@ -194,8 +191,9 @@ Vec2 Nearest(const Vec2& p, const Vec2& a, const Vec2& b) {
 // where.
 bool SegmentsTouch(const Vec2& a0, const Vec2& a1, const Vec2& b0, const Vec2& b1, double eps,
                    Vec2* at) {
-  const double o1 = Cross(a0, a1, b0), o2 = Cross(a0, a1, b1);
-  const double o3 = Cross(b0, b1, a0), o4 = Cross(b0, b1, a1);
+  // Each end's side of the other segment's line (positive to the left).
+  const double o1 = geometry::Cross(a1 - a0, b0 - a0), o2 = geometry::Cross(a1 - a0, b1 - a0);
+  const double o3 = geometry::Cross(b1 - b0, a0 - b0), o4 = geometry::Cross(b1 - b0, a1 - b0);
   if (((o1 > 0 && o2 < 0) || (o1 < 0 && o2 > 0)) && ((o3 > 0 && o4 < 0) || (o3 < 0 && o4 > 0))) {
     const double t = o3 / (o3 - o4);
     *at = {a0[0] + t * (a1[0] - a0[0]), a0[1] + t * (a1[1] - a0[1])};
@@ -206,7 +204,7 @@ bool SegmentsTouch(const Vec2& a0, const Vec2& a1, const Vec2& b0, const Vec2& b
   bool touch = false;
   auto consider = [&](const Vec2& p, const Vec2& s0, const Vec2& s1) {
     const Vec2 q = Nearest(p, s0, s1);
-    const double d = Distance(p, q);
+    const double d = (p - q).norm();
     if (d < best) {
       best = d;
       touch = true;
@@ -459,10 +457,10 @@ absl::StatusOr<std::vector<EdgeCrossing>> FindCrossings(const Mesh& mesh,
           const Vec2 xf = px.vp == vs ? x1 : x0;
           const Vec2 yf = py.vp == vs ? y1 : y0;
           touch = false;
-          if (Distance(xf, s) > eps && Distance(xf, Nearest(xf, y0, y1)) < eps) {
+          if ((xf - s).norm() > eps && (xf - Nearest(xf, y0, y1)).norm() < eps) {
             touch = true;
             meet = xf;
-          } else if (Distance(yf, s) > eps && Distance(yf, Nearest(yf, x0, x1)) < eps) {
+          } else if ((yf - s).norm() > eps && (yf - Nearest(yf, x0, x1)).norm() < eps) {
             touch = true;
             meet = yf;
           }

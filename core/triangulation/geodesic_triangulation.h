@@ -96,7 +96,7 @@ struct RepairOptions {
   bool check_edges = false;
   int threads = 1;  // for tracing; 0: all hardware threads
   // For messages: the input file's id of each mesh vertex (kNone for a
-  // vertex the file does not have, e.g. a midpoint of the flat refinement);
+  // vertex the file does not have, e.g. a midpoint of the long-edge split);
   // empty when the mesh's ids are the file's.
   std::vector<int32_t> input_vertex_ids;
 };

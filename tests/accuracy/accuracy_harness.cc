@@ -26,7 +26,7 @@ absl::StatusOr<std::vector<double>> PlacementWeights(const HarnessFlags& flags, 
                                                      std::shared_ptr<const index::Index> fps,
                                                      int32_t count) {
   GEODEX_ASSIGN_OR_RETURN(const builder::PreparedMesh prepared,
-                          builder::PrepareMesh(m, {}, count, !flags.no_refinement));
+                          builder::PrepareMesh(m, {}, count, !flags.no_split));
   validation::ErrorMapOptions map_options;
   map_options.threads = flags.threads;
   GEODEX_ASSIGN_OR_RETURN(const std::vector<double> map,
@@ -42,7 +42,7 @@ absl::Status BuildIndexFile(const HarnessFlags& flags, const mesh::Mesh& m, int3
   build_options.threads = flags.threads;
   build_options.spacing_weight = spacing_weight;
   GEODEX_ASSIGN_OR_RETURN(const builder::PreparedMesh prepared,
-                          builder::PrepareMesh(m, {}, count, !flags.no_refinement));
+                          builder::PrepareMesh(m, {}, count, !flags.no_split));
   builder::BuildSummary summary;
   GEODEX_ASSIGN_OR_RETURN(const auto data,
                           builder::BuildPreparedIndex(prepared, build_options, &summary));
@@ -119,8 +119,9 @@ AccuracyCommandLine::AccuracyCommandLine()
                   "Targets per source drawn in each distance bin");
   app_.add_option("--seed", f.pairs.seed, "Random seed");
   app_.add_option("--index-dir", f.index_dir, "Cache built indexes here");
-  app_.add_flag("--no-refinement", f.no_refinement,
-                "Build without splitting long edges (geodex-build --no-refinement)");
+  app_.add_flag("--no-split", f.no_split,
+                "Build without splitting long edges (geodex-build --no-split)");
+  app_.add_flag("--no-refinement", f.no_split)->group("");  // --no-split's old name
   app_.add_flag("--error-driven", f.error_driven,
                 "Also build each m with error-driven placement (spacing weights from the "
                 "farthest-point index's error map) and measure it on the same pairs");
@@ -163,7 +164,7 @@ absl::StatusOr<AnswerMode> ParseAnswerMode(const std::string& mode) {
 std::string CachedIndexPath(const HarnessFlags& flags, const std::string& name, int32_t count,
                             const std::string& suffix) {
   return absl::StrFormat("%s/%s-m%d%s%s.gdx", flags.index_dir.empty() ? "/tmp" : flags.index_dir,
-                         name, count, flags.no_refinement ? "-noref" : "", suffix);
+                         name, count, flags.no_split ? "-noref" : "", suffix);
 }
 
 absl::StatusOr<std::shared_ptr<const index::Index>> IndexFor(

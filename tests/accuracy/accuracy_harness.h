@@ -33,7 +33,7 @@ struct HarnessFlags {
   std::string index_dir;          // cache of built indexes; empty: none
   int threads = 0;
   std::vector<std::string> modes = {"unfold", "default", "bounds", "tol0.005"};
-  bool no_refinement = false;
+  bool no_split = false;
   bool error_driven = false;
 };
 

@@ -26,14 +26,14 @@ TEST(AccuracyCommandLineTest, Defaults) {
   EXPECT_EQ(flags.modes, (std::vector<std::string>{"unfold", "default", "bounds", "tol0.005"}));
   EXPECT_EQ(flags.index_dir, "");
   EXPECT_EQ(flags.threads, 0);
-  EXPECT_FALSE(flags.no_refinement);
+  EXPECT_FALSE(flags.no_split);
   EXPECT_FALSE(flags.error_driven);
 }
 
 TEST(AccuracyCommandLineTest, ListsAreCommaSeparated) {
   const HarnessFlags flags = Parse(
       "m.obj --samples 250,500 --modes trace,nowalk --sources 6 --points 20 --per-bin 4 "
-      "--seed 3 --index-dir d --threads 2 --no-refinement --error-driven");
+      "--seed 3 --index-dir d --threads 2 --no-split --error-driven");
   EXPECT_EQ(flags.samples, (std::vector<int32_t>{250, 500}));
   EXPECT_EQ(flags.modes, (std::vector<std::string>{"trace", "nowalk"}));
   EXPECT_EQ(flags.pairs.num_sources, 6);
@@ -42,7 +42,7 @@ TEST(AccuracyCommandLineTest, ListsAreCommaSeparated) {
   EXPECT_EQ(flags.pairs.seed, 3u);
   EXPECT_EQ(flags.index_dir, "d");
   EXPECT_EQ(flags.threads, 2);
-  EXPECT_TRUE(flags.no_refinement);
+  EXPECT_TRUE(flags.no_split);
   EXPECT_TRUE(flags.error_driven);
   EXPECT_THROW(Parse("--samples 5"), CLI::RequiredError);
 }
@@ -78,7 +78,7 @@ TEST(AccuracyHarnessTest, CachedIndexPath) {
   HarnessFlags flags;
   EXPECT_EQ(CachedIndexPath(flags, "bunny", 500, ""), "/tmp/bunny-m500.gdx");
   flags.index_dir = "idx";
-  flags.no_refinement = true;
+  flags.no_split = true;
   EXPECT_EQ(CachedIndexPath(flags, "bunny", 500, "-placed"), "idx/bunny-m500-noref-placed.gdx");
 }
 

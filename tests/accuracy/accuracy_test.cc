@@ -120,7 +120,7 @@ TEST(AccuracyTest, DevelopableSurfacesAreExact) {
 // 1.5 (so that a 2x regression fails), and at least 1e-5 where the measured
 // p99 is 0 to rounding; a coverage limit lets the uncovered share grow 1.5x
 // (at least to 1%). The figures and the command that prints them:
-// tests/bench/README.md, "The CI accuracy guard's limits".
+// tests/bench/accuracy.md, "The CI accuracy guard's limits".
 constexpr double kExact = 1e-5;
 
 TEST(AccuracyTest, Sphere) {

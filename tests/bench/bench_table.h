@@ -1,6 +1,6 @@
 #pragma once
 
-// The Markdown tables the benchmarks print (and bench/README.md quotes).
+// The Markdown tables the benchmarks print (and the pages of tests/bench quote).
 
 #include <string>
 #include <string_view>

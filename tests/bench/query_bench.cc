@@ -22,7 +22,7 @@
 // pairs, rate, error quantiles, bound coverage and the share answered
 // exactly; tolerances 0.005 and 0.001 on area-uniform pairs.
 //
-// Then the exponential map (core/query/internal/exp_map.h): the time of one map round
+// Then the exponential map (core/query/internal/expmap/exp_map.h): the time of one map round
 // an interior point for radii of 3 L, 10 L and the whole mesh, in the default
 // mode and with r from the pure O(1) distance.
 //

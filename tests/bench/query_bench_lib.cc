@@ -15,7 +15,7 @@
 #include "core/query/input_queries.h"
 #include "core/query/internal/query_engine.h"
 #include "core/query/internal/query_knobs.h"
-#include "core/query/internal/unfold_kernel.h"
+#include "core/query/internal/o1/unfold_kernel.h"
 #include "tests/bench/bench_table.h"
 #include "tests/bench/bench_timing.h"
 #include "tests/bench/refinement_accuracy.h"

@@ -40,9 +40,11 @@ done
 declare -A max_len=([obj]=4096 [ply]=4096 [off]=4096 [stl]=4096 [gltf]=4096 [repair]=512 [build]=196
   [index]=16384 [pairs]=2048 [request]=2048)
 
-if [[ ! -f "$build_dir/build.ninja" ]]; then
+# GEODEX_WERROR=ON (tests/run_tests.sh sets it): warnings fail the build; a
+# tree made without it is configured again with it.
+if [[ ! -f "$build_dir/build.ninja" || -n "${GEODEX_WERROR:-}" ]]; then
   CC=clang CXX=clang++ cmake -S "$repo" -B "$build_dir" -G Ninja \
-    -DGEODEX_BUILD_FUZZERS=ON -DGEODEX_WITH_CGAL=OFF >/dev/null
+    -DGEODEX_BUILD_FUZZERS=ON -DGEODEX_WITH_CGAL=OFF -DGEODEX_WERROR="${GEODEX_WERROR:-OFF}" >/dev/null
 fi
 build_log="$build_dir/run_fuzzers_build.log"
 # shellcheck disable=SC2046  # one --target argument per word, as meant

@@ -128,14 +128,14 @@ check "flat grid: Euclidean to 1e-12, unreferenced vertex inf" awk '
              d = $1 - e; if (d < 0) d = -d; if ($1 == "" || d > 1e-12) bad = 1 }
   NR == 82 && $1 != "inf" { bad = 1 }
   END { exit bad || NR != 82 }' "$work/from40.txt"
-# The flat refinement: 60 samples on the 9x9 grid (edges 1 and 1.41, longer
+# The long-edge split: 60 samples on the 9x9 grid (edges 1 and 1.41, longer
 # than half the sample spacing) split its edges flat; the index answers in
 # the grid's own faces and vertices, the sharded pipeline and `calibrate`
 # give the same bytes, and the answers are the flat (Euclidean) distances.
 "$tools/geodex-build" "$work/grid.obj" -o "$work/grid.gdx" --samples 60 --threads 2 \
   >"$work/grid_build.out" 2>&1
 exits 0 "geodex-build of the grid (refined)"
-check "refined build reports the midpoints" grep -q "refinement    [0-9]* midpoints" "$work/grid_build.out"
+check "refined build reports the midpoints" grep -q "split         [0-9]* midpoints" "$work/grid_build.out"
 "$tools/geodex-build" plan "$work/grid.obj" --samples 60 -o "$work/gwd" >/dev/null 2>&1
 exits 0 "geodex-build plan of the grid"
 for i in 0 1; do
@@ -152,14 +152,14 @@ exits 0 "geodex-build of the grid --no-calibration"
   >/dev/null 2>&1
 exits 0 "geodex-build calibrate of the grid"
 check "refined: calibrate gives the one-process index" cmp -s "$work/grid.gdx" "$work/grid_cal.gdx"
-"$tools/geodex-build" "$work/grid.obj" -o "$work/grid_noref.gdx" --samples 60 --no-refinement \
+"$tools/geodex-build" "$work/grid.obj" -o "$work/grid_noref.gdx" --samples 60 --no-split \
   >"$work/grid_noref.out" 2>&1
-exits 0 "geodex-build --no-refinement"
-check "--no-refinement adds no midpoint" grep -q "refinement    none" "$work/grid_noref.out"
+exits 0 "geodex-build --no-split"
+check "--no-split adds no midpoint" grep -q "split         none" "$work/grid_noref.out"
 "$tools/geodex-query" "$work/grid.gdx" --info >"$work/grid_info.txt" 2>&1
 exits 0 "geodex-query --info of the grid"
-check "--info counts the grid's faces and shows the refinement" \
-  sh -c "grep -q '^  mesh          [0-9]* vertices, 128 faces (answered on' '$work/grid_info.txt' && grep -q '^  refinement    [1-9][0-9]* midpoints' '$work/grid_info.txt'"
+check "--info counts the grid's faces and shows the split" \
+  sh -c "grep -q '^  mesh          [0-9]* vertices, 128 faces (answered on' '$work/grid_info.txt' && grep -q '^  split         [1-9][0-9]* midpoints' '$work/grid_info.txt'"
 printf '0 1 0 0 127 0 0 1
 5 0.2 0.3 0.5 100 0.3 0.3 0.4
 17 0.5 0.5 0 90 0.1 0.1 0.8

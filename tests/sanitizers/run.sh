@@ -37,9 +37,10 @@ if [[ $asan -eq 0 && $tsan -eq 0 && $ci -eq 0 ]]; then asan=1 tsan=1; fi
 
 # configure DIR SANITIZERS
 configure() {
-  if [[ ! -f "$1/build.ninja" ]]; then
+  if [[ ! -f "$1/build.ninja" || -n "${GEODEX_WERROR:-}" ]]; then
     cmake -S "$repo" -B "$1" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
-      -DGEODEX_SANITIZE="$2" -DGEODEX_BUILD_BENCHMARKS=OFF -DGEODEX_WITH_CGAL=OFF > /dev/null
+      -DGEODEX_SANITIZE="$2" -DGEODEX_BUILD_BENCHMARKS=OFF -DGEODEX_WITH_CGAL=OFF \
+      -DGEODEX_WERROR="${GEODEX_WERROR:-OFF}" > /dev/null
   fi
 }
 
@@ -68,9 +69,9 @@ if [[ $ci -eq 1 ]]; then
     echo "sanitizers: SKIPPED: no clang++ (deploy/install-deps.sh installs it)"; exit 77
   fi
   dir="$repo/build-fuzz"
-  if [[ ! -f "$dir/build.ninja" ]]; then
+  if [[ ! -f "$dir/build.ninja" || -n "${GEODEX_WERROR:-}" ]]; then
     CC=clang CXX=clang++ cmake -S "$repo" -B "$dir" -G Ninja \
-      -DGEODEX_BUILD_FUZZERS=ON -DGEODEX_WITH_CGAL=OFF > /dev/null
+      -DGEODEX_BUILD_FUZZERS=ON -DGEODEX_WITH_CGAL=OFF -DGEODEX_WERROR="${GEODEX_WERROR:-OFF}" > /dev/null
   fi
   targets=(core/common_tests core/mesh_tests core/index_tests server/server_tests)
   if ! nice -n 10 cmake --build "$dir" -j"$jobs" --target "${targets[@]##*/}" > "$dir/sanitizers_build.log" 2>&1; then

@@ -69,7 +69,7 @@ class InputIds {
   // [num_input_vertices, num_input_vertices + num_vertex_copies).
   int32_t num_vertex_copies() const { return static_cast<int32_t>(vertex_copies_.size()); }
   // The input vertex internal vertex `v` is (a copy's original), or
-  // mesh::kNone for a refinement's midpoint.
+  // mesh::kNone for a midpoint of the split.
   int32_t InputVertex(int32_t v) const {
     if (v < num_input_vertices_) return v;
     const int32_t k = v - num_input_vertices_;
@@ -95,7 +95,7 @@ class InputIds {
   int32_t num_input_vertices_ = 0;
   // Coarse face -> the input face kept for it; empty for identity faces.
   std::vector<int32_t> kept_input_face_;
-  // The refinement (empty without): per coarse face, its pieces
+  // The long-edge split (empty without): per coarse face, its pieces
   // pieces_[piece_offset_[c], piece_offset_[c + 1]).
   std::span<const int32_t> coarse_faces_;
   std::span<const index::SplitFaceRecord> split_faces_;

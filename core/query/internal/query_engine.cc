@@ -6,10 +6,10 @@
 
 #include "absl/strings/str_format.h"
 #include "core/common/status_macros.h"
-#include "core/query/internal/chord_walk.h"
-#include "core/query/internal/distance_field.h"
-#include "core/query/internal/exp_map.h"
-#include "core/query/internal/path_straightening.h"
+#include "core/query/internal/paths/chord_walk.h"
+#include "core/query/internal/fields/distance_field.h"
+#include "core/query/internal/expmap/exp_map.h"
+#include "core/query/internal/paths/path_straightening.h"
 
 namespace geodex::query {
 namespace {
@@ -218,7 +218,9 @@ absl::StatusOr<std::vector<ExpMapVertex>> QueryEngine::ExpMap(const SurfacePoint
     return Distance(from, p, options.distance, &s);
   };
   auto exact_within = [&](const SurfacePoint& from, double radius) {
-    return LocalExactDistances(from, radius, s);
+    FieldWithinOptions within;
+    within.radius = radius;
+    return FieldWithin(std::span<const SurfacePoint>(&from, 1), within, s);
   };
   return query::ExpMap({view_, scale_length_, distance, exact_within}, centre, options);
 }

@@ -4,20 +4,26 @@
 // the part behind the public facade (input_queries.h), which reads and
 // validates points, translates ids and calls this. The builder's validation
 // (core/validation) uses it directly, since it works in internal ids. Each
-// idea has its own part:
+// idea has its own part, in a folder named after the paper's step. Parts
+// take parts (or plain functions), never the engine; the engine composes
+// them:
 //
-//   lifting.h          §5.1  a surface point -> its geodesic triangle and
-//                            distances to the triangle's corner samples
-//   lifted_unfolding.h §5.2  two lifted points -> their O(1) distance
-//   gradient_path.h    §6.2  paths by tracing the approximate field's
-//                            gradient; path_straightening.h straightens them
-//   chord_walk.h       §6.5  a near pair's path length, by the chord's corridor
-//   refinement.h       §6.5  which answers are refined, and how
-//   error_bounds.h     §6.5  the calibrated bound of each kind of answer
-//   local_exact.h            exact propagations near a point
-//   distance_field.h   §6.2  fields from several sources
-//   point_locator.h          the closest surface point to a position
-//   exp_map.h          §6.4  the exponential map (over this engine)
+//   o1/lifting.h               §5.1  a surface point -> its geodesic triangle
+//                                    and distances to the triangle's corners
+//   o1/lifted_unfolding.h      §5.2  two lifted points -> their O(1) distance
+//   o1/unfold_kernel.h         §5.2  the same, four far pairs at a time
+//   paths/gradient_path.h      §6.2  paths by tracing the approximate field's
+//                                    gradient; paths/path_straightening.h
+//                                    straightens them
+//   paths/chord_walk.h         §6.5  a near pair's path length, by the chord's
+//                                    corridor (paths/strip_funnel.h unfolds it)
+//   bounds/refinement.h        §6.5  which answers are refined, and how
+//   bounds/error_bounds.h      §6.5  the calibrated bound of each kind of answer
+//   exact/local_exact.h              exact propagations near a point
+//   fields/distance_field.h    §6.2  fields from several sources
+//   locate/point_locator.h           the closest surface point to a position
+//   expmap/exp_map.h           §6.4  the exponential map (from the distances
+//                                    this engine gives it)
 //
 // Points are valid (mesh::ValidateSurfacePoint against the index's faces)
 // and in internal ids: the facade checks them once, when they enter.
@@ -36,15 +42,15 @@
 #include "absl/status/statusor.h"
 #include "core/index/index.h"
 #include "core/mesh/mesh.h"
-#include "core/query/internal/error_bounds.h"
-#include "core/query/internal/gradient_path.h"
-#include "core/query/internal/lifted_unfolding.h"
-#include "core/query/internal/lifting.h"
-#include "core/query/internal/local_exact.h"
+#include "core/query/internal/bounds/error_bounds.h"
+#include "core/query/internal/paths/gradient_path.h"
+#include "core/query/internal/o1/lifted_unfolding.h"
+#include "core/query/internal/o1/lifting.h"
+#include "core/query/internal/exact/local_exact.h"
 #include "core/query/internal/mesh_view.h"
-#include "core/query/internal/point_locator.h"
+#include "core/query/internal/locate/point_locator.h"
 #include "core/query/internal/query_knobs.h"
-#include "core/query/internal/refinement.h"
+#include "core/query/internal/bounds/refinement.h"
 #include "core/query/query_types.h"
 
 namespace geodex::query {

@@ -9,10 +9,10 @@
 
 #include "core/index/index.h"
 #include "core/mesh/mesh.h"
-#include "core/query/internal/gradient_path.h"
-#include "core/query/internal/lifted_unfolding.h"
-#include "core/query/internal/lifting.h"
-#include "core/query/internal/local_exact.h"
+#include "core/query/internal/paths/gradient_path.h"
+#include "core/query/internal/o1/lifted_unfolding.h"
+#include "core/query/internal/o1/lifting.h"
+#include "core/query/internal/exact/local_exact.h"
 #include "core/query/internal/mesh_view.h"
 #include "core/validation/test_index.h"
 

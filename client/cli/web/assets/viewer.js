@@ -328,7 +328,7 @@
         rows.push(['answered on', `${r.mesh.index_vertices} vertices, ${r.mesh.index_faces} faces`]);
       }
       rows.push(['repairs', r.mesh.repairs]);
-      rows.push(['refinement', r.mesh.refinement_midpoints ? `${r.mesh.refinement_midpoints} midpoints` : 'none']);
+      rows.push(['split', r.mesh.split_midpoints ? `${r.mesh.split_midpoints} midpoints` : 'none']);
       rows.push(['samples', `m = ${r.samples.final} (${r.samples.requested} requested)`]);
       rows.push(['triangles', `${r.triangles} geodesic triangles`]);
       const largest = r.size.sections[0];

@@ -1,0 +1,113 @@
+#include "core/query/internal/bounds/refinement.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <optional>
+#include <tuple>
+
+#include "core/query/internal/paths/chord_walk.h"
+
+namespace geodex::query {
+bool Refiner::Needs(const DistanceOptions& options, bool bounds, bool near, double unfolded) const {
+  return near || bounds || options.tolerance > 0 ||
+         (options.near_pairs != NearPairs::kUnfold && unfolded < refine_below_);
+}
+
+double Refiner::Refine(const SurfacePoint& p_in, const SurfacePoint& q_in, const LiftedPoint& lp,
+                       const LiftedPoint& lq, double unfolded, bool near,
+                       const DistanceOptions& options, QueryScratch* scratch, double* bound) const {
+  const SurfacePoint p = view_.InLowestFaceIfVertex(p_in), q = view_.InLowestFaceIfVertex(q_in);
+  if (!(unfolded < kInf)) {  // different components: exactly unreachable
+    if (bound != nullptr) *bound = bounds_.Of(AnswerKind::kExact, false, unfolded);
+    return unfolded;
+  }
+  // The refinements work from one point to the other: from the smaller, so
+  // that the answer is symmetric.
+  const bool swap = std::tie(q.face, q.w) < std::tie(p.face, p.w);
+  const SurfacePoint& from = swap ? q : p;
+  const SurfacePoint& to = swap ? p : q;
+  auto at_vertex = [](const SurfacePoint& x) { return x.w[0] == 1 || x.w[1] == 1 || x.w[2] == 1; };
+  const bool vertex_pair = at_vertex(p) && at_vertex(q);
+  double d =
+      near ? std::max(unfolded, (view_.PositionOf(p) - view_.PositionOf(q)).norm()) : unfolded;
+  AnswerKind kind = AnswerKind::kUnfold;
+  // The bound of an answer; the spread of an O(1) answer is computed once,
+  // when first needed.
+  std::optional<double> spread;
+  auto bound_of = [&](AnswerKind k, double at) {
+    if (k == AnswerKind::kUnfold && !spread) {
+      spread = bounds_.has_spread() ? unfolding_.Spread(lp, lq, unfolded) : 0;
+    }
+    return bounds_.Of(k, vertex_pair, at, spread.value_or(0));
+  };
+  // Exact answers run a propagation confined to a region round the pair
+  // (its cost follows the region), else one over the whole mesh from `from`
+  // that stops at `to`.
+  QueryScratch own;
+  QueryScratch& solvers = scratch != nullptr ? *scratch : own;
+  // `path_length`: the length of a surface path between the points, if known.
+  auto exact = [&](double path_length = kInf) {
+    std::optional<double> e = exact_.ConfinedDistance(from, to, {}, solvers, path_length);
+    if (!e) e = exact_.NearDistance(from, to, &solvers);
+    if (!e) return false;
+    d = *e;
+    kind = AnswerKind::kExact;
+    return true;
+  };
+  // The O(1) answer plus its bound: a straight walk longer than that is
+  // doubted (NaN without calibration: none is).
+  auto plausible = [&] {
+    const double limit = unfolded + bound_of(AnswerKind::kUnfold, unfolded);
+    return std::isnan(limit) ? kInf : limit;
+  };
+  auto take = [&](const NearPath& path) {
+    d = path.length;
+    kind = path.wraps ? AnswerKind::kWrappedTrace : AnswerKind::kTrace;
+    return true;
+  };
+  // A near pair: the chord's walks find a local geodesic for most; the rest
+  // (both walks failed, bent at several saddles, or ran longer than is
+  // plausible) are answered exactly, which the gradient trace that used to
+  // answer them erred up to 5% at p99 on, in about the same time
+  // (tests/bench/exact_geodesics.md). The trace stays for an index whose mesh cannot
+  // be rebuilt for exact propagation, and for `walk_` off (benchmarks).
+  auto near_path = [&] {
+    if (walk_) {
+      const NearWalk walk = WalkNearPair(view_, from, to, plausible());
+      if (walk.path) return take(*walk.path);
+      if (exact(walk.doubted.value_or(kInf))) return true;
+    }
+    const std::optional<NearPath> t = NearPathLength(view_, paths_, from, to, walk_, plausible());
+    return t && take(*t);
+  };
+  // A surface path is never shorter than the geodesic; one longer than the
+  // O(1) answer plus that answer's bound has settled in a wrong corridor
+  // (round the wrong side of a feature). Under a tolerance it is answered
+  // exactly. Needs the calibration (else the bound is NaN and no path is
+  // doubted).
+  auto wrong_corridor = [&] {
+    return (kind == AnswerKind::kTrace || kind == AnswerKind::kWrappedTrace) &&
+           d > unfolded + bound_of(AnswerKind::kUnfold, unfolded);
+  };
+  if (near || unfolded < refine_below_) {
+    switch (options.near_pairs) {
+      case NearPairs::kPath:
+        near_path();
+        break;
+      case NearPairs::kExact:
+        exact();
+        break;
+      case NearPairs::kUnfold:
+        break;
+    }
+  }
+  if (options.tolerance > 0) {
+    auto within = [&] { return bound_of(kind, d) <= options.tolerance * d; };
+    if (kind != AnswerKind::kExact && (!within() || wrong_corridor())) exact();
+  }
+  if (bound != nullptr) *bound = bound_of(kind, d);
+  return d;
+}
+
+}  // namespace geodex::query

@@ -1,0 +1,63 @@
+#pragma once
+
+// Refinement of the O(1) answer (Xin, Ying & He 2012, §6.5). Its absolute
+// error is about the same at every distance, so its relative error grows as
+// the points get closer: pairs that may be closer than kRefineScale
+// geodesic-triangle edges, and pairs in the same or adjacent geodesic
+// triangles, are answered by default by a local geodesic the chord's walks
+// find (chord_walk.h), else exactly by a propagation confined to a region
+// round the pair (local_exact.h, core/geodesic/confined_geodesic.h); or all
+// exactly, as DistanceOptions::near_pairs says. A caller's tolerance
+// answers exactly every pair whose error bound (error_bounds.h) exceeds
+// tolerance x distance.
+//
+// Thread safety: immutable; every method is const and thread-safe, with one
+// QueryScratch per thread.
+
+#include "core/query/internal/bounds/error_bounds.h"
+#include "core/query/internal/paths/gradient_path.h"
+#include "core/query/internal/o1/lifted_unfolding.h"
+#include "core/query/internal/exact/local_exact.h"
+#include "core/query/internal/mesh_view.h"
+#include "core/query/query_types.h"
+
+namespace geodex::query {
+
+class Refiner {
+ public:
+  // Over the engine's parts, which must outlive this object. Pairs whose
+  // O(1) answer is below `refine_below` are refined by default. `walk`:
+  // near-pair paths try the chord's corridors first (chord_walk.h).
+  Refiner(const MeshView& view, const LiftedUnfolding& unfolding, const ErrorBounds& bounds,
+          const GradientPaths& paths, const LocalExact& exact, bool walk, double refine_below)
+      : view_(view),
+        unfolding_(unfolding),
+        bounds_(bounds),
+        paths_(paths),
+        exact_(exact),
+        walk_(walk),
+        refine_below_(refine_below) {}
+
+  // True when a pair's O(1) answer `unfolded` is not final under `options`
+  // (`bounds`: a bound is asked for; `near`: the lifts are near).
+  bool Needs(const DistanceOptions& options, bool bounds, bool near, double unfolded) const;
+
+  // The answer for a pair of canonical points, valid, lifted to lp and lq,
+  // whose O(1) distance is `unfolded` (near: the lifts are near), refined as
+  // `options` says; its bound in *bound when not null (NaN without
+  // calibration). Symmetric in the points.
+  double Refine(const SurfacePoint& p, const SurfacePoint& q, const LiftedPoint& lp,
+                const LiftedPoint& lq, double unfolded, bool near, const DistanceOptions& options,
+                QueryScratch* scratch, double* bound) const;
+
+ private:
+  MeshView view_;
+  const LiftedUnfolding& unfolding_;
+  const ErrorBounds& bounds_;
+  const GradientPaths& paths_;
+  const LocalExact& exact_;
+  bool walk_;
+  double refine_below_;
+};
+
+}  // namespace geodex::query

@@ -1,0 +1,61 @@
+#pragma once
+
+// The length of a surface path between near points (closer than a few
+// geodesic-triangle edges), which is how the default mode refines them
+// (§6.5): first the corridor of the chord, walked face to face from either
+// end, unfolded into the plane and straightened by the funnel algorithm,
+// moved off the vertices it bends round short of a straight angle on their
+// other side; the gradient trace (gradient_path.h) only when both walks
+// fail, bend at several saddles, or are longer than is plausible. Every
+// candidate is a surface path, never shorter than the geodesic, so the
+// shortest is kept.
+//
+// Thread safety: a pure function of immutable data.
+
+#include <limits>
+#include <optional>
+
+#include "core/query/internal/paths/gradient_path.h"
+#include "core/query/internal/mesh_view.h"
+#include "core/query/query_types.h"
+
+namespace geodex::query {
+
+// A near pair's path length; `wraps` when the path bends round a mesh
+// vertex (else it is a straight line through the faces it crosses: a local
+// geodesic, practically always the shortest path between near points; so
+// is one bending at a single saddle vertex by no more than its angle
+// excess).
+struct NearPath {
+  double length;
+  bool wraps;
+};
+
+// What the chord's walks found between near points.
+struct NearWalk {
+  // The shortest path the walks vouch for: a local geodesic in a corridor
+  // (straight, or bending round one saddle by no more than its angle
+  // excess), or a shorter doubted one beside it.
+  std::optional<NearPath> path;
+  // Without such a path: the shortest candidate the walks doubted (bending
+  // at several saddles, or straight but longer than `plausible`), if any.
+  std::optional<double> doubted;
+};
+
+// The chord's walks from either end between valid canonical points `from`
+// and `to` (from the smaller point, for symmetry). A straight walk longer
+// than `plausible` is doubted (it may run in a wrong corridor).
+NearWalk WalkNearPair(const MeshView& view, const SurfacePoint& from, const SurfacePoint& to,
+                      double plausible = std::numeric_limits<double>::infinity());
+
+// The shortest path found between valid canonical points `from` and `to`
+// (from the smaller point, for symmetry): the walks' (WalkNearPair), else
+// the gradient trace, else the shortest doubted walk; nullopt when neither a
+// walk nor a trace reaches. `walk_chord`: try the chord's corridors first
+// (off: the trace only, for benchmarks).
+std::optional<NearPath> NearPathLength(const MeshView& view, const GradientPaths& paths,
+                                       const SurfacePoint& from, const SurfacePoint& to,
+                                       bool walk_chord,
+                                       double plausible = std::numeric_limits<double>::infinity());
+
+}  // namespace geodex::query

@@ -1,0 +1,105 @@
+#include "core/query/internal/paths/chord_walk.h"
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include "core/mesh/generators.h"
+#include "core/query/internal/query_parts_testing.h"
+#include "gtest/gtest.h"
+
+namespace geodex::query {
+namespace {
+
+// The distance on a sheet of `width` folded at x = width / 2: the length in
+// the unfolded plane (FoldedSheet is developable).
+TEST(ChordWalkTest, NearPairsAcrossAFoldAreTheUnfoldedSegment) {
+  const double width = 2, height = 2;
+  const mesh::Mesh flat = mesh::gen::Grid(10, 10, width, height);
+  const mesh::Mesh folded = mesh::gen::FoldedSheet(10, 10, width, height, 2.0);
+  const testing::QueryParts parts(folded, 20);
+  int straight = 0;
+  for (int32_t f = 0; f + 23 < folded.num_faces(); f += 9) {
+    const SurfacePoint a{f, {0.2, 0.3, 0.5}}, b{f + 23, {0.5, 0.25, 0.25}};
+    // Same ids, same weights: the flat grid is the unfolding of the sheet.
+    const double want = (mesh::PositionOf(flat, a) - mesh::PositionOf(flat, b)).norm();
+    for (const bool walk : {true, false}) {
+      const std::optional<NearPath> path = NearPathLength(parts.view, parts.paths, a, b, walk);
+      ASSERT_TRUE(path.has_value()) << "face " << f;
+      EXPECT_NEAR(path->length, want, 1e-9 * (1 + want)) << "face " << f << " walk " << walk;
+      straight += !path->wraps;
+    }
+  }
+  EXPECT_GT(straight, 0);
+}
+
+// A saddle: eight equilateral triangles round a vertex c (480 degrees),
+// split twice. A geodesic between points whose angle round c is at least
+// pi on both sides passes through c (length r_p + r_q); else it is the
+// straight segment in the unfolding of the shorter side.
+TEST(ChordWalkTest, NearPairsRoundASaddleVertexAreExact) {
+  constexpr int kSectors = 8;
+  const double r = std::sqrt(3 / (4 - 4 * std::pow(std::sin(M_PI / kSectors), 2))),
+               z = std::sqrt(1 - r * r);
+  std::vector<mesh::Vec3> positions = {{0, 0, 0}};
+  std::vector<mesh::Triangle> faces;
+  for (int i = 0; i < kSectors; ++i) {
+    const double t = 2 * M_PI * i / kSectors;
+    positions.push_back({r * std::cos(t), r * std::sin(t), i % 2 ? z : -z});
+    faces.push_back({0, 1 + i, 1 + (i + 1) % kSectors});
+  }
+  const absl::StatusOr<mesh::Mesh> fan = mesh::Mesh::Create(positions, faces, "saddle");
+  ASSERT_TRUE(fan.ok()) << fan.status();
+  const mesh::Mesh saddle = mesh::gen::SplitFacesInFour(*fan, 3);
+  const testing::QueryParts parts(saddle, 12);
+  const double total = kSectors * M_PI / 3;
+  // A point's distance from c and its angle round c from the first edge.
+  auto polar = [&](const mesh::Vec3& x, double* radius) {
+    *radius = x.norm();
+    const double t = std::atan2(x.y(), x.x());
+    const int sector = static_cast<int>(std::floor((t < 0 ? t + 2 * M_PI : t) / (M_PI / 4)));
+    const mesh::Vec3 edge = positions[1 + sector % kSectors];
+    return sector * M_PI / 3 +
+           std::acos(std::clamp(x.dot(edge) / (*radius * edge.norm()), -1.0, 1.0));
+  };
+  int through_c = 0, checked = 0;
+  for (int32_t f = 0; f < saddle.num_faces(); f += 7) {
+    for (int32_t g = f + 3; g < saddle.num_faces(); g += 11) {
+      const SurfacePoint a{f, {0.2, 0.3, 0.5}}, b{g, {0.5, 0.25, 0.25}};
+      double ra, rb;
+      const double ta = polar(mesh::PositionOf(saddle, a), &ra);
+      const double tb = polar(mesh::PositionOf(saddle, b), &rb);
+      // Within 0.4 of c segments in the unfolding stay off the rim.
+      if (ra > 0.4 || rb > 0.4) continue;
+      const double side = std::min(std::abs(ta - tb), total - std::abs(ta - tb));
+      const double want =
+          side >= M_PI ? ra + rb : std::sqrt(ra * ra + rb * rb - 2 * ra * rb * std::cos(side));
+      const std::optional<NearPath> path = NearPathLength(parts.view, parts.paths, a, b, true);
+      ASSERT_TRUE(path.has_value());
+      EXPECT_NEAR(path->length, want, 1e-9 * want) << "faces " << f << " " << g;
+      through_c += side >= M_PI;
+      ++checked;
+    }
+  }
+  EXPECT_GT(checked, 50);
+  EXPECT_GT(through_c, 10);
+}
+
+TEST(ChordWalkTest, ADoubtedWalkGivesWayToAShorterTrace) {
+  // A plausible bound below every length: each walk is doubted, the trace
+  // decides, and the answer is still a surface path (>= the geodesic).
+  const mesh::Mesh sphere = mesh::gen::Sphere(3, 1.0);
+  const testing::QueryParts parts(sphere, 40);
+  const SurfacePoint a{3, {0.2, 0.3, 0.5}}, b{40, {0.5, 0.25, 0.25}};
+  const std::optional<NearPath> free = NearPathLength(parts.view, parts.paths, a, b, true);
+  const std::optional<NearPath> doubted =
+      NearPathLength(parts.view, parts.paths, a, b, true, /*plausible=*/0);
+  ASSERT_TRUE(free && doubted);
+  const double chord = (mesh::PositionOf(sphere, a) - mesh::PositionOf(sphere, b)).norm();
+  EXPECT_GE(free->length, chord);
+  EXPECT_GE(doubted->length, chord);
+  EXPECT_GE(doubted->length, free->length - 1e-12);
+}
+
+}  // namespace
+}  // namespace geodex::query
