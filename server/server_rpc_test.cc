@@ -107,7 +107,9 @@ TEST_P(RpcTest, ErrorBoundsAndToleranceMatchTheEngine) {
       EXPECT_EQ(response.distances(i), expected[i]) << i;
       EXPECT_EQ(response.bounds(i), bounds[i]) << i;
       EXPECT_GE(bounds[i], 0);
-      if (tolerance > 0) EXPECT_LE(bounds[i], tolerance * expected[i]) << i;
+      if (tolerance > 0) {
+        EXPECT_LE(bounds[i], tolerance * expected[i]) << i;
+      }
     }
   }
   // Without error_bounds, no bounds.

@@ -298,7 +298,9 @@ TEST_P(RpcTest, DistanceFieldWithinARadiusMatchesTheEngine) {
         EXPECT_EQ(chunk.vertices(i), field->vertices[next + i]);
         EXPECT_EQ(chunk.distances(i), field->distance[next + i]);
         EXPECT_LE(chunk.distances(i), 0.6);
-        if (nearest) EXPECT_EQ(chunk.nearest_source(i), field->nearest[next + i]);
+        if (nearest) {
+          EXPECT_EQ(chunk.nearest_source(i), field->nearest[next + i]);
+        }
       }
       next += chunk.distances_size();
     }

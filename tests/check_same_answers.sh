@@ -53,8 +53,8 @@ largest_where="none"
 # between numbers at the same place (line, word) of A and B; words that are
 # not both numbers count when they differ, as an infinite difference.
 largest_difference() {
-  awk 'function num(s) { return s ~ /^[-+]?([0-9]+\.?[0-9]*|\.[0-9]+)([eE][-+]?[0-9]+)?[,\]]*$/ }
-    function strip(s) { sub(/[,\]]+$/, "", s); return s }
+  awk 'function num(s) { return s ~ /^[-+]?([0-9]+\.?[0-9]*|\.[0-9]+)([eE][-+]?[0-9]+)?[,\]})]*$/ }
+    function strip(s) { sub(/[,\]})]+$/, "", s); return s }
     NR == FNR { before[FNR] = $0; next }
     {
       n = split(before[FNR], a, /[ \t:\[]+/); m = split($0, b, /[ \t:\[]+/)
@@ -72,11 +72,42 @@ largest_difference() {
     END { if (FNR != length(before) && worst_rel < 1e300) { worst_abs = "inf"; worst_rel = 1e300 }
           printf "%s %g %d\n", worst_abs == "" ? 0 : worst_abs, worst_rel, at }' "$1" "$2"
 }
+# path_lengths FILE -> the length of each path of a geodex-query --paths
+# output, one a line: JSON (a path a line, its points' "xyz") or text
+# (points "x y z", paths apart by blank lines). Two paths of equal length
+# may cross an edge at another point where a crossing is degenerate; their
+# lengths are what a rounding change must leave alone.
+path_lengths() {
+  awk 'function point(x, y, z) {
+         if (have) len += sqrt((x - px) ^ 2 + (y - py) ^ 2 + (z - pz) ^ 2)
+         px = x; py = y; pz = z; have = 1
+       }
+       function flush() { if (have) printf "%.17g\n", len; len = 0; have = 0 }
+       /"xyz"/ {
+         rest = $0
+         while (match(rest, /"xyz": \[[^]]*\]/)) {
+           split(substr(rest, RSTART + 8, RLENGTH - 9), c, /, */)
+           point(c[1], c[2], c[3])
+           rest = substr(rest, RSTART + RLENGTH)
+         }
+         flush(); next
+       }
+       NF == 3 && $1 ~ /^[-+.0-9]/ { point($1, $2, $3); next }
+       { flush() }
+       END { flush() }' "$1"
+}
 compare() {  # compare NAME: $work/before.NAME vs $work/after.NAME
   if cmp -s "$work/before.$1" "$work/after.$1"; then
     echo "  same   $1 ($(wc -c <"$work/after.$1") bytes)"
   else
-    read -r abs rel line < <(largest_difference "$work/before.$1" "$work/after.$1")
+    case "$1" in
+      *.paths | *.corridor)
+        path_lengths "$work/before.$1" >"$work/before.$1.lengths"
+        path_lengths "$work/after.$1" >"$work/after.$1.lengths"
+        read -r abs rel line < <(largest_difference "$work/before.$1.lengths" "$work/after.$1.lengths")
+        line="path $line" ;;
+      *) read -r abs rel line < <(largest_difference "$work/before.$1" "$work/after.$1") ;;
+    esac
     echo "  DIFFER $1: largest difference $abs (relative $rel, line $line)"
     diff <(head -c 2000 "$work/before.$1") <(head -c 2000 "$work/after.$1") | head -5 || true
     if awk -v r="$rel" -v w="$largest_rel" 'BEGIN { exit !(r > w) }'; then

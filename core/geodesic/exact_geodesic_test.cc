@@ -281,7 +281,9 @@ TEST(ExactGeodesicTest, MultiSourceGivesVoronoiAndMinimum) {
       const double d = (m.position(v) - PositionOf(m, sources[s])).norm();
       if (s != nearest) second = std::min(second, d);
     }
-    if (second - best > 1e-9) EXPECT_EQ(solver.NearestSource(v), nearest) << v;
+    if (second - best > 1e-9) {
+      EXPECT_EQ(solver.NearestSource(v), nearest) << v;
+    }
   }
 }
 
@@ -295,8 +297,12 @@ TEST(ExactGeodesicTest, StopRadiusLeavesFarVerticesUnreached) {
   const int64_t limited = solver.stats().windows_created;
   for (int32_t v = 0; v < m.num_vertices(); ++v) {
     const double e = (m.position(v) - m.position(s)).norm();
-    if (e <= 0.2) EXPECT_NEAR(solver.VertexDistance(v), e, 1e-12);
-    if (e > 0.2 + 0.1) EXPECT_EQ(solver.VertexDistance(v), kInfinity);
+    if (e <= 0.2) {
+      EXPECT_NEAR(solver.VertexDistance(v), e, 1e-12);
+    }
+    if (e > 0.2 + 0.1) {
+      EXPECT_EQ(solver.VertexDistance(v), kInfinity);
+    }
   }
   ASSERT_TRUE(solver.Propagate({AtVertex(m, s)}).ok());
   EXPECT_LT(limited * 4, solver.stats().windows_created);

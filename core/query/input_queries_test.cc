@@ -18,7 +18,6 @@
 #include "core/mesh/broken_meshes_testing.h"
 #include "core/mesh/generators.h"
 #include "core/mesh/mesh_repair.h"
-#include "core/query/internal/expmap/exp_map.h"
 #include "core/query/internal/input_ids.h"
 #include "core/query/internal/query_engine.h"
 #include "gmock/gmock.h"
@@ -439,7 +438,7 @@ TEST(InputQueriesTest, PointsAreCheckedWhereTheyEnter) {
   ExpMapOptions options;
   options.radius = 0.8;
   absl::StatusOr<std::vector<ExpMapVertex>> facade = (*queries)->ExpMap(read, 0, options);
-  absl::StatusOr<std::vector<ExpMapVertex>> engine = ExpMap(*b.engine, centre, options);
+  absl::StatusOr<std::vector<ExpMapVertex>> engine = b.engine->ExpMap(centre, options);
   ASSERT_TRUE(facade.ok() && engine.ok());
   ASSERT_EQ(facade->size(), engine->size());
   for (size_t i = 0; i < facade->size(); ++i) {
@@ -473,7 +472,9 @@ void ExpectExactWithin(const RadiusField& field, const geodesic::ExactGeodesicSo
     if (!listed) continue;
     EXPECT_LE(field.distance[k], radius);
     EXPECT_NEAR(field.distance[k], truth, 1e-9 * truth) << "vertex " << v;
-    if (truth <= radius) EXPECT_EQ(field.nearest[k], exact.NearestSource(v)) << "vertex " << v;
+    if (truth <= radius) {
+      EXPECT_EQ(field.nearest[k], exact.NearestSource(v)) << "vertex " << v;
+    }
     ++k;
   }
   EXPECT_EQ(k, field.vertices.size()) << "vertices past the mesh's";
@@ -504,7 +505,9 @@ TEST(InputQueriesTest, FieldWithinIsTheExactFieldInsideTheRadius) {
       ExpectExactWithin(*field, exact, torus.num_vertices(), radius);
       EXPECT_GT(field->vertices.size(), previous);
       previous = field->vertices.size();
-      if (radius < 2 * L) EXPECT_LT(field->vertices.size(), torus.num_vertices() / 4u);
+      if (radius < 2 * L) {
+        EXPECT_LT(field->vertices.size(), torus.num_vertices() / 4u);
+      }
       if (sources.size() == 2) {
         EXPECT_NE(std::find(field->nearest.begin(), field->nearest.end(), 1), field->nearest.end());
       }

@@ -98,7 +98,7 @@ struct RepairOptions {
   // For messages: the input file's id of each mesh vertex (kNone for a
   // vertex the file does not have, e.g. a midpoint of the long-edge split);
   // empty when the mesh's ids are the file's.
-  std::vector<int32_t> input_vertex_ids;
+  std::vector<int32_t> input_vertex_ids = {};  // "= {}": designated initializers may leave it out
 };
 
 // Every refusal of the builder fits one line of this many characters.

@@ -112,7 +112,9 @@ TEST(QueryEngineTest, UnfoldingSpreadVanishesWhereBothOrdersAreExact) {
     const double s = round->UnfoldingSpread(b[k], b[k + 1]);
     EXPECT_EQ(s, round->UnfoldingSpread(b[k + 1], b[k]));
     EXPECT_LT(s, 0.05 * round->O1Distance(b[k], b[k + 1]));
-    if (round->Lift(b[k]).triangle == round->Lift(b[k + 1]).triangle) EXPECT_EQ(s, 0);
+    if (round->Lift(b[k]).triangle == round->Lift(b[k + 1]).triangle) {
+      EXPECT_EQ(s, 0);
+    }
     spread += s > 1e-6;
   }
   EXPECT_GT(spread, 150);

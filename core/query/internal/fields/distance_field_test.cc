@@ -24,7 +24,9 @@ TEST(DistanceFieldTest, FlatSheetFieldIsTheDistanceToTheNearestSource) {
       if (d < best) best = d, nearest = static_cast<int32_t>(s);
     }
     EXPECT_NEAR(field.distance[v], best, 1e-5 * (1 + best)) << "vertex " << v;
-    if (std::abs(field.distance[v] - best) < 1e-3) EXPECT_EQ(field.nearest[v], nearest);
+    if (std::abs(field.distance[v] - best) < 1e-3) {
+      EXPECT_EQ(field.nearest[v], nearest);
+    }
   }
 }
 
