@@ -190,7 +190,7 @@ absl::Status ParsePlyPropertyLine(std::span<const std::string_view> tokens, PlyH
   const int index = static_cast<int>(element.properties.size());
   if (element.is_vertex) {
     for (int axis = 0; axis < 3; ++axis) {
-      if (property.name == std::string_view("xyz" + axis, 1)) {
+      if (property.name == std::string_view(&"xyz"[axis], 1)) {
         if (property.is_list) {
           return absl::InvalidArgumentError("vertex coordinate declared as a list");
         }
