@@ -184,7 +184,7 @@ struct ExpMapQuery {
   double radius = 0;
   // theta = 0 along this direction, projected into the plane of the centre's
   // face; unset: along that face's first edge.
-  std::optional<Position> reference_direction;
+  std::optional<Position> reference_direction = std::nullopt;
   // How r is computed, as in DistanceQuery.
   NearPairs near_pairs = NearPairs::kModelDefault;
   double tolerance = 0;
