@@ -3,14 +3,14 @@
 // Request limits of the Geodex service, and the one place they are checked.
 // Beyond any of them a call fails with RESOURCE_EXHAUSTED, naming the limit.
 // Server-wide values come from flags; a model's config.textproto may lower
-// them (server/model_config.proto).
+// them (server/config/model_config.proto).
 //
 // Thread safety: pure functions.
 
 #include <cstdint>
 
 #include "absl/status/status.h"
-#include "server/model_config.pb.h"
+#include "server/config/model_config.pb.h"
 
 namespace geodex::server {
 
@@ -25,7 +25,9 @@ struct ServiceLimits {
   int64_t max_path_pairs = 10'000;           // pairs of one Path call
   int64_t max_locate_positions = 1'000'000;  // positions of one Locate call
   int64_t max_message_bytes = 64 << 20;      // any received message (gRPC enforces it)
-  // Streaming calls running at once: StreamDistances, Matrix, DistanceField, GetMesh.
+  // Streaming calls running at once: every call with a reactor in
+  // server/streams/ (StreamDistances and each server stream) is admitted
+  // through the one StreamSet that counts them against this limit.
   int32_t max_concurrent_streams = 64;
   // Batches of one StreamDistances call read ahead of the answers written:
   // enough to keep a worker busy while the previous answer is on the wire,

@@ -1,4 +1,4 @@
-#include "server/limits.h"
+#include "server/config/limits.h"
 
 #include <cstdint>
 #include <limits>

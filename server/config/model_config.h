@@ -1,8 +1,8 @@
 #pragma once
 
 // Model names and per-model configuration files of the model repository
-// (server/model_registry.h): DIR/<model>/config.textproto holds a
-// geodex.server.ModelConfig (server/model_config.proto) in text format.
+// (server/registry/model_registry.h): DIR/<model>/config.textproto holds a
+// geodex.server.ModelConfig (server/config/model_config.proto) in text format.
 //
 // Thread safety: pure functions.
 
@@ -11,7 +11,7 @@
 
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
-#include "server/model_config.pb.h"
+#include "server/config/model_config.pb.h"
 
 namespace geodex::server {
 

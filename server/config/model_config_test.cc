@@ -1,8 +1,8 @@
-#include "server/model_config.h"
+#include "server/config/model_config.h"
 
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
-#include "server/limits.h"
+#include "server/config/limits.h"
 #include "server/test_util.h"
 
 namespace geodex::server {

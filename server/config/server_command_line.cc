@@ -1,4 +1,4 @@
-#include "server/server_command_line.h"
+#include "server/config/server_command_line.h"
 
 namespace geodex::server {
 

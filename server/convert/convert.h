@@ -28,7 +28,7 @@
 #include "core/query/input_queries.h"
 #include "core/query/query_types.h"
 #include "geodex/v1/geodex.pb.h"
-#include "server/model_registry.h"
+#include "server/registry/model_registry.h"
 
 namespace geodex::server {
 

@@ -2,7 +2,7 @@
 
 // What a request asks of the engine, as core options: the request's choices
 // where it makes them, else the defaults of the model's configuration
-// (server/model_config.proto). The sibling of server/convert.h, which reads
+// (server/config/model_config.proto). The sibling of server/convert/convert.h, which reads
 // the request's points and writes the answers.
 //
 // Errors: InvalidArgument for an unknown or contradictory choice, naming the
@@ -15,7 +15,7 @@
 #include "absl/status/statusor.h"
 #include "core/query/query_types.h"
 #include "geodex/v1/geodex.pb.h"
-#include "server/model_config.pb.h"
+#include "server/config/model_config.pb.h"
 
 namespace geodex::server {
 

@@ -1,4 +1,4 @@
-#include "server/convert_options.h"
+#include "server/convert/convert_options.h"
 
 #include <cmath>
 #include <limits>

@@ -1,4 +1,4 @@
-#include "server/mapped_files.h"
+#include "server/registry/mapped_files.h"
 
 #include <signal.h>
 #include <unistd.h>

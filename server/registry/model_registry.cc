@@ -1,4 +1,4 @@
-#include "server/model_registry.h"
+#include "server/registry/model_registry.h"
 
 #include <sys/stat.h>
 
@@ -13,7 +13,7 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "absl/strings/str_join.h"
-#include "server/model_config.h"
+#include "server/config/model_config.h"
 #include "spdlog/spdlog.h"
 
 namespace geodex::server {

@@ -6,7 +6,7 @@
 // Layout on disk:
 //
 //   DIR/<model>/<version>/index.gdx    version: a positive decimal integer
-//   DIR/<model>/config.textproto       optional (server/model_config.proto)
+//   DIR/<model>/config.textproto       optional (server/config/model_config.proto)
 //
 // Directories whose name is not a valid model name (ValidateModelName) or
 // version, and version directories without an index.gdx yet, are ignored. An
@@ -35,7 +35,7 @@
 // stops being served at the next scan, since its mapping no longer holds what
 // was validated; it is then loaded afresh like any changed file. Between the
 // change and that scan a query can still read it (and die of SIGBUS if it
-// shrank: server/mapped_files.h).
+// shrank: server/registry/mapped_files.h).
 //
 // Thread safety: every public method is safe from any thread. Resolve and
 // snapshot() copy the published shared_ptr under a mutex held for that copy
@@ -61,8 +61,8 @@
 #include "absl/time/time.h"
 #include "core/index/index.h"
 #include "core/query/input_queries.h"
-#include "server/mapped_files.h"
-#include "server/model_config.pb.h"
+#include "server/config/model_config.pb.h"
+#include "server/registry/mapped_files.h"
 
 namespace geodex::server {
 

@@ -1,4 +1,4 @@
-#include "server/model_registry.h"
+#include "server/registry/model_registry.h"
 
 #include <chrono>
 #include <filesystem>

@@ -1,12 +1,12 @@
-#include "server/call.h"
+#include "server/service/call.h"
 
 #include <algorithm>
 #include <atomic>
 #include <random>
 
 #include "absl/strings/str_format.h"
-#include "server/metrics.h"
-#include "server/status_conversion.h"
+#include "server/service/metrics.h"
+#include "server/service/status_conversion.h"
 #include "spdlog/spdlog.h"
 
 namespace geodex::server {

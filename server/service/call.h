@@ -34,7 +34,7 @@ Call StartCall(grpc::CallbackServerContext* context, const char* method);
 
 // Ends `call` with `status`: records it in `metrics` (may be null), logs an
 // error once (client mistakes at info, the server's own trouble at warn),
-// and returns the status for gRPC (server/status_conversion.h).
+// and returns the status for gRPC (server/service/status_conversion.h).
 grpc::Status FinishCall(const Call& call, const absl::Status& status, Metrics* metrics);
 
 // OK while the call runs; Cancelled or DeadlineExceeded once it is over.

@@ -1,10 +1,10 @@
-#include "server/compute_distances.h"
+#include "server/service/compute_distances.h"
 
 #include <algorithm>
 #include <span>
 
 #include "core/common/status_macros.h"
-#include "server/convert.h"
+#include "server/convert/convert.h"
 
 namespace geodex::server {
 

@@ -7,10 +7,10 @@
 
 #include "absl/status/status.h"
 #include "geodex/v1/geodex.pb.h"
-#include "server/convert_options.h"
-#include "server/limits.h"
-#include "server/model_registry.h"
-#include "server/worker_pool.h"
+#include "server/config/limits.h"
+#include "server/convert/convert_options.h"
+#include "server/registry/model_registry.h"
+#include "server/service/worker_pool.h"
 
 namespace geodex::server {
 

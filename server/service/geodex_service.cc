@@ -1,7 +1,7 @@
 // GeodexService: admission of unary calls and the unary calls themselves;
 // the streaming calls start their reactors (server/streams/).
 
-#include "server/geodex_service.h"
+#include "server/service/geodex_service.h"
 
 #include <algorithm>
 #include <memory>
@@ -10,11 +10,11 @@
 
 #include "absl/strings/str_format.h"
 #include "core/common/status_macros.h"
-#include "server/call.h"
-#include "server/compute_distances.h"
-#include "server/convert.h"
-#include "server/convert_options.h"
-#include "server/model_config.h"
+#include "server/config/model_config.h"
+#include "server/convert/convert.h"
+#include "server/convert/convert_options.h"
+#include "server/service/call.h"
+#include "server/service/compute_distances.h"
 #include "server/streams/distance_stream.h"
 #include "server/streams/exp_map_stream.h"
 #include "server/streams/field_stream.h"

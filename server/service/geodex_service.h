@@ -2,20 +2,19 @@
 
 // The geodex.v1.Geodex service (proto/geodex/v1/geodex.proto) on gRPC's
 // callback API. It holds no geometry: it resolves the model, converts and
-// validates input (server/convert.h, server/convert_options.h), checks the
-// limits (server/limits.h), runs the core engine on the worker pool and
-// converts answers back. Errors leave through server/status_conversion.h.
+// validates input (server/convert/), checks the limits
+// (server/config/limits.h), runs the core engine on the worker pool and
+// converts answers back. Errors leave through status_conversion.h.
 //
 // Threads. Reactions run on gRPC's threads and only move messages; every
 // query, validation and conversion of a batch runs on the WorkerPool. A full
 // pool queue answers RESOURCE_EXHAUSTED.
 //
 // Streams. Each streaming call has a reactor of its own in server/streams/
-// (StreamDistances: distance_stream.h; Matrix: matrix_stream.h;
-// DistanceField: field_stream.h; ExpMap: exp_map_stream.h; GetMesh:
-// mesh_stream.h), which sees the service only through ServiceResources
-// (server/service_resources.h). They write one message at a time and make
-// the next when the write has completed (backpressure).
+// (<call>_stream.h, e.g. distance_stream.h for StreamDistances), which sees
+// the service only through ServiceResources (service_resources.h). They
+// write one message at a time and make the next when the write has
+// completed (backpressure).
 //
 // Deadlines and cancellation: a call cancelled or past its deadline is not
 // started, and long calls (Matrix rows, Path pairs, GetMesh chunks) stop
@@ -34,13 +33,13 @@
 #include <cstdint>
 
 #include "geodex/v1/geodex.grpc.pb.h"
-#include "server/auth.h"
-#include "server/limits.h"
-#include "server/metrics.h"
-#include "server/model_registry.h"
-#include "server/service_resources.h"
+#include "server/config/limits.h"
+#include "server/registry/model_registry.h"
+#include "server/service/auth.h"
+#include "server/service/metrics.h"
+#include "server/service/service_resources.h"
+#include "server/service/worker_pool.h"
 #include "server/streams/stream_set.h"
-#include "server/worker_pool.h"
 
 namespace geodex::server {
 

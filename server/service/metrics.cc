@@ -1,4 +1,4 @@
-#include "server/metrics.h"
+#include "server/service/metrics.h"
 
 #include <exception>
 #include <sstream>

@@ -36,7 +36,7 @@
 #include "prometheus/gauge.h"
 #include "prometheus/histogram.h"
 #include "prometheus/registry.h"
-#include "server/model_registry.h"
+#include "server/registry/model_registry.h"
 
 namespace prometheus {
 class Exposer;

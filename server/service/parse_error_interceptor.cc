@@ -1,4 +1,4 @@
-#include "server/parse_error_interceptor.h"
+#include "server/service/parse_error_interceptor.h"
 
 #include <string>
 #include <utility>

@@ -1,7 +1,7 @@
-#include "server/service_resources.h"
+#include "server/service/service_resources.h"
 
 #include "absl/strings/str_format.h"
-#include "server/auth.h"
+#include "server/service/auth.h"
 
 namespace geodex::server {
 

@@ -3,7 +3,7 @@
 // What a call of the Geodex service needs of the service that runs it, and
 // nothing more: the models, the worker pool, the limits, metrics,
 // authentication and the set of running streams. The unary calls
-// (server/geodex_service.cc) and every stream reactor (server/streams/) see
+// (server/service/geodex_service.cc) and every stream reactor (server/streams/) see
 // the service through this struct alone.
 //
 // Ownership: GeodexService owns one; every pointer it holds outlives the
@@ -16,10 +16,10 @@
 #include "geodex/v1/geodex.pb.h"
 #include "grpcpp/server_context.h"
 #include "grpcpp/support/status.h"
-#include "server/call.h"
-#include "server/limits.h"
-#include "server/model_registry.h"
-#include "server/worker_pool.h"
+#include "server/config/limits.h"
+#include "server/registry/model_registry.h"
+#include "server/service/call.h"
+#include "server/service/worker_pool.h"
 
 namespace geodex::server {
 
@@ -35,7 +35,7 @@ struct ServiceResources {
   ServiceLimits limits;             // server-wide (see LimitsFor)
   StreamSet* streams = nullptr;     // the streaming calls running now
 
-  // OK when the call may run. Errors: Unauthenticated (server/auth.h).
+  // OK when the call may run. Errors: Unauthenticated (server/service/auth.h).
   absl::Status Authorize(const grpc::CallbackServerContext& context) const;
   // The model and version `ref` names, which becomes `call`'s metrics label.
   // Errors: those of ModelRegistry::Resolve.

@@ -1,4 +1,4 @@
-#include "server/status_conversion.h"
+#include "server/service/status_conversion.h"
 
 #include <string>
 
