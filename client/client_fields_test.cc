@@ -232,6 +232,14 @@ TEST(ClientMesh, MalformedChunksAreDataLoss) {
   }
 }
 
+// An exponential map query of `radius` and nothing else (a designated
+// initializer would leave reference_direction to a warning).
+ExpMapQuery WithinRadius(double radius) {
+  ExpMapQuery query;
+  query.radius = radius;
+  return query;
+}
+
 // A chunk of entries (vertex, r, theta) of a map of `total` vertices.
 v1::ExpMapChunk Chunk(std::vector<std::array<double, 3>> entries, int64_t total) {
   v1::ExpMapChunk chunk;
@@ -284,7 +292,7 @@ TEST(ClientExpMap, WithoutDirectionSendsNone) {
     return std::vector<v1::ExpMapChunk>{Chunk({}, 0)};
   });
   Client client(mock);
-  absl::StatusOr<ExpMap> map = client.ExpMap("torus", {0, {1, 0, 0}}, {.radius = 1});
+  absl::StatusOr<ExpMap> map = client.ExpMap("torus", {0, {1, 0, 0}}, WithinRadius(1));
   ASSERT_TRUE(map.ok()) << map.status();
   EXPECT_TRUE(map->vertices.empty());
 }
@@ -295,7 +303,7 @@ TEST(ClientExpMap, BadRadiusIsRejectedBeforeAnyCall) {
   Client client(mock);
   for (double radius : {0.0, -1.0, std::numeric_limits<double>::infinity(),
                         std::numeric_limits<double>::quiet_NaN()}) {
-    absl::StatusOr<ExpMap> map = client.ExpMap("torus", {0, {1, 0, 0}}, {.radius = radius});
+    absl::StatusOr<ExpMap> map = client.ExpMap("torus", {0, {1, 0, 0}}, WithinRadius(radius));
     EXPECT_EQ(map.status().code(), absl::StatusCode::kInvalidArgument) << radius;
     EXPECT_THAT(map.status().message(), HasSubstr("radius"));
   }
@@ -314,7 +322,7 @@ TEST(ClientExpMap, InconsistentChunksAreDataLoss) {
                                                     Chunk({{2, 0.5, 0.1}}, 1)}));  // extra
   Client client(mock);
   for (int i = 0; i < 4; ++i) {
-    EXPECT_EQ(client.ExpMap("torus", {0, {1, 0, 0}}, {.radius = 1}).status().code(),
+    EXPECT_EQ(client.ExpMap("torus", {0, {1, 0, 0}}, WithinRadius(1)).status().code(),
               absl::StatusCode::kDataLoss)
         << i;
   }
@@ -324,7 +332,7 @@ TEST(ClientExpMap, ServerErrorsPassThrough) {
   auto mock = std::make_shared<MockGeodexConnection>();
   EXPECT_CALL(*mock, ExpMap(_)).WillOnce(Return(absl::NotFoundError("no model 'x'")));
   Client client(mock);
-  EXPECT_EQ(client.ExpMap("x", {0, {1, 0, 0}}, {.radius = 1}).status().code(),
+  EXPECT_EQ(client.ExpMap("x", {0, {1, 0, 0}}, WithinRadius(1)).status().code(),
             absl::StatusCode::kNotFound);
 }
 
