@@ -8,7 +8,7 @@
 #include "absl/status/status.h"
 #include "geodex/v1/geodex.pb.h"
 #include "server/config/limits.h"
-#include "server/convert/convert_options.h"
+#include "server/convert/convert.h"
 #include "server/registry/model_registry.h"
 #include "server/service/worker_pool.h"
 

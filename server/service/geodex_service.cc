@@ -12,7 +12,6 @@
 #include "core/common/status_macros.h"
 #include "server/config/model_config.h"
 #include "server/convert/convert.h"
-#include "server/convert/convert_options.h"
 #include "server/service/call.h"
 #include "server/service/compute_distances.h"
 #include "server/streams/distance_stream.h"

@@ -7,7 +7,6 @@
 
 #include "absl/strings/str_format.h"
 #include "server/convert/convert.h"
-#include "server/convert/convert_options.h"
 #include "server/service/call.h"
 #include "server/service/compute_distances.h"
 #include "server/service/metrics.h"

@@ -5,7 +5,6 @@
 
 #include "core/common/status_macros.h"
 #include "server/convert/convert.h"
-#include "server/convert/convert_options.h"
 #include "server/service/service_resources.h"
 #include "server/streams/chunked_write_stream.h"
 

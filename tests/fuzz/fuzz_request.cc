@@ -1,6 +1,6 @@
-// libFuzzer target: the server's reading of requests (server/convert/convert.h,
-// server/convert/convert_options.h) and the engine calls behind them, in process (no
-// gRPC). The first byte picks the message, the rest is its wire encoding:
+// libFuzzer target: the server's reading of requests (server/convert/convert.h)
+// and the engine calls behind them, in process (no gRPC). The first byte
+// picks the message, the rest is its wire encoding:
 //   even: geodex.v1.DistanceRequest -> CheckPairedUp, DistanceOptionsFor,
 //         PointsFromProto, InputQueries::DistanceBatch (as
 //         server/service/compute_distances.cc runs them)
@@ -20,7 +20,6 @@
 #include "geodex/v1/geodex.pb.h"
 #include "server/config/model_config.pb.h"
 #include "server/convert/convert.h"
-#include "server/convert/convert_options.h"
 #include "tests/fuzz/fuzz_model.h"
 
 namespace {
