@@ -398,6 +398,38 @@ absl::StatusOr<std::vector<GeodesicPath>> Client::Path(const ModelRef& model,
   return paths;
 }
 
+absl::StatusOr<std::vector<LocatedPoint>> Client::Locate(
+    const ModelRef& model, absl::Span<const Position> positions) const {
+  if (absl::Status s = CheckModel(model); !s.ok()) return s;
+  std::vector<LocatedPoint> located;
+  located.reserve(positions.size());
+  const size_t chunk = options_.locate_batch_size;
+  for (size_t begin = 0; begin < positions.size(); begin += chunk) {
+    const size_t end = std::min(positions.size(), begin + chunk);
+    v1::LocateRequest request;
+    *request.mutable_model() = ToProto(model);
+    auto* xyz = request.mutable_positions()->mutable_xyz();
+    xyz->Reserve(3 * (end - begin));
+    for (size_t i = begin; i < end; ++i) {
+      for (double c : positions[i]) xyz->Add(c);
+    }
+    absl::StatusOr<v1::LocateResponse> response = connection_->Locate(request);
+    if (!response.ok()) return response.status();
+    absl::StatusOr<std::vector<SurfacePoint>> points = FromProto(response->points());
+    if (!points.ok()) return points.status();
+    if (points->size() != end - begin ||
+        response->distances_size() != static_cast<int>(end - begin)) {
+      return absl::DataLossError(
+          absl::StrFormat("the server located %d points (%d distances) of %d", points->size(),
+                          response->distances_size(), end - begin));
+    }
+    for (size_t i = 0; i < points->size(); ++i) {
+      located.push_back({(*points)[i], response->distances(i)});
+    }
+  }
+  return located;
+}
+
 // ---------------------------------------------------------------------------
 // Connect
 
