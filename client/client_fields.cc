@@ -13,6 +13,17 @@
 #include "geodex/client/client.h"
 
 namespace geodex::client {
+namespace {
+
+// The radius of a field within a radius or of an exponential map: finite and
+// > 0. Checked before any call, so that a bad one costs no round trip.
+absl::Status CheckRadius(double radius) {
+  if (std::isfinite(radius) && radius > 0) return absl::OkStatus();
+  return absl::InvalidArgumentError(
+      absl::StrFormat("the radius must be finite and > 0, got %g", radius));
+}
+
+}  // namespace
 
 absl::StatusOr<VertexDistances> Client::DistanceField(const ModelRef& model,
                                                       absl::Span<const SurfacePoint> sources,
@@ -67,10 +78,7 @@ absl::StatusOr<VertexDistancesWithin> Client::DistanceFieldWithin(
     const ModelRef& model, absl::Span<const SurfacePoint> sources,
     const FieldWithinQuery& query) const {
   if (absl::Status s = CheckModel(model); !s.ok()) return s;
-  if (!(std::isfinite(query.radius) && query.radius > 0)) {
-    return absl::InvalidArgumentError(
-        absl::StrFormat("the radius must be finite and > 0, got %g", query.radius));
-  }
+  if (absl::Status s = CheckRadius(query.radius); !s.ok()) return s;
   v1::DistanceFieldRequest request;
   *request.mutable_model() = ToProto(model);
   *request.mutable_sources() = ToProto(sources);
@@ -126,10 +134,7 @@ absl::StatusOr<VertexDistancesWithin> Client::DistanceFieldWithin(
 absl::StatusOr<client::ExpMap> Client::ExpMap(const ModelRef& model, const SurfacePoint& center,
                                               const ExpMapQuery& query) const {
   if (absl::Status s = CheckModel(model); !s.ok()) return s;
-  if (!(std::isfinite(query.radius) && query.radius > 0)) {
-    return absl::InvalidArgumentError(
-        absl::StrFormat("the radius must be finite and > 0, got %g", query.radius));
-  }
+  if (absl::Status s = CheckRadius(query.radius); !s.ok()) return s;
   v1::ExpMapRequest request;
   *request.mutable_model() = ToProto(model);
   *request.mutable_center() = ToProto(absl::Span<const SurfacePoint>(&center, 1));

@@ -15,7 +15,6 @@
 namespace geodex::client {
 namespace {
 
-using ::testing::_;
 using ::testing::ElementsAre;
 using ::testing::HasSubstr;
 using ::testing::Return;
@@ -330,7 +329,7 @@ TEST(ClientExpMap, InconsistentChunksAreDataLoss) {
 
 TEST(ClientExpMap, ServerErrorsPassThrough) {
   auto mock = std::make_shared<MockGeodexConnection>();
-  EXPECT_CALL(*mock, ExpMap(_)).WillOnce(Return(absl::NotFoundError("no model 'x'")));
+  EXPECT_CALL(*mock, ExpMap).WillOnce(Return(absl::NotFoundError("no model 'x'")));
   Client client(mock);
   EXPECT_EQ(client.ExpMap("x", {0, {1, 0, 0}}, WithinRadius(1)).status().code(),
             absl::StatusCode::kNotFound);
