@@ -23,6 +23,20 @@ absl::Status CheckRadius(double radius) {
       absl::StrFormat("the radius must be finite and > 0, got %g", radius));
 }
 
+// Appends a chunk's vertex ids to `out`, whose ids must keep ascending
+// across chunks: the answers that list vertices list each once, in order.
+absl::Status AppendAscending(const google::protobuf::RepeatedField<int32_t>& ids, const char* what,
+                             std::vector<int32_t>* out) {
+  for (const int32_t id : ids) {
+    if (!out->empty() && id <= out->back()) {
+      return absl::DataLossError(absl::StrFormat(
+          "the server sent %s vertices out of order (%d after %d)", what, id, out->back()));
+    }
+    out->push_back(id);
+  }
+  return absl::OkStatus();
+}
+
 }  // namespace
 
 absl::StatusOr<VertexDistances> Client::DistanceField(const ModelRef& model,
@@ -107,13 +121,8 @@ absl::StatusOr<VertexDistancesWithin> Client::DistanceFieldWithin(
           chunk.vertex_offset(), chunk.vertex_offset() + size, chunk.num_vertices(),
           chunk.nearest_source_size(), field.vertices.size(), n));
     }
-    for (int i = 0; i < size; ++i) {
-      if (!field.vertices.empty() && chunk.vertices(i) <= field.vertices.back()) {
-        return absl::DataLossError(
-            absl::StrFormat("the server sent field vertices out of order (%d after %d)",
-                            chunk.vertices(i), field.vertices.back()));
-      }
-      field.vertices.push_back(chunk.vertices(i));
+    if (absl::Status s = AppendAscending(chunk.vertices(), "field", &field.vertices); !s.ok()) {
+      return s;
     }
     field.distances.insert(field.distances.end(), chunk.distances().begin(),
                            chunk.distances().end());
@@ -161,13 +170,9 @@ absl::StatusOr<client::ExpMap> Client::ExpMap(const ModelRef& model, const Surfa
           size, chunk.r_size(), chunk.theta_size(), chunk.u_size(), chunk.v_size(),
           chunk.num_vertices(), map.vertices.size(), n));
     }
-    for (int i = 0; i < size; ++i) {
-      if (!map.vertices.empty() && chunk.vertices(i) <= map.vertices.back()) {
-        return absl::DataLossError(
-            absl::StrFormat("the server sent exponential map vertices out of order (%d after %d)",
-                            chunk.vertices(i), map.vertices.back()));
-      }
-      map.vertices.push_back(chunk.vertices(i));
+    if (absl::Status s = AppendAscending(chunk.vertices(), "exponential map", &map.vertices);
+        !s.ok()) {
+      return s;
     }
     map.r.insert(map.r.end(), chunk.r().begin(), chunk.r().end());
     map.theta.insert(map.theta.end(), chunk.theta().begin(), chunk.theta().end());
