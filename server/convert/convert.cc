@@ -1,5 +1,6 @@
 #include "server/convert/convert.h"
 
+#include <algorithm>
 #include <array>
 #include <cassert>
 #include <cmath>
@@ -9,6 +10,7 @@
 #include "absl/strings/ascii.h"
 #include "absl/strings/str_format.h"
 #include "absl/strings/str_split.h"
+#include "core/common/status_macros.h"
 #include "core/index/index_report.h"
 
 namespace geodex::server {
