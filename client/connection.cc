@@ -24,40 +24,13 @@ class FailedStream : public DistanceStream {
 
 }  // namespace
 
-absl::StatusOr<v1::ListModelsResponse> GeodexConnection::ListModels(const v1::ListModelsRequest&) {
-  return NotImplemented("ListModels");
-}
-absl::StatusOr<v1::ModelInfo> GeodexConnection::GetModel(const v1::GetModelRequest&) {
-  return NotImplemented("GetModel");
-}
-absl::StatusOr<v1::DistanceResponse> GeodexConnection::Distance(const v1::DistanceRequest&) {
-  return NotImplemented("Distance");
-}
+#define GEODEX_CLIENT_NOT_IMPLEMENTED(Name, Request, Result) \
+  absl::StatusOr<Result> GeodexConnection::Name(const Request&) { return NotImplemented(#Name); }
+GEODEX_CLIENT_RPCS(GEODEX_CLIENT_NOT_IMPLEMENTED)
+#undef GEODEX_CLIENT_NOT_IMPLEMENTED
+
 std::unique_ptr<DistanceStream> GeodexConnection::StreamDistances(const StreamOptions&) {
   return std::make_unique<FailedStream>(NotImplemented("StreamDistances"));
-}
-absl::StatusOr<std::vector<v1::MatrixBlock>> GeodexConnection::Matrix(const v1::MatrixRequest&) {
-  return NotImplemented("Matrix");
-}
-absl::StatusOr<v1::PathResponse> GeodexConnection::Path(const v1::PathRequest&) {
-  return NotImplemented("Path");
-}
-absl::StatusOr<std::vector<v1::DistanceFieldChunk>> GeodexConnection::DistanceField(
-    const v1::DistanceFieldRequest&) {
-  return NotImplemented("DistanceField");
-}
-absl::StatusOr<v1::LocateResponse> GeodexConnection::Locate(const v1::LocateRequest&) {
-  return NotImplemented("Locate");
-}
-absl::StatusOr<std::vector<v1::MeshChunk>> GeodexConnection::GetMesh(const v1::GetMeshRequest&) {
-  return NotImplemented("GetMesh");
-}
-absl::StatusOr<std::vector<v1::ExpMapChunk>> GeodexConnection::ExpMap(const v1::ExpMapRequest&) {
-  return NotImplemented("ExpMap");
-}
-absl::StatusOr<v1::TriangulationResponse> GeodexConnection::GetTriangulation(
-    const v1::GetTriangulationRequest&) {
-  return NotImplemented("GetTriangulation");
 }
 
 }  // namespace geodex::client

@@ -82,43 +82,18 @@ class GrpcConnection : public GeodexConnection {
         deadline_(deadline),
         authorization_(std::move(authorization)) {}
 
-  absl::StatusOr<v1::ListModelsResponse> ListModels(const v1::ListModelsRequest& r) override {
-    return Unary(r, &v1::Geodex::Stub::ListModels);
+  // Call picks the unary or the server-streaming overload from the stub
+  // method's signature.
+#define GEODEX_CLIENT_GRPC_RPC(Name, Request, Result)            \
+  absl::StatusOr<Result> Name(const Request& request) override { \
+    return Call(request, &v1::Geodex::Stub::Name);               \
   }
-  absl::StatusOr<v1::ModelInfo> GetModel(const v1::GetModelRequest& r) override {
-    return Unary(r, &v1::Geodex::Stub::GetModel);
-  }
-  absl::StatusOr<v1::DistanceResponse> Distance(const v1::DistanceRequest& r) override {
-    return Unary(r, &v1::Geodex::Stub::Distance);
-  }
-  absl::StatusOr<v1::PathResponse> Path(const v1::PathRequest& r) override {
-    return Unary(r, &v1::Geodex::Stub::Path);
-  }
-  absl::StatusOr<v1::LocateResponse> Locate(const v1::LocateRequest& r) override {
-    return Unary(r, &v1::Geodex::Stub::Locate);
-  }
-  absl::StatusOr<v1::TriangulationResponse> GetTriangulation(
-      const v1::GetTriangulationRequest& r) override {
-    return Unary(r, &v1::Geodex::Stub::GetTriangulation);
-  }
+  GEODEX_CLIENT_RPCS(GEODEX_CLIENT_GRPC_RPC)
+#undef GEODEX_CLIENT_GRPC_RPC
 
   std::unique_ptr<DistanceStream> StreamDistances(const StreamOptions& options) override {
     return std::make_unique<GrpcDistanceStream>(MakeContext(options.deadline.value_or(deadline_)),
                                                 *stub_);
-  }
-
-  absl::StatusOr<std::vector<v1::MatrixBlock>> Matrix(const v1::MatrixRequest& r) override {
-    return ServerStream<v1::MatrixBlock>(r, &v1::Geodex::Stub::Matrix);
-  }
-  absl::StatusOr<std::vector<v1::DistanceFieldChunk>> DistanceField(
-      const v1::DistanceFieldRequest& r) override {
-    return ServerStream<v1::DistanceFieldChunk>(r, &v1::Geodex::Stub::DistanceField);
-  }
-  absl::StatusOr<std::vector<v1::MeshChunk>> GetMesh(const v1::GetMeshRequest& r) override {
-    return ServerStream<v1::MeshChunk>(r, &v1::Geodex::Stub::GetMesh);
-  }
-  absl::StatusOr<std::vector<v1::ExpMapChunk>> ExpMap(const v1::ExpMapRequest& r) override {
-    return ServerStream<v1::ExpMapChunk>(r, &v1::Geodex::Stub::ExpMap);
   }
 
  private:
@@ -132,10 +107,10 @@ class GrpcConnection : public GeodexConnection {
   }
 
   template <typename Request, typename Response>
-  absl::StatusOr<Response> Unary(const Request& request,
-                                 grpc::Status (v1::Geodex::Stub::*method)(grpc::ClientContext*,
-                                                                          const Request&,
-                                                                          Response*)) {
+  absl::StatusOr<Response> Call(const Request& request,
+                                grpc::Status (v1::Geodex::Stub::*method)(grpc::ClientContext*,
+                                                                         const Request&,
+                                                                         Response*)) {
     auto context = MakeContext(deadline_);
     Response response;
     const grpc::Status status = ((*stub_).*method)(context.get(), request, &response);
@@ -144,7 +119,7 @@ class GrpcConnection : public GeodexConnection {
   }
 
   template <typename Message, typename Request>
-  absl::StatusOr<std::vector<Message>> ServerStream(
+  absl::StatusOr<std::vector<Message>> Call(
       const Request& request,
       std::unique_ptr<grpc::ClientReader<Message>> (v1::Geodex::Stub::*method)(grpc::ClientContext*,
                                                                                const Request&)) {

@@ -42,40 +42,15 @@ class RetryingConnection : public GeodexConnection {
     if (!sleep_) sleep_ = [](absl::Duration d) { absl::SleepFor(d); };
   }
 
-  absl::StatusOr<v1::ListModelsResponse> ListModels(const v1::ListModelsRequest& r) override {
-    return RetryLoop(policy_, sleep_, [&] { return inner_->ListModels(r); });
+#define GEODEX_CLIENT_RETRY_RPC(Name, Request, Result)                        \
+  absl::StatusOr<Result> Name(const Request& request) override {              \
+    return RetryLoop(policy_, sleep_, [&] { return inner_->Name(request); }); \
   }
-  absl::StatusOr<v1::ModelInfo> GetModel(const v1::GetModelRequest& r) override {
-    return RetryLoop(policy_, sleep_, [&] { return inner_->GetModel(r); });
-  }
-  absl::StatusOr<v1::DistanceResponse> Distance(const v1::DistanceRequest& r) override {
-    return RetryLoop(policy_, sleep_, [&] { return inner_->Distance(r); });
-  }
+  GEODEX_CLIENT_RPCS(GEODEX_CLIENT_RETRY_RPC)
+#undef GEODEX_CLIENT_RETRY_RPC
+
   std::unique_ptr<DistanceStream> StreamDistances(const StreamOptions& options) override {
     return inner_->StreamDistances(options);
-  }
-  absl::StatusOr<std::vector<v1::MatrixBlock>> Matrix(const v1::MatrixRequest& r) override {
-    return RetryLoop(policy_, sleep_, [&] { return inner_->Matrix(r); });
-  }
-  absl::StatusOr<v1::PathResponse> Path(const v1::PathRequest& r) override {
-    return RetryLoop(policy_, sleep_, [&] { return inner_->Path(r); });
-  }
-  absl::StatusOr<std::vector<v1::DistanceFieldChunk>> DistanceField(
-      const v1::DistanceFieldRequest& r) override {
-    return RetryLoop(policy_, sleep_, [&] { return inner_->DistanceField(r); });
-  }
-  absl::StatusOr<v1::LocateResponse> Locate(const v1::LocateRequest& r) override {
-    return RetryLoop(policy_, sleep_, [&] { return inner_->Locate(r); });
-  }
-  absl::StatusOr<std::vector<v1::MeshChunk>> GetMesh(const v1::GetMeshRequest& r) override {
-    return RetryLoop(policy_, sleep_, [&] { return inner_->GetMesh(r); });
-  }
-  absl::StatusOr<std::vector<v1::ExpMapChunk>> ExpMap(const v1::ExpMapRequest& r) override {
-    return RetryLoop(policy_, sleep_, [&] { return inner_->ExpMap(r); });
-  }
-  absl::StatusOr<v1::TriangulationResponse> GetTriangulation(
-      const v1::GetTriangulationRequest& r) override {
-    return RetryLoop(policy_, sleep_, [&] { return inner_->GetTriangulation(r); });
   }
 
  private:

@@ -50,8 +50,8 @@ auto RetryLoop(const RetryPolicy& policy, const Sleeper& sleep, F&& f) -> declty
 
 // A connection that retries every call of `inner` under `policy`, except
 // StreamDistances (a stream cannot be replayed transparently; Client::Distance
-// resumes its own streams). Server-streaming calls (Matrix, DistanceField,
-// GetMesh) are retried as a whole. Thread-safe if `inner` is.
+// resumes its own streams). A server-streaming call is retried as a whole.
+// Thread-safe if `inner` is.
 std::shared_ptr<GeodexConnection> MakeRetryingConnection(std::shared_ptr<GeodexConnection> inner,
                                                          RetryPolicy policy,
                                                          Sleeper sleep = nullptr);

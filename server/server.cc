@@ -10,7 +10,7 @@
 #include "grpcpp/health_check_service_interface.h"
 #include "grpcpp/security/server_credentials.h"
 #include "grpcpp/server_builder.h"
-#include "server/parse_error_interceptor.h"
+#include "server/service/parse_error_interceptor.h"
 #include "spdlog/spdlog.h"
 
 namespace geodex::server {

@@ -32,12 +32,12 @@
 #include "absl/time/time.h"
 #include "grpcpp/channel.h"
 #include "grpcpp/server.h"
-#include "server/auth.h"
-#include "server/geodex_service.h"
-#include "server/limits.h"
-#include "server/metrics.h"
-#include "server/model_registry.h"
-#include "server/worker_pool.h"
+#include "server/config/limits.h"
+#include "server/registry/model_registry.h"
+#include "server/service/auth.h"
+#include "server/service/geodex_service.h"
+#include "server/service/metrics.h"
+#include "server/service/worker_pool.h"
 
 namespace geodex::server {
 

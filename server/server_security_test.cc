@@ -7,6 +7,8 @@
 #include <string>
 
 #include "absl/strings/str_format.h"
+#include "geodex/v1/geodex.grpc.pb.h"
+#include "google/protobuf/descriptor.h"
 #include "grpcpp/create_channel.h"
 #include "grpcpp/security/credentials.h"
 #include "gtest/gtest.h"
@@ -148,10 +150,16 @@ TEST(ServerTest, RequestBytesThatDoNotParseAreInvalidArgument) {
   TestServer ts;
   auto channel = ts.TcpChannel();
   const std::string garbage("\xff\xff\xff\x0f", 4);
-  for (const char* method :
-       {"/geodex.v1.Geodex/Distance", "/geodex.v1.Geodex/Path", "/geodex.v1.Geodex/Locate",
-        "/geodex.v1.Geodex/GetModel", "/geodex.v1.Geodex/ListModels",
-        "/geodex.v1.Geodex/DistanceField", "/geodex.v1.Geodex/ExpMap"}) {
+  // Every method that takes one request message, from the service's
+  // descriptor, so that a new one is covered without a change here.
+  const google::protobuf::ServiceDescriptor* service =
+      google::protobuf::DescriptorPool::generated_pool()->FindServiceByName(
+          v1::Geodex::service_full_name());
+  ASSERT_NE(service, nullptr);
+  for (int i = 0; i < service->method_count(); ++i) {
+    if (service->method(i)->client_streaming()) continue;
+    const std::string method =
+        absl::StrFormat("/%s/%s", service->full_name(), service->method(i)->name());
     auto [status, response] = testing::RawUnary(channel, method, garbage);
     EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT) << method;
     EXPECT_NE(status.error_message().find("not a valid protobuf message"), std::string::npos)

@@ -1,24 +1,15 @@
 // geodex: the command-line client of a geodex server.
 //
-//   geodex models                                   models the server knows
-//   geodex info --model M [--format text|json]      one model and its build report
-//   geodex distance --model M --pairs FILE|- [--xyz] [--near-pairs MODE] [--tolerance X]
-//                   [--error-bounds]
-//   geodex path --model M --pairs FILE --format obj|ply|json --out F
-//   geodex field --model M --sources FILE --out field.txt|field.ply
-//   geodex locate --model M --points FILE
-//   geodex expmap --model M --center "F W0 W1 W2" --radius R [--direction X Y Z]
-//                 [--out decal.obj|map.txt] [--image IMG] [--png view.png]
-//   geodex matrix --model M --sources FILE --targets FILE [--near-pairs MODE]
-//   geodex bench --model M --concurrency C --duration S --batch B
-//   geodex web --listen HOST:PORT [--assets DIR]   the viewer and an HTTP/JSON gateway
+//   geodex VERB [flags]     e.g. geodex distance --model M --pairs FILE
+//   geodex --help-all       every verb with its flags
 //
 // Every subcommand takes --server ADDR (default $GEODEX_SERVER, else
 // localhost:50051), --tls-ca/--tls-cert/--tls-key, --token/--token-file and
 // --timeout. Input lines are those of geodex-query (client/cli/text_io.h).
 // Results go to standard output (or --out), errors to standard error. Each
-// verb, its flags and what it writes, is in client/cli/commands/<verb>.cc
-// (the interface they share: client/cli/commands/command.h).
+// verb, its flags and what it writes, is in client/cli/commands/<verb>.cc;
+// the list of verbs and the interface they share are in
+// client/cli/commands/command.h.
 //
 // Exit codes: 0 success; 2 bad usage or bad input, found before anything was
 // asked of the server (unreadable or malformed file, with its line number;
@@ -44,14 +35,11 @@ int Main(int argc, char** argv) {
   app.require_subcommand(1);
   app.set_help_all_flag("--help-all", "Help for every subcommand");
 
-  // The chosen verb runs while parsing and leaves its outcome here. The verbs
-  // are listed by --help in this order.
+  // The chosen verb runs while parsing and leaves its outcome here.
   absl::Status status;
-  for (AddCommand add :
-       {AddModelsCommand, AddInfoCommand, AddDistanceCommand, AddPathCommand, AddFieldCommand,
-        AddExpMapCommand, AddLocateCommand, AddMatrixCommand, AddBenchCommand, AddWebCommand}) {
-    add(&app, &status);
-  }
+#define GEODEX_CLI_VERB_ADDER(Verb) Add##Verb##Command,
+  for (AddCommand add : {GEODEX_CLI_VERBS(GEODEX_CLI_VERB_ADDER)}) add(&app, &status);
+#undef GEODEX_CLI_VERB_ADDER
 
   try {
     app.parse(argc, argv);

@@ -1,7 +1,7 @@
 #pragma once
 
-// A server stream written one message at a time (Matrix, DistanceField,
-// ExpMap, GetMesh): a job on the worker pool computes the next message, the
+// A server stream written one message at a time (every server-streaming
+// call of the service): a job on the worker pool computes the next message, the
 // reactor writes it, and only then is the next one made (backpressure). A
 // job and a write are never in flight together and jobs are sequential, so
 // what a job fills needs no lock.
@@ -12,13 +12,13 @@
 #include "absl/status/status.h"
 #include "absl/strings/str_format.h"
 #include "grpcpp/support/server_callback.h"
+#include "server/service/worker_pool.h"
 #include "server/streams/stream.h"
-#include "server/worker_pool.h"
 
 namespace geodex::server {
 
-// Largest payload of one streamed Matrix block, DistanceField chunk or
-// ExpMap chunk.
+// Largest payload of one streamed message whose size the server chooses (a
+// Matrix block, a field or map chunk).
 inline constexpr int64_t kChunkBytes = 1 << 20;
 
 template <class Response>

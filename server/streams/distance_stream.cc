@@ -6,13 +6,12 @@
 #include <string>
 
 #include "absl/strings/str_format.h"
-#include "server/call.h"
-#include "server/compute_distances.h"
-#include "server/convert.h"
-#include "server/convert_options.h"
-#include "server/metrics.h"
-#include "server/service_resources.h"
-#include "server/status_conversion.h"
+#include "server/convert/convert.h"
+#include "server/service/call.h"
+#include "server/service/compute_distances.h"
+#include "server/service/metrics.h"
+#include "server/service/service_resources.h"
+#include "server/service/status_conversion.h"
 #include "server/streams/stream.h"
 #include "spdlog/spdlog.h"
 

@@ -4,9 +4,8 @@
 #include <vector>
 
 #include "core/common/status_macros.h"
-#include "server/convert.h"
-#include "server/convert_options.h"
-#include "server/service_resources.h"
+#include "server/convert/convert.h"
+#include "server/service/service_resources.h"
 #include "server/streams/chunked_write_stream.h"
 
 namespace geodex::server {

@@ -3,7 +3,7 @@
 // What every streaming reactor of the Geodex service shares: admission, one
 // Finish, and the registration that OnDone removes before the reactor
 // deletes itself. Each reactor sees the service only through
-// ServiceResources (server/service_resources.h).
+// ServiceResources (server/service/service_resources.h).
 //
 // Ownership: gRPC holds a reactor from the handler's return until OnDone,
 // where it deletes itself (the callback API's contract); the StreamSet keeps
@@ -19,8 +19,8 @@
 
 #include "absl/status/status.h"
 #include "grpcpp/server_context.h"
-#include "server/call.h"
-#include "server/service_resources.h"
+#include "server/service/call.h"
+#include "server/service/service_resources.h"
 #include "server/streams/stream_set.h"
 
 namespace geodex::server {

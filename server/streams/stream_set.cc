@@ -1,7 +1,7 @@
 #include "server/streams/stream_set.h"
 
 #include "core/common/status_macros.h"
-#include "server/metrics.h"
+#include "server/service/metrics.h"
 
 namespace geodex::server {
 

@@ -12,7 +12,7 @@
 #include <set>
 
 #include "absl/status/status.h"
-#include "server/limits.h"
+#include "server/config/limits.h"
 
 namespace geodex::server {
 

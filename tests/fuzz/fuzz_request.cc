@@ -1,9 +1,9 @@
-// libFuzzer target: the server's reading of requests (server/convert.h,
-// server/convert_options.h) and the engine calls behind them, in process (no
-// gRPC). The first byte picks the message, the rest is its wire encoding:
+// libFuzzer target: the server's reading of requests (server/convert/convert.h)
+// and the engine calls behind them, in process (no gRPC). The first byte
+// picks the message, the rest is its wire encoding:
 //   even: geodex.v1.DistanceRequest -> CheckPairedUp, DistanceOptionsFor,
 //         PointsFromProto, InputQueries::DistanceBatch (as
-//         server/compute_distances.cc runs them)
+//         server/service/compute_distances.cc runs them)
 //   odd:  geodex.v1.LocateRequest -> PositionsFromProto, InputQueries::Locate
 // against a small generated model (fuzz_model.h) with the default
 // configuration. A request the conversion accepts must be answered: an error
@@ -18,9 +18,8 @@
 
 #include "absl/status/statusor.h"
 #include "geodex/v1/geodex.pb.h"
-#include "server/convert.h"
-#include "server/convert_options.h"
-#include "server/model_config.pb.h"
+#include "server/config/model_config.pb.h"
+#include "server/convert/convert.h"
 #include "tests/fuzz/fuzz_model.h"
 
 namespace {

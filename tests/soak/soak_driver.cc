@@ -1,12 +1,7 @@
 // soak_driver: many concurrent clients of one geodex-server, for
-// tests/soak/soak.sh. Each thread sends a random mix of valid requests
-// (Distance, StreamDistances, Path, DistanceField, ExpMap, GetModel) and
-// invalid ones (faces past the end, NaN and negative weights, wrong lengths,
-// an unknown model, too many pairs, a bad batch inside a good stream) until
-// the time is up. Every valid answer is compared, to the bit, with the
-// offline engine of the version that answered it (--version V=INDEX); every
-// invalid request must be refused with its code while the rest of the call
-// (the other batches of a stream) is answered.
+// tests/soak/soak.sh, until the time is up. What each thread sends and how
+// every answer is checked (to the bit, against the offline engine of the
+// version that answered it, --version V=INDEX) is in soak_client.h.
 //
 //   soak_driver --server ADDR --model M --version 1=v1.gdx --version 2=v2.gdx
 //               [--threads 8] [--seconds 30] [--max-pairs 1000]

@@ -1,8 +1,8 @@
 #pragma once
 
 // The verbs of the `geodex` command line, one file each beside this header
-// (models.cc, info.cc, distance.cc, ...; the usage of all of them heads
-// client/cli/geodex_main.cc).
+// (models.cc, info.cc, distance.cc, ...), each headed by what the verb does;
+// `geodex --help-all` prints the usage of all of them.
 //
 // Add<Verb>Command adds the verb's subcommand to `app` with its flags, in
 // the order `--help` lists them: the connection flags every verb has first,
@@ -21,15 +21,24 @@ namespace geodex::client::cli {
 // The signature every Add<Verb>Command has.
 using AddCommand = void (*)(CLI::App* app, absl::Status* status);
 
-void AddModelsCommand(CLI::App* app, absl::Status* status);    // models.cc
-void AddInfoCommand(CLI::App* app, absl::Status* status);      // info.cc
-void AddDistanceCommand(CLI::App* app, absl::Status* status);  // distance.cc
-void AddPathCommand(CLI::App* app, absl::Status* status);      // path.cc
-void AddFieldCommand(CLI::App* app, absl::Status* status);     // field.cc
-void AddExpMapCommand(CLI::App* app, absl::Status* status);    // expmap.cc
-void AddLocateCommand(CLI::App* app, absl::Status* status);    // locate.cc
-void AddMatrixCommand(CLI::App* app, absl::Status* status);    // matrix.cc
-void AddBenchCommand(CLI::App* app, absl::Status* status);     // bench.cc
-void AddWebCommand(CLI::App* app, absl::Status* status);       // web.cc
+// The verbs, written once, in the order `--help` lists them: X(Verb) stands
+// for Add<Verb>Command, defined in the verb's file. geodex_main.cc adds them
+// all from this list, so a new verb is its file, one line here and one in
+// client/CMakeLists.txt.
+#define GEODEX_CLI_VERBS(X) \
+  X(Models)                 \
+  X(Info)                   \
+  X(Distance)               \
+  X(Path)                   \
+  X(Field)                  \
+  X(ExpMap)                 \
+  X(Locate)                 \
+  X(Matrix)                 \
+  X(Bench)                  \
+  X(Web)
+
+#define GEODEX_CLI_DECLARE_VERB(Verb) void Add##Verb##Command(CLI::App* app, absl::Status* status);
+GEODEX_CLI_VERBS(GEODEX_CLI_DECLARE_VERB)
+#undef GEODEX_CLI_DECLARE_VERB
 
 }  // namespace geodex::client::cli

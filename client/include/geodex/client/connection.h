@@ -9,7 +9,8 @@
 //
 // Requests and responses are the geodex.v1 messages. Every method has a
 // default implementation that returns UNIMPLEMENTED, so subclasses only
-// override what they use and keep compiling when methods are added.
+// override what they use and keep compiling when methods are added. The
+// methods are listed once, in GEODEX_CLIENT_RPCS below.
 //
 // Thread safety: implementations must allow concurrent calls of every method
 // from any number of threads. A DistanceStream is one call: one thread may
@@ -52,29 +53,39 @@ struct StreamOptions {
   std::optional<absl::Duration> deadline;
 };
 
+// The calls of geodex.v1.Geodex other than StreamDistances, written once:
+// X(Name, Request, Result), where GeodexConnection::Name(request) returns
+// absl::StatusOr<Result>. Result is the response of a unary call, or for a
+// server-streaming call the std::vector of all its messages in the order
+// received. The connection interface and its UNIMPLEMENTED defaults, the gRPC
+// connection, the retrying connection and MockGeodexConnection are all
+// expanded from this list, so a new call is one line here (plus its typed
+// method on Client). StreamDistances, the one bidirectional stream, is
+// declared by hand below.
+#define GEODEX_CLIENT_RPCS(X)                                                     \
+  X(ListModels, v1::ListModelsRequest, v1::ListModelsResponse)                    \
+  X(GetModel, v1::GetModelRequest, v1::ModelInfo)                                 \
+  X(Distance, v1::DistanceRequest, v1::DistanceResponse)                          \
+  X(Matrix, v1::MatrixRequest, std::vector<v1::MatrixBlock>)                      \
+  X(Path, v1::PathRequest, v1::PathResponse)                                      \
+  X(DistanceField, v1::DistanceFieldRequest, std::vector<v1::DistanceFieldChunk>) \
+  X(Locate, v1::LocateRequest, v1::LocateResponse)                                \
+  X(GetMesh, v1::GetMeshRequest, std::vector<v1::MeshChunk>)                      \
+  X(ExpMap, v1::ExpMapRequest, std::vector<v1::ExpMapChunk>)                      \
+  X(GetTriangulation, v1::GetTriangulationRequest, v1::TriangulationResponse)
+
 class GeodexConnection {
  public:
   virtual ~GeodexConnection() = default;
 
-  virtual absl::StatusOr<v1::ListModelsResponse> ListModels(const v1::ListModelsRequest& request);
-  virtual absl::StatusOr<v1::ModelInfo> GetModel(const v1::GetModelRequest& request);
-  virtual absl::StatusOr<v1::DistanceResponse> Distance(const v1::DistanceRequest& request);
+#define GEODEX_CLIENT_DECLARE_RPC(Name, Request, Result) \
+  virtual absl::StatusOr<Result> Name(const Request& request);
+  GEODEX_CLIENT_RPCS(GEODEX_CLIENT_DECLARE_RPC)
+#undef GEODEX_CLIENT_DECLARE_RPC
+
   // Opens a stream. Never null; a stream that could not be opened fails its
   // first Write or Read and reports why in Finish.
   virtual std::unique_ptr<DistanceStream> StreamDistances(const StreamOptions& options);
-  // All blocks of the server stream, in the order received.
-  virtual absl::StatusOr<std::vector<v1::MatrixBlock>> Matrix(const v1::MatrixRequest& request);
-  virtual absl::StatusOr<v1::PathResponse> Path(const v1::PathRequest& request);
-  // All chunks of the server stream, in the order received.
-  virtual absl::StatusOr<std::vector<v1::DistanceFieldChunk>> DistanceField(
-      const v1::DistanceFieldRequest& request);
-  virtual absl::StatusOr<v1::LocateResponse> Locate(const v1::LocateRequest& request);
-  // All chunks of the server stream, in the order received.
-  virtual absl::StatusOr<std::vector<v1::MeshChunk>> GetMesh(const v1::GetMeshRequest& request);
-  // All chunks of the server stream, in the order received.
-  virtual absl::StatusOr<std::vector<v1::ExpMapChunk>> ExpMap(const v1::ExpMapRequest& request);
-  virtual absl::StatusOr<v1::TriangulationResponse> GetTriangulation(
-      const v1::GetTriangulationRequest& request);
 };
 
 }  // namespace geodex::client

@@ -23,27 +23,13 @@ namespace geodex::client {
 
 class MockGeodexConnection : public GeodexConnection {
  public:
-  MOCK_METHOD(absl::StatusOr<v1::ListModelsResponse>, ListModels,
-              (const v1::ListModelsRequest& request), (override));
-  MOCK_METHOD(absl::StatusOr<v1::ModelInfo>, GetModel, (const v1::GetModelRequest& request),
-              (override));
-  MOCK_METHOD(absl::StatusOr<v1::DistanceResponse>, Distance, (const v1::DistanceRequest& request),
-              (override));
+#define GEODEX_CLIENT_MOCK_RPC(Name, Request, Result) \
+  MOCK_METHOD(absl::StatusOr<Result>, Name, (const Request& request), (override));
+  GEODEX_CLIENT_RPCS(GEODEX_CLIENT_MOCK_RPC)
+#undef GEODEX_CLIENT_MOCK_RPC
+
   MOCK_METHOD(std::unique_ptr<DistanceStream>, StreamDistances, (const StreamOptions& options),
               (override));
-  MOCK_METHOD(absl::StatusOr<std::vector<v1::MatrixBlock>>, Matrix,
-              (const v1::MatrixRequest& request), (override));
-  MOCK_METHOD(absl::StatusOr<v1::PathResponse>, Path, (const v1::PathRequest& request), (override));
-  MOCK_METHOD(absl::StatusOr<std::vector<v1::DistanceFieldChunk>>, DistanceField,
-              (const v1::DistanceFieldRequest& request), (override));
-  MOCK_METHOD(absl::StatusOr<v1::LocateResponse>, Locate, (const v1::LocateRequest& request),
-              (override));
-  MOCK_METHOD(absl::StatusOr<std::vector<v1::ExpMapChunk>>, ExpMap,
-              (const v1::ExpMapRequest& request), (override));
-  MOCK_METHOD(absl::StatusOr<std::vector<v1::MeshChunk>>, GetMesh,
-              (const v1::GetMeshRequest& request), (override));
-  MOCK_METHOD(absl::StatusOr<v1::TriangulationResponse>, GetTriangulation,
-              (const v1::GetTriangulationRequest& request), (override));
 };
 
 // Note: Client::Distance writes and reads a stream from two threads at once;
