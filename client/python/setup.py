@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import glob
 import os
+import re
 import shlex
 import shutil
 import subprocess
@@ -103,8 +104,19 @@ class CMakeBuild(build_ext):
             shutil.copyfile(assembled / "v1" / name, stubs / name)
 
 
+def version() -> str:
+    match = re.search(r'^__version__ = "([^"]+)"', (HERE / "geodex" / "__init__.py").read_text(), re.M)
+    assert match, "geodex/__init__.py sets no __version__"
+    return match.group(1)
+
+
 _base = os.environ.get("GEODEX_SETUP_BUILD_BASE")
+if _base:
+    os.makedirs(_base, exist_ok=True)
 setup(
+    version=version(),
+    packages=["geodex"],
+    package_data={"geodex": ["py.typed", "*.pyi"]},
     ext_modules=[CMakeExtension("geodex._core")],
     cmdclass={"build_ext": CMakeBuild},
     options={"build": {"build_base": _base}, "egg_info": {"egg_base": _base}} if _base else {},

@@ -30,7 +30,9 @@ GEODEX_CMAKE_BUILD_DIR="$build" GEODEX_SETUP_BUILD_BASE="$work/setup" \
   "$python" -m build --wheel --no-isolation --outdir "$work/dist" "$package" > "$work/build.log" 2>&1 ||
   { cat "$work/build.log"; say "the wheel did not build"; exit 1; }
 wheels=("$work"/dist/geodex-*.whl)
-[ "${#wheels[@]}" -eq 1 ] && [ -f "${wheels[0]}" ] || { say "expected one wheel: ${wheels[*]}"; exit 1; }
+if [ "${#wheels[@]}" -ne 1 ] || [ ! -f "${wheels[0]}" ]; then
+  say "expected one wheel: ${wheels[*]}"; exit 1
+fi
 wheel="${wheels[0]}"
 say "built $(basename "$wheel")"
 # What a wheel must hold: the compiled module, the stubs, the types.
@@ -64,7 +66,7 @@ print(geodex.__file__)")
 say "environment with geodex[client]"
 "$python" -m venv --system-site-packages "$work/with-client"
 # --no-index: the dependencies (numpy, grpcio, protobuf) are Debian's, offline.
-"$work/with-client/bin/pip" install --quiet --no-index "$wheel[client]"
+"$work/with-client/bin/pip" install --quiet --no-index "${wheel}[client]"
 installed "$work/with-client"
 (cd "$work" && "$work/with-client/bin/python" -m pytest -q -p no:cacheprovider tests)
 (cd "$work" && "$work/with-client/bin/python" -m mypy --strict --no-incremental quickstart.py)
