@@ -9,7 +9,7 @@ would copy every number through a Python float.
 
 from __future__ import annotations
 
-from typing import Iterator, List, Optional, Tuple
+from typing import Iterator, List, Optional, Tuple, cast
 
 import grpc
 import numpy as np
@@ -230,7 +230,8 @@ class RemoteQueries(QueryFront[At]):
             except grpc.RpcError as e:
                 raise _in_pairs(_rpc_error(e), lo, hi) from None
             fields = _wire.read_fields(data)
-            polylines = [v for w, v in fields.get(1, ()) if w == 2]
+            # Wire type 2: a length-delimited field, read as a memoryview.
+            polylines = [cast(memoryview, v) for w, v in fields.get(1, ()) if w == 2]
             if len(polylines) != hi - lo:
                 raise DataLoss(f"the server sent {len(polylines)} paths for {hi - lo} pairs")
             paths.extend(_path_of(p) for p in polylines)
@@ -397,7 +398,7 @@ class RemoteQueries(QueryFront[At]):
         try:
             for data in self._mesh_call(request, metadata=self._metadata):
                 fields = _wire.read_fields(data)
-                if vertices is None:
+                if vertices is None or faces is None:
                     vertices = np.empty((_wire.scalar(fields, 1), 3))
                     faces = np.empty((_wire.scalar(fields, 2), 3), dtype=np.int32)
                 positions = _wire.packed_doubles(fields, 5).reshape(-1, 3)
