@@ -157,7 +157,8 @@ Surface DrawSurface(const IndexReport& report, int width, int height) {
     }
   }
   // The legend, top right, in the viewer's words.
-  const std::string limit = absl::StrFormat("limit (target %s)", FormatPercent(report.target_error));
+  const std::string limit =
+      absl::StrFormat("limit (target %s)", FormatPercent(report.target_error));
   const std::pair<std::string, Rgb> legend[] = {
       {"p99", kChartP99Color}, {"RMS", kChartRmsColor}, {limit, kChartLimitColor}};
   double width_needed = 0;

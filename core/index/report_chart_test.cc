@@ -69,7 +69,7 @@ TEST(ReportChartTest, PngHoldsTheImage) {
   ASSERT_EQ(png->substr(0, 8), "\x89PNG\r\n\x1a\n");
   EXPECT_EQ(png->substr(12, 4), "IHDR");
   EXPECT_EQ(png->substr(16, 8), std::string("\0\0\x01\x90\0\0\0\xfa", 8));  // 400 x 250
-  EXPECT_EQ(png->substr(24, 2), std::string("\x08\x02", 2));  // 8 bits, RGB
+  EXPECT_EQ(png->substr(24, 2), std::string("\x08\x02", 2));                // 8 bits, RGB
   const absl::StatusOr<ChartImage> back = DecodeChartPng(*png);
   ASSERT_TRUE(back.ok()) << back.status();
   EXPECT_EQ(back->width, 400);
