@@ -30,7 +30,8 @@ BUILD_PACKAGES=(
   libprotobuf-dev protobuf-compiler libgrpc++-dev protobuf-compiler-grpc
   prometheus-cpp-dev
   libcpp-httplib-dev  # the HTTP server of `geodex web`
-  zlib1g-dev          # PNG output: geodex expmap --png, geodex-build --report-png
+  zlib1g-dev          # PNG output: geodex expmap --png
+  libcairo2-dev fonts-dejavu-core  # the build report's chart: geodex-build --report-png
   libjs-three         # three.js for the web viewer, copied into the build and install trees
   # The Python package geodex: its stubs (grpc_tools), the in-process module
   # (pybind11, python3-dev) and what it imports at run time.
@@ -45,6 +46,9 @@ DEV_PACKAGES=(
   clang libclang-rt-14-dev  # the libFuzzer targets (tests/fuzz)
   openssl  # server tests generate TLS certificates with it
   python3-pytest  # the Python package's tests (client/python/tests)
+  # The package as users install it: the wheel (python3-build), installed
+  # into fresh virtual environments (python3-venv), and its types (mypy).
+  python3-build python3-venv mypy
   shellcheck  # deploy/k8s/check.sh lints every script in deploy/ and tests/
   chromium chromium-driver python3-selenium  # the web viewer's browser test
 )

@@ -1,155 +1,92 @@
 #include "core/index/report_chart.h"
 
-#include <zlib.h>
+#include <cairo.h>
 
 #include <algorithm>
 #include <cassert>
-#include <cctype>
 #include <cmath>
-#include <map>
+#include <cstring>
+#include <memory>
+#include <utility>
 
 #include "absl/strings/str_format.h"
 #include "core/common/file_util.h"
+#include "core/common/status_macros.h"
 
 namespace geodex::index {
 namespace {
 
 using Rgb = std::array<uint8_t, 3>;
-constexpr Rgb kText = {40, 40, 40};
-constexpr Rgb kGrid = {225, 225, 225};
-constexpr Rgb kAxis = {150, 150, 150};
+// The viewer's colours (client/cli/web/assets/viewer.css, #accuracy-chart).
+constexpr Rgb kText = {68, 68, 68};
+constexpr Rgb kGrid = {230, 230, 230};
+constexpr Rgb kAxis = {153, 153, 153};
+constexpr char kFont[] = "DejaVu Sans";
+constexpr double kTickSize = 12;
+constexpr double kTitleSize = 16;
+// The limit's dashes, in pixels on and off.
+constexpr double kDash[] = {8, 5};
 
-// A 5 x 7 bitmap font, upper case: each row's five bits, the leftmost the
-// highest. Lower-case text is drawn in capitals.
-const std::map<char, std::array<uint8_t, 7>>& Font() {
-  static const auto* const font = new std::map<char, std::array<uint8_t, 7>>{
-      {'%', {0x18, 0x19, 0x02, 0x04, 0x08, 0x13, 0x03}},
-      {'(', {0x02, 0x04, 0x08, 0x08, 0x08, 0x04, 0x02}},
-      {')', {0x08, 0x04, 0x02, 0x02, 0x02, 0x04, 0x08}},
-      {',', {0x00, 0x00, 0x00, 0x00, 0x0c, 0x04, 0x08}},
-      {'-', {0x00, 0x00, 0x00, 0x1f, 0x00, 0x00, 0x00}},
-      {'.', {0x00, 0x00, 0x00, 0x00, 0x00, 0x0c, 0x0c}},
-      {'/', {0x00, 0x01, 0x02, 0x04, 0x08, 0x10, 0x00}},
-      {'0', {0x0e, 0x11, 0x13, 0x15, 0x19, 0x11, 0x0e}},
-      {'1', {0x04, 0x0c, 0x04, 0x04, 0x04, 0x04, 0x0e}},
-      {'2', {0x0e, 0x11, 0x01, 0x02, 0x04, 0x08, 0x1f}},
-      {'3', {0x1f, 0x02, 0x04, 0x02, 0x01, 0x11, 0x0e}},
-      {'4', {0x02, 0x06, 0x0a, 0x12, 0x1f, 0x02, 0x02}},
-      {'5', {0x1f, 0x10, 0x1e, 0x01, 0x01, 0x11, 0x0e}},
-      {'6', {0x06, 0x08, 0x10, 0x1e, 0x11, 0x11, 0x0e}},
-      {'7', {0x1f, 0x01, 0x02, 0x04, 0x08, 0x08, 0x08}},
-      {'8', {0x0e, 0x11, 0x11, 0x0e, 0x11, 0x11, 0x0e}},
-      {'9', {0x0e, 0x11, 0x11, 0x0f, 0x01, 0x02, 0x0c}},
-      {':', {0x00, 0x0c, 0x0c, 0x00, 0x0c, 0x0c, 0x00}},
-      {'<', {0x02, 0x04, 0x08, 0x10, 0x08, 0x04, 0x02}},
-      {'=', {0x00, 0x00, 0x1f, 0x00, 0x1f, 0x00, 0x00}},
-      {'>', {0x08, 0x04, 0x02, 0x01, 0x02, 0x04, 0x08}},
-      {'A', {0x0e, 0x11, 0x11, 0x1f, 0x11, 0x11, 0x11}},
-      {'B', {0x1e, 0x11, 0x11, 0x1e, 0x11, 0x11, 0x1e}},
-      {'C', {0x0e, 0x11, 0x10, 0x10, 0x10, 0x11, 0x0e}},
-      {'D', {0x1e, 0x11, 0x11, 0x11, 0x11, 0x11, 0x1e}},
-      {'E', {0x1f, 0x10, 0x10, 0x1e, 0x10, 0x10, 0x1f}},
-      {'F', {0x1f, 0x10, 0x10, 0x1e, 0x10, 0x10, 0x10}},
-      {'G', {0x0e, 0x11, 0x10, 0x17, 0x11, 0x11, 0x0f}},
-      {'H', {0x11, 0x11, 0x11, 0x1f, 0x11, 0x11, 0x11}},
-      {'I', {0x0e, 0x04, 0x04, 0x04, 0x04, 0x04, 0x0e}},
-      {'J', {0x07, 0x02, 0x02, 0x02, 0x02, 0x12, 0x0c}},
-      {'K', {0x11, 0x12, 0x14, 0x18, 0x14, 0x12, 0x11}},
-      {'L', {0x10, 0x10, 0x10, 0x10, 0x10, 0x10, 0x1f}},
-      {'M', {0x11, 0x1b, 0x15, 0x15, 0x11, 0x11, 0x11}},
-      {'N', {0x11, 0x11, 0x19, 0x15, 0x13, 0x11, 0x11}},
-      {'O', {0x0e, 0x11, 0x11, 0x11, 0x11, 0x11, 0x0e}},
-      {'P', {0x1e, 0x11, 0x11, 0x1e, 0x10, 0x10, 0x10}},
-      {'Q', {0x0e, 0x11, 0x11, 0x11, 0x15, 0x12, 0x0d}},
-      {'R', {0x1e, 0x11, 0x11, 0x1e, 0x14, 0x12, 0x11}},
-      {'S', {0x0f, 0x10, 0x10, 0x0e, 0x01, 0x01, 0x1e}},
-      {'T', {0x1f, 0x04, 0x04, 0x04, 0x04, 0x04, 0x04}},
-      {'U', {0x11, 0x11, 0x11, 0x11, 0x11, 0x11, 0x0e}},
-      {'V', {0x11, 0x11, 0x11, 0x11, 0x11, 0x0a, 0x04}},
-      {'W', {0x11, 0x11, 0x11, 0x15, 0x15, 0x15, 0x0a}},
-      {'X', {0x11, 0x11, 0x0a, 0x04, 0x0a, 0x11, 0x11}},
-      {'Y', {0x11, 0x11, 0x0a, 0x04, 0x04, 0x04, 0x04}},
-      {'Z', {0x1f, 0x01, 0x02, 0x04, 0x08, 0x10, 0x1f}},
-  };
-  return *font;
-}
-
-class Canvas {
- public:
-  Canvas(int width, int height) : image_{width, height, {}} {
-    image_.rgb.resize(size_t{3} * width * height, 255);
-  }
-  ChartImage Take() { return std::move(image_); }
-
-  void Set(int x, int y, const Rgb& c) {
-    if (x < 0 || y < 0 || x >= image_.width || y >= image_.height) return;
-    const size_t i = 3 * (static_cast<size_t>(y) * image_.width + x);
-    std::copy(c.begin(), c.end(), image_.rgb.begin() + i);
-  }
-  void Rect(int x0, int y0, int x1, int y1, const Rgb& c) {
-    for (int y = std::min(y0, y1); y <= std::max(y0, y1); ++y) {
-      for (int x = std::min(x0, x1); x <= std::max(x0, x1); ++x) Set(x, y, c);
-    }
-  }
-  // A horizontal line `thickness` pixels thick centred on row y; `dash` > 0
-  // draws dash pixels on, dash off.
-  void HLine(int x0, int x1, int y, int thickness, const Rgb& c, int dash = 0) {
-    for (int x = std::min(x0, x1); x <= std::max(x0, x1); ++x) {
-      if (dash > 0 && ((x - x0) / dash) % 2 == 1) continue;
-      for (int t = 0; t < thickness; ++t) Set(x, y - thickness / 2 + t, c);
-    }
-  }
-  void VLine(int x, int y0, int y1, int thickness, const Rgb& c, int dash = 0) {
-    for (int y = std::min(y0, y1); y <= std::max(y0, y1); ++y) {
-      if (dash > 0 && ((y - y0) / dash) % 2 == 1) continue;
-      for (int t = 0; t < thickness; ++t) Set(x - thickness / 2 + t, y, c);
-    }
-  }
-  void Dot(int cx, int cy, int r, const Rgb& c) {
-    for (int y = -r; y <= r; ++y) {
-      for (int x = -r; x <= r; ++x) {
-        if (x * x + y * y <= r * r) Set(cx + x, cy + y, c);
-      }
-    }
-  }
-  static int TextWidth(const std::string& text, int scale) {
-    return static_cast<int>(text.size()) * 6 * scale - scale;
-  }
-  // `text` with its top-left corner at (x, y).
-  void Text(int x, int y, const std::string& text, int scale, const Rgb& c) {
-    for (const char ch : text) {
-      const auto glyph =
-          Font().find(static_cast<char>(std::toupper(static_cast<unsigned char>(ch))));
-      if (glyph != Font().end()) {
-        for (int row = 0; row < 7; ++row) {
-          for (int col = 0; col < 5; ++col) {
-            if ((glyph->second[row] >> (4 - col)) & 1) {
-              Rect(x + col * scale, y + row * scale, x + col * scale + scale - 1,
-                   y + row * scale + scale - 1, c);
-            }
-          }
-        }
-      }
-      x += 6 * scale;
-    }
-  }
-
- private:
-  ChartImage image_;
+struct SurfaceDeleter {
+  void operator()(cairo_surface_t* s) const { cairo_surface_destroy(s); }
 };
+struct ContextDeleter {
+  void operator()(cairo_t* cr) const { cairo_destroy(cr); }
+};
+using Surface = std::unique_ptr<cairo_surface_t, SurfaceDeleter>;
+using Context = std::unique_ptr<cairo_t, ContextDeleter>;
 
-void AppendBigEndian32(uint32_t v, std::string* out) {
-  for (int shift = 24; shift >= 0; shift -= 8) out->push_back(static_cast<char>(v >> shift));
+void SetColor(cairo_t* cr, const Rgb& c) {
+  cairo_set_source_rgb(cr, c[0] / 255.0, c[1] / 255.0, c[2] / 255.0);
 }
 
-void AppendChunk(const char* type, const std::string& data, std::string* png) {
-  AppendBigEndian32(static_cast<uint32_t>(data.size()), png);
-  const std::string body = std::string(type, 4) + data;
-  *png += body;
-  AppendBigEndian32(
-      static_cast<uint32_t>(crc32(crc32(0, nullptr, 0), reinterpret_cast<const Bytef*>(body.data()),
-                                  static_cast<uInt>(body.size()))),
-      png);
+// Lines are placed so that the pixels the tests look at are covered whole,
+// not blended: a line of odd width runs along a row's (column's) centre,
+// one of even width along the edge between two rows.
+double Centre(int pixel, double width) {
+  return static_cast<int>(width) % 2 == 1 ? pixel + 0.5 : pixel;
+}
+
+void HLine(cairo_t* cr, int x0, int x1, int y, double width, const Rgb& c, bool dashed = false) {
+  SetColor(cr, c);
+  cairo_set_line_width(cr, width);
+  cairo_set_dash(cr, kDash, dashed ? 2 : 0, 0);
+  cairo_move_to(cr, x0, Centre(y, width));
+  cairo_line_to(cr, x1 + 1, Centre(y, width));
+  cairo_stroke(cr);
+}
+
+void VLine(cairo_t* cr, int x, int y0, int y1, double width, const Rgb& c) {
+  SetColor(cr, c);
+  cairo_set_line_width(cr, width);
+  cairo_set_dash(cr, nullptr, 0, 0);
+  cairo_move_to(cr, Centre(x, width), std::min(y0, y1));
+  cairo_line_to(cr, Centre(x, width), std::max(y0, y1) + 1);
+  cairo_stroke(cr);
+}
+
+enum class Anchor { kStart, kMiddle, kEnd };
+
+// `text` with its baseline at y, starting, centred or ending at x (as SVG's
+// text-anchor). Returns its advance.
+double Text(cairo_t* cr, double x, double y, const std::string& text, double size,
+            Anchor anchor = Anchor::kStart) {
+  cairo_set_font_size(cr, size);
+  cairo_text_extents_t extents;
+  cairo_text_extents(cr, text.c_str(), &extents);
+  if (anchor == Anchor::kMiddle) x -= extents.x_advance / 2;
+  if (anchor == Anchor::kEnd) x -= extents.x_advance;
+  SetColor(cr, kText);
+  cairo_move_to(cr, x, y);
+  cairo_show_text(cr, text.c_str());
+  return extents.x_advance;
+}
+
+double TextWidth(cairo_t* cr, const std::string& text, double size) {
+  cairo_set_font_size(cr, size);
+  cairo_text_extents_t extents;
+  cairo_text_extents(cr, text.c_str(), &extents);
+  return extents.x_advance;
 }
 
 // A gridline label: the percentage with as many decimals as the step needs.
@@ -158,6 +95,134 @@ std::string TickLabel(double fraction, double step) {
   const int decimals =
       percent_step >= 1 ? 0 : static_cast<int>(std::ceil(-std::log10(percent_step) - 1e-9));
   return absl::StrFormat("%.*f%%", decimals, 100 * fraction);
+}
+
+// The chart on a new opaque surface; cairo reports an allocation failure
+// in the surface's status.
+Surface DrawSurface(const IndexReport& report, int width, int height) {
+  assert(width >= 320 && height >= 200);
+  Surface surface(cairo_image_surface_create(CAIRO_FORMAT_RGB24, width, height));
+  if (cairo_surface_status(surface.get()) != CAIRO_STATUS_SUCCESS) return surface;
+  const Context context(cairo_create(surface.get()));
+  cairo_t* cr = context.get();
+  cairo_set_source_rgb(cr, 1, 1, 1);
+  cairo_paint(cr);
+  cairo_select_font_face(cr, kFont, CAIRO_FONT_SLANT_NORMAL, CAIRO_FONT_WEIGHT_NORMAL);
+  cairo_set_line_cap(cr, CAIRO_LINE_CAP_BUTT);
+
+  const ChartFrame f = MakeChartFrame(report, width, height);
+  Text(cr, f.left, 26, "relative error by distance", kTitleSize);
+  // The gridlines, labelled: errors, then distances (decades and 3L, the
+  // edge between the target's two limits).
+  for (int k = 0; k * f.error_step <= f.error_max * (1 + 1e-9); ++k) {
+    const double e = k * f.error_step;
+    HLine(cr, f.left, f.right, f.Y(e), 1, k == 0 ? kAxis : kGrid);
+    Text(cr, f.left - 8, f.Y(e) + 4.5, TickLabel(e, f.error_step), kTickSize, Anchor::kEnd);
+  }
+  const std::pair<double, const char*> ticks[] = {
+      {0.1, "0.1L"}, {1, "L"}, {3, "3L"}, {10, "10L"}, {100, "100L"}};
+  for (const auto& [l, label] : ticks) {
+    VLine(cr, f.X(l), f.top, f.bottom, 1, l == kChartMinL ? kAxis : kGrid);
+    // The last label ends at its line, inside the picture.
+    Text(cr, f.X(l) + 0.5, f.bottom + 20, label, kTickSize,
+         l == kChartMaxL ? Anchor::kEnd : Anchor::kMiddle);
+  }
+  Text(cr, (f.left + f.right) / 2.0, f.bottom + 42, "distance / L (log scale)", kTickSize,
+       Anchor::kMiddle);
+  // The target's p99 limit: one dashed path over the bins, a step at 3L.
+  SetColor(cr, kChartLimitColor);
+  cairo_set_line_width(cr, 2);
+  cairo_set_dash(cr, kDash, 2, 0);
+  for (const ReportBin& b : report.bins) {
+    const double from = std::max(b.from_l, kChartMinL), to = std::min(b.to_l, kChartMaxL);
+    const double y = Centre(f.Y(b.p99_limit), 2);
+    if (&b == &report.bins[0]) {
+      cairo_move_to(cr, f.X(from), y);
+    } else {
+      cairo_line_to(cr, f.X(from), y);
+    }
+    cairo_line_to(cr, f.X(to) + 1, y);
+  }
+  cairo_stroke(cr);
+  // The series: RMS under p99; a step over each bin, a dot at its middle.
+  for (const auto& [rms, color] :
+       {std::make_pair(true, kChartRmsColor), std::make_pair(false, kChartP99Color)}) {
+    for (const ReportBin& b : report.bins) {
+      const double v = rms ? b.rms : b.p99;
+      if (!std::isfinite(v)) continue;
+      const double from = std::max(b.from_l, kChartMinL), to = std::min(b.to_l, kChartMaxL);
+      HLine(cr, f.X(from), f.X(to), f.Y(v), 3, color);
+      cairo_arc(cr, f.X(std::sqrt(from * to)) + 0.5, f.Y(v) + 0.5, 4.5, 0, 2 * M_PI);
+      cairo_fill(cr);
+    }
+  }
+  // The legend, top right, in the viewer's words.
+  const std::string limit =
+      absl::StrFormat("limit (target %s)", FormatPercent(report.target_error));
+  const std::pair<std::string, Rgb> legend[] = {
+      {"p99", kChartP99Color}, {"RMS", kChartRmsColor}, {limit, kChartLimitColor}};
+  double width_needed = 0;
+  for (const auto& [label, color] : legend) width_needed += 24 + TextWidth(cr, label, kTickSize);
+  double x = f.right - width_needed - 2 * 16;
+  for (const auto& [label, color] : legend) {
+    const bool dashed = color == kChartLimitColor;
+    HLine(cr, static_cast<int>(x), static_cast<int>(x) + 18, 34, dashed ? 2 : 3, color, dashed);
+    x += 24 + Text(cr, x + 24, 38.5, label, kTickSize) + 16;
+  }
+  cairo_surface_flush(surface.get());
+  return surface;
+}
+
+cairo_status_t AppendToString(void* closure, const unsigned char* data, unsigned int length) {
+  static_cast<std::string*>(closure)->append(reinterpret_cast<const char*>(data), length);
+  return CAIRO_STATUS_SUCCESS;
+}
+
+absl::StatusOr<std::string> SurfacePng(cairo_surface_t* surface) {
+  std::string png;
+  cairo_status_t status = cairo_surface_status(surface);
+  if (status == CAIRO_STATUS_SUCCESS) {
+    status = cairo_surface_write_to_png_stream(surface, AppendToString, &png);
+  }
+  if (status != CAIRO_STATUS_SUCCESS) {
+    return absl::InternalError(
+        absl::StrFormat("cairo could not encode the chart: %s", cairo_status_to_string(status)));
+  }
+  return png;
+}
+
+// An opaque surface's pixels (cairo keeps 0xAARRGGBB in native-endian words).
+ChartImage ImageOf(cairo_surface_t* surface) {
+  ChartImage image;
+  image.width = cairo_image_surface_get_width(surface);
+  image.height = cairo_image_surface_get_height(surface);
+  image.rgb.resize(size_t{3} * image.width * image.height);
+  const unsigned char* data = cairo_image_surface_get_data(surface);
+  const int stride = cairo_image_surface_get_stride(surface);
+  for (int y = 0; y < image.height; ++y) {
+    for (int x = 0; x < image.width; ++x) {
+      uint32_t pixel;
+      std::memcpy(&pixel, data + static_cast<size_t>(y) * stride + 4 * x, 4);
+      uint8_t* out = &image.rgb[3 * (static_cast<size_t>(y) * image.width + x)];
+      out[0] = static_cast<uint8_t>(pixel >> 16);
+      out[1] = static_cast<uint8_t>(pixel >> 8);
+      out[2] = static_cast<uint8_t>(pixel);
+    }
+  }
+  return image;
+}
+
+struct PngReader {
+  std::string_view bytes;
+  size_t at = 0;
+};
+
+cairo_status_t ReadFromView(void* closure, unsigned char* data, unsigned int length) {
+  auto* reader = static_cast<PngReader*>(closure);
+  if (reader->bytes.size() - reader->at < length) return CAIRO_STATUS_READ_ERROR;
+  std::memcpy(data, reader->bytes.data() + reader->at, length);
+  reader->at += length;
+  return CAIRO_STATUS_SUCCESS;
 }
 
 }  // namespace
@@ -202,89 +267,41 @@ ChartFrame MakeChartFrame(const IndexReport& report, int width, int height) {
 }
 
 ChartImage DrawReportChart(const IndexReport& report, int width, int height) {
-  assert(width >= 320 && height >= 200);
-  const ChartFrame f = MakeChartFrame(report, width, height);
-  Canvas c(width, height);
-  c.Text(f.left, 12, "relative error by distance", 2, kText);
-  // The gridlines, labelled: errors, then distances (decades and 3L, the
-  // edge between the target's two limits).
-  for (int k = 0; k * f.error_step <= f.error_max * (1 + 1e-9); ++k) {
-    const double e = k * f.error_step;
-    c.HLine(f.left, f.right, f.Y(e), 1, k == 0 ? kAxis : kGrid);
-    const std::string label = TickLabel(e, f.error_step);
-    c.Text(f.left - 8 - Canvas::TextWidth(label, 1), f.Y(e) - 3, label, 1, kText);
-  }
-  const std::pair<double, const char*> ticks[] = {
-      {0.1, "0.1L"}, {1, "L"}, {3, "3L"}, {10, "10L"}, {100, "100L"}};
-  for (const auto& [l, label] : ticks) {
-    c.VLine(f.X(l), f.top, f.bottom, 1, l == kChartMinL ? kAxis : kGrid);
-    c.Text(f.X(l) - Canvas::TextWidth(label, 1) / 2, f.bottom + 8, label, 1, kText);
-  }
-  const std::string axis = "distance / L (log scale)";
-  c.Text((f.left + f.right - Canvas::TextWidth(axis, 1)) / 2, f.bottom + 28, axis, 1, kText);
-  // The target's p99 limit: dashed, a step at 3L.
-  for (const ReportBin& b : report.bins) {
-    const double from = std::max(b.from_l, kChartMinL), to = std::min(b.to_l, kChartMaxL);
-    c.HLine(f.X(from), f.X(to), f.Y(b.p99_limit), 2, kChartLimitColor, 6);
-  }
-  c.VLine(f.X(3), f.Y(report.bins[1].p99_limit), f.Y(report.bins[2].p99_limit), 2, kChartLimitColor,
-          6);
-  // The series: RMS under p99; a step over each bin, a dot at its middle.
-  for (const auto& [rms, color] :
-       {std::make_pair(true, kChartRmsColor), std::make_pair(false, kChartP99Color)}) {
-    for (const ReportBin& b : report.bins) {
-      const double v = rms ? b.rms : b.p99;
-      if (!std::isfinite(v)) continue;
-      const double from = std::max(b.from_l, kChartMinL), to = std::min(b.to_l, kChartMaxL);
-      c.HLine(f.X(from), f.X(to), f.Y(v), 3, color);
-      c.Dot(f.X(std::sqrt(from * to)), f.Y(v), 4, color);
-    }
-  }
-  // The legend, top right.
-  const std::string limit =
-      absl::StrFormat("%s limit (target %s)", "p99", FormatPercent(report.target_error));
-  int x = f.right - Canvas::TextWidth("p99", 1) - Canvas::TextWidth("RMS", 1) -
-          Canvas::TextWidth(limit, 1) - 3 * 30;
-  const std::pair<std::string, Rgb> legend[] = {
-      {"p99", kChartP99Color}, {"RMS", kChartRmsColor}, {limit, kChartLimitColor}};
-  for (const auto& [label, color] : legend) {
-    if (color == kChartLimitColor) {
-      c.HLine(x, x + 18, 40, 2, color, 6);
-    } else {
-      c.HLine(x, x + 18, 40, 3, color);
-    }
-    c.Text(x + 24, 37, label, 1, kText);
-    x += 30 + Canvas::TextWidth(label, 1);
-  }
-  return c.Take();
+  const Surface surface = DrawSurface(report, width, height);
+  // A surface of a few hundred pixels a side fails only when memory does.
+  assert(cairo_surface_status(surface.get()) == CAIRO_STATUS_SUCCESS);
+  return ImageOf(surface.get());
 }
 
-std::string EncodeChartPng(const ChartImage& image) {
-  const size_t row_bytes = size_t{3} * image.width;
-  std::string rows;
-  rows.reserve((row_bytes + 1) * image.height);
-  for (int y = 0; y < image.height; ++y) {
-    rows.push_back('\0');  // filter type 0: flat colours compress well unfiltered
-    rows.append(reinterpret_cast<const char*>(image.rgb.data()) + y * row_bytes, row_bytes);
+absl::StatusOr<std::string> EncodeChartPng(const ChartImage& image) {
+  assert(image.width > 0 && image.height > 0);
+  assert(image.rgb.size() == size_t{3} * image.width * image.height);
+  const Surface surface(cairo_image_surface_create(CAIRO_FORMAT_RGB24, image.width, image.height));
+  if (cairo_surface_status(surface.get()) == CAIRO_STATUS_SUCCESS) {
+    cairo_surface_flush(surface.get());
+    unsigned char* data = cairo_image_surface_get_data(surface.get());
+    const int stride = cairo_image_surface_get_stride(surface.get());
+    for (int y = 0; y < image.height; ++y) {
+      for (int x = 0; x < image.width; ++x) {
+        const auto [r, g, b] = image.At(x, y);
+        const uint32_t pixel = 0xff000000u | uint32_t{r} << 16 | uint32_t{g} << 8 | b;
+        std::memcpy(data + static_cast<size_t>(y) * stride + 4 * x, &pixel, 4);
+      }
+    }
+    cairo_surface_mark_dirty(surface.get());
   }
-  uLongf size = compressBound(static_cast<uLong>(rows.size()));
-  std::string compressed(size, '\0');
-  const int status = compress2(reinterpret_cast<Bytef*>(compressed.data()), &size,
-                               reinterpret_cast<const Bytef*>(rows.data()),
-                               static_cast<uLong>(rows.size()), Z_BEST_COMPRESSION);
-  // compressBound rules out Z_BUF_ERROR; Z_MEM_ERROR is out of memory.
-  assert(status == Z_OK);
-  (void)status;
-  compressed.resize(size);
-  std::string png = "\x89PNG\r\n\x1a\n";
-  std::string header;
-  AppendBigEndian32(static_cast<uint32_t>(image.width), &header);
-  AppendBigEndian32(static_cast<uint32_t>(image.height), &header);
-  header.append({'\x08', '\x02', '\x00', '\x00', '\x00'});  // 8-bit RGB, no interlace
-  AppendChunk("IHDR", header, &png);
-  AppendChunk("IDAT", compressed, &png);
-  AppendChunk("IEND", "", &png);
-  return png;
+  return SurfacePng(surface.get());
+}
+
+absl::StatusOr<ChartImage> DecodeChartPng(std::string_view png) {
+  PngReader reader{png};
+  const Surface surface(cairo_image_surface_create_from_png_stream(ReadFromView, &reader));
+  const cairo_status_t status = cairo_surface_status(surface.get());
+  if (status != CAIRO_STATUS_SUCCESS) {
+    return absl::InvalidArgumentError(
+        absl::StrFormat("not a PNG cairo reads: %s", cairo_status_to_string(status)));
+  }
+  return ImageOf(surface.get());
 }
 
 absl::Status WriteReportPng(const IndexReport& report, const std::string& path) {
@@ -293,7 +310,9 @@ absl::Status WriteReportPng(const IndexReport& report, const std::string& path) 
         "%s: the index has no accuracy calibration to draw (geodex-build calibrate adds it)",
         path));
   }
-  return AtomicWriteFile(path, EncodeChartPng(DrawReportChart(report)));
+  const Surface surface = DrawSurface(report, 720, 420);
+  GEODEX_ASSIGN_OR_RETURN(const std::string png, SurfacePng(surface.get()));
+  return AtomicWriteFile(path, png);
 }
 
 }  // namespace geodex::index

@@ -9,20 +9,24 @@
 // 100L) with a dot at its geometric middle; relative error runs up a linear
 // axis in %. The error target's p99 limit (2E below 3L, 4E from 3L) is the
 // dashed line. The viewer draws the same chart (client/cli/web/assets/
-// viewer.js) from the report's JSON, with the same frame.
+// report_chart.js) from the report's JSON, with the same frame. Drawn with
+// cairo: anti-aliased lines and DejaVu Sans (any sans-serif fontconfig
+// finds when it is absent).
 //
 //   const IndexReport report = MakeIndexReport(index);
 //   absl::Status written = WriteReportPng(report, "report.png");
 //
 // Thread-safe: pure functions of their arguments (WriteReportPng writes its
-// file).
+// file); each call draws on a cairo surface of its own.
 
 #include <array>
 #include <cstdint>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "absl/status/status.h"
+#include "absl/status/statusor.h"
 #include "core/index/index_report.h"
 
 namespace geodex::index {
@@ -52,7 +56,9 @@ double ChartErrorMax(const IndexReport& report, double* step);
 ChartFrame MakeChartFrame(const IndexReport& report, int width, int height);
 
 // An 8-bit RGB image; pixel (x, y), y = 0 the top row, is the three bytes at
-// rgb[3 * (y * width + x)].
+// rgb[3 * (y * width + x)]. Lines and dots are anti-aliased: a pixel on a
+// figure's edge blends its colour with what lies under it, a pixel inside
+// (the middle row of a series' step, the centre of its dot) has it exactly.
 struct ChartImage {
   int width = 0;
   int height = 0;
@@ -72,8 +78,13 @@ inline constexpr std::array<uint8_t, 3> kChartLimitColor = {90, 90, 90};
 // width >= 320 and height >= 200.
 ChartImage DrawReportChart(const IndexReport& report, int width = 720, int height = 420);
 
-// `image` as PNG bytes (8-bit RGB, zlib-compressed, unfiltered rows).
-std::string EncodeChartPng(const ChartImage& image);
+// `image` as PNG bytes (8-bit RGB, cairo's encoder). Errors: Internal when
+// cairo fails (out of memory).
+absl::StatusOr<std::string> EncodeChartPng(const ChartImage& image);
+
+// The pixels of PNG bytes (any PNG cairo reads; alpha dropped). Errors:
+// InvalidArgument for bytes that are not a PNG cairo can read.
+absl::StatusOr<ChartImage> DecodeChartPng(std::string_view png);
 
 // Draws the chart and writes it atomically to `path`. Errors:
 // FailedPrecondition for a report without a calibration (nothing to draw);

@@ -3,10 +3,11 @@ precomputed indexes (Xin, Ying & He 2012), with numpy arrays in and out.
 
 Two ways in, with the same methods and the same answers:
 
-- :func:`connect` opens a :class:`Client` of a geodex server (gRPC);
+- :func:`connect` opens a :class:`Client` of a geodex server (gRPC; it
+  needs grpcio and protobuf: ``pip install 'geodex[client]'``);
 - :class:`Index` maps an index file and answers in this process, and
   :func:`build` makes one from a mesh (both need the compiled module
-  ``geodex._core``, installed with the package).
+  ``geodex._core``, installed with the package, and numpy only).
 
 A surface point is a face id of the mesh file the index was built from and
 the barycentric weights of that face's three vertices: points are
@@ -14,6 +15,8 @@ the barycentric weights of that face's three vertices: points are
 :class:`Error` subclasses named after their status code
 (:class:`InvalidArgument`, :class:`NotFound`, ...).
 """
+
+from typing import TYPE_CHECKING, NoReturn
 
 from .errors import (
     Aborted,
@@ -36,8 +39,32 @@ from .errors import (
 )
 from . import errors as _errors
 from ._arrays import Located, Path, SurfacePoints
-from .client import Client, Model, Tls, Triangulation, connect
 from ._inprocess import BuildProgress, Index, build, has_in_process
+from ._values import Model, Tls, Triangulation
+
+try:
+    from .client import Client, connect
+except ImportError as _error:
+    # The client's dependencies (grpcio, protobuf) are the extra "client";
+    # without them the rest of the package works, and connect (or Client)
+    # names what is missing. Type checkers see the client as installed.
+    if TYPE_CHECKING or not (_error.name or "").startswith(("grpc", "google")):
+        raise  # a broken installation, not a missing extra
+    _MISSING = (
+        f"geodex.connect needs {'grpcio' if _error.name.startswith('grpc') else 'protobuf'} "
+        f"(module {_error.name} is not installed): pip install 'geodex[client]', or "
+        "install grpcio and protobuf"
+    )
+
+    def connect(*args: object, **kwargs: object) -> NoReturn:
+        """Raises ImportError: the client's dependencies are not installed."""
+        raise ImportError(_MISSING, name="grpc")
+
+    def __getattr__(name: str) -> object:
+        if name == "Client":
+            raise ImportError(_MISSING, name="grpc")
+        raise AttributeError(f"module 'geodex' has no attribute {name!r}")
+
 
 __version__ = "0.1.0"
 

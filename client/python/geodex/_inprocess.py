@@ -20,17 +20,8 @@ from typing import Any, Callable, Dict, List, NamedTuple, Optional, Sequence, Tu
 
 import numpy as np
 
-from ._arrays import (
-    Located,
-    Path,
-    SurfacePoints,
-    as_mesh,
-    as_near_pairs,
-    as_points,
-    as_positions,
-    check_tolerance,
-    is_pathlike,
-)
+from ._arrays import Located, Path, SurfacePoints, as_mesh, is_pathlike
+from ._front import QueryFront
 from .errors import InvalidArgument
 
 try:
@@ -43,7 +34,6 @@ else:
 
 __all__ = ["Index", "build", "BuildProgress", "has_in_process"]
 
-_NEAR_PAIRS = {None: 0, "path": 1, "unfold": 2, "exact": 3}
 # The builder's messages about the rounds of a target-error build.
 _log = logging.getLogger("geodex")
 
@@ -73,7 +63,7 @@ class BuildProgress(NamedTuple):
     total: int
 
 
-class Index:
+class Index(QueryFront[None]):
     """An index file, mapped read-only, answering queries in this process.
 
     Parameters
@@ -151,7 +141,7 @@ class Index:
         this file."""
         return json.loads(self._index.report_json)
 
-    # --- queries ------------------------------------------------------------
+    # --- queries (geodex/_front.py checks the arguments and shapes answers) --
 
     def distance(
         self,
@@ -166,6 +156,21 @@ class Index:
         """Geodesic distances of pairs, ``d[i] = d(a[i], b[i])``, as
         :meth:`geodex.Client.distance` (without the model).
 
+        Parameters
+        ----------
+        a, b : points
+            N points each: ``(faces, weights)``, (N,) integer face ids and
+            (N, 3) float barycentric weights (stored as int32 and float64),
+            or (N, 3) float positions with ``xyz=True``.
+        bounds : bool
+            Also return each distance's absolute error bound.
+        tolerance : float
+            Relative error tolerance (e.g. 0.005); 0: the index's.
+        near_pairs : {None, "path", "unfold", "exact"}
+            How near pairs are answered; None: the index's configuration.
+        xyz : bool
+            ``a`` and ``b`` are (N, 3) positions, located first.
+
         Returns
         -------
         numpy.ndarray or (numpy.ndarray, numpy.ndarray)
@@ -179,18 +184,7 @@ class Index:
         FailedPrecondition
             ``bounds`` or ``tolerance`` of an index without calibration.
         """
-        check_tolerance(tolerance)
-        as_near_pairs(near_pairs)
-        pa, pb = self._points(a, "a", xyz), self._points(b, "b", xyz)
-        if pa.faces.shape[0] != pb.faces.shape[0]:
-            raise InvalidArgument(
-                f"a has {pa.faces.shape[0]} points but b has {pb.faces.shape[0]}; they must pair up"
-            )
-        d, bnd = self._index.distance(
-            pa.faces, pa.weights, pb.faces, pb.weights,
-            _NEAR_PAIRS[near_pairs], float(tolerance), bool(bounds),
-        )
-        return (d, bnd) if bounds else d
+        return self._distance(None, a, b, bounds, tolerance, near_pairs, xyz)
 
     def matrix(
         self,
@@ -202,48 +196,69 @@ class Index:
         near_pairs: Optional[str] = None,
         xyz: bool = False,
     ) -> Union[np.ndarray, Tuple[np.ndarray, np.ndarray]]:
-        """All sources x targets distances, (S, T) float64 (and the bounds
-        with ``bounds``), as :meth:`geodex.Client.matrix`."""
-        check_tolerance(tolerance)
-        as_near_pairs(near_pairs)
-        src, tgt = self._points(sources, "sources", xyz), self._points(targets, "targets", xyz)
-        m, bnd = self._index.matrix(
-            src.faces, src.weights, tgt.faces, tgt.weights,
-            _NEAR_PAIRS[near_pairs], float(tolerance), bool(bounds),
-        )
-        return (m, bnd) if bounds else m
+        """All sources x targets distances, ``m[s, t] = d(sources[s],
+        targets[t])``, as :meth:`geodex.Client.matrix`.
+
+        Parameters are those of :meth:`distance`: ``sources`` are S points
+        ((S,) int faces, (S, 3) float weights), ``targets`` T points.
+
+        Returns
+        -------
+        numpy.ndarray or (numpy.ndarray, numpy.ndarray)
+            (S, T) float64 distances; with ``bounds``, also (S, T) float64
+            bounds.
+        """
+        return self._matrix(None, sources, targets, bounds, tolerance, near_pairs, xyz)
 
     def path(self, a: Any, b: Any, *, exact_corridor: int = 0, xyz: bool = False) -> List[Path]:
-        """Geodesic paths from a[i] to b[i], as :meth:`geodex.Client.path`:
-        one :class:`geodex.Path` per pair (K = 0, length ``inf`` between
-        components)."""
-        if not 0 <= int(exact_corridor) <= 64:
-            raise InvalidArgument(f"exact_corridor must be in [0, 64], not {exact_corridor}")
-        pa, pb = self._points(a, "a", xyz), self._points(b, "b", xyz)
-        if pa.faces.shape[0] != pb.faces.shape[0]:
-            raise InvalidArgument(
-                f"a has {pa.faces.shape[0]} points but b has {pb.faces.shape[0]}; they must pair up"
-            )
-        raw = self._index.path(pa.faces, pa.weights, pb.faces, pb.weights, int(exact_corridor))
-        return [Path(*path) for path in raw]  # (positions, faces, weights, length)
+        """Geodesic paths from a[i] to b[i], as :meth:`geodex.Client.path`.
+
+        Parameters
+        ----------
+        a, b : points
+            N points each: (N,) int faces and (N, 3) float weights, or (N, 3)
+            float positions with ``xyz=True``.
+        exact_corridor : int
+            In [0, 64]: when > 0, each path is also solved exactly within
+            this many edge steps of the traced one, and the shorter kept.
+
+        Returns
+        -------
+        list of Path
+            One per pair: (K, 3) float64 positions, (K,) int32 faces, (K, 3)
+            float64 weights and the float length; K = 0 and length ``inf``
+            between components.
+        """
+        return self._path(None, a, b, exact_corridor, xyz, 1)
 
     def field(
         self, sources: Any, *, radius: float = 0.0, nearest: bool = False, xyz: bool = False
     ) -> Union[np.ndarray, Tuple[np.ndarray, ...]]:
         """The distance from the nearest source to every vertex of the mesh
-        file, (n,) float64; with ``nearest``, also the (n,) int32 index of
-        each vertex's nearest source (-1 if none). With ``radius`` > 0, as
-        :meth:`geodex.Client.field`: the exact distances of the vertices
-        within it only, as (k,) int32 vertices (ascending) and (k,) float64
-        distances (and (k,) int32 nearest sources with ``nearest``); a
-        radius that is negative, NaN or infinite is InvalidArgument."""
-        src = self._points(sources, "sources", xyz)
-        radius = float(radius)
-        if radius != 0:
-            ids, d, near = self._index.field_within(src.faces, src.weights, radius)
-            return (ids, d, near) if nearest else (ids, d)
-        d, near = self._index.field(src.faces, src.weights)
-        return (d, near) if nearest else d
+        file, or to the vertices within ``radius``, as
+        :meth:`geodex.Client.field`.
+
+        Parameters
+        ----------
+        sources : points
+            (S,) int faces and (S, 3) float weights, or (S, 3) float
+            positions with ``xyz=True``.
+        radius : float
+            0: every vertex. > 0 and finite: only the vertices within it,
+            with exact distances. Negative, NaN or infinite:
+            InvalidArgument.
+        nearest : bool
+            Also return each vertex's nearest source.
+
+        Returns
+        -------
+        numpy.ndarray or tuple of numpy.ndarray
+            Without a radius: (n,) float64 per vertex (and (n,) int32 the
+            nearest source, -1 if none, with ``nearest``). With a radius:
+            (k,) int32 vertices, ascending, and (k,) float64 distances (and
+            (k,) int32 nearest sources with ``nearest``).
+        """
+        return self._field(None, sources, radius, nearest, xyz)
 
     def expmap(
         self,
@@ -257,37 +272,106 @@ class Index:
         xyz: bool = False,
     ) -> Tuple[np.ndarray, np.ndarray]:
         """The exponential map round one point, as
-        :meth:`geodex.Client.expmap`: (k,) int32 vertex ids, ascending, and
-        (k, 2) float64 (u, v), or (r, theta) with ``polar``."""
-        check_tolerance(tolerance)
-        as_near_pairs(near_pairs)
-        c = self._points(centre, "centre", xyz)
-        if c.faces.shape[0] != 1:
-            raise InvalidArgument(f"centre must be one point, not {c.faces.shape[0]}")
-        ref = None if direction is None else as_positions(direction, "direction")[0]
-        vertices, r, theta, u, v = self._index.expmap(
-            int(c.faces[0]), c.weights[0], float(radius), ref,
-            _NEAR_PAIRS[near_pairs], float(tolerance),
-        )
-        coords = np.stack([r, theta] if polar else [u, v], axis=1).reshape(-1, 2)
-        return vertices, coords
+        :meth:`geodex.Client.expmap`.
+
+        Parameters
+        ----------
+        centre : point
+            One point: ``(face, (w0, w1, w2))``, or a (3,) position with
+            ``xyz=True``.
+        radius : float
+            Vertices farther than this from the centre are left out.
+        direction : (3,) float, optional
+            theta = 0 along it, projected into the centre's face.
+        polar : bool
+            Return (r, theta) instead of (u, v).
+
+        Returns
+        -------
+        (numpy.ndarray, numpy.ndarray)
+            (k,) int32 vertex ids, ascending, and (k, 2) float64 (u, v), or
+            (r, theta) with ``polar``.
+        """
+        return self._expmap(None, centre, radius, direction, polar, near_pairs, tolerance, xyz)
 
     def locate(self, xyz: Any) -> Located:
-        """The closest surface point of each (N, 3) position: faces,
-        weights (usable as points) and the distances to them."""
-        faces, weights, distances = self._index.locate(as_positions(xyz, "xyz"))
-        return Located(faces, weights, distances)
+        """The closest surface point of each position.
+
+        Parameters
+        ----------
+        xyz : (N, 3) float
+            Positions.
+
+        Returns
+        -------
+        Located
+            faces (N,) int32, weights (N, 3) float64 (usable as points) and
+            distances (N,) float64 from each position to its point.
+        """
+        return self._locate(None, xyz, 0)
 
     def mesh(self) -> Tuple[np.ndarray, np.ndarray]:
         """The mesh file's (V, 3) float64 vertices and (F, 3) int32 faces
         (polygons fan-triangulated), as :meth:`geodex.Client.mesh`."""
-        return self._index.mesh()
+        return self._mesh(None)
 
-    def _points(self, points: Any, name: str, xyz: bool) -> SurfacePoints:
-        if not xyz:
-            return as_points(points, name)
-        located = self.locate(as_positions(points, name))
-        return SurfacePoints(located.faces, located.weights)
+    # --- the back half: geodex._core ----------------------------------------
+
+    def _run_distance(
+        self, at: None, a: SurfacePoints, b: SurfacePoints, near_pairs: int, tolerance: float,
+        bounds: bool,
+    ) -> Tuple[np.ndarray, Optional[np.ndarray]]:
+        d, bnd = self._index.distance(
+            a.faces, a.weights, b.faces, b.weights, near_pairs, tolerance, bounds
+        )
+        return d, (bnd if bounds else None)
+
+    def _run_matrix(
+        self, at: None, sources: SurfacePoints, targets: SurfacePoints, near_pairs: int,
+        tolerance: float, bounds: bool,
+    ) -> Tuple[np.ndarray, Optional[np.ndarray]]:
+        m, bnd = self._index.matrix(
+            sources.faces, sources.weights, targets.faces, targets.weights,
+            near_pairs, tolerance, bounds,
+        )
+        return m, (bnd if bounds else None)
+
+    def _run_path(
+        self, at: None, a: SurfacePoints, b: SurfacePoints, exact_corridor: int, batch_size: int
+    ) -> List[Path]:
+        raw = self._index.path(a.faces, a.weights, b.faces, b.weights, exact_corridor)
+        return [Path(*path) for path in raw]  # (positions, faces, weights, length)
+
+    def _run_field(
+        self, at: None, sources: SurfacePoints, nearest: bool
+    ) -> Tuple[np.ndarray, Optional[np.ndarray]]:
+        d, near = self._index.field(sources.faces, sources.weights)
+        return d, (near if nearest else None)
+
+    def _run_field_within(
+        self, at: None, sources: SurfacePoints, radius: float, nearest: bool
+    ) -> Tuple[np.ndarray, np.ndarray, Optional[np.ndarray]]:
+        ids, d, near = self._index.field_within(sources.faces, sources.weights, radius)
+        return ids, d, (near if nearest else None)
+
+    def _run_expmap(
+        self, at: None, centre: SurfacePoints, radius: float, direction: Optional[np.ndarray],
+        polar: bool, near_pairs: int, tolerance: float,
+    ) -> Tuple[np.ndarray, np.ndarray]:
+        ref = None if direction is None else direction[0]
+        vertices, r, theta, u, v = self._index.expmap(
+            int(centre.faces[0]), centre.weights[0], radius, ref, near_pairs, tolerance
+        )
+        coords = np.stack([r, theta] if polar else [u, v], axis=1).reshape(-1, 2)
+        return vertices, coords
+
+    def _run_locate(self, at: None, xyz: np.ndarray, batch_size: int) -> Located:
+        faces, weights, distances = self._index.locate(xyz)
+        return Located(faces, weights, distances)
+
+    def _run_mesh(self, at: None) -> Tuple[np.ndarray, np.ndarray]:
+        vertices, faces = self._index.mesh()
+        return vertices, faces
 
 
 class _ProgressBar:

@@ -1,0 +1,424 @@
+"""The back half of :class:`geodex.Client`'s queries: requests over gRPC,
+answers decoded (the front half, shared with the in-process index, is
+geodex/_front.py).
+
+Requests carrying arrays are serialised by _wire (bytes in), and the
+numeric answers decoded by it too (bytes out): protobuf's Python objects
+would copy every number through a Python float.
+"""
+
+from __future__ import annotations
+
+from typing import Iterator, List, Optional, Tuple, cast
+
+import grpc
+import numpy as np
+
+from . import _wire
+from ._arrays import Located, Path, SurfacePoints
+from ._front import QueryFront
+from ._messages import _in_pairs, _model_ref, _path_of, _rpc_error
+from .errors import DataLoss, error_for_code
+from .v1 import geodex_pb2 as pb
+
+__all__ = ["At", "RemoteQueries"]
+
+_METHOD = "/geodex.v1.Geodex/"
+
+
+class At:
+    """Where a client's query is answered: the model, and its version (0:
+    the newest until an answer names the version, which then answers the
+    rest of the query, so that positions located first and the query on
+    their points meet the same index)."""
+
+    __slots__ = ("model", "version")
+
+    def __init__(self, model: str, version: int) -> None:
+        self.model = model
+        self.version = int(version)
+
+    def ref(self) -> pb.ModelRef:
+        return _model_ref(self.model, self.version)
+
+    def pin(self, version: int) -> None:
+        if self.version == 0:
+            self.version = version
+
+
+class RemoteQueries(QueryFront[At]):
+    """The seven queries over a channel (``_run_*`` of QueryFront)."""
+
+    _timeout: Optional[float]
+    _metadata: Optional[Tuple[Tuple[str, str], ...]]
+    _batch_size: int
+
+    def _open_methods(self, channel: grpc.Channel) -> None:
+        raw = lambda kind, name: getattr(channel, kind)(_METHOD + name)  # noqa: E731
+        self._distance_call = raw("unary_unary", "Distance")
+        self._stream_distances = raw("stream_stream", "StreamDistances")
+        self._matrix_call = raw("unary_stream", "Matrix")
+        self._path_call = raw("unary_unary", "Path")
+        self._field_call = raw("unary_stream", "DistanceField")
+        self._expmap_call = raw("unary_stream", "ExpMap")
+        self._locate_call = raw("unary_unary", "Locate")
+        self._mesh_call = raw("unary_stream", "GetMesh")
+
+    def _run_distance(
+        self, at: At, a: SurfacePoints, b: SurfacePoints, near_pairs: int, tolerance: float,
+        bounds: bool,
+    ) -> Tuple[np.ndarray, Optional[np.ndarray]]:
+        n = a.faces.shape[0]
+        ref = at.ref()
+        if n > self._batch_size:
+            return self._stream(ref, a, b, bounds, tolerance, near_pairs)
+        head = pb.DistanceRequest(
+            model=ref, near_pairs=near_pairs, tolerance=tolerance, error_bounds=bounds
+        ).SerializeToString()
+        request = (
+            head
+            + _wire.length_delimited(2, _wire.surface_points(a.faces, a.weights))
+            + _wire.length_delimited(3, _wire.surface_points(b.faces, b.weights))
+        )
+        try:
+            data = self._distance_call(request, timeout=self._timeout, metadata=self._metadata)
+        except grpc.RpcError as e:
+            raise _rpc_error(e) from None
+        fields = _wire.read_fields(data)
+        d = self._sized(_wire.packed_doubles(fields, 1), n, "distances").copy()
+        if not bounds:
+            return d, None
+        return d, self._sized(_wire.packed_doubles(fields, 3), n, "bounds").copy()
+
+    def _stream(
+        self,
+        ref: pb.ModelRef,
+        a: SurfacePoints,
+        b: SurfacePoints,
+        bounds: bool,
+        tolerance: float,
+        near_pairs: int,
+    ) -> Tuple[np.ndarray, Optional[np.ndarray]]:
+        """Distances through one StreamDistances call, batch_size pairs a
+        batch. gRPC's sending thread encodes a batch when the previous one
+        has gone out, and the server reads a few batches ahead of its
+        answers, so only a few batches are ever in memory at once."""
+        n = a.faces.shape[0]
+        size = self._batch_size
+        num_batches = (n + size - 1) // size
+        out = np.empty(n, dtype=np.float64)
+        out_bounds = np.empty(n, dtype=np.float64) if bounds else None
+
+        def batches() -> Iterator[bytes]:
+            for k in range(num_batches):
+                lo, hi = k * size, min(n, (k + 1) * size)
+                head = pb.DistanceBatch(
+                    batch_id=k, near_pairs=near_pairs, tolerance=tolerance, error_bounds=bounds
+                )
+                if k == 0:  # later batches reuse the stream's model
+                    head.model.CopyFrom(ref)
+                yield (
+                    head.SerializeToString()
+                    + _wire.length_delimited(
+                        3, _wire.surface_points(a.faces[lo:hi], a.weights[lo:hi])
+                    )
+                    + _wire.length_delimited(
+                        4, _wire.surface_points(b.faces[lo:hi], b.weights[lo:hi])
+                    )
+                )
+
+        call = self._stream_distances(batches(), metadata=self._metadata)
+        k = 0
+        try:
+            for data in call:
+                if k >= num_batches:
+                    raise DataLoss(f"the server answered {k + 1} batches for {num_batches}")
+                lo, hi = k * size, min(n, (k + 1) * size)
+                fields = _wire.read_fields(data)
+                if _wire.scalar(fields, 1) != k:
+                    raise DataLoss(
+                        f"the server answered batch {_wire.scalar(fields, 1)} "
+                        f"when batch {k} was due"
+                    )
+                code = _wire.scalar(fields, 3)
+                if code != 0:
+                    raise _in_pairs(error_for_code(code, _wire.string(fields, 4)), lo, hi)
+                out[lo:hi] = self._sized(_wire.packed_doubles(fields, 2), hi - lo, "distances")
+                if out_bounds is not None:
+                    out_bounds[lo:hi] = self._sized(
+                        _wire.packed_doubles(fields, 6), hi - lo, "bounds"
+                    )
+                k += 1
+        except grpc.RpcError as e:
+            raise _rpc_error(e) from None
+        finally:
+            call.cancel()  # a no-op once the call has ended; stops the sender otherwise
+        if k != num_batches:
+            raise DataLoss(f"the distance stream ended after {k} of {num_batches} batches")
+        return out, out_bounds
+
+    def _run_matrix(
+        self, at: At, sources: SurfacePoints, targets: SurfacePoints, near_pairs: int,
+        tolerance: float, bounds: bool,
+    ) -> Tuple[np.ndarray, Optional[np.ndarray]]:
+        src, tgt = sources, targets
+        s, t = src.faces.shape[0], tgt.faces.shape[0]
+        out = np.empty((s, t), dtype=np.float64)
+        out_bounds = np.empty((s, t), dtype=np.float64) if bounds else None
+        targets_bytes = _wire.length_delimited(3, _wire.surface_points(tgt.faces, tgt.weights))
+        rows_per_call = max(1, (1 << 24) // max(t, 1))
+        start = 0
+        while True:
+            stop = min(s, start + rows_per_call)
+            head = pb.MatrixRequest(
+                model=at.ref(), near_pairs=near_pairs, tolerance=tolerance, error_bounds=bounds
+            ).SerializeToString()
+            request = (
+                head
+                + _wire.length_delimited(
+                    2, _wire.surface_points(src.faces[start:stop], src.weights[start:stop])
+                )
+                + targets_bytes
+            )
+            rows = 0
+            try:
+                for data in self._matrix_call(request, metadata=self._metadata):
+                    fields = _wire.read_fields(data)
+                    offset, count = _wire.scalar(fields, 1), _wire.scalar(fields, 2)
+                    if _wire.scalar(fields, 3) != t or offset < 0 or offset + count > stop - start:
+                        raise DataLoss(
+                            f"matrix block of rows [{offset}, {offset + count}) x "
+                            f"{_wire.scalar(fields, 3)} for {stop - start} x {t}"
+                        )
+                    block = self._sized(_wire.packed_doubles(fields, 4), count * t, "matrix values")
+                    out[start + offset : start + offset + count] = block.reshape(count, t)
+                    if out_bounds is not None:
+                        block = self._sized(
+                            _wire.packed_doubles(fields, 6), count * t, "matrix bounds"
+                        )
+                        rows_at = slice(start + offset, start + offset + count)
+                        out_bounds[rows_at] = block.reshape(count, t)
+                    rows += count
+                    at.pin(_wire.scalar(fields, 5))  # the rest from the version that answered
+            except grpc.RpcError as e:
+                raise _rpc_error(e) from None
+            if rows != stop - start:
+                raise DataLoss(f"the matrix stream sent {rows} of {stop - start} rows")
+            start = stop
+            if start >= s:
+                break
+        return out, out_bounds
+
+    def _run_path(
+        self, at: At, a: SurfacePoints, b: SurfacePoints, exact_corridor: int, batch_size: int
+    ) -> List[Path]:
+        pa, pb_, n = a, b, a.faces.shape[0]
+        paths: List[Path] = []
+        for lo in range(0, max(n, 1), batch_size):
+            hi = min(n, lo + batch_size)
+            request = (
+                pb.PathRequest(model=at.ref(), exact_corridor=exact_corridor).SerializeToString()
+                + _wire.length_delimited(
+                    2, _wire.surface_points(pa.faces[lo:hi], pa.weights[lo:hi])
+                )
+                + _wire.length_delimited(
+                    3, _wire.surface_points(pb_.faces[lo:hi], pb_.weights[lo:hi])
+                )
+            )
+            try:
+                data = self._path_call(request, timeout=self._timeout, metadata=self._metadata)
+            except grpc.RpcError as e:
+                raise _in_pairs(_rpc_error(e), lo, hi) from None
+            fields = _wire.read_fields(data)
+            # Wire type 2: a length-delimited field, read as a memoryview.
+            polylines = [cast(memoryview, v) for w, v in fields.get(1, ()) if w == 2]
+            if len(polylines) != hi - lo:
+                raise DataLoss(f"the server sent {len(polylines)} paths for {hi - lo} pairs")
+            paths.extend(_path_of(p) for p in polylines)
+            at.pin(_wire.scalar(fields, 2))
+        return paths
+
+    def _field_request(self, at: At, sources: SurfacePoints, radius: float, nearest: bool) -> bytes:
+        return (
+            pb.DistanceFieldRequest(
+                model=at.ref(), with_nearest_source=nearest, radius=radius
+            ).SerializeToString()
+            + _wire.length_delimited(2, _wire.surface_points(sources.faces, sources.weights))
+        )
+
+    def _run_field(
+        self, at: At, sources: SurfacePoints, nearest: bool
+    ) -> Tuple[np.ndarray, Optional[np.ndarray]]:
+        request = self._field_request(at, sources, 0.0, nearest)
+        out: Optional[np.ndarray] = None
+        near: Optional[np.ndarray] = None
+        filled = 0
+        try:
+            for data in self._field_call(request, metadata=self._metadata):
+                fields = _wire.read_fields(data)
+                total = _wire.scalar(fields, 4)
+                if out is None:
+                    out = np.empty(total, dtype=np.float64)
+                    near = np.empty(total, dtype=np.int32) if nearest else None
+                offset = _wire.scalar(fields, 1)
+                values = _wire.packed_doubles(fields, 2)
+                if total != out.shape[0] or offset != filled or offset + values.shape[0] > total:
+                    raise DataLoss(
+                        f"field chunk at {offset} ({values.shape[0]} of {total}) after {filled}"
+                    )
+                out[offset : offset + values.shape[0]] = values
+                if near is not None:
+                    near[offset : offset + values.shape[0]] = self._sized(
+                        _wire.packed_varints(fields, 3), values.shape[0], "nearest sources"
+                    )
+                filled += values.shape[0]
+        except grpc.RpcError as e:
+            raise _rpc_error(e) from None
+        if out is None:
+            raise DataLoss("the field stream sent no chunk")
+        if filled != out.shape[0]:
+            raise DataLoss(f"the field stream sent {filled} of {out.shape[0]} vertices")
+        return out, near
+
+    def _run_field_within(
+        self, at: At, sources: SurfacePoints, radius: float, nearest: bool
+    ) -> Tuple[np.ndarray, np.ndarray, Optional[np.ndarray]]:
+        """The sparse chunks of a field within a radius, assembled."""
+        request = self._field_request(at, sources, radius, nearest)
+        vertices: List[np.ndarray] = []
+        distances: List[np.ndarray] = []
+        chunk_sources: List[np.ndarray] = []
+        total: Optional[int] = None
+        filled = 0
+        try:
+            for data in self._field_call(request, metadata=self._metadata):
+                fields = _wire.read_fields(data)
+                n, offset = _wire.scalar(fields, 4), _wire.scalar(fields, 1)
+                d = _wire.packed_doubles(fields, 2)
+                v = _wire.packed_varints(fields, 6)
+                if v.shape[0] != d.shape[0]:
+                    raise DataLoss(
+                        f"field chunk of {d.shape[0]} distances for {v.shape[0]} vertices"
+                        + (" (a whole-mesh field: the server predates radius fields)"
+                           if v.shape[0] == 0 else "")
+                    )
+                total = n if total is None else total
+                if n != total or offset != filled or offset + d.shape[0] > total:
+                    raise DataLoss(f"field chunk at {offset} ({d.shape[0]} of {n}) after {filled}")
+                vertices.append(v)
+                distances.append(np.array(d))
+                if nearest:
+                    chunk_sources.append(
+                        self._sized(_wire.packed_varints(fields, 3), d.shape[0], "nearest sources")
+                    )
+                filled += d.shape[0]
+        except grpc.RpcError as e:
+            raise _rpc_error(e) from None
+        if total is None:
+            raise DataLoss("the field stream sent no chunk")
+        if filled != total:
+            raise DataLoss(f"the field stream sent {filled} of {total} vertices within the radius")
+        ids = np.concatenate(vertices).astype(np.int32) if vertices else np.zeros(0, np.int32)
+        if ids.shape[0] > 1 and not (np.diff(ids) > 0).all():
+            raise DataLoss("the server sent the field's vertices out of order")
+        out = np.concatenate(distances) if distances else np.zeros(0)
+        if not nearest:
+            return ids, out, None
+        near = (
+            np.concatenate(chunk_sources).astype(np.int32)
+            if chunk_sources
+            else np.zeros(0, np.int32)
+        )
+        return ids, out, near
+
+    def _run_expmap(
+        self, at: At, centre: SurfacePoints, radius: float, direction: Optional[np.ndarray],
+        polar: bool, near_pairs: int, tolerance: float,
+    ) -> Tuple[np.ndarray, np.ndarray]:
+        c = centre
+        request = pb.ExpMapRequest(
+            model=at.ref(), radius=radius, near_pairs=near_pairs, tolerance=tolerance
+        )
+        if direction is not None:
+            request.reference_direction.xyz.extend(direction.ravel().tolist())
+        data = request.SerializeToString() + _wire.length_delimited(
+            2, _wire.surface_points(c.faces, c.weights)
+        )
+        vertices: List[np.ndarray] = []
+        first: List[np.ndarray] = []
+        second: List[np.ndarray] = []
+        try:
+            for chunk in self._expmap_call(data, metadata=self._metadata):
+                fields = _wire.read_fields(chunk)
+                vertices.append(_wire.packed_varints(fields, 1))
+                first.append(np.array(_wire.packed_doubles(fields, 2 if polar else 4)))
+                second.append(np.array(_wire.packed_doubles(fields, 3 if polar else 5)))
+        except grpc.RpcError as e:
+            raise _rpc_error(e) from None
+        ids = np.concatenate(vertices).astype(np.int32) if vertices else np.zeros(0, np.int32)
+        coords = np.empty((ids.shape[0], 2))
+        if vertices:
+            coords[:, 0] = np.concatenate(first)
+            coords[:, 1] = np.concatenate(second)
+        if coords.shape[0] != ids.shape[0]:
+            raise DataLoss("the exponential map's arrays differ in length")
+        return ids, coords
+
+    # --- location and the mesh ---------------------------------------------
+
+    def _run_locate(self, at: At, xyz: np.ndarray, batch_size: int) -> Located:
+        n = xyz.shape[0]
+        faces = np.empty(n, dtype=np.int32)
+        weights = np.empty((n, 3), dtype=np.float64)
+        distances = np.empty(n, dtype=np.float64)
+        size = max(1, int(batch_size))
+        for lo in range(0, max(n, 1), size):
+            hi = min(n, lo + size)
+            request = pb.LocateRequest(model=at.ref()).SerializeToString()
+            request += _wire.length_delimited(2, _wire.positions(xyz[lo:hi]))
+            try:
+                data = self._locate_call(request, timeout=self._timeout, metadata=self._metadata)
+            except grpc.RpcError as e:
+                raise _rpc_error(e) from None
+            fields = _wire.read_fields(data)
+            points = _wire.read_fields(_wire.message(fields, 1))
+            faces[lo:hi] = self._sized(_wire.packed_varints(points, 1), hi - lo, "located faces")
+            weights[lo:hi] = self._sized(
+                _wire.packed_doubles(points, 2), 3 * (hi - lo), "located weights"
+            ).reshape(-1, 3)
+            distances[lo:hi] = self._sized(_wire.packed_doubles(fields, 2), hi - lo, "distances")
+            at.pin(_wire.scalar(fields, 3))
+        return Located(faces, weights, distances)
+
+    def _run_mesh(self, at: At) -> Tuple[np.ndarray, np.ndarray]:
+        request = pb.GetMeshRequest(model=at.ref()).SerializeToString()
+        vertices: Optional[np.ndarray] = None
+        faces: Optional[np.ndarray] = None
+        nv = nf = 0
+        try:
+            for data in self._mesh_call(request, metadata=self._metadata):
+                fields = _wire.read_fields(data)
+                if vertices is None or faces is None:
+                    vertices = np.empty((_wire.scalar(fields, 1), 3))
+                    faces = np.empty((_wire.scalar(fields, 2), 3), dtype=np.int32)
+                positions = _wire.packed_doubles(fields, 5).reshape(-1, 3)
+                ids = _wire.packed_varints(fields, 7).reshape(-1, 3)
+                vo, fo = _wire.scalar(fields, 4), _wire.scalar(fields, 6)
+                if vo != nv or fo != nf or vo + positions.shape[0] > vertices.shape[0] or (
+                    fo + ids.shape[0] > faces.shape[0]
+                ):
+                    raise DataLoss(f"mesh chunk at vertex {vo}, face {fo} after {nv}, {nf}")
+                vertices[vo : vo + positions.shape[0]] = positions
+                faces[fo : fo + ids.shape[0]] = ids
+                nv, nf = vo + positions.shape[0], fo + ids.shape[0]
+        except grpc.RpcError as e:
+            raise _rpc_error(e) from None
+        if vertices is None or faces is None or nv != vertices.shape[0] or nf != faces.shape[0]:
+            raise DataLoss("the mesh stream ended early")
+        return vertices, faces
+
+    @staticmethod
+    def _sized(values: np.ndarray, n: int, what: str) -> np.ndarray:
+        if values.shape[0] != n:
+            raise DataLoss(f"the server sent {values.shape[0]} {what} for {n}")
+        return values
