@@ -1,12 +1,16 @@
 #include "core/validation/calibration.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
+#include <functional>
+#include <thread>
 #include <limits>
 #include <vector>
 
 #include "absl/strings/str_format.h"
 #include "core/common/status_macros.h"
+#include "core/common/threads.h"
 #include "core/query/internal/query_engine.h"
 
 namespace geodex::validation {
@@ -130,6 +134,19 @@ void FitSpreadBounds(const std::vector<SpreadSample> (&samples)[index::kAccuracy
   }
 }
 
+// fn(k) for k in [0, n) on `threads` threads (0: all), each k once.
+void ForEachPair(size_t n, int threads, const std::function<void(size_t)>& fn) {
+  const int count = std::min<int>(common::ThreadCount(threads), static_cast<int>(std::max<size_t>(n, 1)));
+  std::atomic<size_t> next{0};
+  auto work = [&] {
+    for (size_t k = next++; k < n; k = next++) fn(k);
+  };
+  std::vector<std::thread> pool;
+  for (int t = 1; t < count; ++t) pool.emplace_back(work);
+  work();
+  for (std::thread& t : pool) t.join();
+}
+
 }  // namespace
 
 UniformConfidence UniformConfidenceOf(const std::vector<double>& errors,
@@ -191,18 +208,33 @@ absl::StatusOr<Calibration> Calibrate(const mesh::Mesh& mesh,
   std::vector<double> by_kind[2][kNumScaleBins];  // |relative error|, BinConfidence's kinds
   std::vector<int32_t> uniform_source;
   const query::DistanceOptions pure{.near_pairs = query::NearPairs::kUnfold};
-  double largest_answer = 0;  // of the last, open answer bin
-  for (const ExactPair& pair : pairs) {
-    const absl::StatusOr<double> u = engine->Distance(pair.p, pair.q, pure);
+  // Each pair's answers in its own slot, gathered in order below: the
+  // calibration does not depend on the thread count.
+  struct Answers {
+    absl::StatusOr<double> unfolded = absl::UnknownError("");
+    absl::StatusOr<double> walked = absl::UnknownError("");
     bool wraps = false;
-    const absl::StatusOr<double> t = engine->WalkedDistance(pair.p, pair.q, &wraps);
+    double spread = 0;
+  };
+  std::vector<Answers> answers(pairs.size());
+  ForEachPair(pairs.size(), options.pairs.threads, [&](size_t k) {
+    Answers& a = answers[k];
+    a.unfolded = engine->Distance(pairs[k].p, pairs[k].q, pure);
+    a.walked = engine->WalkedDistance(pairs[k].p, pairs[k].q, &a.wraps);
+    if (a.unfolded.ok()) a.spread = engine->UnfoldingSpread(pairs[k].p, pairs[k].q);
+  });
+  double largest_answer = 0;  // of the last, open answer bin
+  for (size_t k = 0; k < pairs.size(); ++k) {
+    const ExactPair& pair = pairs[k];
+    const absl::StatusOr<double>& u = answers[k].unfolded;
+    const bool wraps = answers[k].wraps;
+    const absl::StatusOr<double>& t = answers[k].walked;
     if (!u.ok()) continue;
     if (std::isfinite(*u)) largest_answer = std::max(largest_answer, *u);
     if (t.ok() && std::isfinite(*t)) largest_answer = std::max(largest_answer, *t);
     const int bin = AccuracyBinOf(*u, scale);
     unfold[pair.vertices ? 0 : 1][bin].push_back(std::abs(*u - pair.exact));
-    spread[pair.vertices ? 0 : 1][bin].push_back(
-        {std::abs(*u - pair.exact), engine->UnfoldingSpread(pair.p, pair.q), *u});
+    spread[pair.vertices ? 0 : 1][bin].push_back({std::abs(*u - pair.exact), answers[k].spread, *u});
     if (t.ok()) {
       trace[2 * pair.vertices + wraps][AccuracyBinOf(*t, scale)].push_back(
           std::abs(*t - pair.exact));
@@ -230,10 +262,22 @@ absl::StatusOr<Calibration> Calibrate(const mesh::Mesh& mesh,
   GEODEX_ASSIGN_OR_RETURN(std::string bytes, index::SerializeIndex(data));
   GEODEX_ASSIGN_OR_RETURN(auto calibrated, index::Index::FromBytes(std::move(bytes)));
   GEODEX_ASSIGN_OR_RETURN(engine, query::QueryEngine::Create(std::move(calibrated)));
-  for (const ExactPair& pair : pairs) {
-    const absl::StatusOr<double> d = engine->Distance(pair.p, pair.q);
+  std::vector<absl::StatusOr<double>> defaults(pairs.size(), absl::UnknownError(""));
+  ForEachPair(pairs.size(), options.pairs.threads,
+              [&](size_t k) { defaults[k] = engine->Distance(pairs[k].p, pairs[k].q); });
+  FixedBands& bands = result.bands;
+  bands.unit = ScaleLength(mesh.TotalArea(), kFixedUnitSamples);
+  std::vector<double> band_errors[2][kNumFixedBins], far_errors[2];
+  for (size_t k = 0; k < pairs.size(); ++k) {
+    const ExactPair& pair = pairs[k];
+    const absl::StatusOr<double>& d = defaults[k];
     if (!d.ok()) continue;
     const double e = (*d - pair.exact) / pair.exact;
+    const int kind = pair.vertices ? BinConfidence::kVertex : BinConfidence::kInterior;
+    band_errors[kind][FixedBinOf(pair.exact, bands.unit)].push_back(std::abs(e));
+    if (pair.uniform && pair.exact >= FixedBinLower(FixedBands::kFarBin) * bands.unit) {
+      far_errors[kind].push_back(std::abs(e));
+    }
     relative[pair.bin].push_back(e);
     by_kind[pair.vertices ? BinConfidence::kVertex : BinConfidence::kInterior][pair.bin].push_back(
         std::abs(e));
@@ -260,6 +304,15 @@ absl::StatusOr<Calibration> Calibrate(const mesh::Mesh& mesh,
       result.bins.p99[k][b] = x.empty() ? 0 : Quantile(x, 0.99);
       result.bins.p99_upper[k][b] = P99UpperLimit(x);
     }
+  }
+  for (int k = 0; k < 2; ++k) {
+    for (int b = 0; b < kNumFixedBins; ++b) {
+      bands.pairs[k][b] = static_cast<int32_t>(band_errors[k][b].size());
+      bands.p99[k][b] = band_errors[k][b].empty() ? 0 : Quantile(band_errors[k][b], 0.99);
+    }
+    bands.far_pairs[k] = static_cast<int32_t>(far_errors[k].size());
+    bands.far_p99[k] = far_errors[k].empty() ? 0 : Quantile(far_errors[k], 0.99);
+    bands.far_p99_upper[k] = P99UpperLimit(far_errors[k]);
   }
   result.record = r;
   return result;
