@@ -93,10 +93,18 @@ absl::Status AddCalibration(const mesh::Mesh& mesh, index::IndexData& data, int 
 }
 
 // Writes `data` to `out`, checks that it reads back, and adds the closing
-// lines (and the chart).
+// lines (and the chart). No index over `budget` bytes (0: no budget) is
+// written: the rounds predict their bytes, and this is the last word.
 absl::Status WriteAndReport(const index::IndexData& data, BuildSummary& summary,
                             const std::string& out, const PipelineOptions& options,
-                            double calibration_seconds, BuildReport* report) {
+                            double calibration_seconds, int64_t budget, BuildReport* report) {
+  const uint64_t bytes = index::PredictIndexBytes(data);
+  if (budget > 0 && bytes > static_cast<uint64_t>(budget)) {
+    return absl::ResourceExhaustedError(
+        absl::StrFormat("the index would take %.2f MiB, over the index size budget of %s; "
+                        "nothing was written",
+                        bytes / 1048576.0, BudgetText(budget)));
+  }
   GEODEX_RETURN_IF_ERROR(index::WriteIndexFile(data, out));
   GEODEX_ASSIGN_OR_RETURN(auto loaded, index::Index::Open(out));  // validate what we wrote
   summary.index_bytes = loaded->size_bytes();
@@ -133,7 +141,8 @@ absl::StatusOr<BuildReport> BuildToTargetError(const mesh::RepairedMesh& repaire
   }
   BuildReport report;
   GEODEX_RETURN_IF_ERROR(WriteEdges(result.mesh, result.plan, options.edges_obj, &report));
-  GEODEX_RETURN_IF_ERROR(WriteAndReport(result.data, result.summary, out, options, 0, &report));
+  GEODEX_RETURN_IF_ERROR(WriteAndReport(result.data, result.summary, out, options, 0,
+                                        RoundsOf(options).max_index_bytes, &report));
   return report;
 }
 
@@ -246,7 +255,8 @@ absl::StatusOr<BuildReport> MergeTargetRound(const std::string& workdir, TargetS
                                    "writing the index of round %d (m = %d)",
                                    next.stop, next.keep + 1, state.rounds[next.keep].samples));
     }
-    GEODEX_RETURN_IF_ERROR(WriteAndReport(result.data, result.summary, out, options, 0, &report));
+    GEODEX_RETURN_IF_ERROR(WriteAndReport(result.data, result.summary, out, options, 0,
+                                          state.max_index_bytes, &report));
     return report;
   }
   // The next round's directory is complete before the state points at it:
@@ -315,7 +325,8 @@ absl::StatusOr<BuildReport> BuildIndexFile(const std::string& mesh_path, const s
   if (options.calibrate) {
     GEODEX_RETURN_IF_ERROR(AddCalibration(mesh, data, options.build.threads, &calibration_seconds));
   }
-  GEODEX_RETURN_IF_ERROR(WriteAndReport(data, summary, out, options, calibration_seconds, &report));
+  GEODEX_RETURN_IF_ERROR(WriteAndReport(data, summary, out, options, calibration_seconds,
+                                        options.max_index_bytes, &report));
   return report;
 }
 
@@ -398,7 +409,8 @@ absl::StatusOr<BuildReport> MergeBuild(const std::string& workdir, const std::st
   if (options.calibrate) {
     GEODEX_RETURN_IF_ERROR(AddCalibration(mesh, data, options.build.threads, &calibration_seconds));
   }
-  GEODEX_RETURN_IF_ERROR(WriteAndReport(data, summary, out, options, calibration_seconds, &report));
+  GEODEX_RETURN_IF_ERROR(WriteAndReport(data, summary, out, options, calibration_seconds,
+                                        options.max_index_bytes, &report));
   return report;
 }
 

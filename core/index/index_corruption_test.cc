@@ -360,8 +360,8 @@ TEST(IndexTest, RefinementCorruptionWithValidChecksumsIsDataLoss) {
        [&](Image& i) { i.Set<int32_t>(SectionId::kCoarseFaces, 7, nv - 1); }, "coarse face 2"},
       {"more midpoints than vertices", [&](Image& i) { i.header.params.split_vertices = nv + 1; },
        "midpoints"},
-      {"refinement sections in a 1.x file", [&](Image& i) { i.header.format_major = kFormatMajor; },
-       "refinement sections"},
+      {"split sections in a 1.x file", [&](Image& i) { i.header.format_major = kFormatMajor; },
+       "split sections"},
   };
   ExpectDataLoss(bytes, cases);
 }

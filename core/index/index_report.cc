@@ -397,7 +397,7 @@ IndexReport MakeIndexReport(const Index& index) {
     }
   }
   ReadTarget(r);
-  if (r.has_accuracy) ReadBands(r);
+  ReadBands(r);
   r.target_verdict = Verdict(r);
   return r;
 }

@@ -150,14 +150,20 @@ TEST(DistanceCodeTest, NearestCodeWithinItsPrecision) {
     const uint16_t c = DistanceCode::Encode(d, scale);
     const double error = std::abs(DistanceCode::Decode(c, scale) - d);
     // No other code is nearer.
-    if (c > 0) EXPECT_GE(std::abs(DistanceCode::Decode(c - 1, scale) - d), error) << d;
+    if (c > 0) {
+      EXPECT_GE(std::abs(DistanceCode::Decode(c - 1, scale) - d), error) << d;
+    }
     if (c < DistanceCode::kLargest) {
       EXPECT_GE(std::abs(DistanceCode::Decode(c + 1, scale) - d), error) << d;
     }
-    if (d >= largest / 256) worst_relative = std::max(worst_relative, error / d);
-    EXPECT_LE(error, std::max(0x1p-14 * d, 0x1p-22 * largest) * 1.0001) << d;
+    if (d >= largest / 16) worst_relative = std::max(worst_relative, error / d);
+    EXPECT_LE(error, 0x1p-14 * (d + 0x1p-8 * scale) * 1.0001) << d;
+    if (d < 0x1p-8 * scale) {
+      EXPECT_LE(error, 0x1p-22 * scale * 1.0001) << d;
+    }
   }
-  EXPECT_LE(worst_relative, 0x1p-14 * 1.0001);
+  // A sixteenth of the largest distance and more: within 2^-14 (1 + 1/16).
+  EXPECT_LE(worst_relative, 0x1p-14 * (1 + 1.0 / 16) * 1.0001);
   EXPECT_GT(worst_relative, 0x1p-15);  // the bound is tight, not vacuous
 }
 

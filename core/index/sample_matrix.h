@@ -9,10 +9,12 @@
 //
 // The code of a distance d is a float with 13 mantissa bits over 8 octaves:
 // value(c) = scale * (F(c) - 2^-8), F(c) the float whose bits are
-// (c << 10) + bits(2^-8). Rounding to the nearest code errs at most 2^-14
-// (6.1e-5) of d for d >= scale / 256, and at most scale * 2^-22 (2.4e-7 of
-// the largest distance) below it: the answers err 1e-3 to 5e-2 of d, so 16
-// bits carry every digit they use, at half the bytes of a float. Code
+// (c << 10) + bits(2^-8). Rounding to the nearest code errs at most
+// 2^-14 (6.1e-5) of d + scale / 256: 6.1e-5 of d for the long distances
+// that make most of a matrix, up to 1.2e-4 of d at d = scale / 256, and
+// scale * 2^-22 (2.4e-7 of the largest distance) below. The answers err
+// 1e-3 to 5e-2 of d, so 16 bits carry every digit they use, at half the
+// bytes of a float. Code
 // 0xFFFF is +inf (samples on different components). Decoding is a shift,
 // an add and a multiply: no table, nothing more to load than the code.
 //

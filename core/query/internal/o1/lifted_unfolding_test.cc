@@ -30,7 +30,7 @@ TEST(UnfoldingTest, FlatSheetDistancesAreEuclidean) {
   // On a flat sheet every geodesic is straight and every unfolding is exact,
   // both in one triangle (case 3.1) and across triangles (case 3.2).
   const mesh::Mesh sheet = mesh::gen::Grid(12, 12, 2, 2);
-  const testing::QueryParts parts(sheet, 30);
+  const testing::QueryParts parts(sheet, 30, index::MatrixLayout::kFull);
   const std::vector<SurfacePoint> points = Points(sheet, 120, 5);
   int same = 0, other = 0;
   for (size_t i = 0; i + 1 < points.size(); i += 2) {
@@ -122,8 +122,11 @@ TEST(UnfoldingTest, AMatrixStoredOnceGivesTheSameAnswers) {
 }
 
 TEST(UnfoldingTest, ACodedMatrixAnswersWithinItsPrecision) {
-  // The builder's default (format 4): 16-bit codes move every O(1) answer
-  // by about their own precision (6e-5 of a distance), not more.
+  // The builder's default (format 4): 16-bit codes round 6e-5 of a
+  // distance; the unfolding amplifies that where a far sample lies near the
+  // line of an edge of the triangle it is placed from, to a few 1e-4 RMS,
+  // a tenth of the O(1) answer's own error at any m the budget allows
+  // (tests/bench/accuracy.md, "The sample matrix in 16-bit codes").
   const mesh::Mesh sphere = mesh::gen::Sphere(3, 1.0);
   builder::BuildOptions options;
   options.num_samples = 80;
@@ -152,7 +155,7 @@ TEST(UnfoldingTest, ACodedMatrixAnswersWithinItsPrecision) {
     ++n;
   }
   ASSERT_GT(n, 150);
-  EXPECT_LE(std::sqrt(sum2 / n), 1e-4);  // 0.01% RMS
+  EXPECT_LE(std::sqrt(sum2 / n), 5e-4);  // 0.05% RMS
   EXPECT_GT(worst, 0);                   // the codes do round
 }
 
