@@ -4,8 +4,8 @@
 // engine. The default answer meets the target (target_error.h): relative
 // RMS <= E over area-uniform interior pairs, p99 <= 4E over the uniform
 // pairs at least 8 L1000 apart, vertex and interior pairs apart; the index
-// is under the default budget; and in every fixed band the error bounds
-// cover at least 99% of the pairs.
+// is under the default budget; and in every bin the bounds are fitted in
+// they cover at least 99% of the pairs.
 
 #include <algorithm>
 #include <cmath>
@@ -74,7 +74,8 @@ void ExpectDefaultTargetMet(const mesh::Mesh& coarse) {
       validation::DrawPairs(build->mesh, (*index)->num_samples(), pair_options);
   const double unit = validation::ScaleLength(coarse.TotalArea(), validation::kFixedUnitSamples);
   std::vector<double> far[2], uniform;
-  int64_t covered[validation::kNumFixedBins] = {}, pairs_in[validation::kNumFixedBins] = {};
+  // Coverage by the bins the bounds are fitted in (the index's own L).
+  int64_t covered[2][validation::kNumScaleBins] = {}, pairs_in[2][validation::kNumScaleBins] = {};
   for (const validation::ExactPair& pair : pairs) {
     double bound = 0;
     const absl::StatusOr<double> d = (*engine)->Distance(pair.p, pair.q, {}, nullptr, &bound);
@@ -82,11 +83,10 @@ void ExpectDefaultTargetMet(const mesh::Mesh& coarse) {
     const int kind =
         pair.vertices ? validation::BinConfidence::kVertex : validation::BinConfidence::kInterior;
     const double relative = (*d - pair.exact) / pair.exact;
-    const int band = validation::FixedBinOf(pair.exact, unit);
     if (pair.uniform && pair.exact >= 8 * unit) far[kind].push_back(std::abs(relative));
     if (pair.uniform && !pair.vertices) uniform.push_back(relative);
-    covered[band] += std::abs(*d - pair.exact) <= bound + 1e-12 * pair.exact;
-    ++pairs_in[band];
+    covered[kind][pair.bin] += std::abs(*d - pair.exact) <= bound + 1e-12 * pair.exact;
+    ++pairs_in[kind][pair.bin];
   }
   double sum = 0;
   for (double e : uniform) sum += e * e;
@@ -97,10 +97,12 @@ void ExpectDefaultTargetMet(const mesh::Mesh& coarse) {
     ASSERT_GE(far[kind].size(), 200u) << name;
     EXPECT_LE(Quantile(far[kind], 0.99), validation::TargetLimit(1 + kind, target)) << name;
   }
-  for (int band = 0; band < validation::kNumFixedBins; ++band) {
-    if (pairs_in[band] < 100) continue;  // too few for a 1% tail
-    EXPECT_GE(static_cast<double>(covered[band]) / pairs_in[band], 0.99)
-        << validation::FixedBinName(band) << " L1000: coverage of the bounds";
+  for (int kind = 0; kind < 2; ++kind) {
+    for (int bin = 0; bin < validation::kNumScaleBins; ++bin) {
+      if (pairs_in[kind][bin] < 100) continue;  // too few for a 1% tail
+      EXPECT_GE(static_cast<double>(covered[kind][bin]) / pairs_in[kind][bin], 0.99)
+          << (kind == 0 ? "vertex " : "interior ") << bin << ": coverage of the bounds";
+    }
   }
   // Under the default budget, with the sections written as predicted.
   EXPECT_LE(static_cast<int64_t>(bytes_size), validation::kMaxIndexBytes);
