@@ -29,6 +29,22 @@ double Quantile(std::vector<double> x, double q) {
   return x[std::min(x.size() - 1, static_cast<size_t>(q * x.size()))];
 }
 
+// The one-sided 95% normal quantile.
+constexpr double kZ95 = 1.645;
+
+// The order statistic that is at least the q-quantile with 95% confidence
+// (binomial, normal approximation). A bound set at the plain quantile of
+// the held-out errors covers fewer than q of other points' about as often
+// as not, and less still once the best of several fits is kept; the
+// confidence margin is what other sources need.
+double UpperQuantile(std::vector<double> x, double q) {
+  if (x.empty()) return std::numeric_limits<double>::quiet_NaN();
+  std::sort(x.begin(), x.end());
+  const double n = static_cast<double>(x.size());
+  const double rank = q * n + kZ95 * std::sqrt(n * q * (1 - q));
+  return x[std::min(x.size() - 1, static_cast<size_t>(std::ceil(rank)))];
+}
+
 // An answer is no more precise than the float32 distances the index stores
 // and the arithmetic on them: on a surface where the refined answers are
 // exact (a sphere's traces), the held-out errors are rounding, up to a few
@@ -51,7 +67,7 @@ void FillBounds(const std::vector<double> (&errors)[index::kAccuracyBins], doubl
                 double scale_length, double largest_in_last, float* out) {
   double q[index::kAccuracyBins];
   for (int b = 0; b < index::kAccuracyBins; ++b) {
-    q[b] = Quantile(errors[b], quantile);
+    q[b] = UpperQuantile(errors[b], quantile);
     if (!std::isnan(q[b])) {
       q[b] = std::max(q[b], kRelativePrecision * BinReach(b, scale_length, largest_in_last));
     }
@@ -84,9 +100,6 @@ double Rms(const std::vector<double>& x) {
   return x.empty() ? 0 : std::sqrt(sum / x.size());
 }
 
-// The one-sided 95% normal quantile.
-constexpr double kZ95 = 1.645;
-
 // An O(1) answer's absolute error, its spread and its distance.
 struct SpreadSample {
   double error, spread, distance;
@@ -110,7 +123,7 @@ void FitSpreadBounds(const std::vector<SpreadSample> (&samples)[index::kAccuracy
           ratio.push_back(x.error / (x.spread + eps * x.distance));
       }
       if (ratio.empty()) break;
-      const double k = Quantile(ratio, quantile);
+      const double k = UpperQuantile(ratio, quantile);
       for (const SpreadSample& x : samples[b]) bound.push_back(k * (x.spread + eps * x.distance));
       const double median = Quantile(bound, 0.5);
       if (std::isfinite(k) && median < best_median) {
@@ -181,11 +194,7 @@ UniformConfidence UniformConfidenceOf(const std::vector<double>& errors,
 }
 
 double P99UpperLimit(std::vector<double> x) {
-  if (x.empty()) return 0;
-  std::sort(x.begin(), x.end());
-  const double n = static_cast<double>(x.size());
-  const double rank = 0.99 * n + kZ95 * std::sqrt(n * 0.99 * 0.01);
-  return x[std::min(x.size() - 1, static_cast<size_t>(std::ceil(rank)))];
+  return x.empty() ? 0 : UpperQuantile(std::move(x), 0.99);
 }
 
 absl::StatusOr<Calibration> Calibrate(const mesh::Mesh& mesh,

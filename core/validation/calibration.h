@@ -31,7 +31,8 @@ struct CalibrationOptions {
   // lies, and the bounds must hold for sources not seen here.
   PairOptions pairs = {
       .num_sources = 64, .uniform_points = 60, .per_bin_points = 15, .seed = 0x6a09e667f3bcc909ULL};
-  // The bounds are this quantile of the absolute errors in their bin.
+  // The bounds are the 95% upper confidence limit of this quantile of the
+  // absolute errors in their bin.
   double quantile = 0.995;
 };
 
