@@ -236,13 +236,20 @@ NextStep DecideNext(const std::vector<TargetFigures>& rounds, int32_t requested_
     next.done = next.reached = true;
     return next;
   }
-  // More samples that bring the figures no closer spend rows for nothing:
-  // the sampling noise of a round is as large as what a few more samples
-  // gain, or the mesh's error is in what the O(1) answer cannot reach.
+  // More samples that bring no check closer spend rows for nothing: the
+  // sampling noise of a round is as large as what a few more samples gain,
+  // or the mesh's error is in what the O(1) answer cannot reach. One check
+  // that stays put (a uniform RMS set by a few corners) while another falls
+  // under its limit is progress.
   if (last > 0) {
     const int32_t before =
         Closest(std::span<const TargetFigures>(rounds.data(), rounds.size() - 1), target);
-    if (validation::Distance(rounds.back(), target) >= validation::Distance(rounds[before], target)) {
+    bool closer = false;
+    for (int c = 0; c < validation::kNumTargetChecks; ++c) {
+      const TargetFigures &now = rounds.back(), &then = rounds[before];
+      if (now.pairs[c] > 0 && then.pairs[c] > 0 && now.upper[c] < then.upper[c]) closer = true;
+    }
+    if (!closer) {
       next.done = true;
       next.keep = before;
       next.stop = absl::StrFormat("round %d came no closer to the target than round %d",

@@ -22,9 +22,9 @@
 // rows are computed (PredictRoundBytes): a round that would not fit the
 // budget is planned again with fewer samples, and a build whose next round
 // cannot grow m within it stops at the round before. The build stops when
-// the target is met, when a round comes no closer to it than the closest
-// round before (that closest round is the index), or at the cap or the
-// budget.
+// the target is met, when a round brings no check closer to its limit than
+// the closest round before (that closest round is the index), or at the cap
+// or the budget.
 //
 // A round whose refined mesh does not begin with the earlier round's
 // vertices (the split's vertex cap cut it off differently) starts

@@ -138,6 +138,14 @@ TEST(BuildRoundsTest, ARoundThatComesNoCloserStopsAndKeepsTheClosest) {
   constexpr int64_t kBudget = validation::kMaxIndexBytes;
   NextStep next = DecideNext({first, second}, 1000, 8000, 0.005, 1 << 20, kBudget);
   EXPECT_FALSE(next.done);
+  // A worst check that stays put while another falls is progress: go on.
+  TargetFigures rms_stays = first;
+  rms_stays.upper[0] = 0.006;  // 1.2x the RMS limit, the worst check, in both rounds
+  TargetFigures far_falls = rms_stays;
+  far_falls.samples = 1000;
+  far_falls.upper[1] = 0.018;
+  next = DecideNext({rms_stays, far_falls}, 1000, 8000, 0.005, 1 << 20, kBudget);
+  EXPECT_FALSE(next.done);
   next = DecideNext({first, second, third}, 2000, 8000, 0.005, 1 << 20, kBudget);
   EXPECT_TRUE(next.done);
   EXPECT_FALSE(next.reached);

@@ -156,8 +156,9 @@ absl::StatusOr<std::string> SerializeIndex(const IndexData& d) {
   }
   if (layout == MatrixLayout::kCoded) {
     // Checked as floats first: a NaN has no code.
-    GEODEX_RETURN_IF_ERROR(CheckContents(Contents{.counts = {}, .sample_distances_lower = lower},
-                                         absl::StatusCode::kInvalidArgument));
+    Contents floats;
+    floats.sample_distances_lower = lower;
+    GEODEX_RETURN_IF_ERROR(CheckContents(floats, absl::StatusCode::kInvalidArgument));
     double scale = d.sample_distance_scale;
     if (scale == 0) {
       double largest = 0;
