@@ -72,7 +72,7 @@ TEST_P(RpcTest, GetTriangulationIsTheIndexTriangulation) {
 
   // The sample points are valid query points: the distance between two
   // corners of a geodesic triangle is the matrix entry, within the rounding
-  // of its 16-bit code (at most 2^-13 of a distance, index/sample_matrix.h).
+  // of its 24-bit code (at most 2^-21 of a distance, index/sample_matrix.h).
   v1::DistanceRequest distance;
   *distance.mutable_model() = Ref("sphere");
   for (int i = 0; i < std::min(t, 20); ++i) {
@@ -88,7 +88,7 @@ TEST_P(RpcTest, GetTriangulationIsTheIndexTriangulation) {
   for (int i = 0; i < answer.distances_size(); ++i) {
     const int32_t c0 = response.triangle_corners(3 * i), c1 = response.triangle_corners(3 * i + 1);
     EXPECT_NEAR(answer.distances(i), index.SampleDistance(c0, c1),
-                0x1p-13 * (1 + index.SampleDistance(c0, c1)))
+                0x1p-21 * (1 + index.SampleDistance(c0, c1)))
         << "triangle " << i;
   }
 }

@@ -475,7 +475,7 @@ absl::StatusOr<index::IndexData> MergeKeepingRows(const Mesh& mesh, const Plan& 
                           CellDistances::FromRows(plan, neighbors, *rows));
   index::IndexData data;
   data.sample_distances = sample_distance.Matrix();
-  // Stored once, in 16-bit codes: the answers use no more digits (sample_matrix.h).
+  // Stored once, in 24-bit codes: 3/8 of the full float32 matrix (sample_matrix.h).
   data.sample_matrix = index::MatrixLayout::kCoded;
   const AssignmentCounts counts =
       AssignVerticesToTriangles(mesh, plan, sample_distance, vertex_distance, &data.vertices);

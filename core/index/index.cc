@@ -344,7 +344,7 @@ absl::Status Index::Validate() {
   samples_ = SectionView<int32_t>(p, entry(SectionId::kSamples));
   sample_distances_ = SectionView<float>(p, entry(SectionId::kSampleDistances));
   sample_distances_lower_ = SectionView<float>(p, entry(SectionId::kSampleDistancesLower));
-  sample_distances_coded_ = SectionView<uint16_t>(p, entry(SectionId::kSampleDistancesCoded));
+  sample_distances_coded_ = SectionView<PackedCode>(p, entry(SectionId::kSampleDistancesCoded));
   const std::span<const DistanceCodeRecord> distance_code =
       SectionView<DistanceCodeRecord>(p, entry(SectionId::kDistanceCode));
   vertices_ = SectionView<VertexRecord>(p, entry(SectionId::kVertexRecords));

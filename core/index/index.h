@@ -36,7 +36,7 @@ struct IndexData {
   std::vector<int32_t> samples;         // vertex of each sample
   std::vector<float> sample_distances;  // num_samples^2, row-major
   // How the file stores the matrix: in full (1.x / 2.x), its lower triangle
-  // (3.0) or that triangle in 16-bit codes (4.0). Stored once, the matrix
+  // (3.0) or that triangle in 24-bit codes (4.0). Stored once, the matrix
   // must be symmetric with a zero diagonal.
   MatrixLayout sample_matrix = MatrixLayout::kFull;
   // kCoded: the codes' scale (DistanceCode::ScaleFor); 0 chooses it from
@@ -130,8 +130,8 @@ class Index {
   // The strictly lower triangle of a 3.x file (d(a, b), a > b, at
   // a (a - 1) / 2 + b); empty for other files.
   std::span<const float> sample_distances_lower() const { return sample_distances_lower_; }
-  // The same triangle in 16-bit codes, of a 4.x file; empty for others.
-  std::span<const uint16_t> sample_distances_coded() const { return sample_distances_coded_; }
+  // The same triangle in 24-bit codes, of a 4.x file; empty for others.
+  std::span<const PackedCode> sample_distances_coded() const { return sample_distances_coded_; }
   std::span<const VertexRecord> vertices() const { return vertices_; }
   std::span<const GeodesicTriangle> triangles() const { return triangles_; }
   std::span<const BvhNode> bvh_nodes() const { return bvh_nodes_; }
@@ -181,7 +181,7 @@ class Index {
   std::span<const int32_t> samples_;
   std::span<const float> sample_distances_;
   std::span<const float> sample_distances_lower_;
-  std::span<const uint16_t> sample_distances_coded_;
+  std::span<const PackedCode> sample_distances_coded_;
   SampleMatrix matrix_;
   std::span<const VertexRecord> vertices_;
   std::span<const GeodesicTriangle> triangles_;

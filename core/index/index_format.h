@@ -45,9 +45,9 @@
 //        matrix, which a 3.x file does not have, hence the major version.
 //        Otherwise as 2.1 (the split sections optional). Written when
 //        IndexData::sample_matrix asks for MatrixLayout::kLower.
-//   4.0  the lower triangle in 16-bit codes (SampleDistancesCoded, same
-//        order; sample_matrix.h: at most 6.1e-5 of a distance off), with
-//        the codes' scale (DistanceCodeRecord): half the bytes of 3.0, what
+//   4.0  the lower triangle in 24-bit codes (SampleDistancesCoded, same
+//        order; sample_matrix.h: at most 2.4e-7 of a distance off), with
+//        the codes' scale (DistanceCodeRecord): 3/4 of the bytes of 3.0, what
 //        the builder writes by default. A 3.x reader has no matrix to read
 //        in it, hence the major version. This reader reads 1.x to 4.x
 //        (Index::matrix() and SampleDistance read every layout).
@@ -66,7 +66,7 @@ inline constexpr uint32_t kRefinedFormatMinor = 1;
 // The version of an index whose matrix is stored once (split or not).
 inline constexpr uint32_t kPackedFormatMajor = 3;
 inline constexpr uint32_t kPackedFormatMinor = 0;
-// The version of an index whose matrix is stored once, in 16-bit codes.
+// The version of an index whose matrix is stored once, in 24-bit codes.
 inline constexpr uint32_t kCodedFormatMajor = 4;
 inline constexpr uint32_t kCodedFormatMinor = 0;
 inline constexpr uint32_t kByteOrderMark = 0x01020304;  // reads 0x04030201 when swapped
@@ -93,8 +93,8 @@ enum class SectionId : uint32_t {
   // float[num_samples (num_samples - 1) / 2]: the matrix's strictly lower
   // triangle, row by row (3.x, instead of kSampleDistances).
   kSampleDistancesLower = 17,
-  // uint16[num_samples (num_samples - 1) / 2]: the same triangle in 16-bit
-  // codes (4.x, instead of the float sections; sample_matrix.h).
+  // uint8[3][num_samples (num_samples - 1) / 2]: the same triangle in 24-bit
+  // codes, little-endian (4.x, instead of the float sections; sample_matrix.h).
   kSampleDistancesCoded = 18,
   kDistanceCode = 19,  // DistanceCodeRecord[1] (4.x): the codes' scale
 };
@@ -237,14 +237,17 @@ static_assert(sizeof(AccuracyRecord) == 16 + 4 * 6 * kAccuracyBins + 4 * 10);
 // k = 0 for pairs of mesh vertices, 1 for other pairs: factor is the
 // calibration's quantile of |error| / (spread + epsilon * d), and epsilon is
 // the value, among a fixed grid, that makes the bin's median bound smallest
-// (core/validation/calibration.h).
+// (core/validation/calibration.h). factor[k][b] = 0: the bin's constant
+// bound (AccuracyRecord::unfold_bound), where the calibration found the
+// per-pair bounds no tighter (a reader before 4.0 takes it for a bound of 0,
+// and the builder writes it only since 4.0).
 struct SpreadBoundRecord {
   float epsilon[2][kAccuracyBins];
   float factor[2][kAccuracyBins];
 };
 static_assert(sizeof(SpreadBoundRecord) == 4 * 4 * kAccuracyBins);
 
-// The scale of the 16-bit distance codes (4.0): a code c stands for
+// The scale of the 24-bit distance codes (4.0): a code c stands for
 // scale * (F(c) - 2^-8) (sample_matrix.h). Finite and > 0.
 struct DistanceCodeRecord {
   double scale;

@@ -16,6 +16,7 @@
 
 #include "absl/status/status.h"
 #include "core/index/index_format.h"
+#include "core/index/sample_matrix.h"
 
 namespace geodex::index::internal {
 
@@ -50,7 +51,7 @@ constexpr SectionSpec kSpecs[] = {
     {SectionId::kSplitFaces, sizeof(SplitFaceRecord), "split faces", false},
     {SectionId::kSpreadBounds, sizeof(SpreadBoundRecord), "spread bounds", false},
     {SectionId::kSampleDistancesLower, sizeof(float), "sample distances (lower triangle)", false},
-    {SectionId::kSampleDistancesCoded, sizeof(uint16_t), "sample distances (16-bit codes)", false},
+    {SectionId::kSampleDistancesCoded, sizeof(PackedCode), "sample distances (24-bit codes)", false},
     {SectionId::kDistanceCode, sizeof(DistanceCodeRecord), "distance code", false},
 };
 constexpr size_t kNumSpecs = std::size(kSpecs);

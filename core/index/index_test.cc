@@ -72,8 +72,8 @@ TEST(IndexTest, MatrixStoredOnceRoundTrips) {
   EXPECT_EQ(SerializeIndex(diagonal).status().code(), absl::StatusCode::kInvalidArgument);
 }
 
-// Format 4.0: the lower triangle in 16-bit codes. Every distance within
-// 2^-14 of itself (or 2^-22 of the largest below 1/256 of it), a quarter of
+// Format 4.0: the lower triangle in 24-bit codes. Every distance within
+// 2^-22 of itself (or 2^-30 of the largest below 1/256 of it), 3/8 of
 // the full matrix's bytes, +inf kept, and written again to the same bytes.
 TEST(IndexTest, CodedMatrixRoundTrips) {
   IndexData d = MakeSphereIndex();
@@ -103,13 +103,13 @@ TEST(IndexTest, CodedMatrixRoundTrips) {
         EXPECT_EQ(got, exact) << i << " " << j;
         continue;
       }
-      EXPECT_LE(std::abs(got - exact), std::max(0x1p-14 * exact, 0x1p-22 * largest) * 1.0001)
+      EXPECT_LE(std::abs(got - exact), std::max(0x1p-22 * exact, 0x1p-30 * largest) * 1.0001)
           << i << " " << j;
       EXPECT_EQ(got, (*index)->SampleDistance(j, i));
     }
   }
   const size_t saved = full.size() - coded.size();
-  EXPECT_GE(saved + 3 * kAlignment, sizeof(float) * m * m - sizeof(uint16_t) * (m * (m - 1) / 2));
+  EXPECT_GE(saved + 3 * kAlignment, sizeof(float) * m * m - sizeof(PackedCode) * (m * (m - 1) / 2));
   EXPECT_EQ(Serialize(ToIndexData(**index)), coded);
   // A NaN has no code.
   IndexData nan = d;
@@ -141,13 +141,15 @@ TEST(DistanceCodeTest, NearestCodeWithinItsPrecision) {
   EXPECT_EQ(DistanceCode::Decode(DistanceCode::kInfinity, scale),
             std::numeric_limits<double>::infinity());
   for (uint32_t c = 1; c <= DistanceCode::kLargest; ++c) {
-    ASSERT_LT(DistanceCode::Unit(static_cast<uint16_t>(c - 1)),
-              DistanceCode::Unit(static_cast<uint16_t>(c)));
+    ASSERT_LT(DistanceCode::Unit(c - 1), DistanceCode::Unit(c));
+  }
+  for (uint32_t c : {0u, 1u, 0x123456u, DistanceCode::kLargest, DistanceCode::kInfinity}) {
+    EXPECT_EQ(DistanceCode::Unpack(DistanceCode::Pack(c)), c);
   }
   double worst_relative = 0;
   for (int k = 0; k <= 200000; ++k) {
     const double d = largest * std::pow(1e-6, k / 200000.0);
-    const uint16_t c = DistanceCode::Encode(d, scale);
+    const uint32_t c = DistanceCode::Encode(d, scale);
     const double error = std::abs(DistanceCode::Decode(c, scale) - d);
     // No other code is nearer.
     if (c > 0) {
@@ -157,14 +159,14 @@ TEST(DistanceCodeTest, NearestCodeWithinItsPrecision) {
       EXPECT_GE(std::abs(DistanceCode::Decode(c + 1, scale) - d), error) << d;
     }
     if (d >= largest / 16) worst_relative = std::max(worst_relative, error / d);
-    EXPECT_LE(error, 0x1p-14 * (d + 0x1p-8 * scale) * 1.0001) << d;
+    EXPECT_LE(error, 0x1p-22 * (d + 0x1p-8 * scale) * 1.0001) << d;
     if (d < 0x1p-8 * scale) {
-      EXPECT_LE(error, 0x1p-22 * scale * 1.0001) << d;
+      EXPECT_LE(error, 0x1p-30 * scale * 1.0001) << d;
     }
   }
-  // A sixteenth of the largest distance and more: within 2^-14 (1 + 1/16).
-  EXPECT_LE(worst_relative, 0x1p-14 * (1 + 1.0 / 16) * 1.0001);
-  EXPECT_GT(worst_relative, 0x1p-15);  // the bound is tight, not vacuous
+  // A sixteenth of the largest distance and more: within 2^-22 (1 + 1/16).
+  EXPECT_LE(worst_relative, 0x1p-22 * (1 + 1.0 / 16) * 1.0001);
+  EXPECT_GT(worst_relative, 0x1p-23);  // the bound is tight, not vacuous
 }
 
 AccuracyRecord SomeAccuracy() {

@@ -97,7 +97,7 @@ uint64_t PredictIndexBytes(const IndexData& d) {
   const Piece matrix[4] = {
       {nullptr, layout == MatrixLayout::kFull ? m * m * sizeof(float) : 0},
       {nullptr, layout == MatrixLayout::kLower ? lower * sizeof(float) : 0},
-      {nullptr, layout == MatrixLayout::kCoded ? lower * sizeof(uint16_t) : 0},
+      {nullptr, layout == MatrixLayout::kCoded ? lower * sizeof(PackedCode) : 0},
       {nullptr, layout == MatrixLayout::kCoded ? sizeof(DistanceCodeRecord) : 0},
   };
   Piece pieces[kNumSpecs];
@@ -136,7 +136,7 @@ absl::StatusOr<std::string> SerializeIndex(const IndexData& d) {
   // symmetric, as floats or codes.
   const MatrixLayout layout = d.sample_matrix;
   std::vector<float> lower;
-  std::vector<uint16_t> coded;
+  std::vector<PackedCode> coded;
   std::vector<DistanceCodeRecord> code;
   if (layout != MatrixLayout::kFull) {
     const size_t m = counts.num_samples;
@@ -169,7 +169,7 @@ absl::StatusOr<std::string> SerializeIndex(const IndexData& d) {
     }
     code = {DistanceCodeRecord{scale}};
     coded.reserve(lower.size());
-    for (float x : lower) coded.push_back(DistanceCode::Encode(x, scale));
+    for (float x : lower) coded.push_back(DistanceCode::Pack(DistanceCode::Encode(x, scale)));
     lower.clear();
   }
   const std::span<const float> full_matrix = layout == MatrixLayout::kFull
@@ -205,7 +205,7 @@ absl::StatusOr<std::string> SerializeIndex(const IndexData& d) {
   const Piece matrix[4] = {
       {full_matrix.data(), full_matrix.size() * sizeof(float)},
       {lower.data(), lower.size() * sizeof(float)},
-      {coded.data(), coded.size() * sizeof(uint16_t)},
+      {coded.data(), coded.size() * sizeof(PackedCode)},
       {code.data(), code.size() * sizeof(DistanceCodeRecord)},
   };
   Piece pieces[kNumSpecs];

@@ -5,18 +5,21 @@
 //
 //   kFull   float[m][m], row-major (1.x, 2.x);
 //   kLower  float, the strictly lower triangle (3.0);
-//   kCoded  16-bit codes of the strictly lower triangle (4.0).
+//   kCoded  24-bit codes of the strictly lower triangle (4.0).
 //
-// The code of a distance d is a float with 13 mantissa bits over 8 octaves:
+// The code of a distance d is a float with 21 mantissa bits over 8 octaves:
 // value(c) = scale * (F(c) - 2^-8), F(c) the float whose bits are
-// (c << 10) + bits(2^-8). Rounding to the nearest code errs at most
-// 2^-14 (6.1e-5) of d + scale / 256: 6.1e-5 of d for the long distances
-// that make most of a matrix, up to 1.2e-4 of d at d = scale / 256, and
-// scale * 2^-22 (2.4e-7 of the largest distance) below. The answers err
-// 1e-3 to 5e-2 of d, so 16 bits carry every digit they use, at half the
-// bytes of a float. Code
-// 0xFFFF is +inf (samples on different components). Decoding is a shift,
-// an add and a multiply: no table, nothing more to load than the code.
+// (c << 2) + bits(2^-8). Rounding to the nearest code errs at most 2^-22
+// (2.4e-7) of d + scale / 256: 2.4e-7 of d for the long distances that
+// make most of a matrix, up to 4.8e-7 at d = scale / 256, and
+// scale * 2^-30 below. Why 24 bits and not 16: the O(1) answer errs 1e-3
+// to 5e-2 of d, but it is not continuous in the matrix: an unfolding that
+// chooses between two corners or two sides jumps by up to 1% when an
+// entry crosses the choice. With 16 bits (6e-5 of d) enough entries cross
+// to move the answers 3e-4 relative RMS from float32's; with 24 bits,
+// 4e-5 (tests/bench/accuracy.md, "The sample matrix in 24-bit codes").
+// Code 0xFFFFFF is +inf (samples on different components). Decoding is
+// three byte loads, a shift, an add and a multiply: no table.
 //
 // Thread safety: an immutable view; every method is const and thread-safe.
 
@@ -31,24 +34,36 @@ namespace geodex::index {
 
 enum class MatrixLayout : uint8_t { kFull, kLower, kCoded };
 
-// The 16-bit code of a distance (see above).
+// A code as stored: three bytes, little-endian, no alignment.
+struct PackedCode {
+  uint8_t bytes[3];
+};
+static_assert(sizeof(PackedCode) == 3 && alignof(PackedCode) == 1);
+
+// The 24-bit code of a distance (see above).
 class DistanceCode {
  public:
-  static constexpr uint16_t kInfinity = 0xFFFF;
-  static constexpr uint16_t kLargest = 0xFFFE;  // the largest finite code
+  static constexpr uint32_t kInfinity = 0xFFFFFF;
+  static constexpr uint32_t kLargest = 0xFFFFFE;  // the largest finite code
 
   // The scale that gives `largest` (the largest finite distance, >= 0) the
   // largest finite code; 1 when there is none.
   static double ScaleFor(double largest);
   // The nearest code of `d` (>= 0 or +inf) for `scale`.
-  static uint16_t Encode(double d, double scale);
+  static uint32_t Encode(double d, double scale);
   // value(c) for scale 1: exact in double.
-  static double Unit(uint16_t c) {
+  static double Unit(uint32_t c) {
     constexpr uint32_t kBias = 119u << 23;  // the bits of 2^-8
-    return static_cast<double>(std::bit_cast<float>((uint32_t{c} << 10) + kBias)) - 0x1p-8;
+    return static_cast<double>(std::bit_cast<float>((c << 2) + kBias)) - 0x1p-8;
   }
-  static double Decode(uint16_t c, double scale) {
+  static double Decode(uint32_t c, double scale) {
     return c == kInfinity ? std::numeric_limits<double>::infinity() : scale * Unit(c);
+  }
+  static PackedCode Pack(uint32_t c) {
+    return {{static_cast<uint8_t>(c), static_cast<uint8_t>(c >> 8), static_cast<uint8_t>(c >> 16)}};
+  }
+  static uint32_t Unpack(const PackedCode& p) {
+    return uint32_t{p.bytes[0]} | uint32_t{p.bytes[1]} << 8 | uint32_t{p.bytes[2]} << 16;
   }
 };
 
@@ -61,7 +76,7 @@ class SampleMatrix {
   static SampleMatrix Lower(std::span<const float> lower, int32_t num_samples) {
     return SampleMatrix(MatrixLayout::kLower, lower.data(), num_samples, 0);
   }
-  static SampleMatrix Coded(std::span<const uint16_t> codes, int32_t num_samples, double scale) {
+  static SampleMatrix Coded(std::span<const PackedCode> codes, int32_t num_samples, double scale) {
     return SampleMatrix(MatrixLayout::kCoded, codes.data(), num_samples, scale);
   }
 
@@ -79,8 +94,10 @@ class SampleMatrix {
         return a == b ? 0.0 : static_cast<const float*>(data_)[LowerOffset(a, b)];
       case MatrixLayout::kCoded:
         return a == b ? 0.0
-                      : DistanceCode::Decode(static_cast<const uint16_t*>(data_)[LowerOffset(a, b)],
-                                             scale_);
+                      : DistanceCode::Decode(
+                            DistanceCode::Unpack(
+                                static_cast<const PackedCode*>(data_)[LowerOffset(a, b)]),
+                            scale_);
     }
     return 0;
   }
@@ -92,7 +109,7 @@ class SampleMatrix {
       case MatrixLayout::kLower:
         return static_cast<const float*>(data_) + (a == b ? 0 : LowerOffset(a, b));
       case MatrixLayout::kCoded:
-        return static_cast<const uint16_t*>(data_) + (a == b ? 0 : LowerOffset(a, b));
+        return static_cast<const PackedCode*>(data_) + (a == b ? 0 : LowerOffset(a, b));
     }
     return data_;
   }

@@ -107,8 +107,12 @@ struct SpreadSample {
 
 // Per bin (see Calibration): epsilon and factor; a bin without pairs takes
 // the fit of its nearest measured neighbour (below first), like FillBounds.
+// A bin whose best median bound is no smaller than its constant bound
+// `constant[b]` keeps the constant one (factor 0): at the same confidence,
+// the per-pair bounds pay for their spread's tail with a larger factor, and
+// on a coarse index that can outweigh what they save.
 void FitSpreadBounds(const std::vector<SpreadSample> (&samples)[index::kAccuracyBins],
-                     double quantile, float* epsilon, float* factor) {
+                     double quantile, const float* constant, float* epsilon, float* factor) {
   bool fitted[index::kAccuracyBins] = {};
   for (int b = 0; b < index::kAccuracyBins; ++b) {
     epsilon[b] = 0;
@@ -132,6 +136,10 @@ void FitSpreadBounds(const std::vector<SpreadSample> (&samples)[index::kAccuracy
         factor[b] = static_cast<float>(k);
         fitted[b] = true;
       }
+    }
+    if (fitted[b] && !(best_median < constant[b])) {
+      epsilon[b] = 0;
+      factor[b] = 0;
     }
   }
   for (int b = 0; b < index::kAccuracyBins; ++b) {
@@ -261,7 +269,8 @@ absl::StatusOr<Calibration> Calibrate(const mesh::Mesh& mesh,
   }
   Calibration result;
   for (int k = 0; k < 2; ++k) {
-    FitSpreadBounds(spread[k], options.quantile, result.spread.epsilon[k], result.spread.factor[k]);
+    FitSpreadBounds(spread[k], options.quantile, r.unfold_bound[k], result.spread.epsilon[k],
+                    result.spread.factor[k]);
   }
   // The default answer's figures, from an engine that has the bounds (the
   // default mode uses them to doubt a trace).

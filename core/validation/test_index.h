@@ -16,7 +16,7 @@
 namespace geodex::testing {
 
 // The index file bytes of `mesh` with `samples` samples, calibrated when
-// `calibrate`, its sample matrix stored as `matrix` (the builder's 16-bit
+// `calibrate`, its sample matrix stored as `matrix` (the builder's 24-bit
 // codes by default; kFull where a test measures the method to float
 // precision). Errors: the builder's and the calibration's.
 absl::StatusOr<std::string> BuildTestIndex(

@@ -26,7 +26,7 @@ struct Measured {
   PathReport paths;
 };
 
-// `matrix`: the builder's 16-bit codes, or kFull where a test checks the
+// `matrix`: the builder's 24-bit codes, or kFull where a test checks the
 // method to float precision.
 Measured Measure(const mesh::Mesh& m, int32_t samples,
                  index::MatrixLayout matrix = index::MatrixLayout::kCoded) {

@@ -52,7 +52,7 @@ absl::StatusOr<std::shared_ptr<const query::QueryEngine>> EngineOf(index::IndexD
   return query::QueryEngine::Create(std::move(index));
 }
 
-int Run(const std::string& path, int32_t samples, int32_t num_pairs, int threads) {
+int Run(const std::string& path, int32_t samples, int32_t num_pairs, int threads, int round_bits) {
   absl::StatusOr<mesh::RepairedMesh> repaired = mesh::LoadAndRepairMesh(path);
   if (!repaired.ok()) {
     std::fprintf(stderr, "%s: %s\n", path.c_str(), std::string(repaired.status().message()).c_str());
@@ -72,8 +72,20 @@ int Run(const std::string& path, int32_t samples, int32_t num_pairs, int threads
   }
   absl::StatusOr<std::shared_ptr<const query::QueryEngine>> full =
       EngineOf(*data, index::MatrixLayout::kFull);
-  absl::StatusOr<std::shared_ptr<const query::QueryEngine>> coded =
-      EngineOf(*data, index::MatrixLayout::kCoded);
+  absl::StatusOr<std::shared_ptr<const query::QueryEngine>> coded;
+  if (round_bits > 0) {
+    index::IndexData rounded = *data;
+    for (float& x : rounded.sample_distances) {
+      if (!std::isfinite(x) || x == 0) continue;
+      int e;
+      const double f = std::frexp(static_cast<double>(x), &e);
+      const double q = std::ldexp(1.0, round_bits + 1);
+      x = static_cast<float>(std::ldexp(std::nearbyint(f * q) / q, e));
+    }
+    coded = EngineOf(rounded, index::MatrixLayout::kFull);
+  } else {
+    coded = EngineOf(*data, index::MatrixLayout::kCoded);
+  }
   if (!full.ok() || !coded.ok()) return 1;
 
   // The matrix entries.
@@ -124,14 +136,16 @@ int main(int argc, char** argv) {
   std::vector<int32_t> samples = {1000};
   int32_t pairs = 20000;
   int threads = 2;
+  int round_bits = 0;
   app.add_option("meshes", meshes, "meshes (.obj, .ply, .off, .stl, .glb)")->required();
   app.add_option("--samples", samples, "m of each build")->delimiter(',');
   app.add_option("--pairs", pairs, "area-uniform pairs");
   app.add_option("--threads", threads, "builder threads");
+  app.add_option("--round-bits", round_bits, "instead of the codes, float32 rounded to this many mantissa bits");
   CLI11_PARSE(app, argc, argv);
   int status = 0;
   for (const std::string& path : meshes) {
-    for (int32_t m : samples) status |= geodex::Run(path, m, pairs, threads);
+    for (int32_t m : samples) status |= geodex::Run(path, m, pairs, threads, round_bits);
   }
   return status;
 }

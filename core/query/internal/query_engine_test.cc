@@ -87,7 +87,7 @@ double MaxRelativeError(const Mesh& m, const QueryEngine& engine, int num_points
 
 // The unfolding is exact on developable, simply connected surfaces: only the
 // storage of the sample distances limits it. float32 rounds 6e-8 of a
-// distance; the default 16-bit codes up to 1.2e-4 (index/sample_matrix.h),
+// distance; the default 24-bit codes up to 4.8e-7 (index/sample_matrix.h),
 // which the unfolding amplifies where a far sample lies near the line of an
 // edge it is placed from (tests/bench/accuracy.md).
 TEST(QueryEngineTest, DevelopableSurfacesAreExactToTheMatrixPrecision) {

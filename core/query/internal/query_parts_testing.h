@@ -20,7 +20,7 @@ namespace geodex::query::testing {
 
 struct QueryParts {
   // `matrix`: kFull where a test checks the method to float precision (the
-  // builder's default 16-bit codes round 6e-5 of a distance).
+  // builder's default 24-bit codes round 2.4e-7 of a distance).
   explicit QueryParts(const mesh::Mesh& mesh, int32_t samples,
                       index::MatrixLayout matrix = index::MatrixLayout::kCoded)
       : index(Open(mesh, samples, matrix)),
