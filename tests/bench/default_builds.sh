@@ -32,7 +32,7 @@ fi
 work="$(mktemp -d)"
 trap 'rm -rf "$work"' EXIT
 
-printf 'mesh\tm\trounds\treached\tMiB\tmatrix MiB\twall s\tCPU s\tpeak RSS MiB\tfar p99 (vertex / interior)\tuniform RMS\n'
+printf 'mesh\tvertices\tm\trounds (m)\tmet\tMiB\tMiB by section\twall s\tCPU s\tpeak RSS MiB\tuniform RMS\tp99 >=8 L1000 (vertex / interior)\n'
 for name in "${meshes[@]}"; do
   out="$work/$name.gdx"
   log="$work/$name.log"
@@ -42,18 +42,27 @@ for name in "${meshes[@]}"; do
     printf '%s\tfailed: %s\n' "$name" "$(tail -1 "$log")"
     continue
   fi
+  if ! "$build/core/geodex-query" "$out" --info --format json > "$work/$name.json" 2>> "$log"; then
+    printf '%s\tno report: %s\n' "$name" "$(tail -1 "$log")"
+    continue
+  fi
   read -r wall user sys rss < "$work/time"
-  report="$log"
-  m=$(grep -m1 -oP '^\s*samples\s+\K[0-9]+' "$report" || grep -oP 'm = \K[0-9]+' "$report" | tail -1)
-  rounds=$(grep -oP '^target_error_rounds = \K[0-9]+' "$report" || echo 1)
-  reached=$(grep -oP '^target_error_reached = \K\S+' "$report" || echo '-')
-  bytes=$(stat -c %s "$out")
-  matrix=$(grep -m1 -oP 'distance matrix\s+\K[0-9.]+' "$report" || echo '-')
-  far=$(grep -oP '^target_error_round_[0-9]+ = .*' "$report" | tail -1 |
-        grep -oP 'vertex >=8 L1000 p99 \K[0-9.]+%|interior >=8 L1000 p99 \K[0-9.]+%' | paste -sd/ -)
-  rms=$(grep -oP '^target_error_round_[0-9]+ = .*' "$report" | tail -1 |
-        grep -oP 'uniform RMS \K[0-9.]+%' || echo '-')
-  printf '%s\t%s\t%s\t%s\t%.2f\t%s\t%.0f\t%.0f\t%.0f\t%s\t%s\n' "$name" "$m" "$rounds" "$reached" \
-    "$(echo "$bytes / 1048576" | bc -l)" "$matrix" "$wall" "$(echo "$user + $sys" | bc -l)" \
-    "$(echo "$rss / 1024" | bc -l)" "$far" "$rms"
+  python3 - "$name" "$work/$name.json" "$wall" "$user" "$sys" "$rss" <<'PY'
+import json, sys
+name, path, wall, user, sys_s, rss = sys.argv[1:]
+r = json.load(open(path))
+mib = lambda b: b / 1048576
+sections = ", ".join("%s %.2f" % (x["key"], mib(x["bytes"]))
+                     for x in r["size"]["sections"] if x["bytes"] >= 0.005 * 1048576)
+t, a = r["target"], r["accuracy"] or {}
+far = [b for b in a.get("bands", []) if b["from"] >= 8]
+worst = lambda key: max((b[key] for b in far), default=float("nan"))
+print("\t".join([
+    name, str(r["mesh"]["vertices"]), str(r["samples"]["final"]),
+    "%d (%s)" % (len(t["rounds"]), " > ".join(map(str, t["rounds"]))),
+    {True: "met", False: "NOT met", None: "-"}[t["met"]] + ("" if t["met"] else " (%s)" % t["stop"]),
+    "%.2f" % mib(r["size"]["bytes"]), sections, "%.0f" % float(wall), "%.0f" % (float(user) + float(sys_s)),
+    "%.0f" % (int(rss) / 1024), "%.3f%%" % (100 * a.get("uniform_rms", float("nan"))),
+    "%.2f%% / %.2f%%" % (100 * worst("p99_vertex"), 100 * worst("p99_interior"))]))
+PY
 done
