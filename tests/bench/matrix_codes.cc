@@ -1,4 +1,4 @@
-// matrix_codes: what the 16-bit sample distance codes (index/sample_matrix.h)
+// matrix_codes: what the 24-bit sample distance codes (index/sample_matrix.h)
 // cost in accuracy. For each mesh and m, one build, written twice: with the
 // float32 matrix and with the codes. Prints the codes' relative error on the
 // matrix entries (p50, p99, largest), and how far the two indexes' O(1)
@@ -7,7 +7,12 @@
 // relative RMS against the float32 index's default answer, which is exact
 // or walked below kRefineScale L, for each index).
 //
+// With --round-bits K, the second index is the float32 one with every entry
+// rounded to K mantissa bits in memory instead: what a code of another
+// width would cost, without writing it.
+//
 //   matrix_codes MESH... [--samples 1000,3000] [--pairs 20000] [--threads 2]
+//                [--round-bits K]
 
 #include <algorithm>
 #include <cmath>
@@ -131,7 +136,7 @@ int Run(const std::string& path, int32_t samples, int32_t num_pairs, int threads
 }  // namespace geodex
 
 int main(int argc, char** argv) {
-  CLI::App app{"The 16-bit sample distance codes against the float32 matrix"};
+  CLI::App app{"The 24-bit sample distance codes against the float32 matrix"};
   std::vector<std::string> meshes;
   std::vector<int32_t> samples = {1000};
   int32_t pairs = 20000;
