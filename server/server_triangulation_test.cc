@@ -71,7 +71,9 @@ TEST_P(RpcTest, GetTriangulationIsTheIndexTriangulation) {
   }
 
   // The sample points are valid query points: the distance between two
-  // corners of a geodesic triangle is (within float rounding) the matrix entry.
+  // corners of a geodesic triangle is the matrix entry, within what two exact
+  // computations of it differ by (the builder's propagation, stored in a
+  // 24-bit code, and the query's refined answer).
   v1::DistanceRequest distance;
   *distance.mutable_model() = Ref("sphere");
   for (int i = 0; i < std::min(t, 20); ++i) {

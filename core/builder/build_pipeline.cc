@@ -18,6 +18,7 @@
 #include "core/index/report_chart.h"
 #include "core/mesh/generators.h"
 #include "core/validation/calibration.h"
+#include "core/validation/target_error.h"
 
 namespace geodex::builder {
 namespace {
@@ -81,17 +82,29 @@ absl::Status AddCalibration(const mesh::Mesh& mesh, index::IndexData& data, int 
   const auto start = std::chrono::steady_clock::now();
   validation::CalibrationOptions options;
   options.pairs.threads = threads;
-  GEODEX_RETURN_IF_ERROR(validation::AddCalibration(mesh, data, options));
-  data.report += validation::CalibrationText(data.accuracy[0]);
+  validation::Calibration calibration;
+  GEODEX_RETURN_IF_ERROR(validation::AddCalibration(mesh, data, options, &calibration));
+  data.report +=
+      validation::BandsText(validation::FiguresOf(calibration, static_cast<int32_t>(data.samples.size())),
+                            data.accuracy[0].scale_length) +
+      validation::CalibrationText(data.accuracy[0]);
   *seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return absl::OkStatus();
 }
 
 // Writes `data` to `out`, checks that it reads back, and adds the closing
-// lines (and the chart).
+// lines (and the chart). No index over `budget` bytes (0: no budget) is
+// written: the rounds predict their bytes, and this is the last word.
 absl::Status WriteAndReport(const index::IndexData& data, BuildSummary& summary,
                             const std::string& out, const PipelineOptions& options,
-                            double calibration_seconds, BuildReport* report) {
+                            double calibration_seconds, int64_t budget, BuildReport* report) {
+  const uint64_t bytes = index::PredictIndexBytes(data);
+  if (budget > 0 && bytes > static_cast<uint64_t>(budget)) {
+    return absl::ResourceExhaustedError(
+        absl::StrFormat("the index would take %.2f MiB, over the index size budget of %s; "
+                        "nothing was written",
+                        bytes / 1048576.0, BudgetText(budget)));
+  }
   GEODEX_RETURN_IF_ERROR(index::WriteIndexFile(data, out));
   GEODEX_ASSIGN_OR_RETURN(auto loaded, index::Index::Open(out));  // validate what we wrote
   summary.index_bytes = loaded->size_bytes();
@@ -111,6 +124,7 @@ RoundsOptions RoundsOf(const PipelineOptions& options) {
   rounds.build = options.build;
   rounds.target = options.target_error;
   rounds.max_samples = options.max_samples;
+  if (options.max_index_bytes > 0) rounds.max_index_bytes = options.max_index_bytes;
   return rounds;
 }
 
@@ -120,13 +134,15 @@ absl::StatusOr<BuildReport> BuildToTargetError(const mesh::RepairedMesh& repaire
   GEODEX_ASSIGN_OR_RETURN(TargetBuild result, BuildToTarget(repaired.mesh, RecordRepair(repaired),
                                                             RoundsOf(options), options.log));
   if (!result.last.reached) {
-    Log(options, absl::StrFormat("geodex-build: the target error was not reached at m = %d (%s); "
-                                 "writing the last round's index",
-                                 result.rounds.back().samples, result.last.stop));
+    Log(options, absl::StrFormat("geodex-build: the target error was not reached (%s); "
+                                 "writing the index of round %d (m = %d)",
+                                 result.last.stop, result.last.keep + 1,
+                                 result.rounds[result.last.keep].samples));
   }
   BuildReport report;
   GEODEX_RETURN_IF_ERROR(WriteEdges(result.mesh, result.plan, options.edges_obj, &report));
-  GEODEX_RETURN_IF_ERROR(WriteAndReport(result.data, result.summary, out, options, 0, &report));
+  GEODEX_RETURN_IF_ERROR(WriteAndReport(result.data, result.summary, out, options, 0,
+                                        RoundsOf(options).max_index_bytes, &report));
   return report;
 }
 
@@ -150,6 +166,7 @@ absl::StatusOr<BuildReport> PlanTargetBuild(const mesh::RepairedMesh& repaired,
   state.validation_sources = rounds.validation_sources;
   state.seed = rounds.build.seed;
   state.refine = rounds.build.refine_long_edges;
+  state.max_index_bytes = rounds.max_index_bytes;
   GEODEX_RETURN_IF_ERROR(SaveTargetState(state, workdir));
   BuildReport report;
   report.num_samples = round.plan.num_samples();
@@ -172,17 +189,27 @@ absl::StatusOr<std::string> CurrentPlanDirectory(const std::string& workdir,
   return RoundDirectory(workdir, (*state)->round);
 }
 
-// Merge of a target-error build's round: the index when the target is met
-// (or the cap reached), otherwise the next round's plan.
-absl::StatusOr<BuildReport> MergeTargetRound(const std::string& workdir, TargetState state,
-                                             const std::string& out,
-                                             const PipelineOptions& options) {
-  const std::string dir = RoundDirectory(workdir, state.round);
+// A finished round of a distributed target-error build: its merge and
+// calibration, from the plan and rows in its directory.
+absl::StatusOr<std::pair<RoundPlan, RoundResult>> FinishSavedRound(const std::string& dir,
+                                                                   const RoundsOptions& rounds,
+                                                                   std::vector<SampleRow>* rows) {
   GEODEX_ASSIGN_OR_RETURN(auto loaded, LoadPlan(dir));
   GEODEX_ASSIGN_OR_RETURN(RepairRecord record, LoadRepair(loaded.second, dir));
   RoundPlan round{
       PreparedMesh{std::move(loaded.first), std::move(record)}, std::move(loaded.second), {}};
-  GEODEX_ASSIGN_OR_RETURN(std::vector<SampleRow> rows, LoadAllRows(round.plan, dir));
+  GEODEX_ASSIGN_OR_RETURN(*rows, LoadAllRows(round.plan, dir));
+  GEODEX_ASSIGN_OR_RETURN(RoundResult result, FinishRound(round, rows, rounds));
+  return std::make_pair(std::move(round), std::move(result));
+}
+
+// Merge of a target-error build's round: the index when the build is done
+// (the target met, or m can grow no more: the closest round's index),
+// otherwise the next round's plan.
+absl::StatusOr<BuildReport> MergeTargetRound(const std::string& workdir, TargetState state,
+                                             const std::string& out,
+                                             const PipelineOptions& options) {
+  const std::string dir = RoundDirectory(workdir, state.round);
   RoundsOptions rounds;
   rounds.build = options.build;
   rounds.build.seed = state.seed;
@@ -190,48 +217,75 @@ absl::StatusOr<BuildReport> MergeTargetRound(const std::string& workdir, TargetS
   rounds.target = state.target;
   rounds.max_samples = state.cap;
   rounds.validation_sources = state.validation_sources;
-  GEODEX_ASSIGN_OR_RETURN(RoundResult result, FinishRound(round, &rows, rounds));
+  rounds.max_index_bytes = state.max_index_bytes;
+  std::vector<SampleRow> rows;
+  GEODEX_ASSIGN_OR_RETURN(auto finished, FinishSavedRound(dir, rounds, &rows));
+  RoundPlan& round = finished.first;
+  RoundResult& result = finished.second;
   state.rounds.push_back(result.figures);
   Log(options, RoundLine(state.round, result.figures, state.target));
-  GEODEX_ASSIGN_OR_RETURN(const std::string bytes, index::SerializeIndex(result.data));
-  const NextStep next = DecideNext(state.rounds, round.plan.requested_samples, state.cap,
-                                   state.target, static_cast<int64_t>(bytes.size()));
+  NextStep next = DecideNext(state.rounds, round.plan.requested_samples, state.cap, state.target,
+                             static_cast<int64_t>(index::PredictIndexBytes(result.data)),
+                             state.max_index_bytes);
+  std::optional<RoundPlan> following;
+  if (!next.done) {
+    GEODEX_ASSIGN_OR_RETURN(auto coarse, LoadCoarseMesh(workdir));
+    absl::StatusOr<RoundPlan> planned = PlanNextRound(coarse.first, coarse.second, round,
+                                                      std::move(rows), next.num_samples, rounds);
+    if (absl::IsResourceExhausted(planned.status())) {
+      next = AtBudget(state.rounds, state.max_index_bytes);
+    } else {
+      GEODEX_RETURN_IF_ERROR(planned.status());
+      following = *std::move(planned);
+    }
+  }
   BuildReport report;
   if (next.done) {
+    if (next.keep != state.round) {
+      // A later round came no closer: the closest one's index, made again
+      // from its directory (merge and calibration are deterministic).
+      std::vector<SampleRow> kept_rows;
+      GEODEX_ASSIGN_OR_RETURN(auto kept, FinishSavedRound(RoundDirectory(workdir, next.keep),
+                                                          rounds, &kept_rows));
+      result = std::move(kept.second);
+    }
     result.data.report += TargetReport(state.rounds, next, state.target, result.data.accuracy[0]);
     if (!next.reached) {
-      Log(options, absl::StrFormat("geodex-build: the target error was not reached at m = %d "
-                                   "(%s); writing the last round's index",
-                                   result.figures.samples, next.stop));
+      Log(options, absl::StrFormat("geodex-build: the target error was not reached (%s); "
+                                   "writing the index of round %d (m = %d)",
+                                   next.stop, next.keep + 1, state.rounds[next.keep].samples));
     }
-    GEODEX_RETURN_IF_ERROR(WriteAndReport(result.data, result.summary, out, options, 0, &report));
+    GEODEX_RETURN_IF_ERROR(WriteAndReport(result.data, result.summary, out, options, 0,
+                                          state.max_index_bytes, &report));
     return report;
   }
-  GEODEX_ASSIGN_OR_RETURN(auto coarse, LoadCoarseMesh(workdir));
-  GEODEX_ASSIGN_OR_RETURN(
-      const RoundPlan following,
-      PlanNextRound(coarse.first, coarse.second, round, std::move(rows), next.num_samples, rounds));
   // The next round's directory is complete before the state points at it:
   // a merge killed before that point is run again, from this round.
   const std::string next_dir = RoundDirectory(workdir, state.round + 1);
-  GEODEX_RETURN_IF_ERROR(SavePlan(following.prepared.mesh, following.plan, next_dir));
-  GEODEX_RETURN_IF_ERROR(SaveRepair(following.prepared.record, following.plan, next_dir));
+  GEODEX_RETURN_IF_ERROR(SavePlan(following->prepared.mesh, following->plan, next_dir));
+  GEODEX_RETURN_IF_ERROR(SaveRepair(following->prepared.record, following->plan, next_dir));
   GEODEX_RETURN_IF_ERROR(RemoveRows(next_dir));
-  if (following.carried.empty()) {
+  if (following->carried.empty()) {
     GEODEX_RETURN_IF_ERROR(RemoveCarriedRows(next_dir));
   } else {
-    GEODEX_RETURN_IF_ERROR(SaveCarriedRows(following.plan, following.carried, next_dir));
+    GEODEX_RETURN_IF_ERROR(SaveCarriedRows(following->plan, following->carried, next_dir));
   }
+  // Not done: this round is the closest so far (DecideNext stops at the
+  // first that is not). Its directory is kept; the one it replaces is not.
+  const int32_t replaced = state.closest;
+  state.closest = state.round;
   ++state.round;
   GEODEX_RETURN_IF_ERROR(SaveTargetState(state, workdir));
-  std::error_code ignored;  // the finished round is no longer needed
-  std::filesystem::remove_all(dir, ignored);
+  if (replaced >= 0) {
+    std::error_code ignored;
+    std::filesystem::remove_all(RoundDirectory(workdir, replaced), ignored);
+  }
   report.another_round = true;
-  report.num_samples = following.plan.num_samples();
+  report.num_samples = following->plan.num_samples();
   report.text += absl::StrFormat(
       "geodex-build merge: target not met; round %d planned with %d samples (%d carried) in %s: "
       "run the rows shards and merge again\n",
-      state.round + 1, following.plan.num_samples(), following.carried.size(), next_dir);
+      state.round + 1, following->plan.num_samples(), following->carried.size(), next_dir);
   return report;
 }
 
@@ -271,7 +325,8 @@ absl::StatusOr<BuildReport> BuildIndexFile(const std::string& mesh_path, const s
   if (options.calibrate) {
     GEODEX_RETURN_IF_ERROR(AddCalibration(mesh, data, options.build.threads, &calibration_seconds));
   }
-  GEODEX_RETURN_IF_ERROR(WriteAndReport(data, summary, out, options, calibration_seconds, &report));
+  GEODEX_RETURN_IF_ERROR(WriteAndReport(data, summary, out, options, calibration_seconds,
+                                        options.max_index_bytes, &report));
   return report;
 }
 
@@ -354,7 +409,8 @@ absl::StatusOr<BuildReport> MergeBuild(const std::string& workdir, const std::st
   if (options.calibrate) {
     GEODEX_RETURN_IF_ERROR(AddCalibration(mesh, data, options.build.threads, &calibration_seconds));
   }
-  GEODEX_RETURN_IF_ERROR(WriteAndReport(data, summary, out, options, calibration_seconds, &report));
+  GEODEX_RETURN_IF_ERROR(WriteAndReport(data, summary, out, options, calibration_seconds,
+                                        options.max_index_bytes, &report));
   return report;
 }
 

@@ -48,11 +48,14 @@ struct PipelineOptions {
   bool calibrate = true;
   // > 0: build until the held-out error meets this target, in rounds from
   // build.num_samples (build_rounds.h; geodex-build's default is
-  // validation::kDefaultTargetError from kDefaultFirstRoundSamples); 0: build
+  // validation::kDefaultTargetError from a predicted first round); 0: build
   // exactly build.num_samples samples.
   double target_error = 0;
   // With a target error: the cap on m (0: the default cap).
   int32_t max_samples = 0;
+  // With a target error: no index over this many bytes is written (0:
+  // validation::kMaxIndexBytes).
+  int64_t max_index_bytes = 0;
   // Also write the geodesic Delaunay edges as OBJ polylines here.
   std::string edges_obj;
   // Also draw the written index's accuracy by distance as a PNG here

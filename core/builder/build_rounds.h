@@ -18,6 +18,14 @@
 //            target_error.h says.
 //   next m   PredictSamples, from the figures of the rounds so far.
 //
+// Every round's index bytes are predicted from its mesh and plan before its
+// rows are computed (PredictRoundBytes): a round that would not fit the
+// budget is planned again with fewer samples, and a build whose next round
+// cannot grow m within it stops at the round before. The build stops when
+// the target is met, when a round brings no check closer to its limit than
+// the closest round before (that closest round is the index), or at the cap
+// or the budget.
+//
 // A round whose refined mesh does not begin with the earlier round's
 // vertices (the split's vertex cap cut it off differently) starts
 // afresh at its m.
@@ -42,13 +50,23 @@
 
 namespace geodex::builder {
 
-// The first round's m of a build asked for no sample count.
-inline constexpr int32_t kDefaultFirstRoundSamples = 500;
+// BuildOptions::num_samples of a build asked for no sample count: the first
+// round's m is predicted (FirstRoundSamples).
+inline constexpr int32_t kDefaultFirstRoundSamples = 0;
+
+// The first round's m for target E: the m at which the shared meshes' far
+// band (p99 beyond 8 L1000, the check that decides most builds) came
+// closest to 4E from below, scaled as that p99 falls (m^-0.8), within
+// [50, cap].
+int32_t FirstRoundSamples(double target, int32_t cap);
 
 struct RoundsOptions {
-  // num_samples: the first round's m; seed, threads, refinement, progress.
+  // num_samples: the first round's m (kDefaultFirstRoundSamples: predicted);
+  // seed, threads, the split, progress.
   BuildOptions build;
   double target = validation::kDefaultTargetError;
+  // No index over this many bytes is written (geodex-build --max-index-mib).
+  int64_t max_index_bytes = validation::kMaxIndexBytes;
   // Cap on m; 0: validation::kDefaultMaxSamples, and without the flat
   // refinement at most half the referenced vertices.
   int32_t max_samples = 0;
@@ -58,6 +76,9 @@ struct RoundsOptions {
   // halves their variance.
   int32_t validation_sources = 128;
 };
+
+// "32 MiB", or "1.50 MiB" for a budget that is no whole number of MiB.
+std::string BudgetText(int64_t budget);
 
 // The cap on m for `coarse` (the repaired input).
 int32_t SampleCap(const mesh::Mesh& coarse, const RoundsOptions& options);
@@ -70,13 +91,22 @@ struct RoundPlan {
   std::vector<SampleRow> carried;
 };
 
-// Round 0: `coarse` refined for options.build.num_samples (at most the cap),
-// with `repair` (RecordRepair of the input), and its plan.
+// The bytes of the index `round` will make, from its mesh and plan (the
+// report's own lines estimated).
+int64_t PredictRoundBytes(const RoundPlan& round);
+
+// Round 0: `coarse` split for options.build.num_samples (at most the cap),
+// with `repair` (RecordRepair of the input), and its plan; with fewer
+// samples when that index would not fit the budget. Errors:
+// ResourceExhausted when no m fits it (the mesh alone is too large).
 absl::StatusOr<RoundPlan> PlanFirstRound(const mesh::Mesh& coarse, const RepairRecord& repair,
                                          const RoundsOptions& options);
 
 // The round after `previous`, whose rows (all of them, any order) are `rows`:
-// `num_samples` samples, on `coarse` refined for them.
+// `num_samples` samples, on `coarse` split for them, or fewer when that
+// index would not fit the budget. Errors: ResourceExhausted when no round
+// with enough more samples than `previous` to be worth its rows fits it
+// (the build stops at `previous`).
 absl::StatusOr<RoundPlan> PlanNextRound(const mesh::Mesh& coarse, const RepairRecord& repair,
                                         const RoundPlan& previous, std::vector<SampleRow> rows,
                                         int32_t num_samples, const RoundsOptions& options);
@@ -98,17 +128,23 @@ struct NextStep {
   bool done = false;        // the target is met, or m can grow no more
   bool reached = false;     // the target is met
   int32_t num_samples = 0;  // when not done: the next round's m
+  // When done: the round whose index is written (the closest to the target).
+  int32_t keep = 0;
   // When done and not reached: why m stops ("the cap of 8000 samples", "the
-  // index size budget of 64 MiB").
+  // index size budget of 32 MiB", "round 3 came no closer to the target than
+  // round 2").
   std::string stop;
 };
 // `index_bytes`: the size of the last round's index; m grows no further than
-// validation::kMaxIndexBytes allows.
+// `budget` bytes allow.
 NextStep DecideNext(const std::vector<validation::TargetFigures>& rounds, int32_t requested_samples,
-                    int32_t cap, double target, int64_t index_bytes);
+                    int32_t cap, double target, int64_t index_bytes, int64_t budget);
+// The NextStep of a build whose next round found no m within `budget`.
+NextStep AtBudget(const std::vector<validation::TargetFigures>& rounds, int64_t budget);
 
 // The report lines of a target-error build (the target, whether it was
-// reached, each round's figures, the calibration's), for the index's report.
+// reached, each round's figures, the fixed bands of the round kept and what
+// answers each, the calibration's), for the index's report.
 std::string TargetReport(const std::vector<validation::TargetFigures>& rounds, const NextStep& last,
                          double target, const index::AccuracyRecord& accuracy);
 // The line geodex-build logs after a round.
@@ -137,8 +173,12 @@ struct TargetState {
   int32_t validation_sources = 0;
   uint64_t seed = 0;
   bool refine = true;
+  int64_t max_index_bytes = 0;
   int32_t round = 0;                              // the current round
   std::vector<validation::TargetFigures> rounds;  // the finished ones
+  // The finished round closest to the target; its directory is kept, for
+  // the index when a later round comes no closer.
+  int32_t closest = -1;
 };
 std::string RoundDirectory(const std::string& workdir, int32_t round);
 // Writes target.bin atomically. Errors: AtomicWriteFile's.

@@ -50,12 +50,13 @@ TEST(BuildRoundsTest, GrowsTheSamplesUntilTheTargetIsMet) {
 TEST(BuildRoundsTest, StopsAtTheCapAndSaysSo) {
   const mesh::Mesh m = mesh::gen::Sphere(3, 1.0);
   RoundsOptions options = Options(20, 1e-6);
-  options.max_samples = 30;
+  options.max_samples = 20;
   absl::StatusOr<TargetBuild> result = BuildToTarget(m, {}, options, nullptr);
   ASSERT_TRUE(result.ok()) << result.status();
   EXPECT_FALSE(result->last.reached);
-  EXPECT_EQ(result->rounds.size(), 2u);  // 20, then the cap
-  EXPECT_NE(result->data.report.find("target_error_reached = no (the cap of "), std::string::npos);
+  EXPECT_EQ(result->rounds.size(), 1u);  // at the cap from the first round
+  EXPECT_NE(result->data.report.find("target_error_reached = no (the cap of "), std::string::npos)
+      << result->data.report;
   options.target = -1;
   EXPECT_EQ(BuildToTarget(m, {}, options, nullptr).status().code(),
             absl::StatusCode::kInvalidArgument);
@@ -89,34 +90,89 @@ TEST(BuildRoundsTest, DecideNext) {
   met.samples = 500;
   for (int c = 0; c < validation::kNumTargetChecks; ++c) met.pairs[c] = 10;
   constexpr int64_t kSmall = 1 << 20;  // an index of 1 MiB
-  EXPECT_TRUE(DecideNext({met}, 500, 8000, 0.005, kSmall).reached);
+  constexpr int64_t kBudget = validation::kMaxIndexBytes;
+  EXPECT_TRUE(DecideNext({met}, 500, 8000, 0.005, kSmall, kBudget).reached);
   TargetFigures missed = met;
   missed.upper[0] = 0.01;
-  NextStep next = DecideNext({missed}, 500, 8000, 0.005, kSmall);
+  NextStep next = DecideNext({missed}, 500, 8000, 0.005, kSmall, kBudget);
   EXPECT_FALSE(next.done);
   EXPECT_GT(next.num_samples, 500);
-  next = DecideNext({missed}, 8000, 8000, 0.005, kSmall);
+  next = DecideNext({missed}, 8000, 8000, 0.005, kSmall, kBudget);
   EXPECT_TRUE(next.done);
   EXPECT_FALSE(next.reached);
   EXPECT_EQ(next.stop, "the cap of 8000 samples");
   // An index already at the size budget stops m where it is.
   missed.samples = 5000;
-  next = DecideNext({missed}, 5000, 8000, 0.005, validation::kMaxIndexBytes);
+  next = DecideNext({missed}, 5000, 8000, 0.005, kBudget, kBudget);
   EXPECT_TRUE(next.done);
   EXPECT_FALSE(next.reached);
-  EXPECT_EQ(next.stop, "the index size budget of 64 MiB");
+  EXPECT_EQ(next.stop, "the index size budget of 32 MiB");
   // Below it, m grows at most to what fits, with 3% of the budget spare.
   missed.samples = 3000;
-  const int64_t bytes = 2 * int64_t{3000} * 2999;
-  next = DecideNext({missed}, 3000, 8000, 0.005, bytes);
+  const int64_t bytes = int64_t{3000} * 2999 + 3000 * 200;
+  next = DecideNext({missed}, 3000, 8000, 0.005, bytes, kBudget);
   EXPECT_FALSE(next.done);
-  EXPECT_EQ(next.num_samples,
-            validation::SamplesWithinBytes(validation::kMaxIndexBytes * 97 / 100, 3000, bytes));
-  // Room for less than the least growth of a round (1.2x): stop there.
+  EXPECT_EQ(next.num_samples, validation::SamplesWithinBytes(kBudget * 97 / 100, 3000, bytes));
+  // Room for less than the least growth of a round (1.2x): stop there, and
+  // say which budget.
   missed.samples = 4800;
-  next = DecideNext({missed}, 4800, 8000, 0.005, 2 * int64_t{4800} * 4799);
+  next = DecideNext({missed}, 4800, 8000, 0.005, int64_t{4800} * 4799, 20 << 20);
   EXPECT_TRUE(next.done);
-  EXPECT_EQ(next.stop, "the index size budget of 64 MiB");
+  EXPECT_EQ(next.stop, "the index size budget of 20 MiB");
+  EXPECT_EQ(next.keep, 0);
+}
+
+// A round no closer to the target than the closest before it ends the build,
+// which keeps that closest round.
+TEST(BuildRoundsTest, ARoundThatComesNoCloserStopsAndKeepsTheClosest) {
+  TargetFigures first;
+  first.samples = 500;
+  for (int c = 0; c < validation::kNumTargetChecks; ++c) first.pairs[c] = 10;
+  first.upper[1] = 0.03;  // 1.5x the far band's limit of 2%
+  TargetFigures second = first;
+  second.samples = 1000;
+  second.upper[1] = 0.025;  // closer
+  TargetFigures third = second;
+  third.samples = 2000;
+  third.upper[1] = 0.026;  // no closer than the second
+  constexpr int64_t kBudget = validation::kMaxIndexBytes;
+  NextStep next = DecideNext({first, second}, 1000, 8000, 0.005, 1 << 20, kBudget);
+  EXPECT_FALSE(next.done);
+  // A worst check that stays put while another falls is progress: go on.
+  TargetFigures rms_stays = first;
+  rms_stays.upper[0] = 0.006;  // 1.2x the RMS limit, the worst check, in both rounds
+  TargetFigures far_falls = rms_stays;
+  far_falls.samples = 1000;
+  far_falls.upper[1] = 0.018;
+  next = DecideNext({rms_stays, far_falls}, 1000, 8000, 0.005, 1 << 20, kBudget);
+  EXPECT_FALSE(next.done);
+  next = DecideNext({first, second, third}, 2000, 8000, 0.005, 1 << 20, kBudget);
+  EXPECT_TRUE(next.done);
+  EXPECT_FALSE(next.reached);
+  EXPECT_EQ(next.keep, 1);
+  EXPECT_EQ(next.stop, "round 3 came no closer to the target than round 2");
+}
+
+// A budget the target needs more than: the build stops at the last round
+// whose index fits, says so, and its index is under the budget. A budget
+// not even the first round fits is refused with the reason.
+TEST(BuildRoundsTest, StopsAtTheLastRoundWithinTheBudget) {
+  const mesh::Mesh m = mesh::gen::Sphere(4, 1.0);
+  RoundsOptions options = Options(300, 1e-5);
+  options.max_index_bytes = 1 << 20;
+  absl::StatusOr<TargetBuild> result = BuildToTarget(m, {}, options, nullptr);
+  ASSERT_TRUE(result.ok()) << result.status();
+  EXPECT_FALSE(result->last.reached);
+  EXPECT_NE(result->data.report.find("(the index size budget of 1 MiB)"), std::string::npos)
+      << result->data.report;
+  absl::StatusOr<std::string> bytes = index::SerializeIndex(result->data);
+  ASSERT_TRUE(bytes.ok());
+  EXPECT_LE(bytes->size(), size_t{1} << 20);
+  // The prediction is the file's size.
+  EXPECT_EQ(index::PredictIndexBytes(result->data), bytes->size());
+  options.max_index_bytes = 64 << 10;
+  EXPECT_EQ(BuildToTarget(m, {}, options, nullptr).status().code(),
+            absl::StatusCode::kResourceExhausted);
 }
 
 TEST(BuildRoundsTest, TargetStateRoundTripsAndRefusesCorruption) {
@@ -131,10 +187,15 @@ TEST(BuildRoundsTest, TargetStateRoundTripsAndRefusesCorruption) {
   state.validation_sources = 128;
   state.seed = 7;
   state.refine = false;
+  state.max_index_bytes = 1 << 20;
   state.round = 1;
+  state.closest = 0;
   TargetFigures f;
   f.samples = 512;
-  f.upper[3] = 0.25;
+  f.upper[2] = 0.25;
+  f.band_p99[1][3] = 0.03;
+  f.band_pairs[1][3] = 321;
+  f.unit = 0.01;
   state.rounds = {f};
   ASSERT_TRUE(SaveTargetState(state, dir).ok());
   absl::StatusOr<TargetState> loaded = LoadTargetState(dir);
@@ -144,7 +205,12 @@ TEST(BuildRoundsTest, TargetStateRoundTripsAndRefusesCorruption) {
   EXPECT_FALSE(loaded->refine);
   ASSERT_EQ(loaded->rounds.size(), 1u);
   EXPECT_EQ(loaded->rounds[0].samples, 512);
-  EXPECT_EQ(loaded->rounds[0].upper[3], 0.25);
+  EXPECT_EQ(loaded->rounds[0].upper[2], 0.25);
+  EXPECT_EQ(loaded->rounds[0].band_p99[1][3], 0.03);
+  EXPECT_EQ(loaded->rounds[0].band_pairs[1][3], 321);
+  EXPECT_EQ(loaded->rounds[0].unit, 0.01);
+  EXPECT_EQ(loaded->max_index_bytes, 1 << 20);
+  EXPECT_EQ(loaded->closest, 0);
   state.round = 2;  // a round without its figures
   ASSERT_TRUE(SaveTargetState(state, dir).ok());
   EXPECT_EQ(LoadTargetState(dir).status().code(), absl::StatusCode::kDataLoss);

@@ -145,9 +145,8 @@ class CellDistances {
   std::vector<double> slots_;
 };
 
-// Everything of the index but the per-vertex records and the sample matrix:
-// the header fields, the mesh, the samples, the geodesic triangles and the
-// face BVH.
+}  // namespace
+
 void AddMeshAndTriangulation(const Mesh& mesh, const Plan& plan, index::IndexData* data) {
   data->builder_version = kBuilderVersion;
   data->mesh_hash = plan.mesh_hash;
@@ -169,6 +168,8 @@ void AddMeshAndTriangulation(const Mesh& mesh, const Plan& plan, index::IndexDat
   }
   index::BuildFaceBvh(data->positions, data->faces, &data->bvh_nodes, &data->bvh_faces);
 }
+
+namespace {
 
 // The summary's figures but merge_seconds.
 void Summarize(const Mesh& mesh, const Plan& plan, const SampleDistances& sample_distance,
@@ -474,6 +475,8 @@ absl::StatusOr<index::IndexData> MergeKeepingRows(const Mesh& mesh, const Plan& 
                           CellDistances::FromRows(plan, neighbors, *rows));
   index::IndexData data;
   data.sample_distances = sample_distance.Matrix();
+  // Stored once, in 24-bit codes: 3/8 of the full float32 matrix (sample_matrix.h).
+  data.sample_matrix = index::MatrixLayout::kCoded;
   const AssignmentCounts counts =
       AssignVerticesToTriangles(mesh, plan, sample_distance, vertex_distance, &data.vertices);
   AddMeshAndTriangulation(mesh, plan, &data);

@@ -177,6 +177,12 @@ absl::StatusOr<index::IndexData> MergeKeepingRows(const mesh::Mesh& mesh, const 
                                                   std::vector<SampleRow>* rows,
                                                   BuildSummary* summary);
 
+// Everything of the index but the per-vertex records and the sample matrix:
+// the header fields, the mesh, the samples, the geodesic triangles and the
+// face BVH (what Merge adds to them; a builder predicts an index's bytes
+// from it before the rows are computed).
+void AddMeshAndTriangulation(const mesh::Mesh& mesh, const Plan& plan, index::IndexData* data);
+
 // All three phases in one process.
 absl::StatusOr<index::IndexData> BuildIndex(const mesh::Mesh& mesh, const BuildOptions& options,
                                             BuildSummary* summary);

@@ -75,6 +75,18 @@ absl::Status WithPath(const absl::Status& status, const std::string& path) {
   return absl::Status(status.code(), absl::StrCat(path, ": ", status.message()));
 }
 
+bool IsMatrixSection(SectionId id) {
+  return id == SectionId::kSampleDistances || id == SectionId::kSampleDistancesLower ||
+         id == SectionId::kSampleDistancesCoded || id == SectionId::kDistanceCode;
+}
+
+// The matrix sections a file of major version `major` has.
+std::vector<SectionId> MatrixSections(uint32_t major) {
+  if (major >= kCodedFormatMajor) return {SectionId::kSampleDistancesCoded, SectionId::kDistanceCode};
+  if (major >= kPackedFormatMajor) return {SectionId::kSampleDistancesLower};
+  return {SectionId::kSampleDistances};
+}
+
 // Validate's steps. Every check happens before the bytes it guards are used;
 // sizes are compared by subtraction so that no sum can overflow.
 
@@ -104,10 +116,10 @@ absl::StatusOr<FileHeader> ValidateHeader(const uint8_t* p, size_t n) {
         absl::StrFormat("bad byte order mark 0x%08x", h.byte_order_mark));
   }
   if (h.format_major != kFormatMajor && h.format_major != kSplitFormatMajor &&
-      h.format_major != kPackedFormatMajor) {
+      h.format_major != kPackedFormatMajor && h.format_major != kCodedFormatMajor) {
     return absl::FailedPreconditionError(absl::StrFormat(
         "index format version %d.%d is not supported by this reader (version %d.%d)",
-        h.format_major, h.format_minor, kPackedFormatMajor, kPackedFormatMinor));
+        h.format_major, h.format_minor, kCodedFormatMajor, kCodedFormatMinor));
   }
   if (h.header_size < kHeaderSize || h.header_size % 8 != 0) {
     return absl::DataLossError(absl::StrFormat("bad header size %d", h.header_size));
@@ -210,19 +222,21 @@ absl::Status FindSections(const uint8_t* p, size_t n, const FileHeader& h, const
     }
     found[spec] = e;
   }
-  // The matrix: in full before 3.0, its lower triangle from 3.0, never both.
-  const SectionId matrix = h.format_major >= kPackedFormatMajor ? SectionId::kSampleDistancesLower
-                                                                : SectionId::kSampleDistances;
-  const SectionId other = h.format_major >= kPackedFormatMajor ? SectionId::kSampleDistances
-                                                               : SectionId::kSampleDistancesLower;
+  // The matrix: in full before 3.0, its lower triangle in 3.x, in codes
+  // with their scale from 4.0; only the sections of the file's layout.
+  const std::vector<SectionId> layout = MatrixSections(h.format_major);
+  auto in_layout = [&layout](SectionId id) {
+    return std::find(layout.begin(), layout.end(), id) != layout.end();
+  };
   for (size_t s = 0; s < kNumSpecs; ++s) {
-    const std::optional<uint64_t> count = ExpectedCount(kSpecs[s].id, counts);
+    const SectionId id = kSpecs[s].id;
+    const bool matrix = IsMatrixSection(id);
+    const std::optional<uint64_t> count = ExpectedCount(id, counts);
     if (!found[s].has_value() &&
-        (kSpecs[s].required || kSpecs[s].id == matrix || count.value_or(0) > 0) &&
-        kSpecs[s].id != other) {
+        (kSpecs[s].required || in_layout(id) || (!matrix && count.value_or(0) > 0))) {
       return absl::DataLossError(absl::StrFormat("missing section: %s", kSpecs[s].name));
     }
-    if (found[s].has_value() && kSpecs[s].id == other) {
+    if (found[s].has_value() && matrix && !in_layout(id)) {
       return absl::DataLossError(absl::StrFormat("a format %d.%d index with the section %s",
                                                  h.format_major, h.format_minor, kSpecs[s].name));
     }
@@ -330,7 +344,9 @@ absl::Status Index::Validate() {
   samples_ = SectionView<int32_t>(p, entry(SectionId::kSamples));
   sample_distances_ = SectionView<float>(p, entry(SectionId::kSampleDistances));
   sample_distances_lower_ = SectionView<float>(p, entry(SectionId::kSampleDistancesLower));
-  packed_ = h.format_major >= kPackedFormatMajor;
+  sample_distances_coded_ = SectionView<PackedCode>(p, entry(SectionId::kSampleDistancesCoded));
+  const std::span<const DistanceCodeRecord> distance_code =
+      SectionView<DistanceCodeRecord>(p, entry(SectionId::kDistanceCode));
   vertices_ = SectionView<VertexRecord>(p, entry(SectionId::kVertexRecords));
   triangles_ = SectionView<GeodesicTriangle>(p, entry(SectionId::kTriangles));
   bvh_nodes_ = SectionView<BvhNode>(p, entry(SectionId::kFaceBvh));
@@ -345,18 +361,31 @@ absl::Status Index::Validate() {
   spread_bounds_ = SectionView<SpreadBoundRecord>(p, entry(SectionId::kSpreadBounds));
   if (h.format_major < kSplitFormatMajor &&
       (!split_faces_.empty() || !coarse_faces_.empty() || h.params.split_vertices != 0)) {
-    return absl::DataLossError(absl::StrFormat("a format %d.%d index with refinement sections",
+    return absl::DataLossError(absl::StrFormat("a format %d.%d index with split sections",
                                                h.format_major, h.format_minor));
   }
   GEODEX_RETURN_IF_ERROR(CheckAccuracy(accuracy_, absl::StatusCode::kDataLoss));
   GEODEX_RETURN_IF_ERROR(
       CheckSpreadBounds(spread_bounds_, accuracy_.size(), absl::StatusCode::kDataLoss));
 
-  return CheckContents(
+  if (h.format_major >= kCodedFormatMajor && distance_code.size() != 1) {
+    return absl::DataLossError("section distance code: expected one record");
+  }
+  GEODEX_RETURN_IF_ERROR(CheckContents(
       Contents{counts, positions_, faces_, twins_, samples_, sample_distances_,
-               sample_distances_lower_, vertices_, triangles_, bvh_nodes_, bvh_faces_, input_faces_,
-               vertex_copies_, coarse_faces_, split_faces_, h.params.split_vertices},
-      absl::StatusCode::kDataLoss);
+               sample_distances_lower_, distance_code, vertices_, triangles_, bvh_nodes_,
+               bvh_faces_, input_faces_, vertex_copies_, coarse_faces_, split_faces_,
+               h.params.split_vertices},
+      absl::StatusCode::kDataLoss));
+  const int32_t m = num_samples();
+  if (h.format_major >= kCodedFormatMajor) {
+    matrix_ = SampleMatrix::Coded(sample_distances_coded_, m, distance_code[0].scale);
+  } else if (h.format_major >= kPackedFormatMajor) {
+    matrix_ = SampleMatrix::Lower(sample_distances_lower_, m);
+  } else {
+    matrix_ = SampleMatrix::Full(sample_distances_, m);
+  }
+  return absl::OkStatus();
 }
 
 IndexData ToIndexData(const Index& index) {
@@ -369,17 +398,19 @@ IndexData ToIndexData(const Index& index) {
   d.faces = copy(index.faces());
   d.twins = copy(index.twins());
   d.samples = copy(index.samples());
-  if (index.packed_sample_distances()) {
+  d.sample_matrix = index.matrix().layout();
+  d.sample_distance_scale = index.matrix().scale();
+  if (d.sample_matrix == MatrixLayout::kFull) {
+    d.sample_distances = copy(index.sample_distances());
+  } else {
     const int32_t m = index.num_samples();
     d.sample_distances.resize(static_cast<size_t>(m) * m);
     for (int32_t a = 0; a < m; ++a) {
       for (int32_t b = 0; b < m; ++b) {
-        d.sample_distances[static_cast<size_t>(a) * m + b] = index.SampleDistance(a, b);
+        d.sample_distances[static_cast<size_t>(a) * m + b] =
+            static_cast<float>(index.SampleDistance(a, b));
       }
     }
-    d.pack_sample_distances = true;
-  } else {
-    d.sample_distances = copy(index.sample_distances());
   }
   d.vertices = copy(index.vertices());
   d.triangles = copy(index.triangles());

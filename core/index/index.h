@@ -21,6 +21,7 @@
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
 #include "core/index/index_format.h"
+#include "core/index/sample_matrix.h"
 
 namespace geodex::index {
 
@@ -34,9 +35,14 @@ struct IndexData {
   std::vector<int32_t> twins;           // 3 per face
   std::vector<int32_t> samples;         // vertex of each sample
   std::vector<float> sample_distances;  // num_samples^2, row-major
-  // Write the matrix once (format 3.0, its lower triangle): then
-  // sample_distances must be symmetric with a zero diagonal.
-  bool pack_sample_distances = false;
+  // How the file stores the matrix: in full (1.x / 2.x), its lower triangle
+  // (3.0) or that triangle in 24-bit codes (4.0). Stored once, the matrix
+  // must be symmetric with a zero diagonal.
+  MatrixLayout sample_matrix = MatrixLayout::kFull;
+  // kCoded: the codes' scale (DistanceCode::ScaleFor); 0 chooses it from
+  // the largest distance. A loaded index's is kept, so that writing it
+  // again gives the same codes.
+  double sample_distance_scale = 0;
   std::vector<VertexRecord> vertices;
   std::vector<GeodesicTriangle> triangles;
   std::vector<BvhNode> bvh_nodes;
@@ -50,9 +56,9 @@ struct IndexData {
   // vertex_copies.size() vertices), or empty.
   std::vector<InputFaceRecord> input_faces;
   std::vector<int32_t> vertex_copies;
-  // A refined mesh's pieces (format 2.0; see index_format.h): the faces
-  // before refinement (3 vertex ids each) and, per face, where it lies in
-  // them; both empty when the mesh was not refined. params.split_vertices
+  // A split mesh's pieces (format 2.0; see index_format.h): the faces
+  // before the split (3 vertex ids each) and, per face, where it lies in
+  // them; both empty when the mesh was not split. params.split_vertices
   // counts the midpoints.
   std::vector<int32_t> coarse_faces;
   std::vector<SplitFaceRecord> split_faces;
@@ -69,6 +75,12 @@ uint64_t MeshHash(std::span<const double> positions, std::span<const int32_t> fa
 // Index applies on reading (ids out of range, NaN or negative distances, ...):
 // the writer never produces a file the reader rejects.
 absl::StatusOr<std::string> SerializeIndex(const IndexData& data);
+
+// The bytes SerializeIndex writes for `d`, from the arrays' sizes alone: the
+// matrix counted as that of d.samples.size() samples in d.sample_matrix's
+// layout, whether or not d.sample_distances holds it yet (a builder
+// predicts a round's bytes before it computes the round's rows).
+uint64_t PredictIndexBytes(const IndexData& d);
 
 // Writes atomically: a temporary file in the same directory, fsync, rename,
 // fsync of the directory. A reader never sees a half-written file. Errors:
@@ -110,15 +122,16 @@ class Index {
   std::span<const int32_t> faces() const { return faces_; }
   std::span<const int32_t> twins() const { return twins_; }
   std::span<const int32_t> samples() const { return samples_; }
+  // The sample distance matrix, in the file's layout: what queries read.
+  const SampleMatrix& matrix() const { return matrix_; }
   // The full num_samples^2 matrix, row-major, of a 1.x / 2.x file; empty for
-  // a 3.x file, which stores only sample_distances_lower(). Prefer
-  // SampleDistance, which reads either.
+  // later files, which store it once. Prefer matrix().
   std::span<const float> sample_distances() const { return sample_distances_; }
   // The strictly lower triangle of a 3.x file (d(a, b), a > b, at
-  // a (a - 1) / 2 + b); empty for an older file.
+  // a (a - 1) / 2 + b); empty for other files.
   std::span<const float> sample_distances_lower() const { return sample_distances_lower_; }
-  // Whether the matrix is stored once (format 3.x).
-  bool packed_sample_distances() const { return packed_; }
+  // The same triangle in 24-bit codes, of a 4.x file; empty for others.
+  std::span<const PackedCode> sample_distances_coded() const { return sample_distances_coded_; }
   std::span<const VertexRecord> vertices() const { return vertices_; }
   std::span<const GeodesicTriangle> triangles() const { return triangles_; }
   std::span<const BvhNode> bvh_nodes() const { return bvh_nodes_; }
@@ -137,19 +150,14 @@ class Index {
   // of a mesh that needed no repair, or one older than 1.2.
   std::span<const InputFaceRecord> input_faces() const { return input_faces_; }
   std::span<const int32_t> vertex_copies() const { return vertex_copies_; }
-  // The long-edge split (format 2.0); empty for an index of an unrefined mesh.
+  // The long-edge split (format 2.0); empty for an index of a mesh not split.
   std::span<const int32_t> coarse_faces() const { return coarse_faces_; }
   std::span<const SplitFaceRecord> split_faces() const { return split_faces_; }
   int32_t split_vertices() const { return static_cast<int32_t>(header_->params.split_vertices); }
 
-  // d(sample i, sample j) from the matrix, in either layout; i and j in
+  // d(sample i, sample j) from the matrix, in any layout; i and j in
   // [0, num_samples()).
-  float SampleDistance(int32_t i, int32_t j) const {
-    if (!packed_) return sample_distances_[static_cast<size_t>(i) * header_->num_samples + j];
-    if (i == j) return 0.0f;
-    const size_t hi = static_cast<size_t>(std::max(i, j)), lo = static_cast<size_t>(std::min(i, j));
-    return sample_distances_lower_[hi * (hi - 1) / 2 + lo];
-  }
+  double SampleDistance(int32_t i, int32_t j) const { return matrix_(i, j); }
   // Bytes of the file image (mapped or owned).
   size_t size_bytes() const { return size_; }
   // The file image itself (for naming the file a fault address falls in).
@@ -173,7 +181,8 @@ class Index {
   std::span<const int32_t> samples_;
   std::span<const float> sample_distances_;
   std::span<const float> sample_distances_lower_;
-  bool packed_ = false;
+  std::span<const PackedCode> sample_distances_coded_;
+  SampleMatrix matrix_;
   std::span<const VertexRecord> vertices_;
   std::span<const GeodesicTriangle> triangles_;
   std::span<const BvhNode> bvh_nodes_;

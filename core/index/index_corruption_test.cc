@@ -4,7 +4,9 @@
 // valid checksums: each is refused with the right code, none is read.
 
 #include <algorithm>
+#include <cstring>
 #include <filesystem>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -76,17 +78,17 @@ TEST(IndexTest, WrongMagicIsFailedPrecondition) {
 
 TEST(IndexTest, WrongMajorVersionIsFailedPrecondition) {
   Image image = Image::Parse(Serialize(MakeSphereIndex()));
-  image.header.format_major = kPackedFormatMajor + 1;
+  image.header.format_major = kCodedFormatMajor + 1;
   image.header.format_minor = 3;
   const absl::Status status = Index::FromBytes(image.Layout()).status();
   EXPECT_EQ(status.code(), absl::StatusCode::kFailedPrecondition);
-  EXPECT_THAT(status.message(), HasSubstr(absl::StrCat(kPackedFormatMajor + 1, ".3")));
+  EXPECT_THAT(status.message(), HasSubstr(absl::StrCat(kCodedFormatMajor + 1, ".3")));
   EXPECT_THAT(status.message(),
-              HasSubstr(absl::StrCat(kPackedFormatMajor, ".", kPackedFormatMinor)));
+              HasSubstr(absl::StrCat(kCodedFormatMajor, ".", kCodedFormatMinor)));
 }
 
-// A 3.x file has the lower triangle and not the full matrix; an older one
-// the full matrix and not the triangle.
+// A 4.x file has the coded triangle and its scale, a 3.x file the float
+// triangle, an older one the full matrix; none has another's sections.
 TEST(IndexTest, MatrixLayoutMustMatchTheVersion) {
   IndexData d = MakeSphereIndex();
   Image full = Image::Parse(Serialize(d));
@@ -95,13 +97,37 @@ TEST(IndexTest, MatrixLayoutMustMatchTheVersion) {
   absl::Status status = Index::FromBytes(full.Layout()).status();
   EXPECT_EQ(status.code(), absl::StatusCode::kDataLoss);
   EXPECT_THAT(status.message(), HasSubstr("sample distances"));
-  d.pack_sample_distances = true;
+  d.sample_matrix = MatrixLayout::kLower;
   Image packed = Image::Parse(Serialize(d));
   packed.header.format_major = kFormatMajor;
   packed.header.format_minor = kFormatMinor;
   status = Index::FromBytes(packed.Layout()).status();
   EXPECT_EQ(status.code(), absl::StatusCode::kDataLoss);
   EXPECT_THAT(status.message(), HasSubstr("sample distances"));
+  packed.header.format_major = kCodedFormatMajor;
+  status = Index::FromBytes(packed.Layout()).status();
+  EXPECT_EQ(status.code(), absl::StatusCode::kDataLoss);
+  EXPECT_THAT(status.message(), HasSubstr("sample distances"));
+  d.sample_matrix = MatrixLayout::kCoded;
+  Image coded = Image::Parse(Serialize(d));
+  coded.header.format_major = kPackedFormatMajor;
+  status = Index::FromBytes(coded.Layout()).status();
+  EXPECT_EQ(status.code(), absl::StatusCode::kDataLoss);
+  EXPECT_THAT(status.message(), HasSubstr("sample distances"));
+}
+
+// The codes' scale is the one figure of a 4.x matrix that can be wrong.
+TEST(IndexTest, CodedMatrixNeedsOneFiniteScale) {
+  IndexData d = MakeSphereIndex();
+  d.sample_matrix = MatrixLayout::kCoded;
+  for (double scale : {0.0, -1.0, std::numeric_limits<double>::quiet_NaN(),
+                       std::numeric_limits<double>::infinity()}) {
+    Image image = Image::Parse(Serialize(d));
+    std::memcpy(image.Payload(SectionId::kDistanceCode).data(), &scale, sizeof(scale));
+    const absl::Status status = Index::FromBytes(image.Layout()).status();
+    EXPECT_EQ(status.code(), absl::StatusCode::kDataLoss) << scale;
+    EXPECT_THAT(status.message(), HasSubstr("distance code")) << scale;
+  }
 }
 
 TEST(IndexTest, SwappedByteOrderIsFailedPrecondition) {
@@ -334,8 +360,8 @@ TEST(IndexTest, RefinementCorruptionWithValidChecksumsIsDataLoss) {
        [&](Image& i) { i.Set<int32_t>(SectionId::kCoarseFaces, 7, nv - 1); }, "coarse face 2"},
       {"more midpoints than vertices", [&](Image& i) { i.header.params.split_vertices = nv + 1; },
        "midpoints"},
-      {"refinement sections in a 1.x file", [&](Image& i) { i.header.format_major = kFormatMajor; },
-       "refinement sections"},
+      {"split sections in a 1.x file", [&](Image& i) { i.header.format_major = kFormatMajor; },
+       "split sections"},
   };
   ExpectDataLoss(bytes, cases);
 }

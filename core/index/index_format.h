@@ -34,7 +34,7 @@
 //        and params.split_vertices counts the midpoints (the last
 //        vertices). A 1.x reader must refuse such a file (its face ids are
 //        not the input's), hence the major version; an index without
-//        refinement is still written as 1.2, so older readers keep reading it.
+//        split is still written as 1.2, so older readers keep reading it.
 //   1.3 / 2.1  per-pair error bounds of O(1) answers (SpreadBoundRecord),
 //        calibrated with the AccuracyRecord. Optional, written only with a
 //        calibration; older readers ignore it and use the AccuracyRecord's
@@ -43,24 +43,32 @@
 //        lower triangle (SampleDistancesLower, d(a, b) for a > b at
 //        a (a - 1) / 2 + b; the diagonal is 0), half the bytes of the full
 //        matrix, which a 3.x file does not have, hence the major version.
-//        Otherwise as 2.1 (the refinement sections optional). Written when
-//        IndexData::pack_sample_distances asks; this reader reads 1.x, 2.x
-//        and 3.x (Index::SampleDistance reads either layout).
+//        Otherwise as 2.1 (the split sections optional). Written when
+//        IndexData::sample_matrix asks for MatrixLayout::kLower.
+//   4.0  the lower triangle in 24-bit codes (SampleDistancesCoded, same
+//        order; sample_matrix.h: at most 2.4e-7 of a distance off), with
+//        the codes' scale (DistanceCodeRecord): 3/4 of the bytes of 3.0, what
+//        the builder writes by default. A 3.x reader has no matrix to read
+//        in it, hence the major version. This reader reads 1.x to 4.x
+//        (Index::matrix() and SampleDistance read every layout).
 
 #include <cstdint>
 
 namespace geodex::index {
 
 inline constexpr char kMagic[8] = {'G', 'E', 'O', 'D', 'E', 'X', 'I', 'X'};
-// The version written when the mesh was not refined, and when it was; a
-// reader takes both majors, and kPackedFormatMajor.
+// The version written when the mesh was not split, and when it was; a
+// reader takes both majors, kPackedFormatMajor and kCodedFormatMajor.
 inline constexpr uint32_t kFormatMajor = 1;
 inline constexpr uint32_t kFormatMinor = 3;
 inline constexpr uint32_t kSplitFormatMajor = 2;
 inline constexpr uint32_t kRefinedFormatMinor = 1;
-// The version of an index whose matrix is stored once (refined or not).
+// The version of an index whose matrix is stored once (split or not).
 inline constexpr uint32_t kPackedFormatMajor = 3;
 inline constexpr uint32_t kPackedFormatMinor = 0;
+// The version of an index whose matrix is stored once, in 24-bit codes.
+inline constexpr uint32_t kCodedFormatMajor = 4;
+inline constexpr uint32_t kCodedFormatMinor = 0;
 inline constexpr uint32_t kByteOrderMark = 0x01020304;  // reads 0x04030201 when swapped
 inline constexpr uint64_t kAlignment = 64;
 
@@ -79,12 +87,16 @@ enum class SectionId : uint32_t {
   kAccuracy = 11,        // AccuracyRecord[0 or 1] (1.1)
   kInputFaces = 12,      // InputFaceRecord[num_input_faces] (1.2); absent: identity
   kVertexCopies = 13,    // int32[k]: input vertex of the i-th copy (1.2; see InputFaceRecord)
-  kCoarseFaces = 14,     // int32[num_coarse_faces][3]: the faces before refinement (2.0)
-  kSplitFaces = 15,      // SplitFaceRecord[num_faces] (2.0); absent: not refined
+  kCoarseFaces = 14,     // int32[num_coarse_faces][3]: the faces before the split (2.0)
+  kSplitFaces = 15,      // SplitFaceRecord[num_faces] (2.0); absent: not split
   kSpreadBounds = 16,    // SpreadBoundRecord[0 or 1] (1.3 / 2.1); absent: constant bounds
   // float[num_samples (num_samples - 1) / 2]: the matrix's strictly lower
   // triangle, row by row (3.x, instead of kSampleDistances).
   kSampleDistancesLower = 17,
+  // uint8[3][num_samples (num_samples - 1) / 2]: the same triangle in 24-bit
+  // codes, little-endian (4.x, instead of the float sections; sample_matrix.h).
+  kSampleDistancesCoded = 18,
+  kDistanceCode = 19,  // DistanceCodeRecord[1] (4.x): the codes' scale
 };
 
 // Build parameters recorded in the header.
@@ -157,12 +169,12 @@ static_assert(sizeof(InputFaceRecord) == 8);
 inline constexpr uint8_t kInputFaceDropped = 1;     // a duplicate, answered by its twin
 inline constexpr uint8_t kInputFaceReoriented = 2;  // its corners 1 and 2 swapped
 // Vertex ids: the input's vertices, then the repair's copies (kVertexCopies),
-// then the split's midpoints (params.split_vertices). Without
-// refinement InputFaceRecord::face is a face of the index; with it, a coarse
+// then the split's midpoints (params.split_vertices). Without the
+// split InputFaceRecord::face is a face of the index; with it, a coarse
 // face (kCoarseFaces), whose pieces are the faces whose SplitFaceRecord
 // names it.
 
-// Where a face of a refined index lies (2.0): in coarse face `coarse_face`,
+// Where a face of a split index lies (2.0): in coarse face `coarse_face`,
 // its corner i at barycentric weights weight[i] of that face's corners.
 // Midpoint weights are dyadic fractions, exact in float.
 struct SplitFaceRecord {
@@ -225,11 +237,21 @@ static_assert(sizeof(AccuracyRecord) == 16 + 4 * 6 * kAccuracyBins + 4 * 10);
 // k = 0 for pairs of mesh vertices, 1 for other pairs: factor is the
 // calibration's quantile of |error| / (spread + epsilon * d), and epsilon is
 // the value, among a fixed grid, that makes the bin's median bound smallest
-// (core/validation/calibration.h).
+// (core/validation/calibration.h). factor[k][b] = 0: the bin's constant
+// bound (AccuracyRecord::unfold_bound), where the calibration found the
+// per-pair bounds no tighter (a reader before 4.0 takes it for a bound of 0,
+// and the builder writes it only since 4.0).
 struct SpreadBoundRecord {
   float epsilon[2][kAccuracyBins];
   float factor[2][kAccuracyBins];
 };
 static_assert(sizeof(SpreadBoundRecord) == 4 * 4 * kAccuracyBins);
+
+// The scale of the 24-bit distance codes (4.0): a code c stands for
+// scale * (F(c) - 2^-8) (sample_matrix.h). Finite and > 0.
+struct DistanceCodeRecord {
+  double scale;
+};
+static_assert(sizeof(DistanceCodeRecord) == 8);
 
 }  // namespace geodex::index

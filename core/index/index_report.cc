@@ -45,7 +45,8 @@ const std::vector<SectionGroup>& Groups() {
   static const auto* const groups = new std::vector<SectionGroup>{
       {"distance_matrix",
        "distance matrix",
-       {SectionId::kSampleDistances, SectionId::kSampleDistancesLower}},
+       {SectionId::kSampleDistances, SectionId::kSampleDistancesLower,
+        SectionId::kSampleDistancesCoded, SectionId::kDistanceCode}},
       {"mesh", "mesh", {SectionId::kPositions, SectionId::kFaces, SectionId::kTwins}},
       {"vertex_records", "vertex records", {SectionId::kVertexRecords}},
       {"triangles", "samples, triangles", {SectionId::kSamples, SectionId::kTriangles}},
@@ -162,6 +163,40 @@ std::string DescribePlace(const PlacedSample& p) {
   return absl::StrCat(p.copy ? "a copy of vertex " : "vertex ", p.vertex, " ", at);
 }
 
+// The fixed bands of the target (band_* lines of a format 4 build).
+void ReadBands(IndexReport& r) {
+  static const char* const kKeys[] = {"0_0.5", "0.5_1", "1_2", "2_4", "4_8", "8_16", "16_inf"};
+  static const char* const kLabels[] = {"0-0.5", "0.5-1", "1-2", "2-4", "4-8", "8-16", ">=16"};
+  const std::string* unit = Find(r, "band_unit");
+  const std::string* below = Find(r, "band_refined_below");
+  if (unit == nullptr || below == nullptr || !absl::SimpleAtod(*unit, &r.band_unit) ||
+      !absl::SimpleAtod(*below, &r.refined_below)) {
+    return;
+  }
+  for (int b = 0; b < 7; ++b) {
+    ReportBand band;
+    band.key = kKeys[b];
+    band.label = kLabels[b];
+    band.from = b == 0 ? 0 : std::ldexp(1.0, b - 2);
+    band.to = b == 6 ? kInf : std::ldexp(1.0, b - 1);
+    static const char* const kKind[2] = {"vertex", "interior"};
+    for (int k = 0; k < 2; ++k) {
+      const std::string* p99 = Find(r, absl::StrCat("band_p99_", kKind[k], "_", kKeys[b]));
+      const std::string* pairs = Find(r, absl::StrCat("band_pairs_", kKind[k], "_", kKeys[b]));
+      if (pairs == nullptr || !absl::SimpleAtoi(*pairs, &band.pairs[k])) band.pairs[k] = 0;
+      if (p99 == nullptr || band.pairs[k] == 0 || !absl::SimpleAtod(*p99, &band.p99[k])) {
+        band.p99[k] = kNaN;
+      }
+    }
+    band.p99_limit = band.from >= 8 ? 4 * r.target_error : kNaN;
+    band.answer = band.to <= r.refined_below    ? "walked or exact"
+                  : band.from >= r.refined_below ? "O(1)"
+                                                 : absl::StrFormat("walked or exact below %.3g, O(1) above",
+                                                                   r.refined_below);
+    r.bands.push_back(band);
+  }
+}
+
 void ReadTarget(IndexReport& r) {
   const std::string* error = Find(r, "target_error");
   double target = 0;
@@ -220,8 +255,19 @@ std::string Verdict(const IndexReport& r) {
   if (!r.has_accuracy) return none + "; no calibration to compare with";
   std::vector<std::string> over;
   if (r.uniform_rms > r.target_error) over.push_back("the uniform RMS");
-  for (const ReportBin& bin : r.bins) {
-    if (bin.p99 > bin.p99_limit) over.push_back(absl::StrCat("p99 at ", bin.label));
+  if (!r.bands.empty()) {
+    static const char* const kKind[2] = {"vertex", "interior"};
+    for (const ReportBand& band : r.bands) {
+      for (int k = 0; k < 2; ++k) {
+        if (band.p99[k] > band.p99_limit) {
+          over.push_back(absl::StrCat(kKind[k], " p99 at ", band.label, " L1000"));
+        }
+      }
+    }
+  } else {
+    for (const ReportBin& bin : r.bins) {
+      if (bin.p99 > bin.p99_limit) over.push_back(absl::StrCat("p99 at ", bin.label));
+    }
   }
   return absl::StrFormat("%s; measured against the default target %s: %s", none,
                          FormatPercent(r.target_error),
@@ -351,6 +397,7 @@ IndexReport MakeIndexReport(const Index& index) {
     }
   }
   ReadTarget(r);
+  ReadBands(r);
   r.target_verdict = Verdict(r);
   return r;
 }
@@ -424,6 +471,20 @@ std::string IndexReportText(const IndexReport& r, std::string_view title) {
       &out, "                  area-uniform pairs: RMS %s (limit %s), p99 beyond 10L %s\n",
       FormatPercent(r.uniform_rms), FormatPercent(r.target_error),
       FormatPercent(r.uniform_far_p99));
+  if (r.bands.empty()) return out;
+  absl::StrAppendFormat(&out,
+                        "  by distance   p99 in units of L1000 = %.4g (the spacing of 1000 "
+                        "samples); refined below %.3g L1000\n",
+                        r.band_unit, r.refined_below);
+  absl::StrAppendFormat(&out, "                  %-10s %9s %9s %11s  %s\n", "L1000", "vertex",
+                        "interior", "p99 limit", "answered");
+  for (const ReportBand& b : r.bands) {
+    const bool over = b.p99[0] > b.p99_limit || b.p99[1] > b.p99_limit;
+    absl::StrAppendFormat(&out, "                  %-10s %9s %9s %11s  %s%s\n", b.label,
+                          FormatPercent(b.p99[0]), FormatPercent(b.p99[1]),
+                          std::isnan(b.p99_limit) ? std::string("-") : FormatPercent(b.p99_limit),
+                          b.answer, over ? "  over" : "");
+  }
   return out;
 }
 
@@ -488,7 +549,21 @@ std::string IndexReportJson(const IndexReport& r) {
           ", \"to_L\": ", JsonNumber(bin.to_l), ", \"rms\": ", JsonNumber(bin.rms),
           ", \"p99\": ", JsonNumber(bin.p99), ", \"p99_limit\": ", JsonNumber(bin.p99_limit), "}");
     }
-    absl::StrAppend(&out, "\n    ]\n  },\n");
+    absl::StrAppend(&out, "\n    ],\n    \"band_unit\": ",
+                    r.bands.empty() ? "null" : JsonNumber(r.band_unit),
+                    ",\n    \"refined_below\": ",
+                    r.bands.empty() ? "null" : JsonNumber(r.refined_below), ",\n    \"bands\": [");
+    for (size_t b = 0; b < r.bands.size(); ++b) {
+      const ReportBand& band = r.bands[b];
+      absl::StrAppend(&out, b ? ",\n" : "\n", "      {\"key\": ", JsonString(band.key),
+                      ", \"label\": ", JsonString(band.label), ", \"from\": ", JsonNumber(band.from),
+                      ", \"to\": ", JsonNumber(band.to), ", \"p99_vertex\": ", JsonNumber(band.p99[0]),
+                      ", \"p99_interior\": ", JsonNumber(band.p99[1]),
+                      ", \"pairs_vertex\": ", band.pairs[0], ", \"pairs_interior\": ", band.pairs[1],
+                      ", \"p99_limit\": ", JsonNumber(band.p99_limit),
+                      ", \"answer\": ", JsonString(band.answer), "}");
+    }
+    absl::StrAppend(&out, r.bands.empty() ? "]\n  },\n" : "\n    ]\n  },\n");
   } else {
     absl::StrAppend(&out, "  \"accuracy\": null,\n");
   }

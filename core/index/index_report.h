@@ -47,9 +47,28 @@ struct ReportBin {
   double to_l = 0;    // +infinity for the last bin
   double rms = 0;     // relative error of the default answer: RMS
   double p99 = 0;     // and 99th percentile
-  // The error target's limit on the p99 of this bin: 2E below 3L, 4E from
-  // 3L (the target's or, for a build with a fixed m, the default target's).
+  // The limit this bin's p99 is read against: 2E below 3L (answers walked
+  // or exact), 4E from 3L (the target's E or, for a build with a fixed m,
+  // the default's). The target itself judges the bands (ReportBand).
   double p99_limit = 0;
+};
+
+// One band of distances in a unit fixed by the surface, L1000 (the spacing
+// of 1000 samples on it), whatever m: what a user gets at a distance.
+struct ReportBand {
+  std::string key;    // "0_0.5", "0.5_1", ..., "8_16", "16_inf"
+  std::string label;  // "0-0.5", ..., ">=16" (L1000)
+  double from = 0;    // [from, to) L1000
+  double to = 0;
+  // p99 of the default answer's relative error, vertex pairs [0] and
+  // interior pairs [1]; NaN without pairs.
+  double p99[2] = {0, 0};
+  int64_t pairs[2] = {0, 0};
+  // 4E for the bands the target judges (from 8 L1000), NaN for the others.
+  double p99_limit = 0;
+  // How the default mode answers this band: "walked or exact", "O(1)", or
+  // both with the distance in between.
+  std::string answer;
 };
 
 // Bytes of one group of sections (the distance matrix, the mesh, ...).
@@ -121,6 +140,12 @@ struct IndexReport {
   double uniform_rms = 0;   // over area-uniform pairs
   double uniform_far_p99 = 0;
   std::array<ReportBin, 4> bins;
+  // The target's bands (a build of format 4 or later with a calibration;
+  // empty for older indexes), L1000 in mesh units, and the distance below
+  // which the default answer is walked or exact, in L1000.
+  std::vector<ReportBand> bands;
+  double band_unit = 0;
+  double refined_below = 0;
   // Every "key = value" line of the stored report, in order (a key given
   // twice keeps its last value, at its first place).
   std::vector<std::pair<std::string, std::string>> entries;

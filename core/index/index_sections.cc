@@ -42,6 +42,7 @@ std::optional<uint64_t> ExpectedCount(SectionId id, const Counts& c) {
     case SectionId::kSampleDistances:
       return c.num_samples * c.num_samples;
     case SectionId::kSampleDistancesLower:
+    case SectionId::kSampleDistancesCoded:
       return c.num_samples * (c.num_samples - std::min<uint64_t>(c.num_samples, 1)) / 2;
     case SectionId::kVertexRecords:
       return c.num_vertices;
@@ -58,6 +59,7 @@ std::optional<uint64_t> ExpectedCount(SectionId id, const Counts& c) {
     case SectionId::kCoarseFaces:
     case SectionId::kSplitFaces:
     case SectionId::kSpreadBounds:
+    case SectionId::kDistanceCode:
       return std::nullopt;
   }
   return std::nullopt;
@@ -172,6 +174,13 @@ absl::Status CheckContents(const Contents& c, absl::StatusCode code) {
           absl::StrFormat("sample distance %d of the lower triangle is negative or NaN (%g)", i,
                           c.sample_distances_lower[i]));
     }
+  }
+  // Every code is a distance; only the scale can be wrong.
+  if (c.distance_code.size() > 1 ||
+      (!c.distance_code.empty() &&
+       !(c.distance_code[0].scale > 0 && std::isfinite(c.distance_code[0].scale)))) {
+    return fail(absl::StrFormat("distance code: %d records, or a scale that is not finite and > 0",
+                                c.distance_code.size()));
   }
   for (size_t v = 0; v < c.vertices.size(); ++v) {
     const VertexRecord& r = c.vertices[v];

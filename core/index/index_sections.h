@@ -16,6 +16,7 @@
 
 #include "absl/status/status.h"
 #include "core/index/index_format.h"
+#include "core/index/sample_matrix.h"
 
 namespace geodex::index::internal {
 
@@ -35,7 +36,8 @@ constexpr SectionSpec kSpecs[] = {
     {SectionId::kFaces, sizeof(int32_t), "faces", true},
     {SectionId::kTwins, sizeof(int32_t), "twins", true},
     {SectionId::kSamples, sizeof(int32_t), "samples", true},
-    // Required by version: the full matrix before 3.0, its lower triangle from 3.0.
+    // Required by version: the full matrix before 3.0, its lower triangle
+    // from 3.0, in codes with their scale from 4.0.
     {SectionId::kSampleDistances, sizeof(float), "sample distances", false},
     {SectionId::kVertexRecords, sizeof(VertexRecord), "vertex records", true},
     {SectionId::kTriangles, sizeof(GeodesicTriangle), "geodesic triangles", true},
@@ -46,9 +48,11 @@ constexpr SectionSpec kSpecs[] = {
     {SectionId::kInputFaces, sizeof(InputFaceRecord), "input faces", false},
     {SectionId::kVertexCopies, sizeof(int32_t), "vertex copies", false},
     {SectionId::kCoarseFaces, sizeof(int32_t), "coarse faces", false},
-    {SectionId::kSplitFaces, sizeof(SplitFaceRecord), "refined faces", false},
+    {SectionId::kSplitFaces, sizeof(SplitFaceRecord), "split faces", false},
     {SectionId::kSpreadBounds, sizeof(SpreadBoundRecord), "spread bounds", false},
     {SectionId::kSampleDistancesLower, sizeof(float), "sample distances (lower triangle)", false},
+    {SectionId::kSampleDistancesCoded, sizeof(PackedCode), "sample distances (24-bit codes)", false},
+    {SectionId::kDistanceCode, sizeof(DistanceCodeRecord), "distance code", false},
 };
 constexpr size_t kNumSpecs = std::size(kSpecs);
 
@@ -86,6 +90,7 @@ struct Contents {
   std::span<const int32_t> samples;
   std::span<const float> sample_distances;
   std::span<const float> sample_distances_lower;
+  std::span<const DistanceCodeRecord> distance_code;  // 4.x: one record
   std::span<const VertexRecord> vertices;
   std::span<const GeodesicTriangle> triangles;
   std::span<const BvhNode> bvh_nodes;

@@ -3,6 +3,8 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cmath>
+#include <limits>
 #include <filesystem>
 #include <functional>
 #include <string>
@@ -37,13 +39,13 @@ TEST(IndexTest, RoundTripFromBytes) {
 TEST(IndexTest, MatrixStoredOnceRoundTrips) {
   IndexData d = MakeSphereIndex();
   const std::string full = Serialize(d);
-  d.pack_sample_distances = true;
+  d.sample_matrix = MatrixLayout::kLower;
   const std::string packed = Serialize(d);
   absl::StatusOr<std::shared_ptr<const Index>> index = Index::FromBytes(packed);
   ASSERT_TRUE(index.ok()) << index.status();
   EXPECT_EQ((*index)->header().format_major, kPackedFormatMajor);
   EXPECT_EQ((*index)->header().format_minor, kPackedFormatMinor);
-  EXPECT_TRUE((*index)->packed_sample_distances());
+  EXPECT_EQ((*index)->matrix().layout(), MatrixLayout::kLower);
   EXPECT_TRUE((*index)->sample_distances().empty());
   const int32_t m = (*index)->num_samples();
   EXPECT_EQ((*index)->sample_distances_lower().size(), static_cast<size_t>(m * (m - 1) / 2));
@@ -59,7 +61,7 @@ TEST(IndexTest, MatrixStoredOnceRoundTrips) {
   // Older files still read, in their layout.
   absl::StatusOr<std::shared_ptr<const Index>> old = Index::FromBytes(full);
   ASSERT_TRUE(old.ok()) << old.status();
-  EXPECT_FALSE((*old)->packed_sample_distances());
+  EXPECT_EQ((*old)->matrix().layout(), MatrixLayout::kFull);
   EXPECT_EQ((*old)->SampleDistance(3, 7), (*index)->SampleDistance(3, 7));
   // Only a symmetric matrix with a zero diagonal is stored once.
   IndexData asymmetric = d;
@@ -68,6 +70,103 @@ TEST(IndexTest, MatrixStoredOnceRoundTrips) {
   IndexData diagonal = d;
   diagonal.sample_distances[2 * m + 2] = 0.1f;
   EXPECT_EQ(SerializeIndex(diagonal).status().code(), absl::StatusCode::kInvalidArgument);
+}
+
+// Format 4.0: the lower triangle in 24-bit codes. Every distance within
+// 2^-22 of itself (or 2^-30 of the largest below 1/256 of it), 3/8 of
+// the full matrix's bytes, +inf kept, and written again to the same bytes.
+TEST(IndexTest, CodedMatrixRoundTrips) {
+  IndexData d = MakeSphereIndex();
+  const int32_t m = static_cast<int32_t>(d.samples.size());
+  d.sample_distances[1 * m + 0] = d.sample_distances[0 * m + 1] =
+      std::numeric_limits<float>::infinity();
+  const std::string full = Serialize(d);
+  d.sample_matrix = MatrixLayout::kCoded;
+  const std::string coded = Serialize(d);
+  absl::StatusOr<std::shared_ptr<const Index>> index = Index::FromBytes(coded);
+  ASSERT_TRUE(index.ok()) << index.status();
+  EXPECT_EQ((*index)->header().format_major, kCodedFormatMajor);
+  EXPECT_EQ((*index)->header().format_minor, kCodedFormatMinor);
+  EXPECT_EQ((*index)->matrix().layout(), MatrixLayout::kCoded);
+  EXPECT_TRUE((*index)->sample_distances().empty());
+  EXPECT_TRUE((*index)->sample_distances_lower().empty());
+  EXPECT_EQ((*index)->sample_distances_coded().size(), static_cast<size_t>(m * (m - 1) / 2));
+  double largest = 0;
+  for (float x : d.sample_distances) {
+    if (std::isfinite(x)) largest = std::max(largest, static_cast<double>(x));
+  }
+  for (int32_t i = 0; i < m; ++i) {
+    for (int32_t j = 0; j < m; ++j) {
+      const double exact = d.sample_distances[i * m + j];
+      const double got = (*index)->SampleDistance(i, j);
+      if (!std::isfinite(exact)) {
+        EXPECT_EQ(got, exact) << i << " " << j;
+        continue;
+      }
+      EXPECT_LE(std::abs(got - exact), std::max(0x1p-22 * exact, 0x1p-30 * largest) * 1.0001)
+          << i << " " << j;
+      EXPECT_EQ(got, (*index)->SampleDistance(j, i));
+    }
+  }
+  const size_t saved = full.size() - coded.size();
+  EXPECT_GE(saved + 3 * kAlignment, sizeof(float) * m * m - sizeof(PackedCode) * (m * (m - 1) / 2));
+  EXPECT_EQ(Serialize(ToIndexData(**index)), coded);
+  // A NaN has no code.
+  IndexData nan = d;
+  nan.sample_distances[2 * m + 1] = nan.sample_distances[1 * m + 2] = std::nanf("");
+  EXPECT_EQ(SerializeIndex(nan).status().code(), absl::StatusCode::kInvalidArgument);
+}
+
+TEST(IndexTest, PredictedBytesAreTheWrittenBytes) {
+  IndexData d = MakeSphereIndex();
+  for (MatrixLayout layout : {MatrixLayout::kFull, MatrixLayout::kLower, MatrixLayout::kCoded}) {
+    d.sample_matrix = layout;
+    EXPECT_EQ(PredictIndexBytes(d), Serialize(d).size());
+    IndexData without_matrix = d;
+    without_matrix.sample_distances.clear();
+    EXPECT_EQ(PredictIndexBytes(without_matrix), Serialize(d).size());
+  }
+}
+
+// The code itself: nearest, increasing, exact at 0 and the largest distance.
+TEST(DistanceCodeTest, NearestCodeWithinItsPrecision) {
+  const double largest = 3.7;
+  const double scale = DistanceCode::ScaleFor(largest);
+  EXPECT_EQ(DistanceCode::Encode(0, scale), 0);
+  EXPECT_EQ(DistanceCode::Decode(0, scale), 0);
+  EXPECT_EQ(DistanceCode::Encode(largest, scale), DistanceCode::kLargest);
+  EXPECT_NEAR(DistanceCode::Decode(DistanceCode::kLargest, scale), largest, 1e-15);
+  EXPECT_EQ(DistanceCode::Encode(std::numeric_limits<double>::infinity(), scale),
+            DistanceCode::kInfinity);
+  EXPECT_EQ(DistanceCode::Decode(DistanceCode::kInfinity, scale),
+            std::numeric_limits<double>::infinity());
+  for (uint32_t c = 1; c <= DistanceCode::kLargest; ++c) {
+    ASSERT_LT(DistanceCode::Unit(c - 1), DistanceCode::Unit(c));
+  }
+  for (uint32_t c : {0u, 1u, 0x123456u, DistanceCode::kLargest, DistanceCode::kInfinity}) {
+    EXPECT_EQ(DistanceCode::Unpack(DistanceCode::Pack(c)), c);
+  }
+  double worst_relative = 0;
+  for (int k = 0; k <= 200000; ++k) {
+    const double d = largest * std::pow(1e-6, k / 200000.0);
+    const uint32_t c = DistanceCode::Encode(d, scale);
+    const double error = std::abs(DistanceCode::Decode(c, scale) - d);
+    // No other code is nearer.
+    if (c > 0) {
+      EXPECT_GE(std::abs(DistanceCode::Decode(c - 1, scale) - d), error) << d;
+    }
+    if (c < DistanceCode::kLargest) {
+      EXPECT_GE(std::abs(DistanceCode::Decode(c + 1, scale) - d), error) << d;
+    }
+    if (d >= largest / 16) worst_relative = std::max(worst_relative, error / d);
+    EXPECT_LE(error, 0x1p-22 * (d + 0x1p-8 * scale) * 1.0001) << d;
+    if (d < 0x1p-8 * scale) {
+      EXPECT_LE(error, 0x1p-30 * scale * 1.0001) << d;
+    }
+  }
+  // A sixteenth of the largest distance and more: within 2^-22 (1 + 1/16).
+  EXPECT_LE(worst_relative, 0x1p-22 * (1 + 1.0 / 16) * 1.0001);
+  EXPECT_GT(worst_relative, 0x1p-23);  // the bound is tight, not vacuous
 }
 
 AccuracyRecord SomeAccuracy() {

@@ -26,6 +26,85 @@ using internal::kInt32Max;
 using internal::kNumSpecs;
 using internal::kSpecs;
 
+namespace {
+
+struct Piece {
+  const void* data;
+  uint64_t size;
+};
+
+// The sections of `d` in kSpecs order, the matrix's from `matrix` (full,
+// lower, coded, code).
+void LayOut(const IndexData& d, const Piece (&matrix)[4], Piece (&pieces)[kNumSpecs]) {
+  const Piece all[kNumSpecs] = {
+      {d.positions.data(), d.positions.size() * sizeof(double)},
+      {d.faces.data(), d.faces.size() * sizeof(int32_t)},
+      {d.twins.data(), d.twins.size() * sizeof(int32_t)},
+      {d.samples.data(), d.samples.size() * sizeof(int32_t)},
+      matrix[0],
+      {d.vertices.data(), d.vertices.size() * sizeof(VertexRecord)},
+      {d.triangles.data(), d.triangles.size() * sizeof(GeodesicTriangle)},
+      {d.bvh_nodes.data(), d.bvh_nodes.size() * sizeof(BvhNode)},
+      {d.bvh_faces.data(), d.bvh_faces.size() * sizeof(int32_t)},
+      {d.report.data(), d.report.size()},
+      {d.accuracy.data(), d.accuracy.size() * sizeof(AccuracyRecord)},
+      {d.input_faces.data(), d.input_faces.size() * sizeof(InputFaceRecord)},
+      {d.vertex_copies.data(), d.vertex_copies.size() * sizeof(int32_t)},
+      {d.coarse_faces.data(), d.coarse_faces.size() * sizeof(int32_t)},
+      {d.split_faces.data(), d.split_faces.size() * sizeof(SplitFaceRecord)},
+      {d.spread_bounds.data(), d.spread_bounds.size() * sizeof(SpreadBoundRecord)},
+      matrix[1],
+      matrix[2],
+      matrix[3],
+  };
+  std::copy(std::begin(all), std::end(all), std::begin(pieces));
+}
+
+// Whether section i is written. Every section is, empty ones with size 0,
+// but the input-id sections (1.2, 2.0), written only when the mesh was
+// repaired or split so that the index of a mesh that needed neither keeps
+// the 1.1 layout, and the matrix sections of other layouts. The matrix
+// sections of the layout written are, even when empty (no samples).
+bool Written(size_t i, const Piece (&pieces)[kNumSpecs], MatrixLayout layout) {
+  const SectionId id = kSpecs[i].id;
+  if (id == SectionId::kSampleDistances) return layout == MatrixLayout::kFull;
+  if (id == SectionId::kSampleDistancesLower) return layout == MatrixLayout::kLower;
+  if (id == SectionId::kSampleDistancesCoded || id == SectionId::kDistanceCode) {
+    return layout == MatrixLayout::kCoded;
+  }
+  return pieces[i].size > 0 || (id != SectionId::kInputFaces && id != SectionId::kVertexCopies &&
+                                id != SectionId::kCoarseFaces && id != SectionId::kSplitFaces &&
+                                id != SectionId::kSpreadBounds);
+}
+
+// The file's size: header, table and every written section aligned.
+uint64_t FileSize(const Piece (&pieces)[kNumSpecs], MatrixLayout layout) {
+  uint64_t sections = 0;
+  for (size_t i = 0; i < kNumSpecs; ++i) sections += Written(i, pieces, layout) ? 1 : 0;
+  uint64_t cursor = sizeof(FileHeader) + sections * sizeof(SectionEntry);
+  for (size_t i = 0; i < kNumSpecs; ++i) {
+    if (Written(i, pieces, layout)) cursor = AlignUp(cursor) + pieces[i].size;
+  }
+  return cursor;
+}
+
+}  // namespace
+
+uint64_t PredictIndexBytes(const IndexData& d) {
+  const uint64_t m = d.samples.size();
+  const uint64_t lower = m * (m - std::min<uint64_t>(m, 1)) / 2;
+  const MatrixLayout layout = d.sample_matrix;
+  const Piece matrix[4] = {
+      {nullptr, layout == MatrixLayout::kFull ? m * m * sizeof(float) : 0},
+      {nullptr, layout == MatrixLayout::kLower ? lower * sizeof(float) : 0},
+      {nullptr, layout == MatrixLayout::kCoded ? lower * sizeof(PackedCode) : 0},
+      {nullptr, layout == MatrixLayout::kCoded ? sizeof(DistanceCodeRecord) : 0},
+  };
+  Piece pieces[kNumSpecs];
+  LayOut(d, matrix, pieces);
+  return FileSize(pieces, layout);
+}
+
 absl::StatusOr<std::string> SerializeIndex(const IndexData& d) {
   auto bad = [](std::string message) { return absl::InvalidArgumentError(message); };
   if (d.positions.size() % 3 != 0) {
@@ -53,9 +132,13 @@ absl::StatusOr<std::string> SerializeIndex(const IndexData& d) {
     return bad(absl::StrFormat("sample_distances: %d values, expected %d (num_samples^2)",
                                d.sample_distances.size(), counts.num_samples * counts.num_samples));
   }
-  // The matrix stored once (3.0): its lower triangle, checked symmetric.
+  // The matrix stored once (3.0, 4.0): its lower triangle, checked
+  // symmetric, as floats or codes.
+  const MatrixLayout layout = d.sample_matrix;
   std::vector<float> lower;
-  if (d.pack_sample_distances) {
+  std::vector<PackedCode> coded;
+  std::vector<DistanceCodeRecord> code;
+  if (layout != MatrixLayout::kFull) {
     const size_t m = counts.num_samples;
     lower.reserve(m * (m - std::min<size_t>(m, 1)) / 2);
     for (size_t a = 0; a < m; ++a) {
@@ -71,9 +154,27 @@ absl::StatusOr<std::string> SerializeIndex(const IndexData& d) {
       }
     }
   }
-  const std::span<const float> full_matrix = d.pack_sample_distances
-                                                 ? std::span<const float>()
-                                                 : std::span<const float>(d.sample_distances);
+  if (layout == MatrixLayout::kCoded) {
+    // Checked as floats first: a NaN has no code.
+    Contents floats;
+    floats.sample_distances_lower = lower;
+    GEODEX_RETURN_IF_ERROR(CheckContents(floats, absl::StatusCode::kInvalidArgument));
+    double scale = d.sample_distance_scale;
+    if (scale == 0) {
+      double largest = 0;
+      for (float x : lower) {
+        if (std::isfinite(x)) largest = std::max(largest, static_cast<double>(x));
+      }
+      scale = DistanceCode::ScaleFor(largest);
+    }
+    code = {DistanceCodeRecord{scale}};
+    coded.reserve(lower.size());
+    for (float x : lower) coded.push_back(DistanceCode::Pack(DistanceCode::Encode(x, scale)));
+    lower.clear();
+  }
+  const std::span<const float> full_matrix = layout == MatrixLayout::kFull
+                                                 ? std::span<const float>(d.sample_distances)
+                                                 : std::span<const float>();
   if (d.vertices.size() != counts.num_vertices) {
     return bad(absl::StrFormat("vertices: %d records, expected %d (one per vertex)",
                                d.vertices.size(), counts.num_vertices));
@@ -93,7 +194,7 @@ absl::StatusOr<std::string> SerializeIndex(const IndexData& d) {
                                sizeof(FileHeader::builder_version), d.builder_version));
   }
   GEODEX_RETURN_IF_ERROR(CheckContents(
-      Contents{counts, d.positions, d.faces, d.twins, d.samples, d.sample_distances, lower,
+      Contents{counts, d.positions, d.faces, d.twins, d.samples, full_matrix, lower, code,
                d.vertices, d.triangles, d.bvh_nodes, d.bvh_faces, d.input_faces, d.vertex_copies,
                d.coarse_faces, d.split_faces, d.params.split_vertices},
       absl::StatusCode::kInvalidArgument));
@@ -101,44 +202,15 @@ absl::StatusOr<std::string> SerializeIndex(const IndexData& d) {
   GEODEX_RETURN_IF_ERROR(
       CheckSpreadBounds(d.spread_bounds, d.accuracy.size(), absl::StatusCode::kInvalidArgument));
 
-  // Every section is written, empty ones with size 0, in kSpecs order (but the
-  // input-id sections, below).
-  struct Piece {
-    const void* data;
-    uint64_t size;
-  };
-  const Piece pieces[kNumSpecs] = {
-      {d.positions.data(), d.positions.size() * sizeof(double)},
-      {d.faces.data(), d.faces.size() * sizeof(int32_t)},
-      {d.twins.data(), d.twins.size() * sizeof(int32_t)},
-      {d.samples.data(), d.samples.size() * sizeof(int32_t)},
+  const Piece matrix[4] = {
       {full_matrix.data(), full_matrix.size() * sizeof(float)},
-      {d.vertices.data(), d.vertices.size() * sizeof(VertexRecord)},
-      {d.triangles.data(), d.triangles.size() * sizeof(GeodesicTriangle)},
-      {d.bvh_nodes.data(), d.bvh_nodes.size() * sizeof(BvhNode)},
-      {d.bvh_faces.data(), d.bvh_faces.size() * sizeof(int32_t)},
-      {d.report.data(), d.report.size()},
-      {d.accuracy.data(), d.accuracy.size() * sizeof(AccuracyRecord)},
-      {d.input_faces.data(), d.input_faces.size() * sizeof(InputFaceRecord)},
-      {d.vertex_copies.data(), d.vertex_copies.size() * sizeof(int32_t)},
-      {d.coarse_faces.data(), d.coarse_faces.size() * sizeof(int32_t)},
-      {d.split_faces.data(), d.split_faces.size() * sizeof(SplitFaceRecord)},
-      {d.spread_bounds.data(), d.spread_bounds.size() * sizeof(SpreadBoundRecord)},
       {lower.data(), lower.size() * sizeof(float)},
+      {coded.data(), coded.size() * sizeof(PackedCode)},
+      {code.data(), code.size() * sizeof(DistanceCodeRecord)},
   };
-  // The input-id sections (1.2, 2.0) are written only when the mesh was
-  // repaired or refined, so that the index of a mesh that needed neither
-  // keeps the 1.1 layout.
-  // The matrix section of the layout written, even when empty (no samples).
-  const bool packed = d.pack_sample_distances;
-  auto written = [&pieces, packed](size_t i) {
-    const SectionId id = kSpecs[i].id;
-    if (id == SectionId::kSampleDistances) return !packed;
-    if (id == SectionId::kSampleDistancesLower) return packed;
-    return pieces[i].size > 0 || (id != SectionId::kInputFaces && id != SectionId::kVertexCopies &&
-                                  id != SectionId::kCoarseFaces && id != SectionId::kSplitFaces &&
-                                  id != SectionId::kSpreadBounds);
-  };
+  Piece pieces[kNumSpecs];
+  LayOut(d, matrix, pieces);
+  auto written = [&pieces, layout](size_t i) { return Written(i, pieces, layout); };
   const bool refined = !d.split_faces.empty();
   size_t num_sections = 0;
   for (size_t i = 0; i < kNumSpecs; ++i) num_sections += written(i) ? 1 : 0;
@@ -165,8 +237,20 @@ absl::StatusOr<std::string> SerializeIndex(const IndexData& d) {
   FileHeader h;
   std::memset(static_cast<void*>(&h), 0, sizeof(h));  // padding included
   std::memcpy(h.magic, kMagic, sizeof(kMagic));
-  h.format_major = packed ? kPackedFormatMajor : refined ? kSplitFormatMajor : kFormatMajor;
-  h.format_minor = packed ? kPackedFormatMinor : refined ? kRefinedFormatMinor : kFormatMinor;
+  switch (layout) {
+    case MatrixLayout::kCoded:
+      h.format_major = kCodedFormatMajor;
+      h.format_minor = kCodedFormatMinor;
+      break;
+    case MatrixLayout::kLower:
+      h.format_major = kPackedFormatMajor;
+      h.format_minor = kPackedFormatMinor;
+      break;
+    case MatrixLayout::kFull:
+      h.format_major = refined ? kSplitFormatMajor : kFormatMajor;
+      h.format_minor = refined ? kRefinedFormatMinor : kFormatMinor;
+      break;
+  }
   h.byte_order_mark = kByteOrderMark;
   h.header_size = sizeof(FileHeader);
   std::memcpy(h.builder_version, d.builder_version.data(), d.builder_version.size());

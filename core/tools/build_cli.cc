@@ -45,8 +45,13 @@ void BuildCommandLine::AddSamplingOptions(CLI::App* cmd) {
       ->check(CLI::PositiveNumber);
   cmd->add_option("--target-error", o.target_error,
                   "The error target (default 0.005 when --samples is not given): relative RMS "
-                  "over area-uniform pairs <= E, p99 <= 2E below 3L and <= 4E from 3L, vertex "
-                  "and interior pairs, by 95% upper limits on held-out sources")
+                  "over area-uniform pairs <= E and p99 <= 4E for pairs at least 8 L1000 apart "
+                  "(L1000: the spacing of 1000 samples on the surface), vertex and interior "
+                  "pairs, by 95% upper limits on held-out sources")
+      ->check(CLI::PositiveNumber);
+  cmd->add_option("--max-index-mib", args_.max_index_mib,
+                  "With an error target: no index over this many MiB is written; m stops at the "
+                  "last round that fits (default 32)")
       ->check(CLI::PositiveNumber);
   cmd->add_option("--max-samples", o.max_samples,
                   "With an error target: the cap on m (default 8000; with --no-split, "
@@ -100,6 +105,9 @@ BuildJob BuildCommandLine::job() const {
 builder::PipelineOptions BuildCommandLine::Options() const {
   builder::PipelineOptions o = args_.pipeline;
   o.build.refine_long_edges = !args_.no_split;
+  if (args_.max_index_mib > 0) {
+    o.max_index_bytes = static_cast<int64_t>(args_.max_index_mib * 1048576.0);
+  }
   o.calibrate = !args_.no_calibration;
   const CLI::App* sampled = *plan_ ? plan_ : &app_;
   if (sampled->count("--samples") == 0) {

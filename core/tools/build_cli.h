@@ -26,6 +26,7 @@ struct BuildToolArgs {
   builder::PipelineOptions pipeline;
   bool no_split = false;        // --no-split (hidden alias: --no-refinement)
   bool no_calibration = false;  // --no-calibration
+  double max_index_mib = 0;     // --max-index-mib (0: the default budget)
   std::string mesh_path;        // a whole build, plan, calibrate
   std::string out;              // the index a whole build, merge or calibrate writes
   std::string workdir;          // plan (its -o), rows, merge

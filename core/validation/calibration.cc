@@ -1,12 +1,16 @@
 #include "core/validation/calibration.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
+#include <functional>
+#include <thread>
 #include <limits>
 #include <vector>
 
 #include "absl/strings/str_format.h"
 #include "core/common/status_macros.h"
+#include "core/common/threads.h"
 #include "core/query/internal/query_engine.h"
 
 namespace geodex::validation {
@@ -23,6 +27,22 @@ double Quantile(std::vector<double> x, double q) {
   if (x.empty()) return std::numeric_limits<double>::quiet_NaN();
   std::sort(x.begin(), x.end());
   return x[std::min(x.size() - 1, static_cast<size_t>(q * x.size()))];
+}
+
+// The one-sided 95% normal quantile.
+constexpr double kZ95 = 1.645;
+
+// The order statistic that is at least the q-quantile with 95% confidence
+// (binomial, normal approximation). A bound set at the plain quantile of
+// the held-out errors covers fewer than q of other points' about as often
+// as not, and less still once the best of several fits is kept; the
+// confidence margin is what other sources need.
+double UpperQuantile(std::vector<double> x, double q) {
+  if (x.empty()) return std::numeric_limits<double>::quiet_NaN();
+  std::sort(x.begin(), x.end());
+  const double n = static_cast<double>(x.size());
+  const double rank = q * n + kZ95 * std::sqrt(n * q * (1 - q));
+  return x[std::min(x.size() - 1, static_cast<size_t>(std::ceil(rank)))];
 }
 
 // An answer is no more precise than the float32 distances the index stores
@@ -47,7 +67,7 @@ void FillBounds(const std::vector<double> (&errors)[index::kAccuracyBins], doubl
                 double scale_length, double largest_in_last, float* out) {
   double q[index::kAccuracyBins];
   for (int b = 0; b < index::kAccuracyBins; ++b) {
-    q[b] = Quantile(errors[b], quantile);
+    q[b] = UpperQuantile(errors[b], quantile);
     if (!std::isnan(q[b])) {
       q[b] = std::max(q[b], kRelativePrecision * BinReach(b, scale_length, largest_in_last));
     }
@@ -80,9 +100,6 @@ double Rms(const std::vector<double>& x) {
   return x.empty() ? 0 : std::sqrt(sum / x.size());
 }
 
-// The one-sided 95% normal quantile.
-constexpr double kZ95 = 1.645;
-
 // An O(1) answer's absolute error, its spread and its distance.
 struct SpreadSample {
   double error, spread, distance;
@@ -90,8 +107,12 @@ struct SpreadSample {
 
 // Per bin (see Calibration): epsilon and factor; a bin without pairs takes
 // the fit of its nearest measured neighbour (below first), like FillBounds.
+// A bin whose best median bound is no smaller than its constant bound
+// `constant[b]` keeps the constant one (factor 0): at the same confidence,
+// the per-pair bounds pay for their spread's tail with a larger factor, and
+// on a coarse index that can outweigh what they save.
 void FitSpreadBounds(const std::vector<SpreadSample> (&samples)[index::kAccuracyBins],
-                     double quantile, float* epsilon, float* factor) {
+                     double quantile, const float* constant, float* epsilon, float* factor) {
   bool fitted[index::kAccuracyBins] = {};
   for (int b = 0; b < index::kAccuracyBins; ++b) {
     epsilon[b] = 0;
@@ -106,7 +127,7 @@ void FitSpreadBounds(const std::vector<SpreadSample> (&samples)[index::kAccuracy
           ratio.push_back(x.error / (x.spread + eps * x.distance));
       }
       if (ratio.empty()) break;
-      const double k = Quantile(ratio, quantile);
+      const double k = UpperQuantile(ratio, quantile);
       for (const SpreadSample& x : samples[b]) bound.push_back(k * (x.spread + eps * x.distance));
       const double median = Quantile(bound, 0.5);
       if (std::isfinite(k) && median < best_median) {
@@ -115,6 +136,10 @@ void FitSpreadBounds(const std::vector<SpreadSample> (&samples)[index::kAccuracy
         factor[b] = static_cast<float>(k);
         fitted[b] = true;
       }
+    }
+    if (fitted[b] && !(best_median < constant[b])) {
+      epsilon[b] = 0;
+      factor[b] = 0;
     }
   }
   for (int b = 0; b < index::kAccuracyBins; ++b) {
@@ -128,6 +153,19 @@ void FitSpreadBounds(const std::vector<SpreadSample> (&samples)[index::kAccuracy
       }
     }
   }
+}
+
+// fn(k) for k in [0, n) on `threads` threads (0: all), each k once.
+void ForEachPair(size_t n, int threads, const std::function<void(size_t)>& fn) {
+  const int count = std::min<int>(common::ThreadCount(threads), static_cast<int>(std::max<size_t>(n, 1)));
+  std::atomic<size_t> next{0};
+  auto work = [&] {
+    for (size_t k = next++; k < n; k = next++) fn(k);
+  };
+  std::vector<std::thread> pool;
+  for (int t = 1; t < count; ++t) pool.emplace_back(work);
+  work();
+  for (std::thread& t : pool) t.join();
 }
 
 }  // namespace
@@ -164,11 +202,7 @@ UniformConfidence UniformConfidenceOf(const std::vector<double>& errors,
 }
 
 double P99UpperLimit(std::vector<double> x) {
-  if (x.empty()) return 0;
-  std::sort(x.begin(), x.end());
-  const double n = static_cast<double>(x.size());
-  const double rank = 0.99 * n + kZ95 * std::sqrt(n * 0.99 * 0.01);
-  return x[std::min(x.size() - 1, static_cast<size_t>(std::ceil(rank)))];
+  return x.empty() ? 0 : UpperQuantile(std::move(x), 0.99);
 }
 
 absl::StatusOr<Calibration> Calibrate(const mesh::Mesh& mesh,
@@ -191,18 +225,33 @@ absl::StatusOr<Calibration> Calibrate(const mesh::Mesh& mesh,
   std::vector<double> by_kind[2][kNumScaleBins];  // |relative error|, BinConfidence's kinds
   std::vector<int32_t> uniform_source;
   const query::DistanceOptions pure{.near_pairs = query::NearPairs::kUnfold};
-  double largest_answer = 0;  // of the last, open answer bin
-  for (const ExactPair& pair : pairs) {
-    const absl::StatusOr<double> u = engine->Distance(pair.p, pair.q, pure);
+  // Each pair's answers in its own slot, gathered in order below: the
+  // calibration does not depend on the thread count.
+  struct Answers {
+    absl::StatusOr<double> unfolded = absl::UnknownError("");
+    absl::StatusOr<double> walked = absl::UnknownError("");
     bool wraps = false;
-    const absl::StatusOr<double> t = engine->WalkedDistance(pair.p, pair.q, &wraps);
+    double spread = 0;
+  };
+  std::vector<Answers> answers(pairs.size());
+  ForEachPair(pairs.size(), options.pairs.threads, [&](size_t k) {
+    Answers& a = answers[k];
+    a.unfolded = engine->Distance(pairs[k].p, pairs[k].q, pure);
+    a.walked = engine->WalkedDistance(pairs[k].p, pairs[k].q, &a.wraps);
+    if (a.unfolded.ok()) a.spread = engine->UnfoldingSpread(pairs[k].p, pairs[k].q);
+  });
+  double largest_answer = 0;  // of the last, open answer bin
+  for (size_t k = 0; k < pairs.size(); ++k) {
+    const ExactPair& pair = pairs[k];
+    const absl::StatusOr<double>& u = answers[k].unfolded;
+    const bool wraps = answers[k].wraps;
+    const absl::StatusOr<double>& t = answers[k].walked;
     if (!u.ok()) continue;
     if (std::isfinite(*u)) largest_answer = std::max(largest_answer, *u);
     if (t.ok() && std::isfinite(*t)) largest_answer = std::max(largest_answer, *t);
     const int bin = AccuracyBinOf(*u, scale);
     unfold[pair.vertices ? 0 : 1][bin].push_back(std::abs(*u - pair.exact));
-    spread[pair.vertices ? 0 : 1][bin].push_back(
-        {std::abs(*u - pair.exact), engine->UnfoldingSpread(pair.p, pair.q), *u});
+    spread[pair.vertices ? 0 : 1][bin].push_back({std::abs(*u - pair.exact), answers[k].spread, *u});
     if (t.ok()) {
       trace[2 * pair.vertices + wraps][AccuracyBinOf(*t, scale)].push_back(
           std::abs(*t - pair.exact));
@@ -220,7 +269,8 @@ absl::StatusOr<Calibration> Calibrate(const mesh::Mesh& mesh,
   }
   Calibration result;
   for (int k = 0; k < 2; ++k) {
-    FitSpreadBounds(spread[k], options.quantile, result.spread.epsilon[k], result.spread.factor[k]);
+    FitSpreadBounds(spread[k], options.quantile, r.unfold_bound[k], result.spread.epsilon[k],
+                    result.spread.factor[k]);
   }
   // The default answer's figures, from an engine that has the bounds (the
   // default mode uses them to doubt a trace).
@@ -230,10 +280,22 @@ absl::StatusOr<Calibration> Calibrate(const mesh::Mesh& mesh,
   GEODEX_ASSIGN_OR_RETURN(std::string bytes, index::SerializeIndex(data));
   GEODEX_ASSIGN_OR_RETURN(auto calibrated, index::Index::FromBytes(std::move(bytes)));
   GEODEX_ASSIGN_OR_RETURN(engine, query::QueryEngine::Create(std::move(calibrated)));
-  for (const ExactPair& pair : pairs) {
-    const absl::StatusOr<double> d = engine->Distance(pair.p, pair.q);
+  std::vector<absl::StatusOr<double>> defaults(pairs.size(), absl::UnknownError(""));
+  ForEachPair(pairs.size(), options.pairs.threads,
+              [&](size_t k) { defaults[k] = engine->Distance(pairs[k].p, pairs[k].q); });
+  FixedBands& bands = result.bands;
+  bands.unit = ScaleLength(mesh.TotalArea(), kFixedUnitSamples);
+  std::vector<double> band_errors[2][kNumFixedBins], far_errors[2];
+  for (size_t k = 0; k < pairs.size(); ++k) {
+    const ExactPair& pair = pairs[k];
+    const absl::StatusOr<double>& d = defaults[k];
     if (!d.ok()) continue;
     const double e = (*d - pair.exact) / pair.exact;
+    const int kind = pair.vertices ? BinConfidence::kVertex : BinConfidence::kInterior;
+    band_errors[kind][FixedBinOf(pair.exact, bands.unit)].push_back(std::abs(e));
+    if (pair.uniform && pair.exact >= FixedBinLower(FixedBands::kFarBin) * bands.unit) {
+      far_errors[kind].push_back(std::abs(e));
+    }
     relative[pair.bin].push_back(e);
     by_kind[pair.vertices ? BinConfidence::kVertex : BinConfidence::kInterior][pair.bin].push_back(
         std::abs(e));
@@ -260,6 +322,15 @@ absl::StatusOr<Calibration> Calibrate(const mesh::Mesh& mesh,
       result.bins.p99[k][b] = x.empty() ? 0 : Quantile(x, 0.99);
       result.bins.p99_upper[k][b] = P99UpperLimit(x);
     }
+  }
+  for (int k = 0; k < 2; ++k) {
+    for (int b = 0; b < kNumFixedBins; ++b) {
+      bands.pairs[k][b] = static_cast<int32_t>(band_errors[k][b].size());
+      bands.p99[k][b] = band_errors[k][b].empty() ? 0 : Quantile(band_errors[k][b], 0.99);
+    }
+    bands.far_pairs[k] = static_cast<int32_t>(far_errors[k].size());
+    bands.far_p99[k] = far_errors[k].empty() ? 0 : Quantile(far_errors[k], 0.99);
+    bands.far_p99_upper[k] = P99UpperLimit(far_errors[k]);
   }
   result.record = r;
   return result;

@@ -31,7 +31,8 @@ struct CalibrationOptions {
   // lies, and the bounds must hold for sources not seen here.
   PairOptions pairs = {
       .num_sources = 64, .uniform_points = 60, .per_bin_points = 15, .seed = 0x6a09e667f3bcc909ULL};
-  // The bounds are this quantile of the absolute errors in their bin.
+  // The bounds are the 95% upper confidence limit of this quantile of the
+  // absolute errors in their bin.
   double quantile = 0.995;
 };
 
@@ -65,6 +66,24 @@ struct BinConfidence {
   int32_t pairs[2][kNumScaleBins] = {};
 };
 
+// The default answer's relative error in the bins of a unit fixed by the
+// surface (pair_sampling.h: L1000), vertex and interior pairs apart: what a
+// user gets at each distance, whatever m. The far band, pairs at least
+// 8 L1000 apart, holds only undirected draws (area-uniform interior
+// points; uniformly drawn vertices), and its p99 carries its 95% upper
+// confidence limit: what the default target judges (target_error.h).
+struct FixedBands {
+  static constexpr int kFarBin = 5;  // [8, 16) L1000 and beyond
+  double unit = 0;                   // L1000, in mesh units
+  // [kind][bin] over every pair (uniform and drawn in a bin); a bin without
+  // pairs has 0 pairs and 0 figures.
+  double p99[2][kNumFixedBins] = {};
+  int32_t pairs[2][kNumFixedBins] = {};
+  double far_p99[2] = {};
+  double far_p99_upper[2] = {};
+  int32_t far_pairs[2] = {};
+};
+
 // What a calibration measures: the record of the constant bounds and
 // figures, the per-pair bounds of O(1) answers fitted on the same pairs
 // (index::SpreadBoundRecord: per bin, epsilon from a fixed grid of powers
@@ -75,6 +94,7 @@ struct Calibration {
   index::SpreadBoundRecord spread{};
   UniformConfidence confidence;
   BinConfidence bins;
+  FixedBands bands;
 };
 
 // Measures `index` (built from `mesh`) and returns its calibration.

@@ -167,6 +167,20 @@ double ScaleLength(double area, int32_t num_samples) {
   return std::sqrt(2 * area / (std::sqrt(3.0) * num_samples));
 }
 
+const char* FixedBinName(int bin) {
+  static const char* const kNames[kNumFixedBins] = {"0-0.5", "0.5-1", "1-2",  "2-4",
+                                                    "4-8",   "8-16",  ">=16"};
+  return kNames[bin];
+}
+
+double FixedBinLower(int bin) { return bin == 0 ? 0.0 : std::ldexp(1.0, bin - 2); }
+
+int FixedBinOf(double d, double unit) {
+  int b = 0;
+  while (b + 1 < kNumFixedBins && d >= FixedBinLower(b + 1) * unit) ++b;
+  return b;
+}
+
 std::vector<mesh::SurfacePoint> RandomSurfacePoints(const mesh::Mesh& mesh, int32_t count,
                                                     uint64_t seed) {
   std::vector<int32_t> faces(mesh.num_faces());

@@ -31,6 +31,20 @@ int ScaleBinOf(double d, double scale_length);
 // L for a surface of area `area` tiled by `num_samples` samples.
 double ScaleLength(double area, int32_t num_samples);
 
+// Bins in a unit fixed by the surface, not by m: L1000 = ScaleLength(area,
+// 1000). A bin in the index's own L moves closer as m grows, so a target
+// set there can never be met; these bins say what a user gets at a
+// distance: [0, 0.5), [0.5, 1), [1, 2), [2, 4), [4, 8), [8, 16), [16, inf)
+// L1000.
+inline constexpr int kNumFixedBins = 7;
+inline constexpr int32_t kFixedUnitSamples = 1000;
+// "0-0.5", "0.5-1", ..., "8-16", ">=16" (in L1000).
+const char* FixedBinName(int bin);
+// The lower edge of fixed bin `bin`, in L1000.
+double FixedBinLower(int bin);
+// The fixed bin of distance d for unit L1000 `unit`.
+int FixedBinOf(double d, double unit);
+
 // A pair of surface points and their exact geodesic distance.
 struct ExactPair {
   mesh::SurfacePoint p, q;

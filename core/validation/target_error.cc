@@ -4,29 +4,22 @@
 #include <cmath>
 
 #include "absl/strings/str_format.h"
+#include "core/query/query_types.h"
 
 namespace geodex::validation {
 namespace {
 
 constexpr double kRmsRate = 0.7;
-constexpr double kBinRate = 0.6;
-
-int KindOf(int check) { return (check - 1) / kNumScaleBins; }
-int BinOf(int check) { return (check - 1) % kNumScaleBins; }
+constexpr double kFarRate = 0.8;
 
 }  // namespace
 
 std::string TargetCheckName(int check) {
   if (check == 0) return "uniform RMS";
-  return absl::StrFormat("%s %s p99",
-                         KindOf(check) == BinConfidence::kVertex ? "vertex" : "interior",
-                         ScaleBinName(BinOf(check)));
+  return check == 1 ? "vertex >=8 L1000 p99" : "interior >=8 L1000 p99";
 }
 
-double TargetLimit(int check, double target) {
-  if (check == 0) return target;
-  return BinOf(check) < 2 ? 2 * target : 4 * target;
-}
+double TargetLimit(int check, double target) { return check == 0 ? target : 4 * target; }
 
 TargetFigures FiguresOf(const Calibration& calibration, int32_t samples) {
   TargetFigures f;
@@ -34,14 +27,17 @@ TargetFigures FiguresOf(const Calibration& calibration, int32_t samples) {
   f.measured[0] = calibration.record.uniform_rms;
   f.upper[0] = calibration.confidence.rms_upper;
   f.pairs[0] = 1;  // a calibration always has uniform pairs
+  const FixedBands& bands = calibration.bands;
   for (int k = 0; k < 2; ++k) {
-    for (int b = 0; b < kNumScaleBins; ++b) {
-      const int check = 1 + k * kNumScaleBins + b;
-      f.measured[check] = calibration.bins.p99[k][b];
-      f.upper[check] = calibration.bins.p99_upper[k][b];
-      f.pairs[check] = calibration.bins.pairs[k][b];
+    f.measured[1 + k] = bands.far_p99[k];
+    f.upper[1 + k] = bands.far_p99_upper[k];
+    f.pairs[1 + k] = bands.far_pairs[k];
+    for (int b = 0; b < kNumFixedBins; ++b) {
+      f.band_p99[k][b] = bands.p99[k][b];
+      f.band_pairs[k][b] = bands.pairs[k][b];
     }
   }
+  f.unit = bands.unit;
   return f;
 }
 
@@ -61,6 +57,39 @@ int WorstCheck(const TargetFigures& f, double target) {
     if (ratio > worst_ratio) worst = c, worst_ratio = ratio;
   }
   return worst;
+}
+
+double Distance(const TargetFigures& f, double target) {
+  const int worst = WorstCheck(f, target);
+  return f.upper[worst] / TargetLimit(worst, target);
+}
+
+std::string BandsLine(const TargetFigures& f) {
+  std::string out = "p99 by L1000 band, vertex / interior:";
+  for (int b = 0; b < kNumFixedBins; ++b) {
+    auto figure = [&](int k) {
+      return f.band_pairs[k][b] > 0 ? absl::StrFormat("%.2f%%", 100 * f.band_p99[k][b])
+                                    : std::string("-");
+    };
+    out += absl::StrFormat(" %s %s / %s;", FixedBinName(b), figure(0), figure(1));
+  }
+  out.pop_back();
+  return out;
+}
+
+std::string BandsText(const TargetFigures& f, double scale_length) {
+  std::string out = absl::StrFormat("band_unit = %.6g\nband_refined_below = %.6g\n", f.unit,
+                                    f.unit > 0 ? query::kRefineScale * scale_length / f.unit : 0);
+  static const char* const kKind[2] = {"vertex", "interior"};
+  static const char* const kKey[kNumFixedBins] = {"0_0.5", "0.5_1", "1_2",   "2_4",
+                                                  "4_8",   "8_16",  "16_inf"};
+  for (int k = 0; k < 2; ++k) {
+    for (int b = 0; b < kNumFixedBins; ++b) {
+      out += absl::StrFormat("band_p99_%s_%s = %.6g\nband_pairs_%s_%s = %d\n", kKind[k], kKey[b],
+                             f.band_p99[k][b], kKind[k], kKey[b], f.band_pairs[k][b]);
+    }
+  }
+  return out;
 }
 
 std::string FiguresText(const TargetFigures& f, double target) {
@@ -86,7 +115,7 @@ int32_t PredictSamples(std::span<const TargetFigures> rounds, double target, int
   for (int c = 0; c < kNumTargetChecks; ++c) {
     const double limit = TargetLimit(c, target);
     if (last.pairs[c] == 0 || last.upper[c] <= limit) continue;
-    const double rate = c == 0 ? kRmsRate : kBinRate;
+    const double rate = c == 0 ? kRmsRate : kFarRate;
     want = std::max(want, last.samples * std::pow(last.upper[c] / (options.aim * limit), 1 / rate));
   }
   want = std::min(want, last.samples * options.max_growth);
@@ -94,12 +123,12 @@ int32_t PredictSamples(std::span<const TargetFigures> rounds, double target, int
 }
 
 int32_t SamplesWithinBytes(int64_t budget, int32_t samples, int64_t bytes) {
-  // The packed matrix: m (m - 1) / 2 floats.
-  auto matrix = [](double m) { return 2 * m * (m - 1); };
+  // The coded matrix: m (m - 1) / 2 codes of 2 bytes.
+  auto matrix = [](double m) { return m * (m - 1); };
   const double per_sample = std::max(0.0, bytes - matrix(samples)) / std::max(samples, 1);
-  // The positive root of 2 m^2 + (per_sample - 2) m - budget = 0.
-  const double b = per_sample - 2;
-  const double m = (-b + std::sqrt(b * b + 8.0 * static_cast<double>(budget))) / 4;
+  // The positive root of m^2 + (per_sample - 1) m - budget = 0.
+  const double b = per_sample - 1;
+  const double m = (-b + std::sqrt(b * b + 4.0 * static_cast<double>(budget))) / 2;
   return static_cast<int32_t>(std::clamp(std::floor(m), 3.0, 2e9));
 }
 

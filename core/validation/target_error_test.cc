@@ -22,46 +22,61 @@ TargetFigures AtShare(int32_t m, double share) {
   return f;
 }
 
-int Check(int kind, int bin) { return 1 + kind * kNumScaleBins + bin; }
+int FarCheck(int kind) { return 1 + kind; }
 
-TEST(TargetErrorTest, LimitsByBin) {
+TEST(TargetErrorTest, LimitsAndNames) {
   EXPECT_EQ(TargetLimit(0, kE), kE);
-  for (int kind = 0; kind < 2; ++kind) {
-    EXPECT_EQ(TargetLimit(Check(kind, 0), kE), 2 * kE);  // d < L
-    EXPECT_EQ(TargetLimit(Check(kind, 1), kE), 2 * kE);  // L-3L
-    EXPECT_EQ(TargetLimit(Check(kind, 2), kE), 4 * kE);  // 3L-10L
-    EXPECT_EQ(TargetLimit(Check(kind, 3), kE), 4 * kE);  // >= 10L
-  }
+  EXPECT_EQ(TargetLimit(FarCheck(BinConfidence::kVertex), kE), 4 * kE);
+  EXPECT_EQ(TargetLimit(FarCheck(BinConfidence::kInterior), kE), 4 * kE);
   EXPECT_EQ(TargetCheckName(0), "uniform RMS");
-  EXPECT_EQ(TargetCheckName(Check(BinConfidence::kVertex, 2)), "vertex 3L-10L p99");
-  EXPECT_EQ(TargetCheckName(Check(BinConfidence::kInterior, 3)), "interior >=10L p99");
+  EXPECT_EQ(TargetCheckName(FarCheck(BinConfidence::kVertex)), "vertex >=8 L1000 p99");
+  EXPECT_EQ(TargetCheckName(FarCheck(BinConfidence::kInterior)), "interior >=8 L1000 p99");
 }
 
 TEST(TargetErrorTest, EveryJudgedCheckMustBeMetByItsUpperLimit) {
   TargetFigures f = AtShare(1000, 0.99);
   EXPECT_TRUE(TargetMet(f, kE));
-  // One bin over its limit by its upper confidence limit fails the target,
-  // even when its measured p99 is under it.
-  const int c = Check(BinConfidence::kInterior, 2);
+  EXPECT_NEAR(Distance(f, kE), 0.99, 1e-12);
+  // One check over its limit by its upper confidence limit fails the
+  // target, even when its measured p99 is under it.
+  const int c = FarCheck(BinConfidence::kInterior);
   f.upper[c] = 1.01 * TargetLimit(c, kE);
   f.measured[c] = 0.9 * TargetLimit(c, kE);
   EXPECT_FALSE(TargetMet(f, kE));
   EXPECT_EQ(WorstCheck(f, kE), c);
-  EXPECT_NE(FiguresText(f, kE).find("interior 3L-10L p99"), std::string::npos);
+  EXPECT_NEAR(Distance(f, kE), 1.01, 1e-12);
+  EXPECT_NE(FiguresText(f, kE).find("interior >=8 L1000 p99"), std::string::npos);
   EXPECT_NE(FiguresText(f, kE).find("MISSED"), std::string::npos);
-  // A bin without pairs is not judged.
+  // A check without pairs (a surface too small for pairs 8 L1000 apart) is
+  // not judged.
   f.pairs[c] = 0;
   EXPECT_TRUE(TargetMet(f, kE));
 }
 
+TEST(TargetErrorTest, BandsAreReportedNotJudged) {
+  TargetFigures f = AtShare(1000, 0.5);
+  f.unit = 0.01;
+  f.band_p99[BinConfidence::kInterior][3] = 0.04;  // 2-4 L1000: 4%, over any limit
+  f.band_pairs[BinConfidence::kInterior][3] = 300;
+  EXPECT_TRUE(TargetMet(f, kE));
+  EXPECT_NE(BandsLine(f).find("2-4 - / 4.00%"), std::string::npos) << BandsLine(f);
+  // The bands' keys for the report, with the refinement's threshold in
+  // L1000 (kRefineScale of the index's own L).
+  const std::string text = BandsText(f, 0.005);
+  EXPECT_NE(text.find("band_unit = 0.01\n"), std::string::npos) << text;
+  EXPECT_NE(text.find("band_p99_interior_2_4 = 0.04\n"), std::string::npos) << text;
+  EXPECT_NE(text.find("band_pairs_interior_2_4 = 300\n"), std::string::npos) << text;
+  EXPECT_NE(text.find("band_pairs_vertex_16_inf = 0\n"), std::string::npos) << text;
+}
+
 TEST(TargetErrorTest, PredictionFromTheRatesTheFiguresFallAt) {
-  // A bin at 1.62x its limit: a bin's p99 falls as m^-0.6, so it asks
-  // (1.62 / 0.9)^(1 / 0.6) = 2.66x the samples.
+  // The far band at 1.62x its limit: its p99 falls as m^-0.8, so it asks
+  // (1.62 / 0.9)^(1 / 0.8) = 2.08x the samples.
   TargetFigures f = AtShare(500, 0.5);
-  const int c = Check(BinConfidence::kVertex, 2);
+  const int c = FarCheck(BinConfidence::kVertex);
   f.upper[c] = 1.62 * TargetLimit(c, kE);
   std::vector<TargetFigures> rounds = {f};
-  EXPECT_NEAR(PredictSamples(rounds, kE, 100000), 500 * std::pow(1.8, 1 / 0.6), 1);
+  EXPECT_NEAR(PredictSamples(rounds, kE, 100000), 500 * std::pow(1.8, 1 / 0.8), 1);
   // The RMS at 1.62x: it falls as m^-0.7, 1.8^(1/0.7) = 2.32x.
   TargetFigures g = AtShare(500, 0.5);
   g.upper[0] = 1.62 * kE;
@@ -69,7 +84,7 @@ TEST(TargetErrorTest, PredictionFromTheRatesTheFiguresFallAt) {
   EXPECT_NEAR(PredictSamples(rounds, kE, 100000), 500 * std::pow(1.8, 1 / 0.7), 1);
   // The last round decides.
   rounds = {AtShare(250, 5), f};
-  EXPECT_NEAR(PredictSamples(rounds, kE, 100000), 500 * std::pow(1.8, 1 / 0.6), 1);
+  EXPECT_NEAR(PredictSamples(rounds, kE, 100000), 500 * std::pow(1.8, 1 / 0.8), 1);
   // Growth at least 1.2x and at most 3x, and never past the cap.
   TargetFigures barely = AtShare(1000, 0.5);
   barely.upper[0] = 1.0001 * kE;  // (1.0001 / 0.9)^(1 / 0.7) = 1.16
@@ -81,16 +96,17 @@ TEST(TargetErrorTest, PredictionFromTheRatesTheFiguresFallAt) {
 }
 
 TEST(TargetErrorTest, SamplesWithinBytesCountsTheMatrixAndThePerSampleRest) {
-  // An index of exactly its packed matrix: m^2 - m = budget / 2.
+  // An index of exactly its coded lower triangle: m (m - 1) / 2 codes of
+  // 2 bytes.
   const int64_t budget = kMaxIndexBytes;
-  const int32_t m = SamplesWithinBytes(budget, 1000, 2 * int64_t{1000} * 999);
-  EXPECT_LE(2 * int64_t{m} * (m - 1), budget);
-  EXPECT_GT(2 * int64_t{m + 1} * m, budget);
+  const int32_t m = SamplesWithinBytes(budget, 1000, int64_t{1000} * 999);
+  EXPECT_LE(int64_t{m} * (m - 1), budget);
+  EXPECT_GT(int64_t{m + 1} * m, budget);
   EXPECT_NEAR(m, 5793, 1);
   // 4 kB a sample beside the matrix leaves room for fewer.
-  const int32_t fewer = SamplesWithinBytes(budget, 1000, 2 * int64_t{1000} * 999 + 4000 * 1000);
-  EXPECT_LE(2 * int64_t{fewer} * (fewer - 1) + int64_t{4000} * fewer, budget);
-  EXPECT_GT(2 * int64_t{fewer + 1} * fewer + int64_t{4000} * (fewer + 1), budget);
+  const int32_t fewer = SamplesWithinBytes(budget, 1000, int64_t{1000} * 999 + 4000 * 1000);
+  EXPECT_LE(int64_t{fewer} * (fewer - 1) + int64_t{4000} * fewer, budget);
+  EXPECT_GT(int64_t{fewer + 1} * fewer + int64_t{4000} * (fewer + 1), budget);
   EXPECT_LT(fewer, m);
 }
 

@@ -9,26 +9,30 @@
 #include <string>
 
 #include "absl/status/statusor.h"
+#include "core/index/sample_matrix.h"
 #include "core/mesh/mesh.h"
 #include "core/query/internal/query_engine.h"
 
 namespace geodex::testing {
 
 // The index file bytes of `mesh` with `samples` samples, calibrated when
-// `calibrate`. Errors: the builder's and the calibration's.
-absl::StatusOr<std::string> BuildTestIndex(const mesh::Mesh& mesh, int32_t samples,
-                                           bool calibrate = false);
+// `calibrate`, its sample matrix stored as `matrix` (the builder's 24-bit
+// codes by default; kFull where a test measures the method to float
+// precision). Errors: the builder's and the calibration's.
+absl::StatusOr<std::string> BuildTestIndex(
+    const mesh::Mesh& mesh, int32_t samples, bool calibrate = false,
+    index::MatrixLayout matrix = index::MatrixLayout::kCoded);
 
 // A query engine over BuildTestIndex's index.
 absl::StatusOr<std::shared_ptr<const query::QueryEngine>> BuildTestEngine(
     const mesh::Mesh& mesh, int32_t samples, bool calibrate = false,
-    query::QueryOptions options = {});
+    query::QueryOptions options = {}, index::MatrixLayout matrix = index::MatrixLayout::kCoded);
 
 // The same, for test bodies: throws std::runtime_error with the status on
 // failure, which GoogleTest reports as the test's failure (no dereference of
 // an error).
-std::shared_ptr<const query::QueryEngine> TestEngineOrThrow(const mesh::Mesh& mesh, int32_t samples,
-                                                            bool calibrate = false,
-                                                            query::QueryOptions options = {});
+std::shared_ptr<const query::QueryEngine> TestEngineOrThrow(
+    const mesh::Mesh& mesh, int32_t samples, bool calibrate = false,
+    query::QueryOptions options = {}, index::MatrixLayout matrix = index::MatrixLayout::kCoded);
 
 }  // namespace geodex::testing

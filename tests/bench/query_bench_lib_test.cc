@@ -103,7 +103,8 @@ TEST(QueryBenchPointsTest, PackedMatrixIsTheSampleMatrix) {
   const PackedMatrix packed(*ix);
   for (int32_t a = 0; a < ix->num_samples(); ++a) {
     for (int32_t b = 0; b < ix->num_samples(); ++b) {
-      EXPECT_EQ(packed(a, b), static_cast<double>(ix->SampleDistance(a, b))) << a << " " << b;
+      // A float32 copy (of the 24-bit codes, by default).
+      EXPECT_EQ(packed(a, b), static_cast<float>(ix->SampleDistance(a, b))) << a << " " << b;
     }
   }
 }

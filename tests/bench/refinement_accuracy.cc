@@ -39,19 +39,6 @@ mesh::Mesh ExactMesh(const index::Index& ix) {
   return *mesh::Mesh::Create(std::move(positions), std::move(faces), "index", options);
 }
 
-SurfacePoint RandomPoint(int32_t face, bool vertex, std::mt19937_64& rng) {
-  std::uniform_real_distribution<double> u(0, 1);
-  SurfacePoint p{face, {0, 0, 0}};
-  if (vertex) {
-    p.w[rng() % 3] = 1;
-    return p;
-  }
-  double a = u(rng), b = u(rng);
-  if (a + b > 1) a = 1 - a, b = 1 - b;
-  p.w = {1 - a - b, a, b};
-  return p;
-}
-
 // Pairs per O(1) scale bin: a random point and one a random walk of 1 to
 // 64 faces away (longer walks reach the far bins), at most `per_bin` each.
 void DrawBinnedPairs(const index::Index& ix, const query::QueryEngine& engine, bool vertex,
@@ -135,6 +122,19 @@ AccuracyRow Measure(const query::QueryEngine& engine, geodesic::ExactGeodesicSol
 }
 
 }  // namespace
+
+SurfacePoint RandomPoint(int32_t face, bool vertex, std::mt19937_64& rng) {
+  std::uniform_real_distribution<double> u(0, 1);
+  SurfacePoint p{face, {0, 0, 0}};
+  if (vertex) {
+    p.w[rng() % 3] = 1;
+    return p;
+  }
+  double a = u(rng), b = u(rng);
+  if (a + b > 1) a = 1 - a, b = 1 - b;
+  p.w = {1 - a - b, a, b};
+  return p;
+}
 
 std::vector<AccuracyRow> MeasureRefinementAccuracy(std::shared_ptr<const index::Index> ix,
                                                    int per_row) {

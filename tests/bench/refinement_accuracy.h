@@ -17,12 +17,17 @@
 
 #include <cstddef>
 #include <memory>
+#include <random>
 #include <string>
 #include <vector>
 
 #include "core/index/index.h"
+#include "core/mesh/mesh.h"
 
 namespace geodex::bench {
+
+// A uniform random point of `face`, or one of its corners when `vertex`.
+mesh::SurfacePoint RandomPoint(int32_t face, bool vertex, std::mt19937_64& rng);
 
 struct AccuracyRow {
   std::string pairs;  // e.g. "interior L-3L" or "uniform, tolerance 0.005"

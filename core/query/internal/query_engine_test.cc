@@ -17,9 +17,10 @@ namespace gen = mesh::gen;
 using mesh::Mesh;
 using ::testing::HasSubstr;
 
-std::shared_ptr<const QueryEngine> MakeEngine(const Mesh& m, int32_t samples,
-                                              QueryOptions options = {}) {
-  return geodex::testing::TestEngineOrThrow(m, samples, /*calibrate=*/false, options);
+std::shared_ptr<const QueryEngine> MakeEngine(
+    const Mesh& m, int32_t samples, QueryOptions options = {},
+    index::MatrixLayout matrix = index::MatrixLayout::kCoded) {
+  return geodex::testing::TestEngineOrThrow(m, samples, /*calibrate=*/false, options, matrix);
 }
 
 // Area-uniform random surface points.
@@ -85,12 +86,15 @@ double MaxRelativeError(const Mesh& m, const QueryEngine& engine, int num_points
 }
 
 // The unfolding is exact on developable, simply connected surfaces: only the
-// float32 storage of distances limits it.
-TEST(QueryEngineTest, DevelopableSurfacesAreExactToFloatPrecision) {
+// storage of the sample distances limits it. float32 rounds 6e-8 of a
+// distance; the default 24-bit codes up to 4.8e-7 (index/sample_matrix.h),
+// which the unfolding amplifies where a far sample lies near the line of an
+// edge it is placed from (tests/bench/accuracy.md).
+TEST(QueryEngineTest, DevelopableSurfacesAreExactToTheMatrixPrecision) {
   for (const Mesh& m : {gen::FoldedSheet(24, 16, 2.0, 1.0, 1.1), HalfCylinder(24, 16, 1.0, 3.0)}) {
     SCOPED_TRACE(m.name());
-    auto engine = MakeEngine(m, 40);
-    EXPECT_LT(MaxRelativeError(m, *engine, 60), 1e-5);
+    EXPECT_LT(MaxRelativeError(m, *MakeEngine(m, 40, {}, index::MatrixLayout::kFull), 60), 1e-5);
+    EXPECT_LT(MaxRelativeError(m, *MakeEngine(m, 40), 60), 5e-3);
   }
 }
 
@@ -99,7 +103,7 @@ TEST(QueryEngineTest, UnfoldingSpreadVanishesWhereBothOrdersAreExact) {
   // they disagree, symmetrically, and never between points of one
   // geodesic triangle.
   const Mesh sheet = gen::FoldedSheet(24, 16, 2.0, 1.0, 1.1);
-  auto flat = MakeEngine(sheet, 40);
+  auto flat = MakeEngine(sheet, 40, {}, index::MatrixLayout::kFull);
   const std::vector<SurfacePoint> a = RandomPoints(sheet, 200, 3);
   for (size_t k = 0; k + 1 < a.size(); k += 2) {
     EXPECT_LT(flat->UnfoldingSpread(a[k], a[k + 1]), 1e-5 * flat->O1Distance(a[k], a[k + 1]));

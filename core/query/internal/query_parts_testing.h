@@ -19,8 +19,11 @@
 namespace geodex::query::testing {
 
 struct QueryParts {
-  explicit QueryParts(const mesh::Mesh& mesh, int32_t samples)
-      : index(Open(mesh, samples)),
+  // `matrix`: kFull where a test checks the method to float precision (the
+  // builder's default 24-bit codes round 2.4e-7 of a distance).
+  explicit QueryParts(const mesh::Mesh& mesh, int32_t samples,
+                      index::MatrixLayout matrix = index::MatrixLayout::kCoded)
+      : index(Open(mesh, samples, matrix)),
         view{index->positions(), index->faces(), index->twins()},
         unfolding(*index, /*vector_lanes=*/true),
         lifting(view, index->vertices(), unfolding),
@@ -28,8 +31,10 @@ struct QueryParts {
         exact(*index, view) {}
   QueryParts(const QueryParts&) = delete;
 
-  static std::shared_ptr<const index::Index> Open(const mesh::Mesh& mesh, int32_t samples) {
-    absl::StatusOr<std::string> bytes = geodex::testing::BuildTestIndex(mesh, samples);
+  static std::shared_ptr<const index::Index> Open(const mesh::Mesh& mesh, int32_t samples,
+                                                  index::MatrixLayout matrix) {
+    absl::StatusOr<std::string> bytes =
+        geodex::testing::BuildTestIndex(mesh, samples, /*calibrate=*/false, matrix);
     if (!bytes.ok()) throw std::runtime_error(bytes.status().ToString());
     absl::StatusOr<std::shared_ptr<const index::Index>> ix = index::Index::FromBytes(*bytes);
     if (!ix.ok()) throw std::runtime_error(ix.status().ToString());

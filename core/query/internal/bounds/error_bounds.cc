@@ -21,7 +21,9 @@ double ErrorBounds::Of(AnswerKind kind, bool vertex_pair, double d, double sprea
   const int k = vertex_pair ? 0 : 1;
   switch (kind) {
     case AnswerKind::kUnfold:
-      if (spread_ != nullptr) return spread_->factor[k][b] * (spread + spread_->epsilon[k][b] * d);
+      if (spread_ != nullptr && spread_->factor[k][b] > 0) {
+        return spread_->factor[k][b] * (spread + spread_->epsilon[k][b] * d);
+      }
       return accuracy_->unfold_bound[k][b];
     case AnswerKind::kTrace:
       return accuracy_->trace_bound[vertex_pair ? 2 : 0][b];

@@ -35,6 +35,9 @@ std::shared_ptr<const index::Index> CalibratedGrid(bool spread) {
         s.factor[k][b] = 2;
       }
     }
+    // Bin 4 of other pairs keeps its constant bound.
+    s.epsilon[1][4] = 0;
+    s.factor[1][4] = 0;
     data->spread_bounds = {s};
   }
   absl::StatusOr<std::string> bytes = index::SerializeIndex(*data);
@@ -71,6 +74,9 @@ TEST(ErrorBoundsTest, SpreadScalesTheO1Bound) {
   ASSERT_TRUE(bounds.has_spread());
   // factor * (spread + epsilon * d) = 2 * (0.3 + 0.01 * 1).
   EXPECT_FLOAT_EQ(bounds.Of(AnswerKind::kUnfold, false, 1, 0.3), 2 * (0.3 + 0.01f * 1));
+  // A factor of 0: the bin's constant bound (d = 2 = 4 L, bin 4).
+  EXPECT_EQ(bounds.Of(AnswerKind::kUnfold, false, 2, 0.3), 50);
+  EXPECT_FLOAT_EQ(bounds.Of(AnswerKind::kUnfold, true, 2, 0.3), 2 * (0.3 + 0.01f * 2));
   EXPECT_EQ(bounds.Of(AnswerKind::kTrace, false, 0.1), 100);  // traces keep theirs
 }
 

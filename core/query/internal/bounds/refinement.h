@@ -23,6 +23,12 @@
 
 namespace geodex::query {
 
+// A near pair's walk no longer than (1 + kCertifiedExcess) x the chord is
+// taken as it is; a longer one is checked exactly (Refiner::Refine). Below
+// the 2% every near answer must keep, above most walks on smooth parts of a
+// surface (tests/bench/accuracy.md, "Walks the chord certifies").
+inline constexpr double kCertifiedExcess = 0.02;
+
 class Refiner {
  public:
   // Over the engine's parts, which must outlive this object. Pairs whose

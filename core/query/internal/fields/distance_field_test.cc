@@ -12,7 +12,7 @@ namespace {
 
 TEST(DistanceFieldTest, FlatSheetFieldIsTheDistanceToTheNearestSource) {
   const mesh::Mesh sheet = mesh::gen::Grid(10, 10, 2, 2);
-  const testing::QueryParts parts(sheet, 20);
+  const testing::QueryParts parts(sheet, 20, index::MatrixLayout::kFull);
   const std::vector<SurfacePoint> sources = {{3, {0.2, 0.3, 0.5}}, {150, {0.6, 0.2, 0.2}}};
   const DistanceField field = ApproximateField(parts.view, parts.lifting, parts.unfolding, sources);
   ASSERT_EQ(field.distance.size(), static_cast<size_t>(sheet.num_vertices()));

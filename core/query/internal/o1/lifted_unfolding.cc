@@ -16,11 +16,8 @@ using kernel::TwoSideToOutside2;
 }  // namespace
 
 LiftedUnfolding::LiftedUnfolding(const index::Index& index, bool vector_lanes)
-    : matrix_(index.packed_sample_distances() ? index.sample_distances_lower()
-                                              : index.sample_distances()),
-      packed_(index.packed_sample_distances()),
+    : matrix_(index.matrix()),
       triangles_(index.triangles()),
-      num_samples_(index.num_samples()),
       vector_lanes_(vector_lanes) {
   frames_.resize(3 * triangles_.size());
   for (size_t t = 0; t < triangles_.size(); ++t) {
@@ -90,7 +87,7 @@ void LiftedUnfolding::Prefetch(const LiftedPoint& p, const LiftedPoint& q) const
   const LiftedPoint& lo = p.triangle > q.triangle ? q : p;
   const LiftedPoint& hi = p.triangle > q.triangle ? p : q;
   for (int r = 0; r < 3; ++r) {
-    for (int c = 0; c < 3; ++c) __builtin_prefetch(Entry(hi.corner[r], lo.corner[c]));
+    for (int c = 0; c < 3; ++c) __builtin_prefetch(matrix_.Address(hi.corner[r], lo.corner[c]));
   }
 }
 

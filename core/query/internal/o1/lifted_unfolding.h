@@ -47,8 +47,8 @@ class LiftedUnfolding {
   // (the answers are the same to the bit either way).
   LiftedUnfolding(const index::Index& index, bool vector_lanes);
 
-  // The exact geodesic distance between samples a and b.
-  double Matrix(int32_t a, int32_t b) const { return static_cast<double>(*Entry(a, b)); }
+  // The geodesic distance between samples a and b, as the index stores it.
+  double Matrix(int32_t a, int32_t b) const { return matrix_(a, b); }
   // The frames of triangle t's three edges.
   const kernel::Frame<double>* Frames(int32_t t) const { return &frames_[3 * t]; }
 
@@ -78,21 +78,8 @@ class LiftedUnfolding {
  private:
   // What case 3.2 reads for a pair, p in the triangle of smaller id.
   kernel::FarPair GatherFar(const LiftedPoint& p, const LiftedPoint& q) const;
-  // Where d(a, b) is stored: row-major in a full matrix; in a matrix stored
-  // once (format 3), at hi (hi - 1) / 2 + lo of its strict lower triangle.
-  const float* Entry(int32_t a, int32_t b) const {
-    if (!packed_) return &matrix_[static_cast<size_t>(a) * num_samples_ + b];
-    if (a == b) return &kZero;
-    const size_t hi = static_cast<size_t>(std::max(a, b)), lo = static_cast<size_t>(std::min(a, b));
-    return &matrix_[hi * (hi - 1) / 2 + lo];
-  }
-
-  static constexpr float kZero = 0;
-  // The full matrix, or its strict lower triangle when packed_.
-  std::span<const float> matrix_;
-  bool packed_ = false;
+  index::SampleMatrix matrix_;
   std::span<const index::GeodesicTriangle> triangles_;
-  int32_t num_samples_ = 0;
   bool vector_lanes_ = true;
   std::vector<kernel::Frame<double>> frames_;  // 3 per geodesic triangle
 };

@@ -30,7 +30,7 @@ TEST(UnfoldingTest, FlatSheetDistancesAreEuclidean) {
   // On a flat sheet every geodesic is straight and every unfolding is exact,
   // both in one triangle (case 3.1) and across triangles (case 3.2).
   const mesh::Mesh sheet = mesh::gen::Grid(12, 12, 2, 2);
-  const testing::QueryParts parts(sheet, 30);
+  const testing::QueryParts parts(sheet, 30, index::MatrixLayout::kFull);
   const std::vector<SurfacePoint> points = Points(sheet, 120, 5);
   int same = 0, other = 0;
   for (size_t i = 0; i + 1 < points.size(); i += 2) {
@@ -99,11 +99,12 @@ TEST(UnfoldingTest, AMatrixStoredOnceGivesTheSameAnswers) {
       d[static_cast<size_t>(a) * m + b] = d[static_cast<size_t>(b) * m + a] = x;
     }
   }
+  data->sample_matrix = index::MatrixLayout::kFull;
   auto full = index::Index::FromBytes(*index::SerializeIndex(*data));
-  data->pack_sample_distances = true;
+  data->sample_matrix = index::MatrixLayout::kLower;
   auto packed = index::Index::FromBytes(*index::SerializeIndex(*data));
   ASSERT_TRUE(full.ok() && packed.ok());
-  ASSERT_TRUE((*packed)->packed_sample_distances());
+  ASSERT_EQ((*packed)->matrix().layout(), index::MatrixLayout::kLower);
   ASSERT_LT((*packed)->size_bytes(), (*full)->size_bytes());
   const MeshView view{(*full)->positions(), (*full)->faces(), (*full)->twins()};
   const LiftedUnfolding u_full(**full, true), u_packed(**packed, true);
@@ -118,6 +119,44 @@ TEST(UnfoldingTest, AMatrixStoredOnceGivesTheSameAnswers) {
   for (int32_t a = 0; a < m; ++a) {
     for (int32_t b = 0; b < m; ++b) EXPECT_EQ(u_full.Matrix(a, b), u_packed.Matrix(a, b));
   }
+}
+
+TEST(UnfoldingTest, ACodedMatrixAnswersWithinItsPrecision) {
+  // The builder's default (format 4): 24-bit codes round 2.4e-7 of a
+  // distance. The unfolding is not continuous in the matrix (a choice
+  // between corners jumps), so the answers move more than the entries, but
+  // within 1e-4 relative RMS of the float32 matrix's (tests/bench/accuracy.md,
+  // "The sample matrix in 24-bit codes").
+  const mesh::Mesh sphere = mesh::gen::Sphere(3, 1.0);
+  builder::BuildOptions options;
+  options.num_samples = 80;
+  builder::BuildSummary summary;
+  absl::StatusOr<index::IndexData> data = builder::BuildIndex(sphere, options, &summary);
+  ASSERT_TRUE(data.ok()) << data.status();
+  EXPECT_EQ(data->sample_matrix, index::MatrixLayout::kCoded);
+  auto coded = index::Index::FromBytes(*index::SerializeIndex(*data));
+  data->sample_matrix = index::MatrixLayout::kFull;
+  auto full = index::Index::FromBytes(*index::SerializeIndex(*data));
+  ASSERT_TRUE(full.ok() && coded.ok());
+  const MeshView view{(*full)->positions(), (*full)->faces(), (*full)->twins()};
+  const LiftedUnfolding u_full(**full, true), u_coded(**coded, true);
+  const Lifting l_full(view, (*full)->vertices(), u_full);
+  const Lifting l_coded(view, (*coded)->vertices(), u_coded);
+  const std::vector<SurfacePoint> points = Points(sphere, 400, 5);
+  double sum2 = 0, worst = 0;
+  int n = 0;
+  for (size_t i = 0; i + 1 < points.size(); i += 2) {
+    const double a = u_full.Distance(l_full.Lift(points[i]), l_full.Lift(points[i + 1]));
+    const double b = u_coded.Distance(l_coded.Lift(points[i]), l_coded.Lift(points[i + 1]));
+    if (!(a > 1e-3)) continue;
+    const double e = std::abs(b - a) / a;
+    sum2 += e * e;
+    worst = std::max(worst, e);
+    ++n;
+  }
+  ASSERT_GT(n, 150);
+  EXPECT_LE(std::sqrt(sum2 / n), 1e-4);  // 0.01% RMS
+  EXPECT_GT(worst, 0);                   // the codes do round
 }
 
 }  // namespace

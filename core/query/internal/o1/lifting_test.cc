@@ -19,7 +19,7 @@ TEST(LiftingTest, FlatSheetLiftsAreEuclideanDistancesToTheCorners) {
   // On a flat sheet every field is planar: lifted distances are exact for
   // vertices and interior points alike.
   const mesh::Mesh sheet = mesh::gen::Grid(10, 10, 2, 2);
-  const testing::QueryParts parts(sheet, 25);
+  const testing::QueryParts parts(sheet, 25, index::MatrixLayout::kFull);
   for (int32_t f = 0; f < sheet.num_faces(); f += 7) {
     for (const std::array<double, 3>& w :
          {std::array<double, 3>{1.0 / 3, 1.0 / 3, 1.0 / 3}, std::array<double, 3>{0.7, 0.2, 0.1},
