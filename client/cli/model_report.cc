@@ -189,6 +189,26 @@ absl::StatusOr<std::string> ModelReportText(const ModelInfo& m) {
                           FormatPercent(f.Num(a, "uniform_rms")),
                           FormatPercent(f.Num(target, "error")),
                           FormatPercent(f.Num(a, "uniform_far_p99")));
+    // The fixed L1000 bands: in reports since format 4.0, empty or absent
+    // before.
+    const std::vector<const Struct*> bands =
+        a.fields().contains("bands") ? f.List(a, "bands") : std::vector<const Struct*>();
+    if (!bands.empty()) {
+      absl::StrAppendFormat(&out,
+                            "  by distance   p99 in units of L1000 = %.4g (the spacing of 1000 "
+                            "samples); refined below %.3g L1000\n",
+                            f.Num(a, "band_unit"), f.Num(a, "refined_below"));
+      absl::StrAppendFormat(&out, "                  %-10s %9s %9s %11s  %s\n", "L1000", "vertex",
+                            "interior", "p99 limit", "answered");
+      for (const Struct* b : bands) {
+        const double vertex = f.Num(*b, "p99_vertex"), interior = f.Num(*b, "p99_interior");
+        const double limit = f.Num(*b, "p99_limit");
+        absl::StrAppendFormat(&out, "                  %-10s %9s %9s %11s  %s%s\n",
+                              f.Str(*b, "label"), FormatPercent(vertex), FormatPercent(interior),
+                              std::isnan(limit) ? std::string("-") : FormatPercent(limit),
+                              f.Str(*b, "answer"), vertex > limit || interior > limit ? "  over" : "");
+      }
+    }
   }
   if (!f.ok) {
     return absl::InvalidArgumentError(

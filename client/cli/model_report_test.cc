@@ -51,6 +51,12 @@ constexpr char kReport[] = R"json({
     "bins": [
       {"key": "below_L", "label": "d < L", "from_L": 0, "to_L": 1, "rms": 0.00017556928, "p99": 1.6596281e-15, "p99_limit": 0.01},
       {"key": "beyond_10L", "label": ">= 10L", "from_L": 10, "to_L": null, "rms": 0.014184382, "p99": 0.04691552, "p99_limit": 0.02}
+    ],
+    "band_unit": 0.2525,
+    "refined_below": 9.49,
+    "bands": [
+      {"key": "1_2", "label": "1-2", "from": 1, "to": 2, "p99_vertex": 0.0000001, "p99_interior": null, "pairs_vertex": 40, "pairs_interior": 0, "p99_limit": null, "answer": "walked or exact"},
+      {"key": "8_16", "label": "8-16", "from": 8, "to": 16, "p99_vertex": 0.0503, "p99_interior": 0.0139, "pairs_vertex": 900, "pairs_interior": 870, "p99_limit": 0.02, "answer": "walked or exact below 9.49, O(1) above"}
     ]
   },
   "build_report": {
@@ -86,6 +92,13 @@ TEST(ModelReportTest, LaysOutTheServersReport) {
               HasSubstr("                  >= 10L         1.42%     4.69%       2.00%  over\n"));
   EXPECT_THAT(*text,
               HasSubstr("area-uniform pairs: RMS 1.25% (limit 0.500%), p99 beyond 10L 4.73%"));
+  // The fixed L1000 bands, as core/index/index_report.cc lays them out.
+  EXPECT_THAT(*text, HasSubstr("  by distance   p99 in units of L1000 = 0.2525 (the spacing of "
+                               "1000 samples); refined below 9.49 L1000\n"));
+  EXPECT_THAT(*text, HasSubstr("                  1-2          <0.001%       n/a           -  "
+                               "walked or exact\n"));
+  EXPECT_THAT(*text, HasSubstr("                  8-16           5.03%     1.39%       2.00%  "
+                               "walked or exact below 9.49, O(1) above  over\n"));
 }
 
 TEST(ModelReportTest, RefusesAMalformedReport) {

@@ -48,9 +48,12 @@ TEST(BuildRoundsTest, GrowsTheSamplesUntilTheTargetIsMet) {
 }
 
 TEST(BuildRoundsTest, StopsAtTheCapAndSaysSo) {
-  const mesh::Mesh m = mesh::gen::Sphere(3, 1.0);
-  RoundsOptions options = Options(20, 1e-6);
-  options.max_samples = 20;
+  // A long thin torus: at 60 samples most pairs are far apart in the
+  // index's own L, answered in O(1), which no m meets 1e-6 with. (On a
+  // small sphere every pair would be near and refined exactly.)
+  const mesh::Mesh m = mesh::gen::Torus(64, 12, 4.0, 0.5);
+  RoundsOptions options = Options(60, 1e-6);
+  options.max_samples = 60;
   absl::StatusOr<TargetBuild> result = BuildToTarget(m, {}, options, nullptr);
   ASSERT_TRUE(result.ok()) << result.status();
   EXPECT_FALSE(result->last.reached);
