@@ -12,12 +12,13 @@
 // (c << 2) + bits(2^-8). Rounding to the nearest code errs at most 2^-22
 // (2.4e-7) of d + scale / 256: 2.4e-7 of d for the long distances that
 // make most of a matrix, up to 4.8e-7 at d = scale / 256, and
-// scale * 2^-30 below. Why 24 bits and not 16: the O(1) answer errs 1e-3
-// to 5e-2 of d, but it is not continuous in the matrix: an unfolding that
-// chooses between two corners or two sides jumps by up to 1% when an
-// entry crosses the choice. With 16 bits (6e-5 of d) enough entries cross
-// to move the answers 3e-4 relative RMS from float32's; with 24 bits,
-// 4e-5 (tests/bench/accuracy.md, "The sample matrix in 24-bit codes").
+// scale * 2^-30 below. Why 24 bits and not 16, though the O(1) answer
+// errs far more than either: it is not continuous in the matrix (an
+// unfolding that chooses between two corners or two sides jumps when an
+// entry crosses the choice), and with 16 bits enough entries cross to move
+// the answers beyond what the float32 matrix gives by more than the limit
+// the codes are held to (tests/bench/accuracy.md, "The sample matrix in
+// 24-bit codes").
 // Code 0xFFFFFF is +inf (samples on different components). Decoding is
 // three byte loads, a shift, an add and a multiply: no table.
 //
