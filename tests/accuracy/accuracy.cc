@@ -7,11 +7,27 @@
 #include <random>
 #include <span>
 
+#include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "core/geodesic/exact_geodesic.h"
 
 namespace geodex::accuracy {
 namespace {
+
+// The default target's far band starts here (core/validation/target_error.h).
+constexpr double kFarL1000 = 8;
+
+std::string Pct(double x) { return absl::StrFormat("%.3f%%", 100 * x); }
+
+// One Markdown row of MarkdownHeader's columns.
+std::string Row(const std::string& label, const char* kind, const std::string& bin,
+                const BinReport& r) {
+  return absl::StrFormat(
+      "| %s | %s | %s | %d | %s | %s | %s | %s | %s |\n", label, kind, bin, r.error.count,
+      Pct(r.error.rms), Pct(r.error.p99), Pct(r.error.max),
+      std::isnan(r.coverage) ? "-" : Pct(r.coverage),
+      std::isnan(r.median_bound) ? "-" : absl::StrFormat("%.2f", r.median_bound / r.p90_abs_error));
+}
 
 double Percentile(std::vector<double> x, double q) {
   if (x.empty()) return std::numeric_limits<double>::quiet_NaN();
@@ -41,18 +57,26 @@ ErrorStats ErrorStats::Of(std::vector<double> errors) {
   return s;
 }
 
-ModeReport Evaluate(const std::vector<ExactPair>& pairs, const AnswerFn& answer) {
+ModeReport Evaluate(const std::vector<ExactPair>& pairs, const AnswerFn& answer, double unit) {
   struct Acc {
     std::vector<double> rel, abs, bound;
     int64_t covered = 0;
   };
   std::array<Acc, kNumBins> vertex, interior, all;
+  std::array<Acc, kNumFixedBins> fixed_vertex, fixed_interior;
+  Acc far_vertex, far_interior;
   std::vector<double> uniform;
   for (const ExactPair& pair : pairs) {
     const Answer a = answer(pair.p, pair.q);
     const double rel = (a.distance - pair.exact) / pair.exact;
     const double abs = std::abs(a.distance - pair.exact);
-    for (Acc* acc : {&(pair.vertices ? vertex : interior)[pair.bin], &all[pair.bin]}) {
+    std::vector<Acc*> accs = {&(pair.vertices ? vertex : interior)[pair.bin], &all[pair.bin]};
+    if (unit > 0) {
+      const int fixed = validation::FixedBinOf(pair.exact, unit);
+      accs.push_back(&(pair.vertices ? fixed_vertex : fixed_interior)[fixed]);
+      if (pair.exact >= kFarL1000 * unit) accs.push_back(pair.vertices ? &far_vertex : &far_interior);
+    }
+    for (Acc* acc : accs) {
       acc->rel.push_back(rel);
       acc->abs.push_back(abs);
       if (!std::isnan(a.bound)) {
@@ -86,6 +110,12 @@ ModeReport Evaluate(const std::vector<ExactPair>& pairs, const AnswerFn& answer)
       }
     }
   }
+  for (int b = 0; b < kNumFixedBins; ++b) {
+    report.fixed_vertex[b] = finish(fixed_vertex[b]);
+    report.fixed_interior[b] = finish(fixed_interior[b]);
+  }
+  report.far_vertex = finish(far_vertex);
+  report.far_interior = finish(far_interior);
   report.uniform = ErrorStats::Of(uniform);
   return report;
 }
@@ -96,29 +126,46 @@ std::string MarkdownHeader() {
 }
 
 std::string MarkdownRows(const std::string& label, const ModeReport& report) {
-  auto pct = [](double x) { return absl::StrFormat("%.3f%%", 100 * x); };
   std::string out;
   for (int kind = 0; kind < 2; ++kind) {
     for (int b = 0; b < kNumBins; ++b) {
       const BinReport& r = (kind == 0 ? report.vertex : report.interior)[b];
-      if (r.error.count == 0) continue;
-      out += absl::StrFormat(
-          "| %s | %s | %s | %d | %s | %s | %s | %s | %s |\n", label,
-          kind == 0 ? "vertex" : "interior", BinName(b), r.error.count, pct(r.error.rms),
-          pct(r.error.p99), pct(r.error.max), std::isnan(r.coverage) ? "-" : pct(r.coverage),
-          std::isnan(r.median_bound) ? "-"
-                                     : absl::StrFormat("%.2f", r.median_bound / r.p90_abs_error));
+      if (r.error.count > 0) out += Row(label, kind == 0 ? "vertex" : "interior", BinName(b), r);
     }
   }
   // The area-uniform pairs alone, every scale: the figure a target error
   // (geodex-build --target-error) is stated in.
   if (report.uniform.count > 0) {
     out += absl::StrFormat("| %s | uniform | all | %d | %s | %s | %s | - | - |\n", label,
-                           report.uniform.count, pct(report.uniform.rms), pct(report.uniform.p99),
-                           pct(report.uniform.max));
+                           report.uniform.count, Pct(report.uniform.rms), Pct(report.uniform.p99),
+                           Pct(report.uniform.max));
   }
   out += absl::StrFormat("| %s | **worst** | %s | | | **%s** | | | |\n", label,
-                         BinName(report.worst_bin), pct(report.worst_p99));
+                         BinName(report.worst_bin), Pct(report.worst_p99));
+  return out;
+}
+
+std::string MarkdownFixedRows(const std::string& label, const ModeReport& report, double target) {
+  std::string out;
+  for (int kind = 0; kind < 2; ++kind) {
+    for (int b = 0; b < kNumFixedBins; ++b) {
+      const BinReport& r = (kind == 0 ? report.fixed_vertex : report.fixed_interior)[b];
+      if (r.error.count == 0) continue;
+      out += Row(label, kind == 0 ? "vertex" : "interior",
+                 absl::StrCat(validation::FixedBinName(b), " L1000"), r);
+    }
+  }
+  const bool rms_met = report.uniform.rms <= target;
+  const bool vertex_met = report.far_vertex.error.p99 <= 4 * target;
+  const bool interior_met = report.far_interior.error.p99 <= 4 * target;
+  out += absl::StrFormat(
+      "| %s | **target %s** | uniform RMS %s (<= %s)%s; >=8 L1000 p99 vertex %s%s, interior "
+      "%s%s (<= %s) | %d / %d / %d | | | | | |\n",
+      label, rms_met && vertex_met && interior_met ? "met" : "NOT met", Pct(report.uniform.rms),
+      Pct(target), rms_met ? "" : " NOT met", Pct(report.far_vertex.error.p99),
+      vertex_met ? "" : " NOT met", Pct(report.far_interior.error.p99),
+      interior_met ? "" : " NOT met", Pct(4 * target), report.uniform.count,
+      report.far_vertex.error.count, report.far_interior.error.count);
   return out;
 }
 

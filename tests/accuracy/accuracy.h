@@ -53,19 +53,32 @@ struct BinReport {
   double p90_abs_error = std::numeric_limits<double>::quiet_NaN();
 };
 
+using validation::kNumFixedBins;
+
 struct ModeReport {
   std::array<BinReport, kNumBins> vertex, interior, all;
+  // By bins of L1000 (pair_sampling.h), a unit fixed by the surface, when
+  // Evaluate is given it: what the default target is stated in. `far_*`
+  // holds every pair at least 8 L1000 apart.
+  std::array<BinReport, kNumFixedBins> fixed_vertex, fixed_interior;
+  BinReport far_vertex, far_interior;
   ErrorStats uniform;  // the area-uniform interior pairs only, every scale
   // The bin (over vertex and interior) with the largest p99; its p99.
   int worst_bin = 0;
   double worst_p99 = 0;
 };
 
-ModeReport Evaluate(const std::vector<ExactPair>& pairs, const AnswerFn& answer);
+// `unit`: L1000 in mesh units, for the fixed bins (0: left empty).
+ModeReport Evaluate(const std::vector<ExactPair>& pairs, const AnswerFn& answer, double unit = 0);
 
 // Markdown: one row per bin and point kind, then a summary row.
 std::string MarkdownHeader();
 std::string MarkdownRows(const std::string& label, const ModeReport& report);
+// The rows by fixed L1000 bin, then the default target's checks for target
+// error `target` (target_error.h: uniform RMS <= E, p99 at least 8 L1000
+// apart <= 4E, vertex and interior) as measured here, each marked met or
+// not. Same columns as MarkdownHeader.
+std::string MarkdownFixedRows(const std::string& label, const ModeReport& report, double target);
 
 // Path length / exact distance - 1 over area-uniform pairs: Path (traced,
 // straightened, restarted) and the raw gradient trace.

@@ -71,9 +71,11 @@ absl::StatusOr<std::shared_ptr<const index::Index>> CalibratedInMemory(
 
 // Measures one mode (ParseAnswerMode's) of `pairs` with `walking` or, for
 // nowalk, `tracing`; prints its rows and timing.
-absl::Status MeasureMode(const std::string& label, const std::string& mode_name,
-                         const AnswerMode& mode, const std::vector<validation::ExactPair>& pairs,
-                         std::shared_ptr<const query::QueryEngine> engine, int32_t num_samples) {
+absl::Status MeasureMode(const HarnessFlags& flags, const std::string& label,
+                         const std::string& mode_name, const AnswerMode& mode,
+                         const std::vector<validation::ExactPair>& pairs,
+                         std::shared_ptr<const query::QueryEngine> engine, int32_t num_samples,
+                         double unit) {
   query::QueryScratch scratch;
   int64_t failed = 0;
   // The pairs are in the file's ids, as a caller's are.
@@ -93,14 +95,16 @@ absl::Status MeasureMode(const std::string& label, const std::string& mode_name,
     return a;
   };
   const auto start = std::chrono::steady_clock::now();
-  const ModeReport report = Evaluate(pairs, answer);
+  const ModeReport report = Evaluate(pairs, answer, unit);
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   std::fprintf(stderr, "%s %s: %.2f us per pair, %lld failed\n", label.c_str(), mode_name.c_str(),
                1e6 * seconds / pairs.size(), static_cast<long long>(failed));
-  std::printf(
-      "%s",
-      MarkdownRows(absl::StrFormat("%s m=%d %s", label, num_samples, mode_name), report).c_str());
+  const std::string row_label = absl::StrFormat("%s m=%d %s", label, num_samples, mode_name);
+  std::printf("%s", MarkdownRows(row_label, report).c_str());
+  if (flags.target_error > 0) {
+    std::printf("%s", MarkdownFixedRows(row_label, report, flags.target_error).c_str());
+  }
   std::fflush(stdout);
   return absl::OkStatus();
 }
@@ -125,6 +129,12 @@ AccuracyCommandLine::AccuracyCommandLine()
   app_.add_flag("--error-driven", f.error_driven,
                 "Also build each m with error-driven placement (spacing weights from the "
                 "farthest-point index's error map) and measure it on the same pairs");
+  app_.add_option("--index", f.index_file,
+                  "Measure this index file of the one mesh given (e.g. a default build) instead "
+                  "of building one per --samples");
+  app_.add_option("--target-error", f.target_error,
+                  "Also print rows by fixed L1000 bin and the default target's checks for this "
+                  "target error (0.005: the default build's)");
   app_.add_option("--threads", f.threads, "Builder and exact-propagation threads (0: all)");
   app_.add_option(
           "--modes", f.modes,
@@ -181,36 +191,50 @@ absl::StatusOr<std::shared_ptr<const index::Index>> IndexFor(
 
 absl::Status MeasureModes(const HarnessFlags& flags, const std::string& label,
                           const std::vector<validation::ExactPair>& pairs,
-                          std::shared_ptr<const index::Index> index) {
+                          std::shared_ptr<const index::Index> index, double unit) {
   GEODEX_ASSIGN_OR_RETURN(auto walking, query::QueryEngine::Create(index));
   GEODEX_ASSIGN_OR_RETURN(auto tracing,
                           query::CreateQueryEngine(index, {}, {.walk_near_pairs = false}));
   for (const std::string& name : flags.modes) {
     GEODEX_ASSIGN_OR_RETURN(const AnswerMode mode, ParseAnswerMode(name));
-    GEODEX_RETURN_IF_ERROR(MeasureMode(label, name, mode, pairs, mode.nowalk ? tracing : walking,
-                                       index->num_samples()));
+    GEODEX_RETURN_IF_ERROR(MeasureMode(flags, label, name, mode, pairs,
+                                       mode.nowalk ? tracing : walking, index->num_samples(), unit));
   }
   return absl::OkStatus();
 }
 
 absl::Status RunHarness(const HarnessFlags& flags) {
+  if (!flags.index_file.empty() && flags.meshes.size() != 1) {
+    return absl::InvalidArgumentError("--index measures the index of one mesh; give that mesh only");
+  }
   std::printf("%s", MarkdownHeader().c_str());
   for (const std::string& path : flags.meshes) {
     GEODEX_ASSIGN_OR_RETURN(const mesh::Mesh m, LoadHarnessMesh(path));
     const std::string name = std::filesystem::path(path).stem().string();
+    const double unit = validation::ScaleLength(m.TotalArea(), validation::kFixedUnitSamples);
+    validation::PairOptions pair_options = flags.pairs;
+    pair_options.threads = flags.threads;
+    if (!flags.index_file.empty()) {
+      GEODEX_ASSIGN_OR_RETURN(std::shared_ptr<const index::Index> index,
+                              index::Index::Open(flags.index_file));
+      if (index->accuracy() == nullptr) {
+        GEODEX_ASSIGN_OR_RETURN(index, CalibratedInMemory(m, std::move(index), flags.index_file));
+      }
+      const auto pairs = validation::DrawPairs(m, index->num_samples(), pair_options);
+      GEODEX_RETURN_IF_ERROR(MeasureModes(flags, name, pairs, index, unit));
+      continue;
+    }
     for (int32_t count : flags.samples) {
       GEODEX_ASSIGN_OR_RETURN(auto index, IndexFor(flags, m, name, count, "", {}));
-      validation::PairOptions pair_options = flags.pairs;
-      pair_options.threads = flags.threads;
       const auto pairs = validation::DrawPairs(m, index->num_samples(), pair_options);
-      GEODEX_RETURN_IF_ERROR(MeasureModes(flags, name, pairs, index));
+      GEODEX_RETURN_IF_ERROR(MeasureModes(flags, name, pairs, index, unit));
       if (!flags.error_driven) continue;
       GEODEX_ASSIGN_OR_RETURN(const std::vector<double> weights,
                               PlacementWeights(flags, m, index, count));
       GEODEX_ASSIGN_OR_RETURN(auto placed, IndexFor(flags, m, name, count, "-placed", weights));
       // The same pairs: L differs by the few samples repair adds, so a
       // handful of pairs may sit in a neighbouring bin.
-      GEODEX_RETURN_IF_ERROR(MeasureModes(flags, name + " error-driven", pairs, placed));
+      GEODEX_RETURN_IF_ERROR(MeasureModes(flags, name + " error-driven", pairs, placed, unit));
     }
   }
   return absl::OkStatus();

@@ -35,6 +35,12 @@ struct HarnessFlags {
   std::vector<std::string> modes = {"unfold", "default", "bounds", "tol0.005"};
   bool no_split = false;
   bool error_driven = false;
+  // An index file to measure (of the one mesh given) instead of building
+  // one per --samples: a default build, say.
+  std::string index_file;
+  // > 0: also rows by fixed L1000 bin and the default target's checks for
+  // this target error (core/validation/target_error.h), as measured here.
+  double target_error = 0;
 };
 
 // The geodex-accuracy app: parsing it (CLI11_PARSE) fills flags().
@@ -86,15 +92,18 @@ absl::StatusOr<std::shared_ptr<const index::Index>> IndexFor(
 
 // Prints on stdout a Markdown row per bin and point kind for every mode of
 // flags.modes, answering `pairs` (in the mesh file's ids) with `index`;
-// timing on stderr. Errors: the queries' setup, ParseAnswerMode's (after
+// with flags.target_error, also the rows of MarkdownFixedRows for L1000
+// `unit`; timing on stderr. Errors: the queries' setup, ParseAnswerMode's (after
 // the rows of the modes before).
 absl::Status MeasureModes(const HarnessFlags& flags, const std::string& label,
                           const std::vector<validation::ExactPair>& pairs,
-                          std::shared_ptr<const index::Index> index);
+                          std::shared_ptr<const index::Index> index, double unit = 0);
 
 // The whole run: the Markdown header, then for every mesh and m the rows of
 // MeasureModes (and of the error-driven placement with
-// flags.error_driven). Errors: the first mesh's, index's or mode's.
+// flags.error_driven), or the rows of flags.index_file. Errors: the first
+// mesh's, index's or mode's; InvalidArgument for an index file with other
+// than one mesh.
 absl::Status RunHarness(const HarnessFlags& flags);
 
 }  // namespace geodex::accuracy

@@ -1,10 +1,12 @@
 #include "tests/accuracy/accuracy_harness.h"
 
+#include <cmath>
 #include <filesystem>
 #include <string>
 #include <vector>
 
 #include "core/mesh/generators.h"
+#include "tests/accuracy/accuracy.h"
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
 
@@ -45,6 +47,64 @@ TEST(AccuracyCommandLineTest, ListsAreCommaSeparated) {
   EXPECT_TRUE(flags.no_split);
   EXPECT_TRUE(flags.error_driven);
   EXPECT_THROW(Parse("--samples 5"), CLI::RequiredError);
+}
+
+TEST(AccuracyCommandLineTest, AnIndexFileAndATarget) {
+  const HarnessFlags flags = Parse("m.obj --index m.gdx --target-error 0.005");
+  EXPECT_EQ(flags.index_file, "m.gdx");
+  EXPECT_EQ(flags.target_error, 0.005);
+  EXPECT_EQ(Parse("m.obj").target_error, 0);
+}
+
+TEST(AccuracyHarnessTest, AnIndexFileNeedsOneMesh) {
+  HarnessFlags flags = Parse("a.obj b.obj --index a.gdx");
+  const absl::Status status = RunHarness(flags);
+  EXPECT_EQ(status.code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(status.message(), HasSubstr("one mesh"));
+}
+
+// Pairs at known distances, answered with known errors: the fixed bins and
+// the target's checks count what they should.
+TEST(AccuracyHarnessTest, FixedBinsAndTheTargetChecks) {
+  const double unit = 2.0;  // L1000
+  std::vector<ExactPair> pairs;
+  auto add = [&](double exact, bool vertices, bool uniform) {
+    ExactPair pair;
+    pair.exact = exact;
+    pair.vertices = vertices;
+    pair.uniform = uniform;
+    pair.q.face = static_cast<int32_t>(pairs.size());  // the answer below finds the pair by it
+    pairs.push_back(pair);
+  };
+  for (int i = 0; i < 100; ++i) add(0.5, false, true);   // 0.25 L1000: bin 0-0.5
+  for (int i = 0; i < 100; ++i) add(20.0, true, true);   // 10 L1000: 8-16, far
+  for (int i = 0; i < 100; ++i) add(40.0, false, true);  // 20 L1000: >=16, far
+  // Relative error 1% below 8 L1000 and 0.5% beyond: RMS over the uniform
+  // interior pairs (bins 0-0.5 and >=16) is sqrt((1e-4 + 0.25e-4) / 2).
+  const AnswerFn answer = [&](const mesh::SurfacePoint&, const mesh::SurfacePoint& q) {
+    const double exact = pairs[q.face].exact;
+    return Answer{exact * (exact >= 8 * unit ? 1.005 : 1.01)};
+  };
+  const ModeReport report = Evaluate(pairs, answer, unit);
+  EXPECT_EQ(report.fixed_interior[0].error.count, 100);
+  EXPECT_EQ(report.fixed_vertex[5].error.count, 100);
+  EXPECT_EQ(report.fixed_interior[6].error.count, 100);
+  EXPECT_EQ(report.far_vertex.error.count, 100);
+  EXPECT_EQ(report.far_interior.error.count, 100);
+  EXPECT_NEAR(report.far_interior.error.p99, 0.005, 1e-12);
+  EXPECT_NEAR(report.uniform.rms, std::sqrt((1e-4 + 0.25e-4) / 2), 1e-12);
+
+  std::string rows = MarkdownFixedRows("x", report, 0.01);
+  EXPECT_THAT(rows, HasSubstr("| x | interior | 0-0.5 L1000 | 100 |"));
+  EXPECT_THAT(rows, HasSubstr("**target met**"));
+  rows = MarkdownFixedRows("x", report, 0.004);  // RMS 0.79% > 0.4%; p99 0.5% <= 1.6%
+  EXPECT_THAT(rows, HasSubstr("**target NOT met**"));
+  EXPECT_THAT(rows, HasSubstr("uniform RMS 0.791% (<= 0.400%) NOT met"));
+  rows = MarkdownFixedRows("x", report, 0.001);  // p99 0.5% > 0.4% too
+  EXPECT_THAT(rows, HasSubstr("vertex 0.500% NOT met"));
+
+  // Without a unit the fixed bins stay empty.
+  EXPECT_EQ(Evaluate(pairs, answer).far_vertex.error.count, 0);
 }
 
 TEST(AccuracyHarnessTest, AnswerModes) {

@@ -8,6 +8,9 @@
 #     BUILD_DIR  a build tree with core/geodex-build (default: build)
 #     MESH       names under ../shared/meshes (default: every mesh but the cow)
 #   GEODEX_BENCH_THREADS  builder threads (default 2)
+#   GEODEX_BENCH_KEEP     a folder to keep the indexes in (<mesh>.gdx, with
+#                         the build's log beside it), for the accuracy
+#                         harness (geodex-accuracy MESH --index FILE)
 set -euo pipefail
 
 repo="$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)"
@@ -31,6 +34,8 @@ else
 fi
 work="$(mktemp -d)"
 trap 'rm -rf "$work"' EXIT
+keep="${GEODEX_BENCH_KEEP:-}"
+[[ -n "$keep" ]] && mkdir -p "$keep"
 
 printf 'mesh\tvertices\tm\trounds (m)\tmet\tMiB\tMiB by section\twall s\tCPU s\tpeak RSS MiB\tuniform RMS\tp99 >=8 L1000 (vertex / interior)\n'
 for name in "${meshes[@]}"; do
@@ -47,6 +52,7 @@ for name in "${meshes[@]}"; do
     continue
   fi
   read -r wall user sys rss < "$work/time"
+  [[ -n "$keep" ]] && cp "$out" "$log" "$keep/"
   python3 - "$name" "$work/$name.json" "$wall" "$user" "$sys" "$rss" <<'PY'
 import json, sys
 name, path, wall, user, sys_s, rss = sys.argv[1:]

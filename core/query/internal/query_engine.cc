@@ -62,7 +62,7 @@ absl::StatusOr<double> QueryEngine::Distance(const SurfacePoint& p, const Surfac
   const LiftedPoint la = lifting_.Lift(a), lb = lifting_.Lift(b);
   const double d = unfolding_.Distance(la, lb);
   const bool near = unfolding_.AreNear(la, lb);
-  if (!refiner_.Needs(options, bound != nullptr, near, d)) return d;
+  if (!refiner_.Needs(options, bound != nullptr, near, d, a, b)) return d;
   return refiner_.Refine(a, b, la, lb, d, near, options, scratch, bound);
 }
 
@@ -83,7 +83,7 @@ absl::Status QueryEngine::DistanceBatch(std::span<const SurfacePoint> a,
   if (scratch == nullptr) scratch = &own;
   auto refine = [&](size_t k, const LiftedPoint& p, const LiftedPoint& q) {
     const bool near = unfolding_.AreNear(p, q);
-    if (refiner_.Needs(options, want_bounds, near, out[k])) {
+    if (refiner_.Needs(options, want_bounds, near, out[k], a[k], b[k])) {
       out[k] = refiner_.Refine(view_.Canonical(a[k]), view_.Canonical(b[k]), p, q, out[k], near,
                                options, scratch, want_bounds ? &bounds[k] : nullptr);
     }

@@ -29,6 +29,14 @@ namespace geodex::query {
 // surface (tests/bench/accuracy.md, "Walks the chord certifies").
 inline constexpr double kCertifiedExcess = 0.02;
 
+// A pair whose O(1) answer lands above refine_below is still refined when
+// its chord is below and the answer below kChordNet x refine_below: the
+// calibrated margin in refine_below covers 99.5% of the O(1) answer's
+// overestimates, this its tail (a bunny's pair 2.9 L apart answered 11%
+// long), at the price of walking the pairs just past refine_below on curved
+// parts, where the chord is shorter than the geodesic.
+inline constexpr double kChordNet = 1.5;
+
 class Refiner {
  public:
   // Over the engine's parts, which must outlive this object. Pairs whose
@@ -44,9 +52,11 @@ class Refiner {
         walk_(walk),
         refine_below_(refine_below) {}
 
-  // True when a pair's O(1) answer `unfolded` is not final under `options`
-  // (`bounds`: a bound is asked for; `near`: the lifts are near).
-  bool Needs(const DistanceOptions& options, bool bounds, bool near, double unfolded) const;
+  // True when the O(1) answer `unfolded` of the pair p, q (any valid points)
+  // is not final under `options` (`bounds`: a bound is asked for; `near`:
+  // the lifts are near).
+  bool Needs(const DistanceOptions& options, bool bounds, bool near, double unfolded,
+             const SurfacePoint& p, const SurfacePoint& q) const;
 
   // The answer for a pair of canonical points, valid, lifted to lp and lq,
   // whose O(1) distance is `unfolded` (near: the lifts are near), refined as
@@ -62,6 +72,11 @@ class Refiner {
   const ErrorBounds& bounds_;
   const GradientPaths& paths_;
   const LocalExact& exact_;
+  // True when the pair may be closer than refine_below: its O(1) answer is
+  // below it, or overestimates by less than kChordNet and the chord, never
+  // longer than the geodesic, is below it.
+  bool MayBeNear(double unfolded, const SurfacePoint& p, const SurfacePoint& q) const;
+
   bool walk_;
   double refine_below_;
 };

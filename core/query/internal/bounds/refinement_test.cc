@@ -25,12 +25,28 @@ struct RefinerFixture {
 TEST(RefinerTest, WhatIsRefinedFollowsTheOptions) {
   const RefinerFixture f(mesh::gen::Sphere(2, 1.0), 30, /*refine_below=*/0.5);
   const DistanceOptions path, unfold{.near_pairs = NearPairs::kUnfold};
-  EXPECT_TRUE(f.refiner.Needs(path, false, /*near=*/true, 2.0));  // near pairs always
-  EXPECT_TRUE(f.refiner.Needs(path, false, false, 0.4));          // below refine_below
-  EXPECT_FALSE(f.refiner.Needs(path, false, false, 0.6));
-  EXPECT_FALSE(f.refiner.Needs(unfold, false, false, 0.4));  // pure O(1)
-  EXPECT_TRUE(f.refiner.Needs(unfold, /*bounds=*/true, false, 0.6));
-  EXPECT_TRUE(f.refiner.Needs({.tolerance = 0.01}, false, false, 0.6));
+  // Two points far apart (chord 2 on the unit sphere) and two close ones.
+  const mesh::SurfacePoint top = f.parts.view.Canonical({0, {1, 0, 0}});
+  mesh::SurfacePoint bottom = top;
+  double farthest = 0;
+  for (int32_t face = 0; face < f.parts.index->num_faces(); ++face) {
+    const mesh::SurfacePoint x = f.parts.view.Canonical({face, {1, 0, 0}});
+    const double chord = (f.parts.view.PositionOf(x) - f.parts.view.PositionOf(top)).norm();
+    if (chord > farthest) farthest = chord, bottom = x;
+  }
+  const mesh::SurfacePoint& p = top;
+  const mesh::SurfacePoint& q = bottom;
+  EXPECT_TRUE(f.refiner.Needs(path, false, /*near=*/true, 2.0, p, q));  // near pairs always
+  EXPECT_TRUE(f.refiner.Needs(path, false, false, 0.4, p, q));          // below refine_below
+  EXPECT_FALSE(f.refiner.Needs(path, false, false, 0.6, p, q));
+  EXPECT_FALSE(f.refiner.Needs(unfold, false, false, 0.4, p, q));  // pure O(1)
+  EXPECT_TRUE(f.refiner.Needs(unfold, /*bounds=*/true, false, 0.6, p, q));
+  EXPECT_TRUE(f.refiner.Needs({.tolerance = 0.01}, false, false, 0.6, p, q));
+  // An answer a little above refine_below whose chord is below: the answer
+  // may overestimate a near pair, which is refined; not past kChordNet.
+  EXPECT_TRUE(f.refiner.Needs(path, false, false, 0.6, p, p));
+  EXPECT_FALSE(f.refiner.Needs(path, false, false, 0.5 * kChordNet + 0.01, p, p));
+  EXPECT_FALSE(f.refiner.Needs(unfold, false, false, 0.6, p, p));
 }
 
 TEST(RefinerTest, RefinedNearPairsOnAFoldAreExactAndSymmetric) {
