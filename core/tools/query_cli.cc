@@ -116,6 +116,11 @@ void QueryCommandLine::AddAnswerOptions() {
                   "With --pairs: relative error tolerance (e.g. 0.005): refine every pair whose "
                   "bound exceeds tolerance x distance (0: off)")
       ->check(CLI::NonNegativeNumber);
+  app_.add_option("--refine-below", a.refine_below,
+                  "With --pairs: refine (as --near-pairs says) every pair that may be closer "
+                  "than this many L1000, the spacing of 1,000 samples on the surface (e.g. 8: "
+                  "the every-distance mode; 0: the index's own threshold, 3 of its spacings)")
+      ->check(CLI::NonNegativeNumber);
   app_.add_option("--exact-path-corridor", a.exact_path_corridor,
                   "With --paths: also solve exactly within this many edge steps of the traced "
                   "path and keep the shorter (not O(k); 0: off)")
@@ -133,6 +138,7 @@ query::DistanceOptions DistanceOptionsOf(const QueryToolArgs& args) {
                        : args.near_pairs == "unfold"                 ? query::NearPairs::kUnfold
                                                                      : query::NearPairs::kPath;
   options.tolerance = args.tolerance;
+  options.refine_below_l1000 = args.refine_below;
   return options;
 }
 

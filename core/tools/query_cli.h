@@ -45,6 +45,7 @@ struct QueryToolArgs {
   bool nearest = false;             // --field: also the nearest source
   bool error_bounds = false;        // --pairs: also each answer's bound
   double tolerance = 0;
+  double refine_below = 0;  // --refine-below, in L1000 (0: the index's threshold)
   int32_t exact_path_corridor = 0;
 };
 
@@ -67,7 +68,8 @@ class QueryCommandLine {
   CLI::App app_;
 };
 
-// The distance options the flags ask for (near pairs, tolerance).
+// The distance options the flags ask for (near pairs, tolerance, the
+// refinement threshold).
 query::DistanceOptions DistanceOptionsOf(const QueryToolArgs& args);
 
 // The index's build report (core/index/index_report.h) for --info: text

@@ -78,6 +78,8 @@ TEST(QueryCommandLineTest, RefusesWhatCli11Checks) {
   EXPECT_THROW(Parse("x.gdx --pairs a --near-pairs fast"), CLI::ValidationError);
   EXPECT_THROW(Parse("x.gdx --paths a --exact-path-corridor 65"), CLI::ValidationError);
   EXPECT_THROW(Parse("x.gdx --pairs a --tolerance -1"), CLI::ValidationError);
+  EXPECT_THROW(Parse("x.gdx --pairs a --refine-below -1"), CLI::ValidationError);
+  EXPECT_EQ(Parse("x.gdx --pairs a --refine-below 8").refine_below, 8);
   EXPECT_THROW(Parse("x.gdx --paths a --format csv"), CLI::ValidationError);
   EXPECT_THROW(Parse("x.gdx --expmap '0 1 0 0' --direction 1 0"), CLI::ArgumentMismatch);
 }
@@ -88,7 +90,8 @@ TEST(QueryCommandLineTest, HelpNamesEveryQuery) {
   EXPECT_THAT(help, StartsWith("geodex-query: geodesic queries from an index file, offline."));
   for (const char* flag :
        {"--pairs", "--paths", "--field", "--locate", "--expmap", "--info", "--near-pairs",
-        "--exact-near-pairs", "--error-bounds", "--tolerance", "--exact-path-corridor",
+        "--exact-near-pairs", "--error-bounds", "--tolerance", "--refine-below",
+        "--exact-path-corridor",
         "--linear-baseline", "--nearest", "--format", "--radius", "--direction"}) {
     EXPECT_THAT(help, HasSubstr(flag));
   }
@@ -101,6 +104,9 @@ TEST(QueryToolTest, DistanceOptionsFollowTheFlags) {
   args.tolerance = 0.02;
   EXPECT_EQ(DistanceOptionsOf(args).near_pairs, query::NearPairs::kUnfold);
   EXPECT_EQ(DistanceOptionsOf(args).tolerance, 0.02);
+  EXPECT_EQ(DistanceOptionsOf(args).refine_below_l1000, 0);
+  args.refine_below = 8;
+  EXPECT_EQ(DistanceOptionsOf(args).refine_below_l1000, 8);
   args.exact_near = true;  // --exact-near-pairs wins over --near-pairs
   EXPECT_EQ(DistanceOptionsOf(args).near_pairs, query::NearPairs::kExact);
   args = {};

@@ -139,7 +139,8 @@ AccuracyCommandLine::AccuracyCommandLine()
   app_.add_option(
           "--modes", f.modes,
           "Answer modes: unfold (pure O(1)), default, exact (near pairs exactly), bounds "
-          "(default with error bounds), tolX (tolerance X, e.g. tol0.005), trace, nowalk (default "
+          "(default with error bounds), tolX (tolerance X, e.g. tol0.005), belowX (default, "
+          "refining every pair closer than X L1000, e.g. below8), trace, nowalk (default "
           "without the walks of near pairs: the trace only)")
       ->delimiter(',');
 }
@@ -162,6 +163,8 @@ absl::StatusOr<AnswerMode> ParseAnswerMode(const std::string& mode) {
     m.options.near_pairs = query::NearPairs::kExact;
   } else if (mode == "bounds") {
     m.bounds = true;
+  } else if (mode.rfind("below", 0) == 0) {
+    m.options.refine_below_l1000 = std::stod(mode.substr(5));
   } else if (mode.rfind("tol", 0) == 0) {
     m.options.tolerance = std::stod(mode.substr(3));
     m.bounds = true;

@@ -71,8 +71,9 @@ struct AnswerMode {
   bool nowalk = false;  // an engine without the walks of near pairs ("nowalk")
 };
 
-// unfold, default, exact, bounds, tolX (tolerance X, with bounds; X as
-// std::stod reads it, which throws when it is no number), trace, nowalk.
+// unfold, default, exact, bounds, tolX (tolerance X, with bounds), belowX
+// (default, refining below X L1000: DistanceOptions::refine_below_l1000),
+// trace, nowalk; X as std::stod reads it, which throws when it is no number.
 // Errors: InvalidArgument "unknown mode M".
 absl::StatusOr<AnswerMode> ParseAnswerMode(const std::string& mode);
 

@@ -120,6 +120,9 @@ TEST(AccuracyHarnessTest, AnswerModes) {
   mode = ParseAnswerMode("tol0.01");
   EXPECT_TRUE(mode->bounds);
   EXPECT_EQ(mode->options.tolerance, 0.01);
+  mode = ParseAnswerMode("below8");
+  EXPECT_EQ(mode->options.refine_below_l1000, 8);
+  EXPECT_FALSE(mode->bounds);
   mode = ParseAnswerMode("trace");
   EXPECT_TRUE(mode->trace);
   EXPECT_FALSE(mode->nowalk);

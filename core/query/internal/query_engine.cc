@@ -52,7 +52,9 @@ QueryEngine::QueryEngine(std::shared_ptr<const index::Index> index, QueryOptions
       // is closer: with a calibration, refine every pair that may be closer
       // than 3L (its answer minus the bound of answers between 3L and 5L).
       refine_below_(kRefineScale * scale_length_ + bounds_.RefineMargin()),
-      refiner_(view_, unfolding_, bounds_, paths_, exact_, knobs_.walk_near_pairs, refine_below_) {}
+      l1000_(ScaleLength(view_, 1000)),
+      refiner_(view_, unfolding_, bounds_, paths_, exact_, knobs_.walk_near_pairs, refine_below_,
+               l1000_) {}
 
 absl::StatusOr<double> QueryEngine::Distance(const SurfacePoint& p, const SurfacePoint& q,
                                              const DistanceOptions& options, QueryScratch* scratch,

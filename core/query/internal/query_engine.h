@@ -116,6 +116,9 @@ class QueryEngine {
   // kRefineScale * scale_length(), plus the calibration's bound of O(1)
   // answers between 3L and 5L (a pair answered beyond 3L may be closer).
   double refine_below() const { return refine_below_; }
+  // L1000 = sqrt(2 A / (sqrt(3) 1000)): the unit of
+  // DistanceOptions::refine_below_l1000, fixed by the surface whatever m.
+  double l1000() const { return l1000_; }
   // True when the index carries its accuracy calibration (error bounds).
   bool has_error_bounds() const { return bounds_.available(); }
 
@@ -187,6 +190,7 @@ class QueryEngine {
   PointLocator locator_;
   double scale_length_;
   double refine_below_;
+  double l1000_;
   Refiner refiner_;
 };
 

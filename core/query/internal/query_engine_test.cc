@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <random>
 
 #include "core/builder/builder.h"
@@ -334,6 +335,45 @@ TEST(QueryEngineTest, NearPairsTheWalksCannotSettleAreExact) {
   }
   EXPECT_GT(near, 10);
   EXPECT_GT(unsettled, 10);
+}
+
+// A request that raises the threshold past every pair (the every-distance
+// mode at its extreme) refines them all: each answer is the walks' local
+// geodesic or exact, so no worse than the O(1) answer, and much better on a
+// coarse index. A threshold it cannot parse is refused.
+TEST(QueryEngineTest, ARequestRaisesTheRefinementThresholdInL1000) {
+  const Mesh m = gen::Torus(48, 24, 1.0, 0.45);
+  auto engine = MakeEngine(m, 60);
+  EXPECT_NEAR(engine->l1000(), engine->scale_length() * std::sqrt(60 / 1000.0), 1e-12);
+  const DistanceOptions every{.refine_below_l1000 = 1e6};
+  const auto points = RandomPoints(m, 120, 5);
+  double o1_worst = 0, every_worst = 0;
+  geodesic::ExactGeodesicSolver solver(m);
+  for (size_t i = 0; i + 1 < points.size(); i += 2) {
+    const SurfacePoint& p = points[i];
+    const SurfacePoint& q = points[i + 1];
+    ASSERT_TRUE(solver.Propagate({p}).ok());
+    const double exact = solver.DistanceAt(q);
+    const double o1 = *engine->Distance(p, q, {.near_pairs = NearPairs::kUnfold});
+    const double refined = *engine->Distance(p, q, every);
+    const auto walked = engine->WalkedDistance(p, q);
+    const double exactly = *engine->Distance(p, q, {.near_pairs = NearPairs::kExact,
+                                                    .refine_below_l1000 = 1e6});
+    EXPECT_TRUE((walked.ok() && refined == *walked) || refined == exactly)
+        << refined << " walked " << (walked.ok() ? *walked : -1) << " exact " << exactly;
+    EXPECT_NEAR(exactly, exact, 1e-9 * exact);
+    double out = 0;
+    ASSERT_TRUE(engine->DistanceBatch({&p, 1}, {&q, 1}, {&out, 1}, every).ok());
+    EXPECT_EQ(out, refined);
+    o1_worst = std::max(o1_worst, std::abs(o1 - exact) / exact);
+    every_worst = std::max(every_worst, std::abs(refined - exact) / exact);
+  }
+  EXPECT_GT(o1_worst, 0.03);       // 60 samples: the O(1) answer errs by several %
+  EXPECT_LT(every_worst, 0.0201);  // walks within 2% of the chord's certificate, or exact
+  for (const double bad : {-1.0, std::nan(""), std::numeric_limits<double>::infinity()}) {
+    const absl::StatusOr<double> d = engine->Distance(points[0], points[1], {.refine_below_l1000 = bad});
+    EXPECT_EQ(d.status().code(), absl::StatusCode::kInvalidArgument) << bad;
+  }
 }
 
 // An O(1) answer that overestimates puts a pair closer than 3L above 3L; a

@@ -49,6 +49,10 @@ absl::Status ErrorBounds::CheckOptions(const DistanceOptions& options, bool boun
     return absl::InvalidArgumentError(
         absl::StrFormat("tolerance must be finite and >= 0, not %g", options.tolerance));
   }
+  if (!(options.refine_below_l1000 >= 0) || !std::isfinite(options.refine_below_l1000)) {
+    return absl::InvalidArgumentError(absl::StrFormat(
+        "refine_below_l1000 must be finite and >= 0, not %g", options.refine_below_l1000));
+  }
   if ((bounds || options.tolerance > 0) && accuracy_ == nullptr) {
     return absl::FailedPreconditionError(
         "the index has no accuracy calibration (error bounds, tolerance): rebuild it, or add one "

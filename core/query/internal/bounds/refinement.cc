@@ -9,16 +9,17 @@
 #include "core/query/internal/paths/chord_walk.h"
 
 namespace geodex::query {
-bool Refiner::MayBeNear(double unfolded, const SurfacePoint& p, const SurfacePoint& q) const {
-  return unfolded < refine_below_ ||
-         (unfolded < kChordNet * refine_below_ &&
-          (view_.PositionOf(p) - view_.PositionOf(q)).norm() < refine_below_);
+bool Refiner::MayBeNear(double unfolded, double below, const SurfacePoint& p,
+                        const SurfacePoint& q) const {
+  return unfolded < below || (unfolded < kChordNet * below &&
+                              (view_.PositionOf(p) - view_.PositionOf(q)).norm() < below);
 }
 
 bool Refiner::Needs(const DistanceOptions& options, bool bounds, bool near, double unfolded,
                     const SurfacePoint& p, const SurfacePoint& q) const {
   return near || bounds || options.tolerance > 0 ||
-         (options.near_pairs != NearPairs::kUnfold && MayBeNear(unfolded, p, q));
+         (options.near_pairs != NearPairs::kUnfold &&
+          MayBeNear(unfolded, RefineBelow(options), p, q));
 }
 
 double Refiner::Refine(const SurfacePoint& p_in, const SurfacePoint& q_in, const LiftedPoint& lp,
@@ -106,7 +107,7 @@ double Refiner::Refine(const SurfacePoint& p_in, const SurfacePoint& q_in, const
     return (kind == AnswerKind::kTrace || kind == AnswerKind::kWrappedTrace) &&
            d > unfolded + bound_of(AnswerKind::kUnfold, unfolded);
   };
-  if (near || MayBeNear(unfolded, p, q)) {
+  if (near || MayBeNear(unfolded, RefineBelow(options), p, q)) {
     switch (options.near_pairs) {
       case NearPairs::kPath:
         near_path();

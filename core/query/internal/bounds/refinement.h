@@ -14,6 +14,8 @@
 // Thread safety: immutable; every method is const and thread-safe, with one
 // QueryScratch per thread.
 
+#include <algorithm>
+
 #include "core/query/internal/bounds/error_bounds.h"
 #include "core/query/internal/paths/gradient_path.h"
 #include "core/query/internal/o1/lifted_unfolding.h"
@@ -40,17 +42,20 @@ inline constexpr double kChordNet = 1.5;
 class Refiner {
  public:
   // Over the engine's parts, which must outlive this object. Pairs whose
-  // O(1) answer is below `refine_below` are refined by default. `walk`:
-  // near-pair paths try the chord's corridors first (chord_walk.h).
+  // O(1) answer is below `refine_below` are refined by default, or below
+  // DistanceOptions::refine_below_l1000 x `l1000` where that is more.
+  // `walk`: near-pair paths try the chord's corridors first (chord_walk.h).
   Refiner(const MeshView& view, const LiftedUnfolding& unfolding, const ErrorBounds& bounds,
-          const GradientPaths& paths, const LocalExact& exact, bool walk, double refine_below)
+          const GradientPaths& paths, const LocalExact& exact, bool walk, double refine_below,
+          double l1000)
       : view_(view),
         unfolding_(unfolding),
         bounds_(bounds),
         paths_(paths),
         exact_(exact),
         walk_(walk),
-        refine_below_(refine_below) {}
+        refine_below_(refine_below),
+        l1000_(l1000) {}
 
   // True when the O(1) answer `unfolded` of the pair p, q (any valid points)
   // is not final under `options` (`bounds`: a bound is asked for; `near`:
@@ -72,13 +77,19 @@ class Refiner {
   const ErrorBounds& bounds_;
   const GradientPaths& paths_;
   const LocalExact& exact_;
-  // True when the pair may be closer than refine_below: its O(1) answer is
+  // True when the pair may be closer than `below`: its O(1) answer is
   // below it, or overestimates by less than kChordNet and the chord, never
   // longer than the geodesic, is below it.
-  bool MayBeNear(double unfolded, const SurfacePoint& p, const SurfacePoint& q) const;
+  bool MayBeNear(double unfolded, double below, const SurfacePoint& p,
+                 const SurfacePoint& q) const;
+  // The threshold of a call: refine_below, raised by the options.
+  double RefineBelow(const DistanceOptions& options) const {
+    return std::max(refine_below_, options.refine_below_l1000 * l1000_);
+  }
 
   bool walk_;
   double refine_below_;
+  double l1000_;
 };
 
 }  // namespace geodex::query

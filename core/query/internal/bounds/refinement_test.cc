@@ -12,11 +12,13 @@ namespace geodex::query {
 namespace {
 
 struct RefinerFixture {
+  // L1000 is a tenth of refine_below here, whatever the mesh: the tests
+  // below raise the threshold in its units.
   explicit RefinerFixture(const mesh::Mesh& mesh, int32_t samples, double refine_below)
       : parts(mesh, samples),
         bounds(*parts.index),
         refiner(parts.view, parts.unfolding, bounds, parts.paths, parts.exact, /*walk=*/true,
-                refine_below) {}
+                refine_below, refine_below / 10) {}
   testing::QueryParts parts;
   ErrorBounds bounds;
   Refiner refiner;
@@ -47,6 +49,17 @@ TEST(RefinerTest, WhatIsRefinedFollowsTheOptions) {
   EXPECT_TRUE(f.refiner.Needs(path, false, false, 0.6, p, p));
   EXPECT_FALSE(f.refiner.Needs(path, false, false, 0.5 * kChordNet + 0.01, p, p));
   EXPECT_FALSE(f.refiner.Needs(unfold, false, false, 0.6, p, p));
+
+  // A request raises the threshold (16 L1000 = 16 x 0.05 = 0.8), never
+  // lowers it.
+  const DistanceOptions every{.refine_below_l1000 = 16};
+  EXPECT_TRUE(f.refiner.Needs(every, false, false, 0.7, p, q));
+  EXPECT_FALSE(f.refiner.Needs(every, false, false, 0.9, p, q));  // the chord is 2
+  const DistanceOptions lower{.refine_below_l1000 = 2};  // 0.1: the index's 0.5 holds
+  EXPECT_TRUE(f.refiner.Needs(lower, false, false, 0.4, p, q));
+  EXPECT_FALSE(f.refiner.Needs(lower, false, false, 0.6, p, q));
+  EXPECT_FALSE(f.refiner.Needs({.near_pairs = NearPairs::kUnfold, .refine_below_l1000 = 16}, false,
+                               false, 0.7, p, q));
 }
 
 TEST(RefinerTest, RefinedNearPairsOnAFoldAreExactAndSymmetric) {
