@@ -324,15 +324,15 @@ absl::StatusOr<query::NearPairs> NearPairsFor(const ModelConfig& config, int req
 }  // namespace
 
 DistanceChoice DistanceChoice::Of(const v1::DistanceRequest& r) {
-  return {r.near_pairs(), r.exact_near_pairs(), r.tolerance(), r.error_bounds()};
+  return {r.near_pairs(), r.exact_near_pairs(), r.tolerance(), r.error_bounds(), r.refine_below()};
 }
 
 DistanceChoice DistanceChoice::Of(const v1::DistanceBatch& r) {
-  return {r.near_pairs(), r.exact_near_pairs(), r.tolerance(), r.error_bounds()};
+  return {r.near_pairs(), r.exact_near_pairs(), r.tolerance(), r.error_bounds(), r.refine_below()};
 }
 
 DistanceChoice DistanceChoice::Of(const v1::MatrixRequest& r) {
-  return {r.near_pairs(), false, r.tolerance(), r.error_bounds()};
+  return {r.near_pairs(), false, r.tolerance(), r.error_bounds(), r.refine_below()};
 }
 
 absl::StatusOr<query::DistanceOptions> DistanceOptionsFor(const ModelConfig& config,
@@ -346,6 +346,11 @@ absl::StatusOr<query::DistanceOptions> DistanceOptionsFor(const ModelConfig& con
         absl::StrFormat("tolerance must be finite and >= 0, not %g", tolerance));
   }
   options.tolerance = tolerance > 0 ? tolerance : config.tolerance();
+  if (!(choice.refine_below >= 0) || !std::isfinite(choice.refine_below)) {
+    return absl::InvalidArgumentError(
+        absl::StrFormat("refine_below must be finite and >= 0, not %g", choice.refine_below));
+  }
+  options.refine_below_l1000 = choice.refine_below;
   return options;
 }
 

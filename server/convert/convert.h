@@ -133,6 +133,7 @@ struct DistanceChoice {
   bool exact_near_pairs = false;
   double tolerance = 0;
   bool error_bounds = false;
+  double refine_below = 0;  // in L1000 (DistanceOptions::refine_below_l1000)
 
   static DistanceChoice Of(const v1::DistanceRequest& request);
   static DistanceChoice Of(const v1::DistanceBatch& request);
@@ -142,9 +143,10 @@ struct DistanceChoice {
 // The near-pair mode and tolerance of `choice`. The mode is the request's
 // (near_pairs, or the deprecated exact_near_pairs), else the configuration's
 // (exact_near_pairs, then unfold_near_pairs), else by path length; the
-// tolerance is the request's when > 0, else the configuration's. Errors:
-// InvalidArgument for an unknown near_pairs value, exact_near_pairs beside
-// another mode, or a negative or non-finite tolerance.
+// tolerance is the request's when > 0, else the configuration's; the
+// refinement threshold is the request's. Errors: InvalidArgument for an
+// unknown near_pairs value, exact_near_pairs beside another mode, or a
+// negative or non-finite tolerance or threshold.
 absl::StatusOr<query::DistanceOptions> DistanceOptionsFor(const ModelConfig& config,
                                                           const DistanceChoice& choice);
 

@@ -284,13 +284,20 @@ TEST(DistanceOptionsForTest, RefusesUnknownContradictoryAndBadChoices) {
     EXPECT_THAT(std::string(options.status().message()),
                 HasSubstr("exact_near_pairs contradicts near_pairs = NEAR_PAIRS_"));
   }
-  for (double tolerance :
+  for (double bad :
        {-0.1, std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::infinity()}) {
-    options = DistanceOptionsFor(config, {.tolerance = tolerance});
-    EXPECT_EQ(options.status().code(), absl::StatusCode::kInvalidArgument) << tolerance;
+    options = DistanceOptionsFor(config, {.tolerance = bad});
+    EXPECT_EQ(options.status().code(), absl::StatusCode::kInvalidArgument) << bad;
     EXPECT_THAT(std::string(options.status().message()),
                 HasSubstr("tolerance must be finite and >= 0"));
+    options = DistanceOptionsFor(config, {.refine_below = bad});
+    EXPECT_EQ(options.status().code(), absl::StatusCode::kInvalidArgument) << bad;
+    EXPECT_THAT(std::string(options.status().message()),
+                HasSubstr("refine_below must be finite and >= 0"));
   }
+  options = DistanceOptionsFor(config, {.refine_below = 8});
+  ASSERT_TRUE(options.ok()) << options.status();
+  EXPECT_EQ(options->refine_below_l1000, 8);
 }
 
 TEST(DistanceChoiceTest, ReadsEachRequestsFields) {
@@ -299,7 +306,9 @@ TEST(DistanceChoiceTest, ReadsEachRequestsFields) {
   distance.set_exact_near_pairs(true);
   distance.set_tolerance(0.5);
   distance.set_error_bounds(true);
+  distance.set_refine_below(8);
   DistanceChoice c = DistanceChoice::Of(distance);
+  EXPECT_EQ(c.refine_below, 8);
   EXPECT_EQ(c.near_pairs, v1::NEAR_PAIRS_UNFOLD);
   EXPECT_TRUE(c.exact_near_pairs);
   EXPECT_EQ(c.tolerance, 0.5);
@@ -308,7 +317,9 @@ TEST(DistanceChoiceTest, ReadsEachRequestsFields) {
   v1::DistanceBatch batch;
   batch.set_exact_near_pairs(true);
   batch.set_tolerance(0.25);
+  batch.set_refine_below(4);
   c = DistanceChoice::Of(batch);
+  EXPECT_EQ(c.refine_below, 4);
   EXPECT_TRUE(c.exact_near_pairs);
   EXPECT_EQ(c.tolerance, 0.25);
   EXPECT_FALSE(c.error_bounds);
@@ -316,7 +327,9 @@ TEST(DistanceChoiceTest, ReadsEachRequestsFields) {
   v1::MatrixRequest matrix;
   matrix.set_near_pairs(v1::NEAR_PAIRS_EXACT);
   matrix.set_error_bounds(true);
+  matrix.set_refine_below(16);
   c = DistanceChoice::Of(matrix);
+  EXPECT_EQ(c.refine_below, 16);
   EXPECT_EQ(c.near_pairs, v1::NEAR_PAIRS_EXACT);
   EXPECT_FALSE(c.exact_near_pairs);
   EXPECT_TRUE(c.error_bounds);
