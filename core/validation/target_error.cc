@@ -123,12 +123,12 @@ int32_t PredictSamples(std::span<const TargetFigures> rounds, double target, int
 }
 
 int32_t SamplesWithinBytes(int64_t budget, int32_t samples, int64_t bytes) {
-  // The coded matrix: m (m - 1) / 2 codes of 2 bytes.
-  auto matrix = [](double m) { return m * (m - 1); };
+  // The coded matrix: m (m - 1) / 2 codes of 3 bytes (sample_matrix.h).
+  auto matrix = [](double m) { return 1.5 * m * (m - 1); };
   const double per_sample = std::max(0.0, bytes - matrix(samples)) / std::max(samples, 1);
-  // The positive root of m^2 + (per_sample - 1) m - budget = 0.
-  const double b = per_sample - 1;
-  const double m = (-b + std::sqrt(b * b + 4.0 * static_cast<double>(budget))) / 2;
+  // The positive root of 1.5 m^2 + (per_sample - 1.5) m - budget = 0.
+  const double a = 1.5, b = per_sample - 1.5;
+  const double m = (-b + std::sqrt(b * b + 4 * a * static_cast<double>(budget))) / (2 * a);
   return static_cast<int32_t>(std::clamp(std::floor(m), 3.0, 2e9));
 }
 

@@ -41,16 +41,16 @@ namespace geodex::validation {
 
 // The target of a build asked for no sample count.
 inline constexpr double kDefaultTargetError = 0.005;
-// The default cap on m: its coded matrix (m (m - 1) bytes) is 64 MB.
+// The default cap on m: its coded matrix (1.5 m (m - 1) bytes) is 96 MB.
 inline constexpr int32_t kDefaultMaxSamples = 8000;
 // The most bytes a target-error build's index may take by default. A server
 // holds many models, so m stops growing where the next index would not
-// fit; the coded matrix alone is 32 MiB near m = 5,800.
+// fit; the coded matrix alone is 32 MiB near m = 4,730.
 inline constexpr int64_t kMaxIndexBytes = int64_t{32} << 20;
 
 // The largest m whose index fits in `budget` bytes, predicted from an index
 // of `samples` samples that takes `bytes`: the coded matrix grows as
-// m (m - 1) bytes, the rest (the split mesh, vertex records, calibration)
+// 1.5 m (m - 1) bytes, the rest (the split mesh, vertex records, calibration)
 // at most in proportion to m.
 int32_t SamplesWithinBytes(int64_t budget, int32_t samples, int64_t bytes);
 

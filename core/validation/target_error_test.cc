@@ -97,16 +97,17 @@ TEST(TargetErrorTest, PredictionFromTheRatesTheFiguresFallAt) {
 
 TEST(TargetErrorTest, SamplesWithinBytesCountsTheMatrixAndThePerSampleRest) {
   // An index of exactly its coded lower triangle: m (m - 1) / 2 codes of
-  // 2 bytes.
+  // 3 bytes.
   const int64_t budget = kMaxIndexBytes;
-  const int32_t m = SamplesWithinBytes(budget, 1000, int64_t{1000} * 999);
-  EXPECT_LE(int64_t{m} * (m - 1), budget);
-  EXPECT_GT(int64_t{m + 1} * m, budget);
-  EXPECT_NEAR(m, 5793, 1);
+  auto matrix = [](int64_t m) { return 3 * m * (m - 1) / 2; };
+  const int32_t m = SamplesWithinBytes(budget, 1000, matrix(1000));
+  EXPECT_LE(matrix(m), budget);
+  EXPECT_GT(matrix(m + 1), budget);
+  EXPECT_NEAR(m, 4730, 1);
   // 4 kB a sample beside the matrix leaves room for fewer.
-  const int32_t fewer = SamplesWithinBytes(budget, 1000, int64_t{1000} * 999 + 4000 * 1000);
-  EXPECT_LE(int64_t{fewer} * (fewer - 1) + int64_t{4000} * fewer, budget);
-  EXPECT_GT(int64_t{fewer + 1} * fewer + int64_t{4000} * (fewer + 1), budget);
+  const int32_t fewer = SamplesWithinBytes(budget, 1000, matrix(1000) + 4000 * 1000);
+  EXPECT_LE(matrix(fewer) + int64_t{4000} * fewer, budget);
+  EXPECT_GT(matrix(fewer + 1) + int64_t{4000} * (fewer + 1), budget);
   EXPECT_LT(fewer, m);
 }
 
