@@ -187,6 +187,7 @@ absl::Status StreamDistancesOnce(GeodexConnection& connection, const v1::ModelRe
                          batch.set_near_pairs(ToProto(query.near_pairs));
                          batch.set_tolerance(query.tolerance);
                          batch.set_error_bounds(query.error_bounds);
+                         batch.set_refine_below(query.refine_below);
                          const size_t begin = k * batch_size;
                          const size_t end = std::min(pairs.size(), begin + batch_size);
                          PairsToProto(pairs, begin, end, batch.mutable_a(), batch.mutable_b());
@@ -261,6 +262,7 @@ absl::StatusOr<Distances> Client::Distance(const ModelRef& model, absl::Span<con
     request.set_near_pairs(ToProto(query.near_pairs));
     request.set_tolerance(query.tolerance);
     request.set_error_bounds(query.error_bounds);
+    request.set_refine_below(query.refine_below);
     PairsToProto(pairs, 0, pairs.size(), request.mutable_a(), request.mutable_b());
     absl::StatusOr<v1::DistanceResponse> response = connection_->Distance(request);
     if (!response.ok()) return response.status();

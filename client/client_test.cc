@@ -168,11 +168,12 @@ TEST(ClientDistance, OneBatchIsOneUnaryCall) {
   EXPECT_THAT(*d, ElementsAre(0.5, 1.5, 2.5));
 }
 
-TEST(ClientDistance, ToleranceAndBoundsAreSentAndBoundsReturned) {
+TEST(ClientDistance, ToleranceThresholdAndBoundsAreSentAndBoundsReturned) {
   auto mock = std::make_shared<MockGeodexConnection>();
   EXPECT_CALL(*mock, Distance).WillOnce([](const v1::DistanceRequest& r) {
     EXPECT_EQ(r.tolerance(), 0.005);
     EXPECT_TRUE(r.error_bounds());
+    EXPECT_EQ(r.refine_below(), 8);
     EXPECT_EQ(r.near_pairs(), v1::NEAR_PAIRS_UNSPECIFIED);
     v1::DistanceResponse response;
     for (int f : r.a().faces()) {
@@ -183,7 +184,8 @@ TEST(ClientDistance, ToleranceAndBoundsAreSentAndBoundsReturned) {
   });
   Client client(mock, SmallBatches(3));
   absl::StatusOr<Distances> d =
-      client.Distance("torus", NumberedPairs(3), {.tolerance = 0.005, .error_bounds = true});
+      client.Distance("torus", NumberedPairs(3),
+                      {.tolerance = 0.005, .error_bounds = true, .refine_below = 8});
   ASSERT_TRUE(d.ok()) << d.status();
   EXPECT_THAT(d->distance, ElementsAre(0.5, 1.5, 2.5));
   EXPECT_THAT(d->bound, ElementsAre(0, 0.01, 0.02));
@@ -223,7 +225,10 @@ TEST(ClientDistance, BatchesAreSizedNumberedAndOnlyTheFirstNamesTheModel) {
     return std::make_unique<Proxy>(&fake);
   });
   Client client(mock, SmallBatches(100));
-  ASSERT_TRUE(client.Distance(ModelRef("torus", 4), NumberedPairs(250), NearPairs::kExact).ok());
+  ASSERT_TRUE(client
+                  .Distance(ModelRef("torus", 4), NumberedPairs(250),
+                            DistanceQuery{.near_pairs = NearPairs::kExact, .refine_below = 4})
+                  .ok());
   const std::vector<v1::DistanceBatch> batches = fake.batches();
   ASSERT_EQ(batches.size(), 3u);
   EXPECT_EQ(batches[0].model().name(), "torus");
@@ -231,6 +236,7 @@ TEST(ClientDistance, BatchesAreSizedNumberedAndOnlyTheFirstNamesTheModel) {
   for (size_t k = 0; k < batches.size(); ++k) {
     EXPECT_EQ(batches[k].batch_id(), k);
     EXPECT_EQ(batches[k].near_pairs(), v1::NEAR_PAIRS_EXACT);
+    EXPECT_EQ(batches[k].refine_below(), 4);
     if (k > 0) {
       EXPECT_TRUE(batches[k].model().name().empty()) << k;
     }

@@ -215,6 +215,17 @@ if [ $FAKE -eq 0 ]; then
     [ "$(awk 'NF == 2 && $2 >= 0 && $2 <= 0.005 * $1 + 1e-12' d_bounds.txt | wc -l)" -eq 42 ] &&
     pass "distance --error-bounds --tolerance 0.005 equals geodex-query; every bound meets it" ||
     fail "distance with bounds differs from geodex-query" d_offline.txt d_bounds.txt err.txt
+  # The every-distance mode: the threshold travels in L1000, and a server
+  # answers as the offline tool does; it refines more than the default.
+  "$QUERY_BIN" models/cube/1/index.gdx --pairs pairs.txt --refine-below 1000 > d_offline.txt 2> err.txt
+  "$GEODEX" distance "${S[@]}" --model "$MODEL" --pairs pairs.txt --refine-below 1000 \
+    > d_every.txt 2>> err.txt
+  "$QUERY_BIN" models/cube/1/index.gdx --pairs pairs.txt --near-pairs exact --refine-below 1000 \
+    > d_exact.txt 2>> err.txt
+  same_numbers d_offline.txt d_every.txt &&
+    [ "$(paste d_every.txt d_exact.txt | awk '$1 < $2 * (1 - 1e-9) || $1 > $2 * 1.0201' | wc -l)" -eq 0 ] &&
+    pass "distance --refine-below 1000 equals geodex-query's; every answer within 2% of exact" ||
+    fail "distance --refine-below differs from geodex-query or from exact" d_offline.txt d_every.txt d_exact.txt err.txt
 fi
 
 # Paths. Path tracing belongs to core (a pair it cannot trace is INTERNAL, and

@@ -63,6 +63,12 @@ void AddDistanceCommand(CLI::App* app, absl::Status* status) {
                    "Relative error tolerance (e.g. 0.005): the server refines every pair whose "
                    "error bound exceeds tolerance x distance (0: the model's)")
       ->check(CLI::NonNegativeNumber);
+  distance
+      ->add_option("--refine-below", flags->query.refine_below,
+                   "Refine every pair that may be closer than this many L1000, the spacing of "
+                   "1,000 samples on the surface (e.g. 8: the every-distance mode; 0: the "
+                   "model's threshold)")
+      ->check(CLI::NonNegativeNumber);
   distance->add_flag("--error-bounds", flags->query.error_bounds,
                      "Print 'distance bound' per line: bound = the absolute error bound");
   distance->add_option("--batch", flags->batch, "Pairs per streamed batch")

@@ -67,6 +67,12 @@ struct DistanceQuery {
   double tolerance = 0;
   // Return each distance's absolute error bound.
   bool error_bounds = false;
+  // Also refine every pair that may be closer than this many L1000, the
+  // spacing of 1,000 samples on the surface (a unit fixed by the surface):
+  // raises the model's threshold (three of its spacings), never lowers it.
+  // About 8 is the every-distance mode (geodex.v1.DistanceRequest). 0: the
+  // model's.
+  double refine_below = 0;
 };
 
 // Distances in input order, and with DistanceQuery::error_bounds their
