@@ -47,6 +47,7 @@ double Refiner::Refine(const SurfacePoint& p_in, const SurfacePoint& q_in, const
   QueryScratch own;
   QueryScratch& solvers = scratch != nullptr ? *scratch : own;
   // `path_length`: the length of a surface path between the points, if known.
+  NearPairStats& stats = solvers.near_pair_stats();
   auto exact = [&](double path_length = kInf) {
     std::optional<double> e = exact_.ConfinedDistance(from, to, {}, solvers, path_length);
     if (!e) e = exact_.NearDistance(from, to, &solvers);
@@ -81,10 +82,20 @@ double Refiner::Refine(const SurfacePoint& p_in, const SurfacePoint& q_in, const
   // (tests/bench/exact_geodesics.md). The trace stays for an index whose mesh cannot
   // be rebuilt for exact propagation, and for `walk_` off (benchmarks).
   auto near_path = [&] {
+    ++stats.pairs;
     if (walk_) {
-      const NearWalk walk = WalkNearPair(view_, from, to, plausible());
+      const NearWalk walk = WalkNearPair(view_, from, to, plausible(), &stats);
       if (walk.path && certified(walk.path->length)) return take(*walk.path);
-      if (exact(walk.path ? walk.path->length : walk.doubted.value_or(kInf))) return true;
+      const double upper = walk.path ? walk.path->length : walk.doubted.value_or(kInf);
+      const bool solved = exact(upper);
+      ++stats.exact_solves;
+      stats.exact_with_walk += upper < kInf;
+      if (const auto& confined = solvers.solvers().confined) {
+        stats.exact_rounds += confined->stats().rounds;
+        stats.exact_region_faces += confined->stats().region_faces;
+        stats.exact_windows += confined->stats().windows_created;
+      }
+      if (solved) return true;
       if (walk.path) return take(*walk.path);  // a mesh without exact propagation
     }
     const std::optional<NearPath> t = NearPathLength(view_, paths_, from, to, walk_, plausible());

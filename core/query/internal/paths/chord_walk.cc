@@ -231,7 +231,9 @@ std::optional<double> AngleSum(const MeshView& view, int32_t face, int32_t v) {
 }  // namespace
 
 NearWalk WalkNearPair(const MeshView& view, const SurfacePoint& from, const SurfacePoint& to,
-                      double plausible) {
+                      double plausible, NearPairStats* stats) {
+  NearPairStats unused;
+  NearPairStats& count = stats != nullptr ? *stats : unused;
   // First the corridors of the chord, from either end, unfolded into the
   // plane. A straight segment through the corridor is a local geodesic, as
   // the straightened trace would be, found without evaluating the distance
@@ -260,6 +262,9 @@ NearWalk WalkNearPair(const MeshView& view, const SurfacePoint& from, const Surf
         !corridor.Unfold(view, a, b)) {
       continue;
     }
+    ++count.walks;
+    count.faces_crossed += static_cast<int64_t>(corridor.faces().size());
+    count.faces_unfolded += static_cast<int64_t>(corridor.faces().size());
     if (const std::optional<double> length = corridor.StraightLength()) {
       if (*length <= plausible) return {NearPath{*length, false}, std::nullopt};
       doubt(*length);
@@ -294,7 +299,9 @@ NearWalk WalkNearPair(const MeshView& view, const SurfacePoint& from, const Surf
         }
         break;
       }
+      ++count.releases;
       if (!corridor.Release(view, *shortcut) || !corridor.Unfold(view, a, b)) break;
+      count.faces_unfolded += static_cast<int64_t>(corridor.faces().size());
     }
   }
   // Every candidate is a surface path: the shortest is the closest.

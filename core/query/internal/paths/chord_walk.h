@@ -17,6 +17,7 @@
 
 #include "core/query/internal/paths/gradient_path.h"
 #include "core/query/internal/mesh_view.h"
+#include "core/query/query_scratch.h"
 #include "core/query/query_types.h"
 
 namespace geodex::query {
@@ -44,9 +45,11 @@ struct NearWalk {
 
 // The chord's walks from either end between valid canonical points `from`
 // and `to` (from the smaller point, for symmetry). A straight walk longer
-// than `plausible` is doubted (it may run in a wrong corridor).
+// than `plausible` is doubted (it may run in a wrong corridor). `stats`
+// (optional) counts the walks, their faces and releases.
 NearWalk WalkNearPair(const MeshView& view, const SurfacePoint& from, const SurfacePoint& to,
-                      double plausible = std::numeric_limits<double>::infinity());
+                      double plausible = std::numeric_limits<double>::infinity(),
+                      NearPairStats* stats = nullptr);
 
 // The shortest path found between valid canonical points `from` and `to`
 // (from the smaller point, for symmetry): the walks' (WalkNearPair), else
