@@ -2,7 +2,7 @@
 
 // Per-thread working memory of the queries that are not O(1): the exact
 // solver that refinements and exact neighbourhoods run (its arrays grow with
-// the mesh, so a thread keeps it and reuses it). Optional wherever a query
+// the mesh, so a thread keeps it and reuses it), and the near pairs' walks. Optional wherever a query
 // takes it: without one, a query makes its own for the call.
 //
 // Thread safety: one QueryScratch per thread; it is not shared.
@@ -47,11 +47,16 @@ class QueryScratch {
   // The solvers, made (empty) on first use: a scratch that no query needs
   // allocates nothing.
   Solvers& solvers();
+  // The chord walks' corridors and layouts (internal/paths/chord_walk.h),
+  // made on first use.
+  struct Walks;
+  Walks& walks();
 
   NearPairStats& near_pair_stats() { return near_pair_stats_; }
 
  private:
   std::unique_ptr<Solvers> solvers_;
+  std::unique_ptr<Walks> walks_;
   NearPairStats near_pair_stats_;
 };
 

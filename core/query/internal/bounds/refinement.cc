@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 #include <optional>
+#include <span>
 #include <tuple>
 
 #include "core/query/internal/paths/chord_walk.h"
@@ -48,8 +49,10 @@ double Refiner::Refine(const SurfacePoint& p_in, const SurfacePoint& q_in, const
   QueryScratch& solvers = scratch != nullptr ? *scratch : own;
   // `path_length`: the length of a surface path between the points, if known.
   NearPairStats& stats = solvers.near_pair_stats();
-  auto exact = [&](double path_length = kInf) {
-    std::optional<double> e = exact_.ConfinedDistance(from, to, {}, solvers, path_length);
+  // `seeds`: the faces the region starts from (none: a chain of faces from
+  // one point to the other).
+  auto exact = [&](double path_length = kInf, std::span<const int32_t> seeds = {}) {
+    std::optional<double> e = exact_.ConfinedDistance(from, to, seeds, solvers, path_length);
     if (!e) e = exact_.NearDistance(from, to, &solvers);
     if (!e) return false;
     d = *e;
@@ -84,10 +87,14 @@ double Refiner::Refine(const SurfacePoint& p_in, const SurfacePoint& q_in, const
   auto near_path = [&] {
     ++stats.pairs;
     if (walk_) {
-      const NearWalk walk = WalkNearPair(view_, from, to, plausible(), &stats);
+      const NearWalk walk = WalkNearPair(view_, from, to, plausible(), &solvers);
       if (walk.path && certified(walk.path->length)) return take(*walk.path);
+      // The doubted walk's length prunes the propagation from its first
+      // window, and its corridor, where the shortest path mostly runs, is
+      // the first region (a chain of faces found by a search round the
+      // pair cost more than the propagation in it).
       const double upper = walk.path ? walk.path->length : walk.doubted.value_or(kInf);
-      const bool solved = exact(upper);
+      const bool solved = exact(upper, walk.corridor);
       ++stats.exact_solves;
       stats.exact_with_walk += upper < kInf;
       if (const auto& confined = solvers.solvers().confined) {
