@@ -231,6 +231,15 @@ ScaleBins DrawScalePairs(const index::Index& ix, const query::QueryEngine& engin
   return bins;
 }
 
+// True when `ix` carries its accuracy calibration; else prints a note row
+// for `label` saying so.
+bool Calibrated(const std::string& label, const index::Index& ix) {
+  if (ix.accuracy() != nullptr) return true;
+  std::printf("| %s | (no accuracy calibration in the index: run geodex-build calibrate) |\n",
+              label.c_str());
+  return false;
+}
+
 // One refinement row's rates on the pairs `x`, `y`.
 RefinementFigures MeasureRefinement(const query::QueryEngine& engine,
                                     const query::QueryEngine& traces_only, const char* name,
@@ -368,11 +377,7 @@ std::string ThroughputRow(const std::string& label, const ThroughputFigures& f) 
 }
 
 void BenchRefinement(const std::string& label, std::shared_ptr<const index::Index> ix, int n) {
-  if (ix->accuracy() == nullptr) {
-    std::printf("| %s | (no accuracy calibration in the index: run geodex-build calibrate) |\n",
-                label.c_str());
-    return;
-  }
+  if (!Calibrated(label, *ix)) return;
   auto engine = *query::QueryEngine::Create(ix);
   auto traces_only = *query::CreateQueryEngine(ix, {}, {.walk_near_pairs = false});
   const auto a = InteriorPoints(*ix, n, 1), b = InteriorPoints(*ix, n, 2);
@@ -492,11 +497,7 @@ std::string FieldRow(const std::string& label, const FieldFigures& f) {
 }
 
 void BenchNearProfile(const std::string& label, std::shared_ptr<const index::Index> ix, int n) {
-  if (ix->accuracy() == nullptr) {
-    std::printf("| %s | (no accuracy calibration in the index: run geodex-build calibrate) |\n",
-                label.c_str());
-    return;
-  }
+  if (!Calibrated(label, *ix)) return;
   auto engine = *query::QueryEngine::Create(ix);
   const ScaleBins bins = DrawScalePairs(*ix, *engine, n);
   const Points &x = bins.a[1], &y = bins.b[1];

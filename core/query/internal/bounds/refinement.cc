@@ -96,7 +96,7 @@ double Refiner::Refine(const SurfacePoint& p_in, const SurfacePoint& q_in, const
       const double upper = walk.path ? walk.path->length : walk.doubted.value_or(kInf);
       const bool solved = exact(upper, walk.corridor);
       ++stats.exact_solves;
-      stats.exact_with_walk += upper < kInf;
+      stats.exact_with_walk += walk.path || walk.doubted;
       if (const auto& confined = solvers.solvers().confined) {
         stats.exact_rounds += confined->stats().rounds;
         stats.exact_region_faces += confined->stats().region_faces;

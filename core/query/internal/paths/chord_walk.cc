@@ -22,9 +22,14 @@ std::array<double, 3> Velocity(const MeshView& view, int32_t f, const Vec3& dir)
   const Vec3 v[3] = {view.Position(view.Vertex(f, 0)), view.Position(view.Vertex(f, 1)),
                      view.Position(view.Vertex(f, 2))};
   const Vec3 n = (v[1] - v[0]).cross(v[2] - v[0]);
-  const double area2 = n.squaredNorm();
+  // One division, not three: a walk's step waits on each (the velocity
+  // only chooses the edge the walk leaves by; the path's length is measured
+  // in the corridor's layout).
+  const double inverse_area2 = 1 / n.squaredNorm();
   std::array<double, 3> beta;
-  for (int i = 0; i < 3; ++i) beta[i] = n.cross(v[(i + 2) % 3] - v[(i + 1) % 3]).dot(dir) / area2;
+  for (int i = 0; i < 3; ++i) {
+    beta[i] = n.cross(v[(i + 2) % 3] - v[(i + 1) % 3]).dot(dir) * inverse_area2;
+  }
   return beta;
 }
 
@@ -227,8 +232,8 @@ bool WalkCorridor(const MeshView& view, const PathPoint& from, const PathPoint& 
     if (exit < 0 || !(t > 1e-14)) return false;
     for (int i = 0; i < 3; ++i) w[i] = std::max(w[i] + t * beta[i], 0.0);
     w[exit] = 0;
-    const double sum = w[0] + w[1] + w[2];
-    for (double& c : w) c /= sum;
+    const double inverse_sum = 1 / (w[0] + w[1] + w[2]);
+    for (double& c : w) c *= inverse_sum;
     if (w[0] > 1 - 1e-9 || w[1] > 1 - 1e-9 || w[2] > 1 - 1e-9) return false;
     const Vec3 last = x;
     x = w[0] * view.Position(view.Vertex(f, 0)) + w[1] * view.Position(view.Vertex(f, 1)) +
