@@ -84,7 +84,7 @@ void ConfinedGeodesicSolver::AddFace(int32_t f) {
 }
 
 void ConfinedGeodesicSolver::GrowRings(std::vector<int32_t>& vertices, int32_t rings) {
-  std::vector<int32_t> next;
+  std::vector<int32_t>& next = next_vertices_;
   for (int32_t ring = 0; ring < rings && !vertices.empty(); ++ring) {
     next.clear();
     for (const int32_t v : vertices) {
@@ -125,13 +125,23 @@ void ConfinedGeodesicSolver::AddEllipsoid(int32_t start, const Vec3& p, const Ve
   // Faces some point x of which may have |x - p| + |x - q| <= length, by a
   // lower bound on that sum over the face: its value at the centroid less
   // twice the face's radius about it.
+  // The centroids and radii are the same in every call: computed once
+  // (they were a tenth of a near pair's exact check).
+  if (face_ball_.empty()) {
+    face_ball_.resize(mesh_.num_faces());
+    for (int32_t f = 0; f < mesh_.num_faces(); ++f) {
+      const auto& [a, b, c] = mesh_.face(f);
+      const Vec3 centroid = (mesh_.position(a) + mesh_.position(b) + mesh_.position(c)) / 3;
+      const double radius =
+          std::max({(mesh_.position(a) - centroid).norm(), (mesh_.position(b) - centroid).norm(),
+                    (mesh_.position(c) - centroid).norm()});
+      face_ball_[f] = {centroid.x(), centroid.y(), centroid.z(), radius};
+    }
+  }
   auto inside = [&](int32_t f) {
-    const auto& [a, b, c] = mesh_.face(f);
-    const Vec3 centroid = (mesh_.position(a) + mesh_.position(b) + mesh_.position(c)) / 3;
-    const double radius =
-        std::max({(mesh_.position(a) - centroid).norm(), (mesh_.position(b) - centroid).norm(),
-                  (mesh_.position(c) - centroid).norm()});
-    return (centroid - p).norm() + (centroid - q).norm() - 2 * radius <= length;
+    const std::array<double, 4>& ball = face_ball_[f];
+    const Vec3 centroid(ball[0], ball[1], ball[2]);
+    return (centroid - p).norm() + (centroid - q).norm() - 2 * ball[3] <= length;
   };
   // chain_parent_ marks the faces tested (-1), chain_reached_ lists them;
   // the ones inside are queued.

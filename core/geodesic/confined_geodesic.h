@@ -43,6 +43,7 @@
 // and is not thread-safe; use one per thread. Any number of solvers may
 // share one const Mesh.
 
+#include <array>
 #include <cstdint>
 #include <memory>
 #include <span>
@@ -142,7 +143,11 @@ class ConfinedGeodesicSolver {
   std::vector<int32_t> chain_parent_;
   std::vector<int32_t> chain_reached_;
   std::vector<int32_t> ellipsoid_queue_;
+  // Per face, the centroid and the largest distance from it to a corner
+  // (AddEllipsoid's test), made on the first call that needs them.
+  std::vector<std::array<double, 4>> face_ball_;
   std::vector<int32_t> vertices_;
+  std::vector<int32_t> next_vertices_;  // GrowRings' next ring
   ConfinedStats stats_;
 };
 

@@ -2,7 +2,7 @@
 
 // Per-thread working memory of the queries that are not O(1): the exact
 // solver that refinements and exact neighbourhoods run (its arrays grow with
-// the mesh, so a thread keeps it and reuses it). Optional wherever a query
+// the mesh, so a thread keeps it and reuses it), and the near pairs' walks. Optional wherever a query
 // takes it: without one, a query makes its own for the call.
 //
 // Thread safety: one QueryScratch per thread; it is not shared.
@@ -10,9 +10,27 @@
 //   query::QueryScratch scratch;  // per worker thread
 //   GEODEX_RETURN_IF_ERROR(queries->DistanceBatch(a, b, out, options, &scratch));
 
+#include <cstdint>
 #include <memory>
 
 namespace geodex::query {
+
+// What the near-pair refinements run with one QueryScratch did, summed over
+// its calls (the default mode's walks and the exact solves behind them):
+// counts for profiles (tests/bench/query_bench --near-profile), never read
+// by the queries themselves.
+struct NearPairStats {
+  int64_t pairs = 0;               // near pairs refined in the default mode
+  int64_t walks = 0;               // chord walks that found a corridor
+  int64_t faces_crossed = 0;       // faces of those corridors as walked
+  int64_t faces_unfolded = 0;      // faces laid out in the plane, releases included
+  int64_t releases = 0;            // corridors moved round a vertex
+  int64_t exact_solves = 0;        // pairs sent to the confined exact solver
+  int64_t exact_with_walk = 0;     // of those, pruned by a walk's length from the start
+  int64_t exact_rounds = 0;        // its propagations
+  int64_t exact_region_faces = 0;  // faces of its last regions
+  int64_t exact_windows = 0;       // windows it created
+};
 
 class QueryScratch {
  public:
@@ -29,9 +47,17 @@ class QueryScratch {
   // The solvers, made (empty) on first use: a scratch that no query needs
   // allocates nothing.
   Solvers& solvers();
+  // The chord walks' corridors and layouts (internal/paths/chord_walk.h),
+  // made on first use.
+  struct Walks;
+  Walks& walks();
+
+  NearPairStats& near_pair_stats() { return near_pair_stats_; }
 
  private:
   std::unique_ptr<Solvers> solvers_;
+  std::unique_ptr<Walks> walks_;
+  NearPairStats near_pair_stats_;
 };
 
 }  // namespace geodex::query

@@ -11,7 +11,12 @@
 // near pairs drawn on purpose. So is the time of one Path between random
 // interior points, traced (O(k)) and with an exact corridor of 8 steps.
 //
-//   query_bench [--index FILE.gdx]... [--pairs N] [--accuracy-pairs N]
+//   query_bench [--index FILE.gdx]... [--pairs N] [--accuracy-pairs N] [--near-profile]
+//
+// --near-profile prints only the near pairs' table: the batch rates at d<L
+// and L-3L of the O(1) answer, and the L-3L pairs one call at a time by how
+// the default mode answered them (walk, releases, exact solve), with their
+// cost, the faces their walks crossed and the exact solver's rounds.
 //
 // Then, per index with its accuracy calibration, the refinement table: the
 // default mode, the pure O(1) mode, the default with error bounds and with

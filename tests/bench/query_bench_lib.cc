@@ -231,6 +231,15 @@ ScaleBins DrawScalePairs(const index::Index& ix, const query::QueryEngine& engin
   return bins;
 }
 
+// True when `ix` carries its accuracy calibration; else prints a note row
+// for `label` saying so.
+bool Calibrated(const std::string& label, const index::Index& ix) {
+  if (ix.accuracy() != nullptr) return true;
+  std::printf("| %s | (no accuracy calibration in the index: run geodex-build calibrate) |\n",
+              label.c_str());
+  return false;
+}
+
 // One refinement row's rates on the pairs `x`, `y`.
 RefinementFigures MeasureRefinement(const query::QueryEngine& engine,
                                     const query::QueryEngine& traces_only, const char* name,
@@ -277,6 +286,8 @@ std::unique_ptr<CLI::App> QueryBenchFlags(QueryBenchOptions* options) {
   app->add_flag("--field-only", options->field_only, "Only the distance field table");
   app->add_option("--accuracy-pairs", options->accuracy_pairs,
                   "Pairs per row of the table against the exact engine");
+  app->add_flag("--near-profile", options->near_profile,
+                "Only the near pairs' rates and where their time goes");
   return app;
 }
 
@@ -366,11 +377,7 @@ std::string ThroughputRow(const std::string& label, const ThroughputFigures& f) 
 }
 
 void BenchRefinement(const std::string& label, std::shared_ptr<const index::Index> ix, int n) {
-  if (ix->accuracy() == nullptr) {
-    std::printf("| %s | (no accuracy calibration in the index: run geodex-build calibrate) |\n",
-                label.c_str());
-    return;
-  }
+  if (!Calibrated(label, *ix)) return;
   auto engine = *query::QueryEngine::Create(ix);
   auto traces_only = *query::CreateQueryEngine(ix, {}, {.walk_near_pairs = false});
   const auto a = InteriorPoints(*ix, n, 1), b = InteriorPoints(*ix, n, 2);
@@ -489,6 +496,111 @@ std::string FieldRow(const std::string& label, const FieldFigures& f) {
                       absl::StrFormat("%.3gM", f.us > 0 ? f.per_field / f.us : 0)});
 }
 
+void BenchNearProfile(const std::string& label, std::shared_ptr<const index::Index> ix, int n) {
+  if (!Calibrated(label, *ix)) return;
+  auto engine = *query::QueryEngine::Create(ix);
+  const ScaleBins bins = DrawScalePairs(*ix, *engine, n);
+  const Points &x = bins.a[1], &y = bins.b[1];
+  query::QueryScratch scratch;
+  // The engine's exact mesh and the scratch's solvers, made before the clocks
+  // run.
+  (void)engine->Distance(x[0], y[0], {.near_pairs = query::NearPairs::kExact}, &scratch);
+  const size_t all = x.size();
+  const double near_rate = BatchRate(*engine, bins.a[0], bins.b[0], {}, false, bins.a[0].size());
+  const double default_rate = BatchRate(*engine, x, y, {}, false, all);
+  const double pure_rate =
+      BatchRate(*engine, x, y, {.near_pairs = query::NearPairs::kUnfold}, false, all);
+  // Each pair's class from its first call; its time, the least of three
+  // calls (the machine is shared: a call preempted once is not its cost).
+  enum Class { kStraight, kReleased, kExactWalked, kExactUnwalked, kOther, kClasses };
+  constexpr const char* kNames[kClasses] = {"straight walk", "walk with releases",
+                                            "exact, pruned by a walk", "exact, no walk",
+                                            "not walked"};
+  std::vector<Class> cls(all);
+  std::vector<double> seconds(all, 1e300);
+  NearProfileRow rows[kClasses];
+  for (int pass = 0; pass < 3; ++pass) {
+    for (size_t i = 0; i < all; ++i) {
+      const query::NearPairStats before = scratch.near_pair_stats();
+      const Clock::time_point start = Clock::now();
+      const absl::StatusOr<double> d = engine->Distance(x[i], y[i], {}, &scratch);
+      seconds[i] = std::min(seconds[i], SecondsSince(start));
+      if (!d.ok() || pass > 0) continue;
+      const query::NearPairStats& after = scratch.near_pair_stats();
+      cls[i] = after.pairs == before.pairs               ? kOther
+               : after.exact_solves > before.exact_solves ? (after.exact_with_walk >
+                                                                     before.exact_with_walk
+                                                                 ? kExactWalked
+                                                                 : kExactUnwalked)
+               : after.releases > before.releases        ? kReleased
+                                                          : kStraight;
+      NearProfileRow& row = rows[cls[i]];
+      row.faces_crossed += static_cast<double>(after.faces_crossed - before.faces_crossed);
+      row.faces_unfolded += static_cast<double>(after.faces_unfolded - before.faces_unfolded);
+      row.releases += static_cast<double>(after.releases - before.releases);
+      row.exact_rounds += static_cast<double>(after.exact_rounds - before.exact_rounds);
+      row.exact_region_faces +=
+          static_cast<double>(after.exact_region_faces - before.exact_region_faces);
+    }
+  }
+  NearProfileRow total;
+  total.how = absl::StrFormat("all (d<L %.3fM/s, L-3L %.3fM/s, pure O(1) %.3fM/s)",
+                              near_rate / 1e6, default_rate / 1e6, pure_rate / 1e6);
+  for (size_t i = 0; i < all; ++i) {
+    ++rows[cls[i]].count;
+    rows[cls[i]].us += 1e6 * seconds[i];
+  }
+  for (int c = 0; c < kClasses; ++c) {
+    NearProfileRow& row = rows[c];
+    total.count += row.count;
+    total.us += row.us;
+    total.faces_crossed += row.faces_crossed;
+    total.faces_unfolded += row.faces_unfolded;
+    total.releases += row.releases;
+    total.exact_rounds += row.exact_rounds;
+    total.exact_region_faces += row.exact_region_faces;
+  }
+  for (NearProfileRow* row : {&rows[0], &rows[1], &rows[2], &rows[3], &rows[4], &total}) {
+    if (row->count == 0) continue;
+    if (row != &total) row->how = kNames[row - rows];
+    const double count = static_cast<double>(row->count);
+    row->share = count / static_cast<double>(all);
+    row->us /= count;
+    row->faces_crossed /= count;
+    row->faces_unfolded /= count;
+    row->releases /= count;
+    row->exact_rounds /= count;
+    row->exact_region_faces /= count;
+    std::printf("%s\n", NearProfileRowText(label, *row).c_str());
+  }
+}
+
+std::string NearProfileHeader() {
+  return "\nNear pairs at L-3L of the O(1) answer, one Distance call each (least of 3), by how "
+         "the default mode answered them\n" +
+         MarkdownHeader({"index", "how", "pairs", "share", "us a pair", "faces crossed",
+                         "faces unfolded", "releases", "exact rounds", "exact region faces",
+                         "us a face crossed"});
+}
+
+std::string NearProfileRowText(const std::string& label, const NearProfileRow& row) {
+  return MarkdownRow({
+      label,
+      row.how,
+      absl::StrFormat("%zu", row.count),
+      absl::StrFormat("%.1f%%", 100 * row.share),
+      absl::StrFormat("%.2f", row.us),
+      absl::StrFormat("%.1f", row.faces_crossed),
+      absl::StrFormat("%.1f", row.faces_unfolded),
+      absl::StrFormat("%.2f", row.releases),
+      absl::StrFormat("%.2f", row.exact_rounds),
+      absl::StrFormat("%.0f", row.exact_region_faces),
+      row.faces_crossed > 0 && row.exact_rounds == 0
+          ? absl::StrFormat("%.3f", row.us / row.faces_crossed)
+          : std::string("-"),
+  });
+}
+
 std::string ExpMapHeader() {
   return MarkdownHeader({"index", "radius", "vertices mapped", "one map, default",
                          "one map, pure O(1)", "per vertex, default"});
@@ -505,7 +617,7 @@ int RunQueryBench(const QueryBenchOptions& options) {
   std::printf("(batch: far pairs %s)\n", query::kernel::HasAvx2Lanes()
                                              ? "four at a time with AVX2"
                                              : "one at a time: no AVX2 in this build or CPU");
-  std::printf("%s", ThroughputHeader().c_str());
+  if (!options.near_profile) std::printf("%s", ThroughputHeader().c_str());
   if (options.indexes.empty()) return RunOnGeneratedSphere(options.pairs);
   std::vector<std::shared_ptr<const index::Index>> loaded;
   for (const std::string& path : options.indexes) {
@@ -515,10 +627,16 @@ int RunQueryBench(const QueryBenchOptions& options) {
       return 1;
     }
     loaded.push_back(*ix);
+    if (options.near_profile) {
+      if (loaded.size() == 1) std::printf("%s", NearProfileHeader().c_str());
+      BenchNearProfile(path, *ix, std::min(options.pairs, 200'000));
+      continue;
+    }
     if (!options.expmap_only && !options.field_only) {
       std::printf("%s\n", ThroughputRow(path, MeasureThroughput(*ix, options.pairs)).c_str());
     }
   }
+  if (options.near_profile) return 0;
   if (!options.expmap_only && !options.field_only) {
     std::printf("%s", RefinementHeader().c_str());
     for (size_t i = 0; i < loaded.size(); ++i) {

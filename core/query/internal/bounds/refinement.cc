@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 #include <optional>
+#include <span>
 #include <tuple>
 
 #include "core/query/internal/paths/chord_walk.h"
@@ -55,8 +56,11 @@ double Refiner::Refine(const SurfacePoint& p_in, const SurfacePoint& q_in, const
   QueryScratch own;
   QueryScratch& solvers = scratch != nullptr ? *scratch : own;
   // `path_length`: the length of a surface path between the points, if known.
-  auto exact = [&](double path_length = kInf) {
-    std::optional<double> e = exact_.ConfinedDistance(from, to, {}, solvers, path_length);
+  NearPairStats& stats = solvers.near_pair_stats();
+  // `seeds`: the faces the region starts from (none: a chain of faces from
+  // one point to the other).
+  auto exact = [&](double path_length = kInf, std::span<const int32_t> seeds = {}) {
+    std::optional<double> e = exact_.ConfinedDistance(from, to, seeds, solvers, path_length);
     if (!e) e = exact_.NearDistance(from, to, &solvers);
     if (!e) return false;
     d = *e;
@@ -89,10 +93,24 @@ double Refiner::Refine(const SurfacePoint& p_in, const SurfacePoint& q_in, const
   // (tests/bench/exact_geodesics.md). The trace stays for an index whose mesh cannot
   // be rebuilt for exact propagation, and for `walk_` off (benchmarks).
   auto near_path = [&] {
+    ++stats.pairs;
     if (walk_) {
-      const NearWalk walk = WalkNearPair(view_, from, to, plausible());
+      const NearWalk walk = WalkNearPair(view_, from, to, plausible(), &solvers);
       if (walk.path && certified(walk.path->length)) return take(*walk.path);
-      if (exact(walk.path ? walk.path->length : walk.doubted.value_or(kInf))) return true;
+      // The doubted walk's length prunes the propagation from its first
+      // window, and its corridor, where the shortest path mostly runs, is
+      // the first region (a chain of faces found by a search round the
+      // pair cost more than the propagation in it).
+      const double upper = walk.path ? walk.path->length : walk.doubted.value_or(kInf);
+      const bool solved = exact(upper, walk.corridor);
+      ++stats.exact_solves;
+      stats.exact_with_walk += walk.path || walk.doubted;
+      if (const auto& confined = solvers.solvers().confined) {
+        stats.exact_rounds += confined->stats().rounds;
+        stats.exact_region_faces += confined->stats().region_faces;
+        stats.exact_windows += confined->stats().windows_created;
+      }
+      if (solved) return true;
       if (walk.path) return take(*walk.path);  // a mesh without exact propagation
     }
     const std::optional<NearPath> t = NearPathLength(view_, paths_, from, to, walk_, plausible());

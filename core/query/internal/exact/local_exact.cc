@@ -13,16 +13,6 @@
 
 namespace geodex::query {
 
-QueryScratch::QueryScratch() = default;
-QueryScratch::~QueryScratch() = default;
-QueryScratch::QueryScratch(QueryScratch&&) noexcept = default;
-QueryScratch& QueryScratch::operator=(QueryScratch&&) noexcept = default;
-
-QueryScratch::Solvers& QueryScratch::solvers() {
-  if (solvers_ == nullptr) solvers_ = std::make_unique<Solvers>();
-  return *solvers_;
-}
-
 LocalExact::LocalExact(const index::Index& index, const MeshView& view)
     : index_(&index), view_(view) {}
 

@@ -22,9 +22,14 @@ std::array<double, 3> Velocity(const MeshView& view, int32_t f, const Vec3& dir)
   const Vec3 v[3] = {view.Position(view.Vertex(f, 0)), view.Position(view.Vertex(f, 1)),
                      view.Position(view.Vertex(f, 2))};
   const Vec3 n = (v[1] - v[0]).cross(v[2] - v[0]);
-  const double area2 = n.squaredNorm();
+  // One division, not three: a walk's step waits on each (the velocity
+  // only chooses the edge the walk leaves by; the path's length is measured
+  // in the corridor's layout).
+  const double inverse_area2 = 1 / n.squaredNorm();
   std::array<double, 3> beta;
-  for (int i = 0; i < 3; ++i) beta[i] = n.cross(v[(i + 2) % 3] - v[(i + 1) % 3]).dot(dir) / area2;
+  for (int i = 0; i < 3; ++i) {
+    beta[i] = n.cross(v[(i + 2) % 3] - v[(i + 1) % 3]).dot(dir) * inverse_area2;
+  }
   return beta;
 }
 
@@ -48,11 +53,12 @@ Vec3 UnfoldHeading(const MeshView& view, int32_t f, const std::array<int32_t, 2>
 }
 
 // A corridor of faces (consecutive ones share an edge) unfolded into one
-// plane (strip_funnel.h), with the points it runs between. The shortest
-// path through it is found by the funnel algorithm on the unfolded edges it
-// crosses (portals), in a few flops a face; where that path bends round a
-// vertex short of a straight angle on the vertex's other side, the
-// corridor is moved to that side (Release).
+// plane (strip_funnel.h), with the points it runs between, in a walk
+// scratch's arrays. The shortest path through it is found by the funnel
+// algorithm on the unfolded edges it crosses (portals), in a few flops a
+// face; where that path bends round a vertex short of a straight angle on
+// the vertex's other side, the corridor is moved to that side (Release),
+// and only the faces after the bend are laid out again.
 class Corridor {
  public:
   // Where the funnel's path bends: the vertex, the run of portals
@@ -65,38 +71,71 @@ class Corridor {
   };
   using Bends = absl::InlinedVector<Bend, 8>;
 
+  explicit Corridor(QueryScratch::Walks& scratch)
+      : faces_(scratch.faces), flat_(scratch.flat), portals_(scratch.portals) {}
+
   std::vector<int32_t>& faces() { return faces_; }
 
-  // Unfolds faces() from `from` (a point faces()[0] holds) to `to` (one the
-  // last face holds). False when consecutive faces share no edge.
-  bool Unfold(const MeshView& view, const SurfacePoint& from, const SurfacePoint& to) {
-    return UnfoldStrip(view, faces_, from, to, 0, &strip_);
+  // Lays out faces() from `from` (a point faces()[0] holds) to `to` (one the
+  // last face holds), keeping the layouts of the faces before `first` (laid
+  // out by the last call, and unchanged since). The layouts are those of
+  // UnfoldStrip, to the bit: each face is placed across the edge it shares
+  // with the one before, as laid out. False when consecutive faces share no
+  // edge.
+  bool Unfold(const MeshView& view, const SurfacePoint& from, const SurfacePoint& to,
+              size_t first = 0) {
+    const size_t n = faces_.size();
+    flat_.resize(n);
+    portals_.resize(n - 1);
+    if (first == 0) {
+      flat_[0] = LayOutFace(view, faces_[0]);
+      start_ = LocateInFlat(view, flat_[0], from, 0);
+      first = 1;
+    }
+    for (size_t t = first; t < n; ++t) {
+      const int32_t f = faces_[t - 1];
+      int edge = -1;
+      for (int i = 0; i < 3; ++i) {
+        const int32_t h = view.twins[3 * f + i];
+        if (h >= 0 && h / 3 == faces_[t]) edge = i;
+      }
+      if (edge < 0) return false;
+      // The half-edge runs from corner `edge` to the next, with f on its
+      // left: going out of f, its end is on the left.
+      const int left = (edge + 1) % 3;
+      const int32_t a = view.Vertex(f, left), b = view.Vertex(f, edge);
+      const FlatFace& prev = flat_[t - 1];
+      portals_[t - 1] = {{prev.corners[left], prev.corners[edge]}, {a, b}};
+      flat_[t] = UnfoldAcross(view, prev, faces_[t], a, b);
+    }
+    end_ = LocateInFlat(view, flat_[n - 1], to, 0);
+    return true;
   }
 
   // |end - start| when that segment passes through every portal.
   std::optional<double> StraightLength() const {
-    return query::StraightLength(strip_.start, strip_.portals, strip_.end);
+    return query::StraightLength(start_, portals_, end_);
   }
 
   // The length of the shortest path through the corridor (the funnel
   // algorithm, Lee & Preparata 1984) and where it bends.
   double Shortest(Bends* bends) const {
-    const FunnelPath path = query::Funnel(strip_.start, strip_.portals, strip_.end);
-    const size_t n = strip_.portals.size(), count = path.bends.size();
+    const FunnelPath path = query::Funnel(start_, portals_, end_);
+    const size_t n = portals_.size(), count = path.bends.size();
     // The path's k-th vertex: the start, the bends, the end.
     auto point = [&](size_t k) -> const Vec2& {
-      if (k == 0) return strip_.start;
-      if (k > count) return strip_.end;
+      if (k == 0) return start_;
+      if (k > count) return end_;
       const FunnelBend& bend = path.bends[k - 1];
-      return strip_.portals[bend.portal].ends[bend.side];
+      return portals_[bend.portal].ends[bend.side];
     };
     bends->clear();
     for (size_t k = 0; k < count; ++k) {
       const auto [at, side] = path.bends[k];
-      const int32_t v = strip_.portals[at].vertices[side];
+      const int32_t v = portals_[at].vertices[side];
       size_t first = at, last = at;
-      while (first > 0 && strip_.portals[first - 1].vertices[side] == v) --first;
-      while (last + 1 < n && strip_.portals[last + 1].vertices[side] == v) ++last;
+      while (first > 0 && portals_[first - 1].vertices[side] == v) --first;
+      while (last + 1 < n && portals_[last + 1].vertices[side] == v) ++last;
       const Vec2 d = point(k + 1) - point(k), e = point(k + 2) - point(k + 1);
       bends->push_back({v, first, last, std::atan2(std::abs(Cross(d, e)), d.dot(e))});
     }
@@ -105,7 +144,8 @@ class Corridor {
 
   // Moves the corridor to the other side of the bend's vertex: the faces
   // holding it between the bend's portals are replaced by those round the
-  // vertex the other way. False at the boundary.
+  // vertex the other way. False at the boundary. The faces from
+  // bend.first + 1 on must be laid out again (Unfold(..., bend.first + 1)).
   bool Release(const MeshView& view, const Bend& bend) {
     const int32_t v = bend.vertex;
     const int32_t from = faces_[bend.first], to = faces_[bend.last + 1];
@@ -119,8 +159,10 @@ class Corridor {
   }
 
  private:
-  std::vector<int32_t> faces_;
-  UnfoldedStrip strip_;
+  std::vector<int32_t>& faces_;
+  std::vector<FlatFace>& flat_;
+  std::vector<Portal>& portals_;
+  Vec2 start_ = Vec2::Zero(), end_ = Vec2::Zero();
 };
 
 // A corridor from `from` to `to` found without the distance field: from
@@ -190,8 +232,8 @@ bool WalkCorridor(const MeshView& view, const PathPoint& from, const PathPoint& 
     if (exit < 0 || !(t > 1e-14)) return false;
     for (int i = 0; i < 3; ++i) w[i] = std::max(w[i] + t * beta[i], 0.0);
     w[exit] = 0;
-    const double sum = w[0] + w[1] + w[2];
-    for (double& c : w) c /= sum;
+    const double inverse_sum = 1 / (w[0] + w[1] + w[2]);
+    for (double& c : w) c *= inverse_sum;
     if (w[0] > 1 - 1e-9 || w[1] > 1 - 1e-9 || w[2] > 1 - 1e-9) return false;
     const Vec3 last = x;
     x = w[0] * view.Position(view.Vertex(f, 0)) + w[1] * view.Position(view.Vertex(f, 1)) +
@@ -203,6 +245,15 @@ bool WalkCorridor(const MeshView& view, const PathPoint& from, const PathPoint& 
     heading_edge = {view.Vertex(f, (exit + 1) % 3), view.Vertex(f, (exit + 2) % 3)};
     f = g / 3;
     faces->push_back(f);
+    // The next step reads a neighbour's corners and twins: a random pair's
+    // corridor is seldom in cache, so both lines of each neighbour are
+    // fetched while this step's arithmetic runs.
+    for (int k = 0; k < 3; ++k) {
+      const int32_t next = view.twins[3 * f + k];
+      if (next < 0) continue;
+      __builtin_prefetch(&view.faces[next - next % 3]);
+      __builtin_prefetch(&view.twins[next - next % 3]);
+    }
     w = AcrossEdge(g, exit, w);
   }
   return false;
@@ -231,7 +282,11 @@ std::optional<double> AngleSum(const MeshView& view, int32_t face, int32_t v) {
 }  // namespace
 
 NearWalk WalkNearPair(const MeshView& view, const SurfacePoint& from, const SurfacePoint& to,
-                      double plausible) {
+                      double plausible, QueryScratch* scratch) {
+  QueryScratch own;
+  QueryScratch& s = scratch != nullptr ? *scratch : own;
+  QueryScratch::Walks& walks = s.walks();
+  NearPairStats& count = s.near_pair_stats();
   // First the corridors of the chord, from either end, unfolded into the
   // plane. A straight segment through the corridor is a local geodesic, as
   // the straightened trace would be, found without evaluating the distance
@@ -249,9 +304,15 @@ NearWalk WalkNearPair(const MeshView& view, const SurfacePoint& from, const Surf
   constexpr int kMaxReleases = 8;
   const PathPoint ends[2] = {{from, view.PositionOf(from)}, {to, view.PositionOf(to)}};
   std::optional<double> doubted;
-  auto doubt = [&](double length) { doubted = std::min(length, doubted.value_or(length)); };
+  Corridor corridor(walks);
+  // The corridors of `doubted` and `found`, in walks.doubted_faces and
+  // walks.found_faces.
+  auto doubt = [&](double length) {
+    if (doubted && *doubted <= length) return;
+    doubted = length;
+    walks.doubted_faces.assign(corridor.faces().begin(), corridor.faces().end());
+  };
   std::optional<NearPath> found;
-  Corridor corridor;
   Corridor::Bends bends;
   for (int start = 0; start < 2; ++start) {
     const SurfacePoint& a = ends[start].point;
@@ -260,8 +321,11 @@ NearWalk WalkNearPair(const MeshView& view, const SurfacePoint& from, const Surf
         !corridor.Unfold(view, a, b)) {
       continue;
     }
+    ++count.walks;
+    count.faces_crossed += static_cast<int64_t>(corridor.faces().size());
+    count.faces_unfolded += static_cast<int64_t>(corridor.faces().size());
     if (const std::optional<double> length = corridor.StraightLength()) {
-      if (*length <= plausible) return {NearPath{*length, false}, std::nullopt};
+      if (*length <= plausible) return {NearPath{*length, false}, std::nullopt, corridor.faces()};
       doubt(*length);
       continue;
     }
@@ -285,24 +349,36 @@ NearWalk WalkNearPair(const MeshView& view, const SurfacePoint& from, const Surf
       if (shortcut == nullptr) {
         if (length <= plausible && bends.size() <= 1) {
           // Straight in the walk's own corridor: as sure as a straight walk.
-          if (release == 0 && bends.empty()) return {NearPath{length, false}, std::nullopt};
+          if (release == 0 && bends.empty()) {
+            return {NearPath{length, false}, std::nullopt, corridor.faces()};
+          }
           // Else a local geodesic in a corridor the walk did not find by
           // itself: kept, but the other walk may find a shorter one.
-          if (!found || length < found->length) found = NearPath{length, !bends.empty()};
+          if (!found || length < found->length) {
+            found = NearPath{length, !bends.empty()};
+            walks.found_faces.assign(corridor.faces().begin(), corridor.faces().end());
+          }
         } else {
           doubt(length);
         }
         break;
       }
-      if (!corridor.Release(view, *shortcut) || !corridor.Unfold(view, a, b)) break;
+      ++count.releases;
+      if (!corridor.Release(view, *shortcut)) break;
+      const size_t changed = shortcut->first + 1;
+      if (!corridor.Unfold(view, a, b, changed)) break;
+      count.faces_unfolded += static_cast<int64_t>(corridor.faces().size() - changed);
     }
   }
   // Every candidate is a surface path: the shortest is the closest.
   if (found) {
-    if (doubted && *doubted < found->length) return {NearPath{*doubted, true}, std::nullopt};
-    return {found, std::nullopt};
+    if (doubted && *doubted < found->length) {
+      return {NearPath{*doubted, true}, std::nullopt, walks.doubted_faces};
+    }
+    return {found, std::nullopt, walks.found_faces};
   }
-  return {std::nullopt, doubted};
+  if (doubted) return {std::nullopt, doubted, walks.doubted_faces};
+  return {};
 }
 
 std::optional<NearPath> NearPathLength(const MeshView& view, const GradientPaths& paths,

@@ -10,13 +10,18 @@
 // candidate is a surface path, never shorter than the geodesic, so the
 // shortest is kept.
 //
-// Thread safety: a pure function of immutable data.
+// Thread safety: pure functions of immutable data and the caller's scratch.
 
+#include <cstdint>
 #include <limits>
 #include <optional>
+#include <span>
+#include <vector>
 
 #include "core/query/internal/paths/gradient_path.h"
 #include "core/query/internal/mesh_view.h"
+#include "core/query/internal/paths/strip_funnel.h"
+#include "core/query/query_scratch.h"
 #include "core/query/query_types.h"
 
 namespace geodex::query {
@@ -31,6 +36,19 @@ struct NearPath {
   bool wraps;
 };
 
+// The working memory of the chord's walks, kept per thread in a
+// QueryScratch so that a near pair allocates nothing once the vectors have
+// grown to the longest corridor seen: the corridor being walked, its faces
+// laid out in the plane (each once: a release lays out again only the
+// faces after its bend) and its portals, and the faces of the corridors
+// the walks returned.
+struct QueryScratch::Walks {
+  std::vector<int32_t> faces;
+  std::vector<FlatFace> flat;  // flat[t]: faces[t] laid out
+  std::vector<Portal> portals;
+  std::vector<int32_t> found_faces, doubted_faces;
+};
+
 // What the chord's walks found between near points.
 struct NearWalk {
   // The shortest path the walks vouch for: a local geodesic in a corridor
@@ -40,13 +58,20 @@ struct NearWalk {
   // Without such a path: the shortest candidate the walks doubted (bending
   // at several saddles, or straight but longer than `plausible`), if any.
   std::optional<double> doubted;
+  // The faces of the corridor of `path` (else of `doubted`), in order from
+  // `from`: where the shortest path is most likely to run, the region an
+  // exact check starts from. Lives in the scratch until its next walk.
+  std::span<const int32_t> corridor;
 };
 
 // The chord's walks from either end between valid canonical points `from`
 // and `to` (from the smaller point, for symmetry). A straight walk longer
-// than `plausible` is doubted (it may run in a wrong corridor).
+// than `plausible` is doubted (it may run in a wrong corridor). `scratch`
+// (optional: without, the call makes its own) holds the walks' memory and
+// counts them in its NearPairStats.
 NearWalk WalkNearPair(const MeshView& view, const SurfacePoint& from, const SurfacePoint& to,
-                      double plausible = std::numeric_limits<double>::infinity());
+                      double plausible = std::numeric_limits<double>::infinity(),
+                      QueryScratch* scratch = nullptr);
 
 // The shortest path found between valid canonical points `from` and `to`
 // (from the smaller point, for symmetry): the walks' (WalkNearPair), else

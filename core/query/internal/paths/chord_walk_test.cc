@@ -2,10 +2,13 @@
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
 #include <vector>
 
 #include "core/mesh/generators.h"
+#include "core/query/internal/paths/strip_funnel.h"
 #include "core/query/internal/query_parts_testing.h"
+#include "core/query/query_scratch.h"
 #include "gtest/gtest.h"
 
 namespace geodex::query {
@@ -99,6 +102,46 @@ TEST(ChordWalkTest, ADoubtedWalkGivesWayToAShorterTrace) {
   EXPECT_GE(free->length, chord);
   EXPECT_GE(doubted->length, chord);
   EXPECT_GE(doubted->length, free->length - 1e-12);
+}
+
+// The walks keep their corridors and layouts in a scratch from pair to
+// pair, and a release lays out only the faces after its bend: neither may
+// change an answer. A kept scratch gives what a fresh one gives, to the
+// bit, and a released corridor's length is that of the same faces laid
+// out whole (UnfoldStrip) and straightened by the funnel.
+TEST(ChordWalkTest, AKeptScratchAndReleasedLayoutsGiveTheAnswersOfFreshOnes) {
+  // The inside of a torus is a field of saddle vertices: walks release.
+  const mesh::Mesh torus = mesh::gen::Torus(48, 24, 1.0, 0.45);
+  const testing::QueryParts parts(torus, 60);
+  QueryScratch kept;
+  int compared = 0, released = 0;
+  for (int32_t f = 0; f < torus.num_faces(); f += 13) {
+    for (const int32_t step : {5, 37, 101, 151}) {
+      const int32_t g = (f + step) % torus.num_faces();
+      SurfacePoint a{f, {0.2, 0.3, 0.5}}, b{g, {0.5, 0.25, 0.25}};
+      if (g < f) std::swap(a, b);
+      const int64_t releases = kept.near_pair_stats().releases;
+      const NearWalk walk = WalkNearPair(parts.view, a, b, kInf, &kept);
+      const NearWalk fresh = WalkNearPair(parts.view, a, b);
+      ASSERT_EQ(walk.path.has_value(), fresh.path.has_value()) << f << " " << g;
+      ASSERT_EQ(walk.doubted.has_value(), fresh.doubted.has_value()) << f << " " << g;
+      if (walk.doubted) EXPECT_EQ(*walk.doubted, *fresh.doubted) << f << " " << g;
+      EXPECT_TRUE(std::equal(walk.corridor.begin(), walk.corridor.end(), fresh.corridor.begin(),
+                             fresh.corridor.end()));
+      if (!walk.path) continue;
+      ++compared;
+      EXPECT_EQ(walk.path->length, fresh.path->length) << f << " " << g;
+      EXPECT_EQ(walk.path->wraps, fresh.path->wraps) << f << " " << g;
+      if (kept.near_pair_stats().releases == releases) continue;
+      ++released;
+      UnfoldedStrip strip;
+      ASSERT_TRUE(UnfoldStrip(parts.view, walk.corridor, a, b, 0, &strip));
+      EXPECT_EQ(Funnel(strip.start, strip.portals, strip.end).length, walk.path->length)
+          << f << " " << g;
+    }
+  }
+  EXPECT_GT(compared, 100);
+  EXPECT_GT(released, 5);
 }
 
 }  // namespace
