@@ -305,6 +305,11 @@ NearWalk WalkNearPair(const MeshView& view, const SurfacePoint& from, const Surf
   const PathPoint ends[2] = {{from, view.PositionOf(from)}, {to, view.PositionOf(to)}};
   std::optional<double> doubted;
   Corridor corridor(walks);
+  // The corridor returned lives in the scratch: none when the scratch is
+  // this call's own.
+  const auto in_scratch = [&](std::span<const int32_t> faces) {
+    return scratch != nullptr ? faces : std::span<const int32_t>();
+  };
   // The corridors of `doubted` and `found`, in walks.doubted_faces and
   // walks.found_faces.
   auto doubt = [&](double length) {
@@ -325,7 +330,7 @@ NearWalk WalkNearPair(const MeshView& view, const SurfacePoint& from, const Surf
     count.faces_crossed += static_cast<int64_t>(corridor.faces().size());
     count.faces_unfolded += static_cast<int64_t>(corridor.faces().size());
     if (const std::optional<double> length = corridor.StraightLength()) {
-      if (*length <= plausible) return {NearPath{*length, false}, std::nullopt, corridor.faces()};
+      if (*length <= plausible) return {NearPath{*length, false}, std::nullopt, in_scratch(corridor.faces())};
       doubt(*length);
       continue;
     }
@@ -350,7 +355,7 @@ NearWalk WalkNearPair(const MeshView& view, const SurfacePoint& from, const Surf
         if (length <= plausible && bends.size() <= 1) {
           // Straight in the walk's own corridor: as sure as a straight walk.
           if (release == 0 && bends.empty()) {
-            return {NearPath{length, false}, std::nullopt, corridor.faces()};
+            return {NearPath{length, false}, std::nullopt, in_scratch(corridor.faces())};
           }
           // Else a local geodesic in a corridor the walk did not find by
           // itself: kept, but the other walk may find a shorter one.
@@ -373,11 +378,11 @@ NearWalk WalkNearPair(const MeshView& view, const SurfacePoint& from, const Surf
   // Every candidate is a surface path: the shortest is the closest.
   if (found) {
     if (doubted && *doubted < found->length) {
-      return {NearPath{*doubted, true}, std::nullopt, walks.doubted_faces};
+      return {NearPath{*doubted, true}, std::nullopt, in_scratch(walks.doubted_faces)};
     }
-    return {found, std::nullopt, walks.found_faces};
+    return {found, std::nullopt, in_scratch(walks.found_faces)};
   }
-  if (doubted) return {std::nullopt, doubted, walks.doubted_faces};
+  if (doubted) return {std::nullopt, doubted, in_scratch(walks.doubted_faces)};
   return {};
 }
 

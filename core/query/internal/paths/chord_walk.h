@@ -60,7 +60,8 @@ struct NearWalk {
   std::optional<double> doubted;
   // The faces of the corridor of `path` (else of `doubted`), in order from
   // `from`: where the shortest path is most likely to run, the region an
-  // exact check starts from. Lives in the scratch until its next walk.
+  // exact check starts from. Lives in the scratch until its next walk;
+  // empty when WalkNearPair was given no scratch.
   std::span<const int32_t> corridor;
 };
 
