@@ -87,10 +87,12 @@ query::NearPairs NearPairsOf(int mode) {
   }
 }
 
-query::DistanceOptions DistanceOptionsOf(int near_pairs, double tolerance) {
+query::DistanceOptions DistanceOptionsOf(int near_pairs, double tolerance,
+                                         double refine_below = 0) {
   query::DistanceOptions options;
   options.near_pairs = NearPairsOf(near_pairs);
   options.tolerance = tolerance;
+  options.refine_below_l1000 = refine_below;
   return options;
 }
 
@@ -125,7 +127,7 @@ class Index {
   // (distances, bounds or None) of pairs (a[i], b[i]).
   py::tuple Distance(const Faces& a_faces, const Weights& a_weights, const Faces& b_faces,
                      const Weights& b_weights, int near_pairs, double tolerance,
-                     bool bounds) const {
+                     bool bounds, double refine_below) const {
     const int64_t n = a_faces.size();
     if (b_faces.size() != n) {
       throw StatusError(absl::InvalidArgumentError(
@@ -136,7 +138,7 @@ class Index {
     if (bounds) out_bounds.emplace(n);
     double* d = out.mutable_data();
     double* bnd = bounds ? out_bounds->mutable_data() : nullptr;
-    const query::DistanceOptions options = DistanceOptionsOf(near_pairs, tolerance);
+    const query::DistanceOptions options = DistanceOptionsOf(near_pairs, tolerance, refine_below);
     {
       py::gil_scoped_release release;
       // Blocks of kBlockPairs pairs, each read (checked and translated) and
@@ -172,14 +174,15 @@ class Index {
   // (S x T distances, bounds or None); row s is one DistanceBatch of
   // sources[s] repeated against the targets.
   py::tuple Matrix(const Faces& s_faces, const Weights& s_weights, const Faces& t_faces,
-                   const Weights& t_weights, int near_pairs, double tolerance, bool bounds) const {
+                   const Weights& t_weights, int near_pairs, double tolerance, bool bounds,
+                   double refine_below) const {
     const int64_t s = s_faces.size(), t = t_faces.size();
     py::array_t<double> out({s, t});
     std::optional<py::array_t<double>> out_bounds;
     if (bounds) out_bounds.emplace(std::vector<int64_t>{s, t});
     double* m = out.mutable_data();
     double* bnd = bounds ? out_bounds->mutable_data() : nullptr;
-    const query::DistanceOptions options = DistanceOptionsOf(near_pairs, tolerance);
+    const query::DistanceOptions options = DistanceOptionsOf(near_pairs, tolerance, refine_below);
     {
       py::gil_scoped_release release;
       query::EnginePoints sources, targets;

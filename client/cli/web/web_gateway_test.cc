@@ -137,6 +137,7 @@ TEST_F(WebGatewayTest, DistanceRoundTripsEveryDoubleExactly) {
     EXPECT_EQ(request.b().weights(2), 1.0 / 3.0);
     EXPECT_TRUE(request.error_bounds());
     EXPECT_EQ(request.near_pairs(), v1::NEAR_PAIRS_EXACT);
+    EXPECT_EQ(request.refine_below(), 8);  // the every-distance mode, in L1000
     v1::DistanceResponse response;
     response.add_distances(d);
     response.add_distances(std::numeric_limits<double>::infinity());
@@ -148,7 +149,7 @@ TEST_F(WebGatewayTest, DistanceRoundTripsEveryDoubleExactly) {
   const HttpResponse r = Post("/v1/models/torus:distance", R"({
       "a": {"faces": [12], "weights": [0.6, 0.1, 0.3]},
       "b": {"faces": [3], "weights": [0.3333333333333333, 0.3333333333333333, 0.3333333333333333]},
-      "errorBounds": true, "near_pairs": "NEAR_PAIRS_EXACT"})");
+      "errorBounds": true, "near_pairs": "NEAR_PAIRS_EXACT", "refineBelow": 8})");
   ASSERT_EQ(r.status, 200) << r.body;
   EXPECT_THAT(r.body, HasSubstr("\"Infinity\""));
   const v1::DistanceResponse parsed = Parse<v1::DistanceResponse>(r);

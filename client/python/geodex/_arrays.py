@@ -275,15 +275,21 @@ def as_near_pairs(near_pairs: Optional[str]) -> Optional[str]:
     return near_pairs
 
 
+def check_nonnegative(name: str, value: float) -> float:
+    """``value`` as a float, finite and >= 0; InvalidArgument naming
+    ``name`` otherwise."""
+    try:
+        t = float(value)
+    except (TypeError, ValueError):
+        raise InvalidArgument(f"{name} must be a number, not {value!r}") from None
+    if not (np.isfinite(t) and t >= 0):
+        raise InvalidArgument(f"{name} must be finite and >= 0, not {t}")
+    return t
+
+
 def check_tolerance(tolerance: float) -> float:
     """A relative error tolerance: finite and >= 0 (0: none)."""
-    try:
-        t = float(tolerance)
-    except (TypeError, ValueError):
-        raise InvalidArgument(f"tolerance must be a number, not {tolerance!r}") from None
-    if not (np.isfinite(t) and t >= 0):
-        raise InvalidArgument(f"tolerance must be finite and >= 0, not {t}")
-    return t
+    return check_nonnegative("tolerance", tolerance)
 
 
 def is_pathlike(x: Any) -> bool:

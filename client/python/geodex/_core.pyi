@@ -32,12 +32,12 @@ class Index:
     def report_json(self) -> str: ...
     def distance(
         self, a_faces: _Faces, a_weights: _Weights, b_faces: _Faces, b_weights: _Weights,
-        near_pairs: int, tolerance: float, bounds: bool, /,
+        near_pairs: int, tolerance: float, bounds: bool, refine_below: float, /,
     ) -> Tuple[_F64, Optional[_F64]]:
         """(N,) float64 distances and, with bounds, (N,) float64 bounds."""
     def matrix(
         self, s_faces: _Faces, s_weights: _Weights, t_faces: _Faces, t_weights: _Weights,
-        near_pairs: int, tolerance: float, bounds: bool, /,
+        near_pairs: int, tolerance: float, bounds: bool, refine_below: float, /,
     ) -> Tuple[_F64, Optional[_F64]]:
         """(S, T) float64 distances and, with bounds, (S, T) float64 bounds."""
     def path(

@@ -22,7 +22,7 @@ from typing import Any, Generic, List, Optional, Sequence, Tuple, TypeVar, Union
 import numpy as np
 
 from ._arrays import Located, Path, SurfacePoints, as_near_pairs, as_points, as_positions
-from ._arrays import check_tolerance
+from ._arrays import check_nonnegative, check_tolerance
 from .errors import InvalidArgument
 
 __all__ = ["QueryFront", "NEAR_PAIRS"]
@@ -45,14 +45,14 @@ class QueryFront(Generic[At]):
 
     def _run_distance(
         self, at: At, a: SurfacePoints, b: SurfacePoints, near_pairs: int, tolerance: float,
-        bounds: bool,
+        bounds: bool, refine_below: float,
     ) -> Tuple[np.ndarray, Optional[np.ndarray]]:
         """(N,) float64 distances, and (N,) bounds when ``bounds``."""
         raise NotImplementedError
 
     def _run_matrix(
         self, at: At, sources: SurfacePoints, targets: SurfacePoints, near_pairs: int,
-        tolerance: float, bounds: bool,
+        tolerance: float, bounds: bool, refine_below: float,
     ) -> Tuple[np.ndarray, Optional[np.ndarray]]:
         """(S, T) float64 distances, and (S, T) bounds when ``bounds``."""
         raise NotImplementedError
@@ -115,26 +115,28 @@ class QueryFront(Generic[At]):
 
     def _distance(
         self, at: At, a: Any, b: Any, bounds: bool, tolerance: float, near_pairs: Optional[str],
-        xyz: bool,
+        xyz: bool, refine_below: float,
     ) -> Distances:
         check_tolerance(tolerance)
+        below = check_nonnegative("refine_below", refine_below)
         as_near_pairs(near_pairs)
         pa, pb = self._points(at, [a, b], ("a", "b"), xyz)
         self._pair_up(pa, pb)
         d, bnd = self._run_distance(
-            at, pa, pb, NEAR_PAIRS[near_pairs], float(tolerance), bool(bounds)
+            at, pa, pb, NEAR_PAIRS[near_pairs], float(tolerance), bool(bounds), below
         )
         return (d, bnd) if bnd is not None else d
 
     def _matrix(
         self, at: At, sources: Any, targets: Any, bounds: bool, tolerance: float,
-        near_pairs: Optional[str], xyz: bool,
+        near_pairs: Optional[str], xyz: bool, refine_below: float,
     ) -> Distances:
         check_tolerance(tolerance)
+        below = check_nonnegative("refine_below", refine_below)
         as_near_pairs(near_pairs)
         src, tgt = self._points(at, [sources, targets], ("sources", "targets"), xyz)
         m, bnd = self._run_matrix(
-            at, src, tgt, NEAR_PAIRS[near_pairs], float(tolerance), bool(bounds)
+            at, src, tgt, NEAR_PAIRS[near_pairs], float(tolerance), bool(bounds), below
         )
         return (m, bnd) if bnd is not None else m
 

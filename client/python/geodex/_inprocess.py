@@ -152,6 +152,7 @@ class Index(QueryFront[None]):
         *,
         near_pairs: Optional[str] = None,
         xyz: bool = False,
+        refine_below: float = 0.0,
     ) -> Union[np.ndarray, Tuple[np.ndarray, np.ndarray]]:
         """Geodesic distances of pairs, ``d[i] = d(a[i], b[i])``, as
         :meth:`geodex.Client.distance` (without the model).
@@ -170,6 +171,10 @@ class Index(QueryFront[None]):
             How near pairs are answered; None: the index's configuration.
         xyz : bool
             ``a`` and ``b`` are (N, 3) positions, located first.
+        refine_below : float
+            Also refine every pair that may be closer than this many L1000
+            (the spacing of 1,000 samples on the surface); 8: the
+            every-distance mode. 0: the index's threshold.
 
         Returns
         -------
@@ -184,7 +189,7 @@ class Index(QueryFront[None]):
         FailedPrecondition
             ``bounds`` or ``tolerance`` of an index without calibration.
         """
-        return self._distance(None, a, b, bounds, tolerance, near_pairs, xyz)
+        return self._distance(None, a, b, bounds, tolerance, near_pairs, xyz, refine_below)
 
     def matrix(
         self,
@@ -195,6 +200,7 @@ class Index(QueryFront[None]):
         *,
         near_pairs: Optional[str] = None,
         xyz: bool = False,
+        refine_below: float = 0.0,
     ) -> Union[np.ndarray, Tuple[np.ndarray, np.ndarray]]:
         """All sources x targets distances, ``m[s, t] = d(sources[s],
         targets[t])``, as :meth:`geodex.Client.matrix`.
@@ -208,7 +214,9 @@ class Index(QueryFront[None]):
             (S, T) float64 distances; with ``bounds``, also (S, T) float64
             bounds.
         """
-        return self._matrix(None, sources, targets, bounds, tolerance, near_pairs, xyz)
+        return self._matrix(
+            None, sources, targets, bounds, tolerance, near_pairs, xyz, refine_below
+        )
 
     def path(self, a: Any, b: Any, *, exact_corridor: int = 0, xyz: bool = False) -> List[Path]:
         """Geodesic paths from a[i] to b[i], as :meth:`geodex.Client.path`.
@@ -319,20 +327,20 @@ class Index(QueryFront[None]):
 
     def _run_distance(
         self, at: None, a: SurfacePoints, b: SurfacePoints, near_pairs: int, tolerance: float,
-        bounds: bool,
+        bounds: bool, refine_below: float,
     ) -> Tuple[np.ndarray, Optional[np.ndarray]]:
         d, bnd = self._index.distance(
-            a.faces, a.weights, b.faces, b.weights, near_pairs, tolerance, bounds
+            a.faces, a.weights, b.faces, b.weights, near_pairs, tolerance, bounds, refine_below
         )
         return d, (bnd if bounds else None)
 
     def _run_matrix(
         self, at: None, sources: SurfacePoints, targets: SurfacePoints, near_pairs: int,
-        tolerance: float, bounds: bool,
+        tolerance: float, bounds: bool, refine_below: float,
     ) -> Tuple[np.ndarray, Optional[np.ndarray]]:
         m, bnd = self._index.matrix(
             sources.faces, sources.weights, targets.faces, targets.weights,
-            near_pairs, tolerance, bounds,
+            near_pairs, tolerance, bounds, refine_below,
         )
         return m, (bnd if bounds else None)
 

@@ -66,14 +66,15 @@ class RemoteQueries(QueryFront[At]):
 
     def _run_distance(
         self, at: At, a: SurfacePoints, b: SurfacePoints, near_pairs: int, tolerance: float,
-        bounds: bool,
+        bounds: bool, refine_below: float,
     ) -> Tuple[np.ndarray, Optional[np.ndarray]]:
         n = a.faces.shape[0]
         ref = at.ref()
         if n > self._batch_size:
-            return self._stream(ref, a, b, bounds, tolerance, near_pairs)
+            return self._stream(ref, a, b, bounds, tolerance, near_pairs, refine_below)
         head = pb.DistanceRequest(
-            model=ref, near_pairs=near_pairs, tolerance=tolerance, error_bounds=bounds
+            model=ref, near_pairs=near_pairs, tolerance=tolerance, error_bounds=bounds,
+            refine_below=refine_below,
         ).SerializeToString()
         request = (
             head
@@ -98,6 +99,7 @@ class RemoteQueries(QueryFront[At]):
         bounds: bool,
         tolerance: float,
         near_pairs: int,
+        refine_below: float,
     ) -> Tuple[np.ndarray, Optional[np.ndarray]]:
         """Distances through one StreamDistances call, batch_size pairs a
         batch. gRPC's sending thread encodes a batch when the previous one
@@ -113,7 +115,8 @@ class RemoteQueries(QueryFront[At]):
             for k in range(num_batches):
                 lo, hi = k * size, min(n, (k + 1) * size)
                 head = pb.DistanceBatch(
-                    batch_id=k, near_pairs=near_pairs, tolerance=tolerance, error_bounds=bounds
+                    batch_id=k, near_pairs=near_pairs, tolerance=tolerance, error_bounds=bounds,
+                    refine_below=refine_below,
                 )
                 if k == 0:  # later batches reuse the stream's model
                     head.model.CopyFrom(ref)
@@ -159,7 +162,7 @@ class RemoteQueries(QueryFront[At]):
 
     def _run_matrix(
         self, at: At, sources: SurfacePoints, targets: SurfacePoints, near_pairs: int,
-        tolerance: float, bounds: bool,
+        tolerance: float, bounds: bool, refine_below: float,
     ) -> Tuple[np.ndarray, Optional[np.ndarray]]:
         src, tgt = sources, targets
         s, t = src.faces.shape[0], tgt.faces.shape[0]
@@ -171,7 +174,8 @@ class RemoteQueries(QueryFront[At]):
         while True:
             stop = min(s, start + rows_per_call)
             head = pb.MatrixRequest(
-                model=at.ref(), near_pairs=near_pairs, tolerance=tolerance, error_bounds=bounds
+                model=at.ref(), near_pairs=near_pairs, tolerance=tolerance, error_bounds=bounds,
+                refine_below=refine_below,
             ).SerializeToString()
             request = (
                 head

@@ -218,6 +218,7 @@ class Client(RemoteQueries):
         near_pairs: Optional[str] = None,
         xyz: bool = False,
         version: int = 0,
+        refine_below: float = 0.0,
     ) -> Union[np.ndarray, Tuple[np.ndarray, np.ndarray]]:
         """Geodesic distances of pairs: ``d[i] = d(a[i], b[i])``.
 
@@ -242,6 +243,10 @@ class Client(RemoteQueries):
             ``a`` and ``b`` are positions, located first.
         version : int
             The model version (0: the newest).
+        refine_below : float
+            Also refine every pair that may be closer than this many L1000
+            (the spacing of 1,000 samples on the surface; 8: the
+            every-distance mode). 0: the model's threshold.
 
         Returns
         -------
@@ -259,7 +264,9 @@ class Client(RemoteQueries):
         NotFound
             An unknown model or version.
         """
-        return self._distance(At(model, version), a, b, bounds, tolerance, near_pairs, xyz)
+        return self._distance(
+            At(model, version), a, b, bounds, tolerance, near_pairs, xyz, refine_below
+        )
 
     def matrix(
         self,
@@ -272,6 +279,7 @@ class Client(RemoteQueries):
         near_pairs: Optional[str] = None,
         xyz: bool = False,
         version: int = 0,
+        refine_below: float = 0.0,
     ) -> Union[np.ndarray, Tuple[np.ndarray, np.ndarray]]:
         """All sources x targets distances: ``m[s, t] = d(sources[s],
         targets[t])``.
@@ -283,7 +291,9 @@ class Client(RemoteQueries):
         fails ResourceExhausted.
         """
         at = At(model, version)
-        return self._matrix(at, sources, targets, bounds, tolerance, near_pairs, xyz)
+        return self._matrix(
+            at, sources, targets, bounds, tolerance, near_pairs, xyz, refine_below
+        )
 
     def path(
         self,

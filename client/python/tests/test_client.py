@@ -87,6 +87,8 @@ def test_bounds_and_tolerance_equal_geodex_query(client, torus_index, tmp_path, 
     assert (bounds >= 0).all()
     refined = query_distances(torus_index, tmp_path, a, b, "--tolerance", "0.005")
     assert max_relative_difference(client.distance(MODEL, a, b, tolerance=0.005), refined) <= 1e-12
+    every = query_distances(torus_index, tmp_path, a, b, "--refine-below", "8")
+    assert max_relative_difference(client.distance(MODEL, a, b, refine_below=8), every) <= 1e-12
 
 
 def test_matrix_rows_are_distances(client, num_faces):

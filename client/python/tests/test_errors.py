@@ -92,6 +92,8 @@ def test_bad_options(client, num_faces):
     g = good(num_faces)
     with pytest.raises(geodex.InvalidArgument, match="tolerance"):
         client.distance(MODEL, g, g, tolerance=-0.1)
+    with pytest.raises(geodex.InvalidArgument, match="refine_below must be finite"):
+        client.distance(MODEL, g, g, refine_below=float("nan"))
     with pytest.raises(geodex.InvalidArgument, match="near_pairs"):
         client.distance(MODEL, g, g, near_pairs="fast")
     with pytest.raises(geodex.InvalidArgument, match="exact_corridor"):

@@ -48,11 +48,14 @@ def test_the_build_report_is_the_servers(index, client):
 
 
 @pytest.mark.parametrize("options", [{}, {"bounds": True}, {"near_pairs": "unfold"},
-                                     {"near_pairs": "exact"}, {"tolerance": 0.005}])
+                                     {"near_pairs": "exact"}, {"tolerance": 0.005},
+                                     {"refine_below": 8}])
 def test_distances_equal_the_servers_to_the_bit(index, client, num_faces, options):
     # Under a tolerance, far pairs are refined exactly (milliseconds each);
-    # the exact mode propagates for every near pair.
-    n = 200 if "tolerance" in options else 2000 if options.get("near_pairs") == "exact" else 20000
+    # the exact mode propagates for every near pair, the every-distance mode
+    # refines pairs up to 8 L1000 apart.
+    slow = "tolerance" in options or "refine_below" in options
+    n = 200 if slow else 2000 if options.get("near_pairs") == "exact" else 20000
     a, b = random_points(num_faces, n, 41), random_points(num_faces, n, 42)
     b.faces[::2] = a.faces[::2]  # near pairs too
     ours, theirs = index.distance(a, b, **options), client.distance(MODEL, a, b, **options)

@@ -2,8 +2,10 @@
 
 #include <memory>
 
-// The definitions of the parts a scratch holds: its special members need
-// them complete.
+// QueryScratch's special members and accessors, which need the parts it
+// holds complete. Apart from query_scratch.h's own unit: the parts'
+// headers include query_scratch.h, and a unit of its own including them
+// would close an include loop.
 #include "core/query/internal/exact/local_exact.h"
 #include "core/query/internal/paths/chord_walk.h"
 
