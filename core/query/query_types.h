@@ -60,9 +60,10 @@ struct DistanceOptions {
   // than this many L1000 (the spacing of 1,000 samples on the surface,
   // sqrt(2A / (sqrt(3) 1000)): a unit fixed by the surface, not by the
   // index's m). It raises the default threshold, never lowers it. Raised to
-  // where the index's O(1) answer is good enough (about 8 L1000 for p99 <=
-  // 2% at m = 2,500-4,000), every answer is walked, exact or such an O(1)
-  // answer: the every-distance mode. 0: the index's own threshold.
+  // where the index's O(1) answer is good enough (its build report gives
+  // the p99 by band of L1000), every answer is walked, exact or such an
+  // O(1) answer: the every-distance mode (tests/bench/accuracy.md). 0: the
+  // index's own threshold.
   double refine_below_l1000 = 0;
 };
 

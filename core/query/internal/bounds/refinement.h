@@ -34,9 +34,10 @@ inline constexpr double kCertifiedExcess = 0.02;
 // A pair whose O(1) answer lands above refine_below is still refined when
 // its chord is below and the answer below kChordNet x refine_below: the
 // calibrated margin in refine_below covers 99.5% of the O(1) answer's
-// overestimates, this its tail (a bunny's pair 2.9 L apart answered 11%
-// long), at the price of walking the pairs just past refine_below on curved
-// parts, where the chord is shorter than the geodesic.
+// overestimates, this its tail (tests/bench/accuracy.md, "Pairs the O(1)
+// answer pushes past the threshold"), at the price of walking the pairs just
+// past refine_below on curved parts, where the chord is shorter than the
+// geodesic.
 inline constexpr double kChordNet = 1.5;
 
 class Refiner {
