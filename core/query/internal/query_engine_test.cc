@@ -403,7 +403,9 @@ TEST(QueryEngineTest, PairsThatMayBeCloserThan3LAreRefined) {
       const bool margin = o1 >= three_l && o1 < below;
       const bool net = o1 >= below && o1 < kChordNet * below && chord < below;
       if (!margin && !net) {
-        if (o1 >= three_l) EXPECT_EQ(*engine->Distance(p, q), o1);
+        if (o1 >= three_l) {
+          EXPECT_EQ(*engine->Distance(p, q), o1);
+        }
         continue;
       }
       (margin ? in_margin : in_net) += 1;
