@@ -4,13 +4,16 @@
 #include <atomic>
 #include <cmath>
 #include <functional>
-#include <thread>
 #include <limits>
+#include <span>
+#include <thread>
+#include <utility>
 #include <vector>
 
 #include "absl/strings/str_format.h"
 #include "core/common/status_macros.h"
 #include "core/common/threads.h"
+#include "core/query/internal/input_ids.h"
 #include "core/query/internal/query_engine.h"
 
 namespace geodex::validation {
@@ -170,6 +173,40 @@ void ForEachPair(size_t n, int threads, const std::function<void(size_t)>& fn) {
 
 }  // namespace
 
+// Vertex pairs are among the file's vertices, not the split's midpoints:
+// those are flat points, and bounds fitted on them would be too tight for
+// the corners callers ask about. The split is flat, so the mesh before it
+// is the same surface: its exact propagations, most of a calibration's
+// time, give the same distances over several times fewer vertices.
+absl::StatusOr<std::vector<ExactPair>> HeldOutPairs(const mesh::Mesh& mesh,
+                                                    const index::Index& index,
+                                                    PairOptions options) {
+  const int32_t coarse_vertices = index.num_vertices() - index.split_vertices();
+  options.vertex_limit = coarse_vertices;
+  const std::span<const int32_t> coarse_faces = index.coarse_faces();
+  if (index.split_vertices() == 0 || coarse_faces.empty()) {
+    return DrawPairs(mesh, index.num_samples(), options);
+  }
+  std::vector<mesh::Vec3> positions(mesh.positions().begin(),
+                                    mesh.positions().begin() + coarse_vertices);
+  std::vector<mesh::Triangle> faces(coarse_faces.size() / 3);
+  for (size_t f = 0; f < faces.size(); ++f) {
+    faces[f] = {coarse_faces[3 * f], coarse_faces[3 * f + 1], coarse_faces[3 * f + 2]};
+  }
+  // The coarse mesh is the repaired input, which may keep faces of zero area.
+  GEODEX_ASSIGN_OR_RETURN(
+      const mesh::Mesh coarse,
+      mesh::Mesh::Create(std::move(positions), std::move(faces), mesh.name(),
+                         mesh::MeshOptions{.allow_zero_area_faces = true}));
+  std::vector<ExactPair> pairs = DrawPairs(coarse, index.num_samples(), options);
+  const query::InputIds ids(index);
+  for (ExactPair& pair : pairs) {
+    GEODEX_ASSIGN_OR_RETURN(pair.p, ids.CoarseToInternal(pair.p));
+    GEODEX_ASSIGN_OR_RETURN(pair.q, ids.CoarseToInternal(pair.q));
+  }
+  return pairs;
+}
+
 UniformConfidence UniformConfidenceOf(const std::vector<double>& errors,
                                       const std::vector<int32_t>& source,
                                       const std::vector<double>& far) {
@@ -213,12 +250,8 @@ absl::StatusOr<Calibration> Calibrate(const mesh::Mesh& mesh,
   }
   GEODEX_ASSIGN_OR_RETURN(auto engine, query::QueryEngine::Create(index));
   const double scale = engine->scale_length();
-  // Vertex pairs among the file's vertices, not a refinement's midpoints:
-  // those are flat points, and bounds fitted on them would be too tight for
-  // the corners callers ask about.
-  PairOptions pair_options = options.pairs;
-  pair_options.vertex_limit = index->num_vertices() - index->split_vertices();
-  const std::vector<ExactPair> pairs = DrawPairs(mesh, index->num_samples(), pair_options);
+  GEODEX_ASSIGN_OR_RETURN(const std::vector<ExactPair> pairs,
+                          HeldOutPairs(mesh, *index, options.pairs));
   std::vector<double> unfold[2][index::kAccuracyBins], trace[4][index::kAccuracyBins];
   std::vector<SpreadSample> spread[2][index::kAccuracyBins];
   std::vector<double> relative[kNumScaleBins], uniform, uniform_far;

@@ -110,6 +110,17 @@ absl::Status AddCalibration(const mesh::Mesh& mesh, index::IndexData& data,
                             const CalibrationOptions& options = {},
                             Calibration* calibration = nullptr);
 
+// The held-out pairs Calibrate measures `index` (built from `mesh`) on, in
+// the index's internal ids: DrawPairs with `options`, vertex pairs among
+// the vertices before the long-edge split. On an index of a split mesh the
+// pairs are drawn, and their exact distances propagated, on the mesh before
+// the split (the index's coarse faces over its first vertices). Errors:
+// InvalidArgument when those do not make a mesh; Internal when a point
+// finds no piece of its face. Exposed for tests.
+absl::StatusOr<std::vector<ExactPair>> HeldOutPairs(const mesh::Mesh& mesh,
+                                                    const index::Index& index,
+                                                    PairOptions options);
+
 // The upper confidence limits of UniformConfidence for relative errors
 // `errors` drawn from sources `source` (parallel arrays), and for the
 // absolute relative errors `far` of the pairs beyond 10L. Exposed for tests.

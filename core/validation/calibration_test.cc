@@ -4,7 +4,10 @@
 #include <cmath>
 
 #include "core/builder/builder.h"
+#include "core/builder/mesh_arrays.h"
+#include "core/geodesic/vertex_geodesic.h"
 #include "core/mesh/generators.h"
+#include "core/mesh/mesh_repair.h"
 #include "core/query/internal/query_engine.h"
 #include "gtest/gtest.h"
 
@@ -154,6 +157,67 @@ TEST(CalibrationTest, PairsDoNotDependOnTheThreadCount) {
   const auto other = DrawPairs(m, 300, options);
   ASSERT_FALSE(other.empty());
   EXPECT_NE(other[0].exact, one[0].exact);
+}
+
+// A coarse sphere (42 vertices) sampled more finely than it has vertices:
+// the builder splits its long edges, and the held-out pairs are drawn and
+// propagated on the 42-vertex mesh. Their exact distances must be the split
+// mesh's, their points internal ones, their vertex pairs the file's vertices.
+TEST(CalibrationTest, PairsOfASplitIndexAreDrawnBeforeTheSplitWithTheSameDistances) {
+  const mesh::Mesh coarse = mesh::gen::Sphere(1, 1.0);
+  auto prepared = builder::PrepareMesh(coarse, builder::RecordRepair(mesh::WithoutRepairs(coarse)),
+                                       120, /*refine=*/true);
+  ASSERT_TRUE(prepared.ok()) << prepared.status();
+  ASSERT_GT(prepared->mesh.num_vertices(), 3 * coarse.num_vertices());
+  builder::BuildOptions options;
+  options.num_samples = 120;
+  options.threads = 2;
+  builder::BuildSummary summary;
+  auto data = builder::BuildPreparedIndex(*prepared, options, &summary);
+  ASSERT_TRUE(data.ok()) << data.status();
+  auto index = index::Index::FromBytes(*index::SerializeIndex(*data));
+  ASSERT_TRUE(index.ok()) << index.status();
+  ASSERT_EQ((*index)->num_vertices() - (*index)->split_vertices(), coarse.num_vertices());
+
+  const mesh::Mesh& split = prepared->mesh;
+  auto pairs = HeldOutPairs(split, **index,
+                            {.num_sources = 6, .uniform_points = 20, .per_bin_points = 5, .seed = 5});
+  ASSERT_TRUE(pairs.ok()) << pairs.status();
+  ASSERT_GT(pairs->size(), 100u);
+  geodesic::VertexGeodesicSolver solver(split);
+  int vertex_pairs = 0;
+  for (int32_t s = 0; s < 6; ++s) {
+    std::vector<mesh::SurfacePoint> targets;
+    std::vector<const ExactPair*> of_source;
+    for (const ExactPair& pair : *pairs) {
+      if (pair.source != s) continue;
+      for (const mesh::SurfacePoint& x : {pair.p, pair.q}) {
+        ASSERT_GE(x.face, 0);
+        ASSERT_LT(x.face, split.num_faces());
+        EXPECT_NEAR(x.w[0] + x.w[1] + x.w[2], 1.0, 1e-12);
+      }
+      if (pair.vertices) {
+        ++vertex_pairs;
+        // At a corner of the file's mesh: one weight 1, on a vertex below the split's.
+        for (const mesh::SurfacePoint& x : {pair.p, pair.q}) {
+          const int corner = static_cast<int>(std::max_element(x.w.begin(), x.w.end()) - x.w.begin());
+          EXPECT_EQ(x.w[corner], 1.0);
+          EXPECT_LT(split.face(x.face)[corner], coarse.num_vertices());
+        }
+      }
+      targets.push_back(pair.q);
+      of_source.push_back(&pair);
+    }
+    if (targets.empty()) continue;
+    geodesic::VertexGeodesicOptions exact;
+    exact.targets = targets;
+    ASSERT_TRUE(solver.Propagate({of_source[0]->p}, exact).ok());
+    for (size_t k = 0; k < targets.size(); ++k) {
+      EXPECT_NEAR(solver.TargetDistance(k), of_source[k]->exact, 1e-9 + 1e-7 * of_source[k]->exact)
+          << "source " << s << ", pair " << k;
+    }
+  }
+  EXPECT_GT(vertex_pairs, 0);
 }
 
 TEST(CalibrationTest, RefusesAnIndexOfAnotherMesh) {

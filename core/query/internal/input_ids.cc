@@ -52,6 +52,11 @@ absl::StatusOr<mesh::SurfacePoint> InputIds::ToInternal(const mesh::SurfacePoint
     coarse = {r.face, {0, 0, 0}};
     for (int i = 0; i < 3; ++i) coarse.w[r.corner[i]] = p.w[i];
   }
+  return CoarseToInternal(coarse);
+}
+
+absl::StatusOr<mesh::SurfacePoint> InputIds::CoarseToInternal(
+    const mesh::SurfacePoint& coarse) const {
   if (split_faces_.empty()) return coarse;
   // The piece whose smallest weight of the point is the largest: the one
   // holding it (on a shared edge either is right; rounding may leave the

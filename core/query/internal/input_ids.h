@@ -63,6 +63,12 @@ class InputIds {
   // and returns it as an internal point.
   absl::StatusOr<mesh::SurfacePoint> ToInternal(const mesh::SurfacePoint& p,
                                                 double tolerance = 1e-6) const;
+  // A point of the mesh before the long-edge split (the repaired mesh,
+  // whose vertices are the index's first ones; face in range, weights a
+  // partition of 1) as an internal point: the piece of its face that holds
+  // it, or the point itself without the split. Errors: Internal when no
+  // piece of its face can hold it.
+  absl::StatusOr<mesh::SurfacePoint> CoarseToInternal(const mesh::SurfacePoint& coarse) const;
   // An internal point in the input face kept for its face.
   mesh::SurfacePoint ToInput(const mesh::SurfacePoint& p) const;
   // Internal vertices that are a repair's copy of an input vertex: ids
