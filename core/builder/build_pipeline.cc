@@ -319,7 +319,10 @@ absl::StatusOr<BuildReport> BuildIndexFile(const std::string& mesh_path, const s
   BuildReport report;
   GEODEX_RETURN_IF_ERROR(WriteEdges(mesh, plan, options.edges_obj, &report));
   BuildSummary summary;
-  GEODEX_ASSIGN_OR_RETURN(auto data, BuildIndexFromPlan(mesh, plan, options.build, &summary));
+  GEODEX_ASSIGN_OR_RETURN(const std::optional<CoarseSurface> surface,
+                          CoarseSurfaceOf(mesh, prepared.record));
+  GEODEX_ASSIGN_OR_RETURN(auto data, BuildIndexFromPlan(mesh, plan, options.build, &summary,
+                                                        surface ? &*surface : nullptr));
   AddRepair(prepared.record, &data);
   double calibration_seconds = 0;
   if (options.calibrate) {
@@ -382,8 +385,12 @@ absl::StatusOr<BuildReport> ComputeShardRows(const std::string& workdir, std::st
   GEODEX_ASSIGN_OR_RETURN(auto loaded, LoadPlan(dir));
   const auto& [mesh, plan] = loaded;
   GEODEX_ASSIGN_OR_RETURN(std::vector<SampleRow> carried, LoadCarriedRows(plan, dir));
+  GEODEX_ASSIGN_OR_RETURN(const RepairRecord repair, LoadRepair(plan, dir));
+  GEODEX_ASSIGN_OR_RETURN(const std::optional<CoarseSurface> surface,
+                          CoarseSurfaceOf(mesh, repair));
   const std::vector<int32_t> ids = ShardSamples(plan.num_samples(), index, count);
-  GEODEX_ASSIGN_OR_RETURN(auto rows, ComputeRows(mesh, plan, ids, options.build, carried));
+  GEODEX_ASSIGN_OR_RETURN(auto rows, ComputeRows(mesh, plan, ids, options.build, carried,
+                                                 surface ? &*surface : nullptr));
   GEODEX_RETURN_IF_ERROR(SaveRows(plan, rows, index, count, dir));
   BuildReport report;
   report.num_samples = plan.num_samples();

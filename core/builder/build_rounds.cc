@@ -340,9 +340,11 @@ absl::StatusOr<TargetBuild> BuildToTarget(const mesh::Mesh& coarse, const Repair
     std::vector<int32_t> all(round.plan.num_samples());
     for (int32_t a = 0; a < round.plan.num_samples(); ++a) all[a] = a;
     const auto start = std::chrono::steady_clock::now();
-    GEODEX_ASSIGN_OR_RETURN(
-        std::vector<SampleRow> rows,
-        ComputeRows(round.prepared.mesh, round.plan, all, options.build, round.carried));
+    GEODEX_ASSIGN_OR_RETURN(const std::optional<CoarseSurface> surface,
+                            CoarseSurfaceOf(round.prepared.mesh, round.prepared.record));
+    GEODEX_ASSIGN_OR_RETURN(std::vector<SampleRow> rows,
+                            ComputeRows(round.prepared.mesh, round.plan, all, options.build,
+                                        round.carried, surface ? &*surface : nullptr));
     const double rows_seconds = SecondsSince(start);
     round.carried = {};
     GEODEX_ASSIGN_OR_RETURN(RoundResult result, FinishRound(round, &rows, options));

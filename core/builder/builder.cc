@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 #include <mutex>
+#include <optional>
 #include <thread>
 
 #include "absl/strings/str_cat.h"
@@ -23,6 +24,7 @@ namespace {
 
 using mesh::kNone;
 using mesh::Mesh;
+using mesh::SurfacePoint;
 
 double SecondsSince(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -373,7 +375,8 @@ absl::StatusOr<Plan> ExtendPlan(const Mesh& mesh, std::span<const int32_t> previ
 absl::StatusOr<std::vector<SampleRow>> ComputeRows(const Mesh& mesh, const Plan& plan,
                                                    std::span<const int32_t> sample_ids,
                                                    const BuildOptions& options,
-                                                   std::span<SampleRow> carried) {
+                                                   std::span<SampleRow> carried,
+                                                   const CoarseSurface* coarse) {
   const int32_t m = plan.num_samples();
   for (int32_t id : sample_ids) {
     if (id < 0 || id >= m) {
@@ -399,11 +402,40 @@ absl::StatusOr<std::vector<SampleRow>> ComputeRows(const Mesh& mesh, const Plan&
   std::mutex progress_mutex;
   const int threads = std::min<int>(ThreadCount(options), std::max<size_t>(1, sample_ids.size()));
   std::vector<absl::Status> errors(threads);
+  if (coarse != nullptr && static_cast<int32_t>(coarse->points.size()) != mesh.num_vertices()) {
+    return absl::InvalidArgumentError("the coarse surface is not of this mesh");
+  }
+  // On a split mesh the rows propagate on the surface before the split
+  // (CoarseSurface): the same distances over several times fewer vertices,
+  // read at the samples and cell vertices as target points.
+  std::vector<SurfacePoint> sample_points;
+  if (coarse != nullptr) {
+    for (int32_t b = 0; b < m; ++b) sample_points.push_back(coarse->points[plan.samples[b]]);
+  }
   auto worker = [&](int id) {
     // Rows need vertex distances only: the wavefront engine, whose memory
     // follows the front rather than the whole propagation.
-    geodesic::VertexGeodesicSolver solver(mesh);
+    geodesic::VertexGeodesicSolver solver(coarse != nullptr ? coarse->mesh : mesh);
     std::vector<double> cap;
+    std::vector<SurfacePoint> targets;
+    // From sample a, with `targets` laid out as `first_cell` points before
+    // the cell vertices' (coarse) or none (split mesh).
+    auto propagate = [&](int32_t a, geodesic::VertexGeodesicOptions propagation) {
+      if (coarse == nullptr) return solver.Propagate({plan.samples[a]}, propagation);
+      propagation.targets = targets;
+      return solver.Propagate({sample_points[a]}, propagation);
+    };
+    // After propagate: the distance to vertex v of `mesh`, target k of the
+    // coarse propagation; +inf where it did not reach.
+    auto distance = [&](int32_t v, size_t k) {
+      return coarse == nullptr ? solver.VertexDistance(v) : solver.TargetDistance(k);
+    };
+    auto cell_targets = [&](std::span<const int32_t> cell_vertices, bool with_samples) {
+      targets.clear();
+      if (coarse == nullptr) return;
+      if (with_samples) targets = sample_points;
+      for (int32_t v : cell_vertices) targets.push_back(coarse->points[v]);
+    };
     for (size_t k; (k = next.fetch_add(1)) < sample_ids.size();) {
       const int32_t a = sample_ids[k];
       SampleRow& row = rows[k];
@@ -411,39 +443,48 @@ absl::StatusOr<std::vector<SampleRow>> ComputeRows(const Mesh& mesh, const Plan&
       const std::vector<int32_t> cell_vertices = CellVertices(plan, neighbors[a], a);
       if (a < static_cast<int32_t>(carried.size())) {
         // Exact below the cap (vertices the propagation did not reach
-        // sooner keep it, NearestSource kNone); a full propagation when a
-        // cell vertex lies beyond it after all.
+        // sooner keep it: +inf at the targets, NearestSource kNone at
+        // vertices); a full propagation when a cell vertex lies beyond it
+        // after all.
         const double radius = reach.Radius(a);
         row.to_samples = std::move(carried[a].to_samples);
         if (radius > 0) {
-          cap.assign(mesh.num_vertices(), radius);
+          cap.assign(solver.mesh().num_vertices(), radius);
           geodesic::VertexGeodesicOptions bounded;
           bounded.initial_distance = cap;
-          if (absl::Status status = solver.Propagate({plan.samples[a]}, bounded); !status.ok()) {
+          cell_targets(cell_vertices, false);
+          if (absl::Status status = propagate(a, bounded); !status.ok()) {
             errors[id] = status;
             return;
           }
           bool reached = true;
-          for (int32_t v : cell_vertices) reached &= solver.NearestSource(v) == 0;
+          for (size_t j = 0; j < cell_vertices.size(); ++j) {
+            reached &= coarse == nullptr ? solver.NearestSource(cell_vertices[j]) == 0
+                                         : std::isfinite(solver.TargetDistance(j));
+          }
           if (reached) {
-            for (int32_t v : cell_vertices)
-              row.to_cell_vertices.push_back(solver.VertexDistance(v));
+            for (size_t j = 0; j < cell_vertices.size(); ++j)
+              row.to_cell_vertices.push_back(distance(cell_vertices[j], j));
           }
         }
       }
       if (row.to_samples.empty() || row.to_cell_vertices.size() != cell_vertices.size()) {
         row.to_cell_vertices.clear();
-        if (absl::Status status = solver.Propagate({plan.samples[a]}); !status.ok()) {
+        const bool with_samples = row.to_samples.empty();
+        cell_targets(cell_vertices, with_samples);
+        if (absl::Status status = propagate(a, {}); !status.ok()) {
           errors[id] = status;
           return;
         }
-        if (row.to_samples.empty()) {
+        const size_t first_cell = coarse != nullptr && with_samples ? m : 0;
+        if (with_samples) {
           row.to_samples.resize(m);
-          for (int32_t b = 0; b < m; ++b) {
-            row.to_samples[b] = solver.VertexDistance(plan.samples[b]);
-          }
+          for (int32_t b = 0; b < m; ++b) row.to_samples[b] = distance(plan.samples[b], b);
+          row.to_samples[a] = 0;  // a target at the source, whatever its rounding
         }
-        for (int32_t v : cell_vertices) row.to_cell_vertices.push_back(solver.VertexDistance(v));
+        for (size_t j = 0; j < cell_vertices.size(); ++j) {
+          row.to_cell_vertices.push_back(distance(cell_vertices[j], first_cell + j));
+        }
       }
       const int64_t finished = ++done;
       if (options.progress) {
@@ -499,11 +540,13 @@ absl::StatusOr<index::IndexData> BuildIndex(const Mesh& mesh, const BuildOptions
 
 absl::StatusOr<index::IndexData> BuildIndexFromPlan(const Mesh& mesh, const Plan& plan,
                                                     const BuildOptions& options,
-                                                    BuildSummary* summary) {
+                                                    BuildSummary* summary,
+                                                    const CoarseSurface* coarse) {
   std::vector<int32_t> all(plan.num_samples());
   for (int32_t a = 0; a < plan.num_samples(); ++a) all[a] = a;
   const auto start = std::chrono::steady_clock::now();
-  GEODEX_ASSIGN_OR_RETURN(std::vector<SampleRow> rows, ComputeRows(mesh, plan, all, options));
+  GEODEX_ASSIGN_OR_RETURN(std::vector<SampleRow> rows,
+                          ComputeRows(mesh, plan, all, options, {}, coarse));
   const double rows_seconds = SecondsSince(start);
   GEODEX_ASSIGN_OR_RETURN(index::IndexData data, Merge(mesh, plan, std::move(rows), summary));
   summary->rows_seconds = rows_seconds;
@@ -513,8 +556,13 @@ absl::StatusOr<index::IndexData> BuildIndexFromPlan(const Mesh& mesh, const Plan
 absl::StatusOr<index::IndexData> BuildPreparedIndex(const PreparedMesh& prepared,
                                                     const BuildOptions& options,
                                                     BuildSummary* summary) {
-  absl::StatusOr<index::IndexData> data = BuildIndex(prepared.mesh, options, summary);
-  if (data.ok()) AddRepair(prepared.record, &*data);
+  GEODEX_ASSIGN_OR_RETURN(const std::optional<CoarseSurface> coarse,
+                          CoarseSurfaceOf(prepared.mesh, prepared.record));
+  GEODEX_ASSIGN_OR_RETURN(const Plan plan, MakePlan(prepared.mesh, options));
+  GEODEX_ASSIGN_OR_RETURN(index::IndexData data,
+                          BuildIndexFromPlan(prepared.mesh, plan, options, summary,
+                                             coarse ? &*coarse : nullptr));
+  AddRepair(prepared.record, &data);
   return data;
 }
 

@@ -151,6 +151,14 @@ absl::StatusOr<Plan> ExtendPlan(const mesh::Mesh& mesh, std::span<const int32_t>
 // propagation that stops past its and its neighbours' cells (Plan's
 // cell_radius bounds how far that is), a few percent of a full one; a full
 // propagation when that bound does not hold.
+// `coarse`, for a mesh whose long edges were split (CoarseSurfaceOf): the
+// propagations run on the surface before the split, several times cheaper,
+// and are read at the samples' and cell vertices' points; the distances are
+// the split mesh's to rounding. Every process of a build passes the same.
+// `coarse`, for a mesh whose long edges were split (CoarseSurfaceOf): the
+// propagations run on the surface before the split, several times cheaper,
+// and are read at the samples' and cell vertices' points; the distances are
+// the split mesh's to rounding. Every process of one build passes the same.
 // Errors: InvalidArgument for an id outside [0, plan.num_samples()), or a
 // carried row that does not reach its own sample or has more entries than
 // the plan has samples; an error of the exact propagation (then no rows are
@@ -159,7 +167,8 @@ absl::StatusOr<Plan> ExtendPlan(const mesh::Mesh& mesh, std::span<const int32_t>
 absl::StatusOr<std::vector<SampleRow>> ComputeRows(const mesh::Mesh& mesh, const Plan& plan,
                                                    std::span<const int32_t> sample_ids,
                                                    const BuildOptions& options,
-                                                   std::span<SampleRow> carried = {});
+                                                   std::span<SampleRow> carried = {},
+                                                   const CoarseSurface* coarse = nullptr);
 
 // Phase 3: assembles the index from the plan and the rows of every sample (any
 // order) and fills `summary` (vertex_assignment.h assigns the vertices).
@@ -189,7 +198,8 @@ absl::StatusOr<index::IndexData> BuildIndex(const mesh::Mesh& mesh, const BuildO
 // The rows and merge phases in one process, for a plan already made.
 absl::StatusOr<index::IndexData> BuildIndexFromPlan(const mesh::Mesh& mesh, const Plan& plan,
                                                     const BuildOptions& options,
-                                                    BuildSummary* summary);
+                                                    BuildSummary* summary,
+                                                    const CoarseSurface* coarse = nullptr);
 
 // BuildIndex on `prepared.mesh` with `prepared.record` added (AddRepair): the
 // index a whole geodex-build makes, before its calibration.

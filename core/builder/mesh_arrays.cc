@@ -5,6 +5,7 @@
 #include <limits>
 
 #include "absl/strings/str_format.h"
+#include "core/common/status_macros.h"
 
 namespace geodex::builder {
 
@@ -46,6 +47,53 @@ void AddRepair(const RepairRecord& record, index::IndexData* data) {
   data->split_faces = record.split_faces;
   data->params.split_vertices = static_cast<uint32_t>(record.split_vertices);
   data->report = record.report + data->report;
+}
+
+absl::StatusOr<std::optional<CoarseSurface>> CoarseSurfaceOf(
+    const mesh::Mesh& split, std::span<const int32_t> coarse_faces,
+    std::span<const index::SplitFaceRecord> split_faces, int32_t split_vertices) {
+  if (split_vertices == 0 && split_faces.empty()) return std::nullopt;
+  const int32_t coarse_vertices = split.num_vertices() - split_vertices;
+  if (split_vertices <= 0 || coarse_vertices <= 0 || coarse_faces.size() % 3 != 0 ||
+      static_cast<int64_t>(split_faces.size()) != split.num_faces()) {
+    return absl::InvalidArgumentError(absl::StrFormat(
+        "the split sections (%d faces, %d pieces, %d added vertices) are not of a mesh of %d "
+        "vertices and %d faces",
+        coarse_faces.size() / 3, split_faces.size(), split_vertices, split.num_vertices(),
+        split.num_faces()));
+  }
+  for (int32_t v : coarse_faces) {
+    if (v < 0 || v >= coarse_vertices) {
+      return absl::InvalidArgumentError(
+          absl::StrFormat("a coarse face names vertex %d of %d", v, coarse_vertices));
+    }
+  }
+  const int32_t num_coarse_faces = static_cast<int32_t>(coarse_faces.size() / 3);
+  std::vector<mesh::Vec3> positions(split.positions().begin(),
+                                    split.positions().begin() + coarse_vertices);
+  std::vector<mesh::Triangle> faces(num_coarse_faces);
+  for (int32_t f = 0; f < num_coarse_faces; ++f) {
+    faces[f] = {coarse_faces[3 * f], coarse_faces[3 * f + 1], coarse_faces[3 * f + 2]};
+  }
+  // The repaired input may keep faces of zero area.
+  GEODEX_ASSIGN_OR_RETURN(
+      mesh::Mesh coarse,
+      mesh::Mesh::Create(std::move(positions), std::move(faces), split.name(),
+                         mesh::MeshOptions{.allow_zero_area_faces = true}));
+  std::vector<mesh::SurfacePoint> points(split.num_vertices());
+  for (int32_t f = 0; f < split.num_faces(); ++f) {
+    const index::SplitFaceRecord& r = split_faces[f];
+    if (r.coarse_face < 0 || r.coarse_face >= num_coarse_faces) {
+      return absl::InvalidArgumentError(
+          absl::StrFormat("piece %d lies in coarse face %d of %d", f, r.coarse_face,
+                          num_coarse_faces));
+    }
+    for (int i = 0; i < 3; ++i) {
+      // The weights of a flat split are dyadic: float keeps them exactly.
+      points[split.face(f)[i]] = {r.coarse_face, {r.weight[i][0], r.weight[i][1], r.weight[i][2]}};
+    }
+  }
+  return std::optional<CoarseSurface>{CoarseSurface{std::move(coarse), std::move(points)}};
 }
 
 absl::StatusOr<mesh::LongEdgeSplit> SplitForSamples(const mesh::Mesh& mesh, int32_t num_samples) {

@@ -5,13 +5,14 @@
 #include <cmath>
 #include <functional>
 #include <limits>
-#include <span>
+#include <optional>
 #include <thread>
 #include <utility>
 #include <vector>
 
 #include "absl/strings/str_format.h"
 #include "core/common/status_macros.h"
+#include "core/builder/mesh_arrays.h"
 #include "core/common/threads.h"
 #include "core/query/internal/input_ids.h"
 #include "core/query/internal/query_engine.h"
@@ -181,23 +182,12 @@ void ForEachPair(size_t n, int threads, const std::function<void(size_t)>& fn) {
 absl::StatusOr<std::vector<ExactPair>> HeldOutPairs(const mesh::Mesh& mesh,
                                                     const index::Index& index,
                                                     PairOptions options) {
-  const int32_t coarse_vertices = index.num_vertices() - index.split_vertices();
-  options.vertex_limit = coarse_vertices;
-  const std::span<const int32_t> coarse_faces = index.coarse_faces();
-  if (index.split_vertices() == 0 || coarse_faces.empty()) {
-    return DrawPairs(mesh, index.num_samples(), options);
-  }
-  std::vector<mesh::Vec3> positions(mesh.positions().begin(),
-                                    mesh.positions().begin() + coarse_vertices);
-  std::vector<mesh::Triangle> faces(coarse_faces.size() / 3);
-  for (size_t f = 0; f < faces.size(); ++f) {
-    faces[f] = {coarse_faces[3 * f], coarse_faces[3 * f + 1], coarse_faces[3 * f + 2]};
-  }
-  // The coarse mesh is the repaired input, which may keep faces of zero area.
-  GEODEX_ASSIGN_OR_RETURN(
-      const mesh::Mesh coarse,
-      mesh::Mesh::Create(std::move(positions), std::move(faces), mesh.name(),
-                         mesh::MeshOptions{.allow_zero_area_faces = true}));
+  options.vertex_limit = index.num_vertices() - index.split_vertices();
+  if (index.split_faces().empty()) return DrawPairs(mesh, index.num_samples(), options);
+  GEODEX_ASSIGN_OR_RETURN(const std::optional<builder::CoarseSurface> surface,
+                          builder::CoarseSurfaceOf(mesh, index.coarse_faces(), index.split_faces(),
+                                                   index.split_vertices()));
+  const mesh::Mesh& coarse = surface->mesh;
   std::vector<ExactPair> pairs = DrawPairs(coarse, index.num_samples(), options);
   const query::InputIds ids(index);
   for (ExactPair& pair : pairs) {
