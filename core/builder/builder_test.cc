@@ -2,6 +2,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <optional>
 
 #include "absl/strings/str_cat.h"
 #include "core/builder/workdir.h"
@@ -300,6 +301,61 @@ TEST(BuilderTest, GrownPlanWithCarriedRowsGivesTheIndexOfFullRows) {
   EXPECT_EQ(ExtendPlan(m, {}, options).status().code(), absl::StatusCode::kInvalidArgument);
   std::vector<int32_t> repeated = {first->samples[0], first->samples[0]};
   EXPECT_EQ(ExtendPlan(m, repeated, options).status().code(), absl::StatusCode::kInvalidArgument);
+}
+
+// On a split mesh the rows propagate on the surface before the split, read
+// at the samples' and cell vertices' points: the distances of full
+// propagations on the split mesh, to rounding, for full rows and for rows
+// carried from an earlier plan (bounded propagations).
+TEST(BuilderTest, RowsOnTheCoarseSurfaceAreTheSplitMeshRows) {
+  const mesh::Mesh coarse = gen::Cube(2, 2.0);  // long edges: every m splits it
+  absl::StatusOr<PreparedMesh> prepared = PrepareMesh(coarse, {}, 60, true);
+  ASSERT_TRUE(prepared.ok()) << prepared.status();
+  const mesh::Mesh& m = prepared->mesh;
+  absl::StatusOr<std::optional<CoarseSurface>> surface = CoarseSurfaceOf(m, prepared->record);
+  ASSERT_TRUE(surface.ok()) << surface.status();
+  ASSERT_TRUE(surface->has_value());
+  ASSERT_EQ((*surface)->mesh.num_vertices(), coarse.num_vertices());
+  ASSERT_GT(m.num_vertices(), 4 * coarse.num_vertices());
+
+  BuildOptions options;
+  options.num_samples = 30;
+  options.threads = 2;
+  absl::StatusOr<Plan> first = MakePlan(m, options);
+  ASSERT_TRUE(first.ok()) << first.status();
+  options.num_samples = 60;
+  absl::StatusOr<Plan> plan = ExtendPlan(m, first->samples, options);
+  ASSERT_TRUE(plan.ok()) << plan.status();
+  std::vector<int32_t> all(plan->num_samples()), all_first(first->num_samples());
+  for (int32_t a = 0; a < plan->num_samples(); ++a) all[a] = a;
+  for (int32_t a = 0; a < first->num_samples(); ++a) all_first[a] = a;
+  absl::StatusOr<std::vector<SampleRow>> split_rows = ComputeRows(m, *plan, all, options);
+  absl::StatusOr<std::vector<SampleRow>> coarse_rows =
+      ComputeRows(m, *plan, all, options, {}, &**surface);
+  absl::StatusOr<std::vector<SampleRow>> carried =
+      ComputeRows(m, *first, all_first, options, {}, &**surface);
+  ASSERT_TRUE(split_rows.ok() && coarse_rows.ok() && carried.ok());
+  for (SampleRow& row : *carried) row.to_cell_vertices.clear();
+  absl::StatusOr<std::vector<SampleRow>> reused =
+      ComputeRows(m, *plan, all, options, *carried, &**surface);
+  ASSERT_TRUE(reused.ok()) << reused.status();
+  for (int32_t a = 0; a < plan->num_samples(); ++a) {
+    const SampleRow& x = (*split_rows)[a];
+    for (const SampleRow* y : {&(*coarse_rows)[a], &(*reused)[a]}) {
+      ASSERT_EQ(x.to_cell_vertices.size(), y->to_cell_vertices.size()) << a;
+      for (size_t k = 0; k < x.to_cell_vertices.size(); ++k) {
+        EXPECT_NEAR(x.to_cell_vertices[k], y->to_cell_vertices[k], 1e-9) << a;
+      }
+      ASSERT_LE(y->to_samples.size(), x.to_samples.size());
+      for (size_t b = 0; b < y->to_samples.size(); ++b) {
+        EXPECT_NEAR(x.to_samples[b], y->to_samples[b], 1e-9) << a << " " << b;
+      }
+    }
+  }
+  // A coarse surface of another mesh is refused.
+  CoarseSurface other{coarse, {}};
+  EXPECT_EQ(ComputeRows(m, *plan, all, options, {}, &other).status().code(),
+            absl::StatusCode::kInvalidArgument);
 }
 
 }  // namespace
