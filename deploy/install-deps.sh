@@ -30,7 +30,7 @@ BUILD_PACKAGES=(
   libprotobuf-dev protobuf-compiler libgrpc++-dev protobuf-compiler-grpc
   prometheus-cpp-dev
   libcpp-httplib-dev  # the HTTP server of `geodex web`
-  zlib1g-dev          # PNG output: geodex expmap --png
+  zlib1g-dev          # the CLI's PNG pictures (client/cli/image.h)
   libcairo2-dev fonts-dejavu-core  # the build report's chart: geodex-build --report-png
   libjs-three         # three.js for the web viewer, copied into the build and install trees
   # The Python package geodex: its stubs (grpc_tools), the in-process module

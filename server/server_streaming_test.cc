@@ -16,6 +16,7 @@
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
 #include "server/server_test_util.h"
+#include "server/streams/exp_map_stream.h"
 
 namespace geodex::server {
 namespace {
@@ -533,6 +534,43 @@ TEST(ServerTest, ExpMapRejectsBadRequests) {
   EXPECT_EQ(ReadExpMap(*stub, unknown).status.error_code(), grpc::StatusCode::NOT_FOUND);
   // The server keeps serving.
   EXPECT_TRUE(ReadExpMap(*stub, request({good}, 0.5)).status.ok());
+}
+
+// The request's options as exp_map_stream.h reads them, without a server.
+TEST(ExpMapOptionsForTest, RadiusDirectionAndDistanceOptions) {
+  v1::ExpMapRequest request;
+  request.set_radius(0.75);
+  request.set_near_pairs(v1::NEAR_PAIRS_UNFOLD);
+  for (double x : {0.3, -1.0, 0.2}) request.mutable_reference_direction()->add_xyz(x);
+  ModelConfig config;
+  config.set_tolerance(0.01);
+  auto options = ExpMapOptionsFor(config, request);
+  ASSERT_TRUE(options.ok()) << options.status();
+  EXPECT_EQ(options->radius, 0.75);
+  ASSERT_TRUE(options->reference_direction.has_value());
+  EXPECT_EQ(options->reference_direction->x(), 0.3);
+  EXPECT_EQ(options->reference_direction->y(), -1.0);
+  EXPECT_EQ(options->reference_direction->z(), 0.2);
+  EXPECT_EQ(options->distance.near_pairs, query::NearPairs::kUnfold);
+  EXPECT_EQ(options->distance.tolerance, 0.01);
+
+  request.clear_reference_direction();
+  options = ExpMapOptionsFor(ModelConfig(), request);
+  ASSERT_TRUE(options.ok()) << options.status();
+  EXPECT_FALSE(options->reference_direction.has_value());
+}
+
+TEST(ExpMapOptionsForTest, RefusesADirectionOfOtherThanThreeNumbers) {
+  v1::ExpMapRequest request;
+  for (double x : {1.0, 0.0}) request.mutable_reference_direction()->add_xyz(x);
+  auto options = ExpMapOptionsFor(ModelConfig(), request);
+  EXPECT_EQ(options.status().code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(std::string(options.status().message()),
+              HasSubstr("reference_direction: give one direction (3 numbers), got 2 numbers"));
+  request.clear_reference_direction();
+  request.set_tolerance(-1);
+  EXPECT_EQ(ExpMapOptionsFor(ModelConfig(), request).status().code(),
+            absl::StatusCode::kInvalidArgument);
 }
 
 TEST(ServerTest, GetMeshInSmallChunksTilesVerticesAndFaces) {

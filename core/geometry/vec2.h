@@ -1,11 +1,11 @@
 #pragma once
 
 // The one 2D vector of core: a point or direction in the plane of an
-// unfolding (query/strip_funnel.h), a tangent plane (query/exp_map.h) or a
-// face's own frame (triangulation/geodesic_edges.cc). Eigen's fixed-size
-// vector, as mesh::Vec3 is for 3D: its arithmetic is element by element,
-// in the order written, so results round as the same formulas on two
-// doubles do.
+// unfolding (query/strip_funnel.h), a tangent plane (geodesic polar
+// coordinates round a point) or a face's own frame
+// (triangulation/geodesic_edges.cc). Eigen's fixed-size vector, as
+// mesh::Vec3 is for 3D: its arithmetic is element by element, in the order
+// written, so results round as the same formulas on two doubles do.
 //
 // Thread safety: a value type and a pure function.
 

@@ -151,20 +151,6 @@ void RadiusFieldChunkToProto(const query::RadiusField& field, int64_t offset, in
                                     field.vertices.begin() + offset + count);
 }
 
-void ExpMapChunkToProto(std::span<const query::ExpMapVertex> map, int64_t offset, int64_t count,
-                        int64_t version, v1::ExpMapChunk* chunk) {
-  chunk->Clear();
-  chunk->set_num_vertices(static_cast<int64_t>(map.size()));
-  chunk->set_version(version);
-  for (const query::ExpMapVertex& e : map.subspan(offset, count)) {
-    chunk->add_vertices(e.vertex);
-    chunk->add_r(e.r);
-    chunk->add_theta(e.theta);
-    chunk->add_u(e.u);
-    chunk->add_v(e.v);
-  }
-}
-
 void MeshChunkToProto(const query::InputQueries& queries, int64_t vertex_offset,
                       int64_t vertex_count, int64_t face_offset, int64_t face_count,
                       int64_t version, v1::MeshChunk* chunk) {
@@ -351,23 +337,6 @@ absl::StatusOr<query::DistanceOptions> DistanceOptionsFor(const ModelConfig& con
         absl::StrFormat("refine_below must be finite and >= 0, not %g", choice.refine_below));
   }
   options.refine_below_l1000 = choice.refine_below;
-  return options;
-}
-
-absl::StatusOr<query::ExpMapOptions> ExpMapOptionsFor(const ModelConfig& config,
-                                                      const v1::ExpMapRequest& request) {
-  query::ExpMapOptions options;
-  options.radius = request.radius();
-  const auto& direction = request.reference_direction().xyz();
-  if (direction.size() == 3) {
-    options.reference_direction = mesh::Vec3(direction[0], direction[1], direction[2]);
-  } else if (!direction.empty()) {
-    return absl::InvalidArgumentError(absl::StrFormat(
-        "reference_direction: give one direction (3 numbers), got %d numbers", direction.size()));
-  }
-  GEODEX_ASSIGN_OR_RETURN(options.distance,
-                          DistanceOptionsFor(config, {.near_pairs = request.near_pairs(),
-                                                      .tolerance = request.tolerance()}));
   return options;
 }
 

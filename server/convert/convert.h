@@ -1,6 +1,10 @@
 #pragma once
 
-// The one place where geodex.v1 messages become core types and back.
+// Where geodex.v1 messages become core types and back: what the calls share
+// (points, positions, distance options, the model) and most answers. A
+// streamed call may instead read its own options and write its own chunks
+// beside its reactor (server/streams/<call>_stream.*, as the exponential
+// map's does), with the helpers here, so that adding one leaves this file.
 //
 // Reading validates everything a query needs, with messages that name the
 // offending element the way the request spells it ("a[17]: face id 99999 out
@@ -11,8 +15,9 @@
 // from; when the builder repaired that mesh they differ from the index's
 // (core/query/internal/input_ids.h). Points are read into the index's ids here
 // (PointsFromProto), and every answer that names faces or vertices is written
-// back in input ids here too (paths, located points, fields, exponential maps,
-// the mesh, the triangulation, the model's counts).
+// back in input ids (here: paths, located points, fields, the mesh, the
+// triangulation, the model's counts; InputQueries answers other calls in
+// input ids already).
 //
 // Thread safety: pure functions (outputs are the caller's).
 
@@ -95,11 +100,6 @@ void RadiusFieldChunkToProto(const query::RadiusField& field, int64_t offset, in
                              bool with_nearest_source, int64_t version,
                              v1::DistanceFieldChunk* chunk);
 
-// Entries [offset, offset + count) of an exponential map (in input ids:
-// InputQueries::ExpMap).
-void ExpMapChunkToProto(std::span<const query::ExpMapVertex> map, int64_t offset, int64_t count,
-                        int64_t version, v1::ExpMapChunk* chunk);
-
 // Vertices [vertex_offset, vertex_offset + vertex_count) and faces
 // [face_offset, face_offset + face_count) of the input mesh of `queries`'
 // index (the mesh file's vertices and faces, also when it was repaired), with
@@ -149,13 +149,6 @@ struct DistanceChoice {
 // negative or non-finite tolerance or threshold.
 absl::StatusOr<query::DistanceOptions> DistanceOptionsFor(const ModelConfig& config,
                                                           const DistanceChoice& choice);
-
-// The exponential map's radius, reference direction and distance options
-// (as DistanceOptionsFor). The centre is not read here (PointsFromProto).
-// Errors: InvalidArgument for a reference direction that is not 3 numbers,
-// and those of DistanceOptionsFor.
-absl::StatusOr<query::ExpMapOptions> ExpMapOptionsFor(const ModelConfig& config,
-                                                      const v1::ExpMapRequest& request);
 
 // Most faces a Path call's exact corridor may reach round the trace: the
 // exact solve costs a propagation over the corridor.

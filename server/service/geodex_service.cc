@@ -15,10 +15,6 @@
 #include "server/service/call.h"
 #include "server/service/compute_distances.h"
 #include "server/streams/distance_stream.h"
-#include "server/streams/exp_map_stream.h"
-#include "server/streams/field_stream.h"
-#include "server/streams/matrix_stream.h"
-#include "server/streams/mesh_stream.h"
 
 namespace geodex::server {
 namespace {
@@ -223,25 +219,13 @@ grpc::ServerBidiReactor<v1::DistanceBatch, v1::DistanceResult>* GeodexService::S
   return StartDistanceStream(&resources_, context);
 }
 
-grpc::ServerWriteReactor<v1::MatrixBlock>* GeodexService::Matrix(
-    grpc::CallbackServerContext* context, const v1::MatrixRequest* request) {
-  return StartMatrixStream(&resources_, context, request);
-}
-
-grpc::ServerWriteReactor<v1::DistanceFieldChunk>* GeodexService::DistanceField(
-    grpc::CallbackServerContext* context, const v1::DistanceFieldRequest* request) {
-  return StartFieldStream(&resources_, context, request);
-}
-
-grpc::ServerWriteReactor<v1::ExpMapChunk>* GeodexService::ExpMap(
-    grpc::CallbackServerContext* context, const v1::ExpMapRequest* request) {
-  return StartExpMapStream(&resources_, context, request);
-}
-
-grpc::ServerWriteReactor<v1::MeshChunk>* GeodexService::GetMesh(
-    grpc::CallbackServerContext* context, const v1::GetMeshRequest* request) {
-  return StartMeshStream(&resources_, context, request);
-}
+#define GEODEX_SERVER_DEFINE_STREAM(Name, Request, Chunk, Start)                                 \
+  grpc::ServerWriteReactor<v1::Chunk>* GeodexService::Name(grpc::CallbackServerContext* context, \
+                                                           const v1::Request* request) {         \
+    return Start(&resources_, context, request);                                                 \
+  }
+GEODEX_SERVER_STREAMED_CALLS(GEODEX_SERVER_DEFINE_STREAM)
+#undef GEODEX_SERVER_DEFINE_STREAM
 
 // --- shutdown ----------------------------------------------------------------------
 

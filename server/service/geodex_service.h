@@ -11,7 +11,8 @@
 // pool queue answers RESOURCE_EXHAUSTED.
 //
 // Streams. Each streaming call has a reactor of its own in server/streams/
-// (<call>_stream.h, e.g. distance_stream.h for StreamDistances), which sees
+// (<call>_stream.h, e.g. distance_stream.h for StreamDistances; the
+// server-streaming ones are listed in streamed_calls.h), which sees
 // the service only through ServiceResources (service_resources.h). They
 // write one message at a time and make the next when the write has
 // completed (backpressure).
@@ -40,6 +41,7 @@
 #include "server/service/service_resources.h"
 #include "server/service/worker_pool.h"
 #include "server/streams/stream_set.h"
+#include "server/streams/streamed_calls.h"
 
 namespace geodex::server {
 
@@ -69,23 +71,23 @@ class GeodexService final : public v1::Geodex::CallbackService {
                                      v1::DistanceResponse* response) override;
   grpc::ServerBidiReactor<v1::DistanceBatch, v1::DistanceResult>* StreamDistances(
       grpc::CallbackServerContext* context) override;
-  grpc::ServerWriteReactor<v1::MatrixBlock>* Matrix(grpc::CallbackServerContext* context,
-                                                    const v1::MatrixRequest* request) override;
   grpc::ServerUnaryReactor* Path(grpc::CallbackServerContext* context,
                                  const v1::PathRequest* request,
                                  v1::PathResponse* response) override;
-  grpc::ServerWriteReactor<v1::DistanceFieldChunk>* DistanceField(
-      grpc::CallbackServerContext* context, const v1::DistanceFieldRequest* request) override;
-  grpc::ServerWriteReactor<v1::ExpMapChunk>* ExpMap(grpc::CallbackServerContext* context,
-                                                    const v1::ExpMapRequest* request) override;
   grpc::ServerUnaryReactor* Locate(grpc::CallbackServerContext* context,
                                    const v1::LocateRequest* request,
                                    v1::LocateResponse* response) override;
-  grpc::ServerWriteReactor<v1::MeshChunk>* GetMesh(grpc::CallbackServerContext* context,
-                                                   const v1::GetMeshRequest* request) override;
   grpc::ServerUnaryReactor* GetTriangulation(grpc::CallbackServerContext* context,
                                              const v1::GetTriangulationRequest* request,
                                              v1::TriangulationResponse* response) override;
+
+  // The server-streaming calls (server/streams/streamed_calls.h), each of
+  // which starts its reactor.
+#define GEODEX_SERVER_DECLARE_STREAM(Name, Request, Chunk, Start)                 \
+  grpc::ServerWriteReactor<v1::Chunk>* Name(grpc::CallbackServerContext* context, \
+                                            const v1::Request* request) override;
+  GEODEX_SERVER_STREAMED_CALLS(GEODEX_SERVER_DECLARE_STREAM)
+#undef GEODEX_SERVER_DECLARE_STREAM
 
  private:
   // Runs `fn(call, worker) -> absl::Status` on the pool and finishes the call

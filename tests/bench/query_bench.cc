@@ -27,9 +27,8 @@
 // pairs, rate, error quantiles, bound coverage and the share answered
 // exactly; tolerances 0.005 and 0.001 on area-uniform pairs.
 //
-// Then the exponential map (core/query/internal/expmap/exp_map.h): the time of one map round
-// an interior point for radii of 3 L, 10 L and the whole mesh, in the default
-// mode and with r from the pure O(1) distance.
+// Then the tables that queries register from their own files (QueryBenchTable
+// in query_bench_lib.h), each with its --<flag>-only option.
 //
 // Without --index it builds an index of a generated sphere (a note says so).
 //

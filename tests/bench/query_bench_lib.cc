@@ -257,7 +257,8 @@ RefinementFigures MeasureRefinement(const query::QueryEngine& engine,
   return f;
 }
 
-// The throughput row, then the exponential map table, of a sphere built here.
+// The throughput row, then the registered tables and the distance fields, of
+// a sphere built here.
 int RunOnGeneratedSphere(int pairs) {
   std::printf("(no --index given: a generated sphere, m = 500)\n");
   builder::BuildOptions options;
@@ -266,8 +267,10 @@ int RunOnGeneratedSphere(int pairs) {
   auto data = builder::BuildIndex(mesh::gen::Sphere(5, 1.0), options, &summary);
   auto ix = index::Index::FromBytes(*index::SerializeIndex(*data));
   std::printf("%s\n", ThroughputRow("sphere(5)", MeasureThroughput(*ix, pairs)).c_str());
-  std::printf("\n%s", ExpMapHeader().c_str());
-  BenchExpMap("sphere(5)", *ix);
+  for (const QueryBenchTable* table : QueryBenchTables()) {
+    std::printf("\n%s", table->header().c_str());
+    table->run("sphere(5)", *ix);
+  }
   std::printf("\nDistance fields (5 interior sources, one at a time)\n%s", FieldHeader().c_str());
   if (const absl::Status status = BenchField("sphere(5)", *ix); !status.ok()) {
     std::fprintf(stderr, "sphere(5): %s\n", status.ToString().c_str());
@@ -282,7 +285,9 @@ std::unique_ptr<CLI::App> QueryBenchFlags(QueryBenchOptions* options) {
   auto app = std::make_unique<CLI::App>("query_bench: constant-time query throughput, one thread.");
   app->add_option("--index", options->indexes, "Index files to measure");
   app->add_option("--pairs", options->pairs, "Pairs per measurement");
-  app->add_flag("--expmap-only", options->expmap_only, "Only the exponential map table");
+  for (const QueryBenchTable* table : QueryBenchTables()) {
+    app->add_flag("--" + table->flag + "-only", options->table_only[table->flag], table->help);
+  }
   app->add_flag("--field-only", options->field_only, "Only the distance field table");
   app->add_option("--accuracy-pairs", options->accuracy_pairs,
                   "Pairs per row of the table against the exact engine");
@@ -416,36 +421,6 @@ std::string RefinementRow(const std::string& label, const RefinementFigures& f) 
       absl::StrFormat("%.3fM", f.traced_rate / 1e6),
       absl::StrFormat("%.2f", f.traced_rate / f.pure_rate),
   });
-}
-
-void BenchExpMap(const std::string& label, std::shared_ptr<const index::Index> ix) {
-  auto engine = *query::QueryEngine::Create(ix);
-  const auto centres = InteriorPoints(*ix, 5, 7);
-  const double l = engine->scale_length();
-  for (const double radius : {3 * l, 10 * l, std::numeric_limits<double>::max()}) {
-    double ms[2];
-    size_t mapped = 0;
-    for (int mode = 0; mode < 2; ++mode) {
-      query::ExpMapOptions options;
-      options.radius = radius;
-      if (mode == 1) options.distance.near_pairs = query::NearPairs::kUnfold;
-      query::QueryScratch scratch;
-      (void)engine->ExpMap(centres[0], options, &scratch);  // the lazy exact mesh
-      mapped = 0;
-      const double t0 = ThreadCpuSeconds();
-      for (const mesh::SurfacePoint& c : centres) {
-        mapped += engine->ExpMap(c, options, &scratch)->size();
-      }
-      ms[mode] = 1e3 * (ThreadCpuSeconds() - t0) / centres.size();
-    }
-    ExpMapFigures f;
-    f.radius = radius == std::numeric_limits<double>::max() ? "whole mesh"
-                                                            : absl::StrFormat("%.0f L", radius / l);
-    f.per_map = static_cast<double>(mapped) / centres.size();
-    f.default_ms = ms[0];
-    f.pure_ms = ms[1];
-    std::printf("%s\n", ExpMapRow(label, f).c_str());
-  }
 }
 
 absl::Status BenchField(const std::string& label, std::shared_ptr<const index::Index> ix) {
@@ -601,16 +576,26 @@ std::string NearProfileRowText(const std::string& label, const NearProfileRow& r
   });
 }
 
-std::string ExpMapHeader() {
-  return MarkdownHeader({"index", "radius", "vertices mapped", "one map, default",
-                         "one map, pure O(1)", "per vertex, default"});
+namespace {
+
+std::vector<QueryBenchTable>& Registry() {
+  static auto* const tables = new std::vector<QueryBenchTable>;
+  return *tables;
 }
 
-std::string ExpMapRow(const std::string& label, const ExpMapFigures& f) {
-  return MarkdownRow({label, f.radius, absl::StrFormat("%.0f", f.per_map),
-                      absl::StrFormat("%.2f ms", f.default_ms),
-                      absl::StrFormat("%.2f ms", f.pure_ms),
-                      absl::StrFormat("%.2f us", 1e3 * f.default_ms / f.per_map)});
+}  // namespace
+
+bool RegisterQueryBenchTable(QueryBenchTable table) {
+  Registry().push_back(std::move(table));
+  return true;
+}
+
+std::vector<const QueryBenchTable*> QueryBenchTables() {
+  std::vector<const QueryBenchTable*> out;
+  for (const QueryBenchTable& table : Registry()) out.push_back(&table);
+  std::sort(out.begin(), out.end(),
+            [](const QueryBenchTable* a, const QueryBenchTable* b) { return a->flag < b->flag; });
+  return out;
 }
 
 int RunQueryBench(const QueryBenchOptions& options) {
@@ -619,6 +604,13 @@ int RunQueryBench(const QueryBenchOptions& options) {
                                              : "one at a time: no AVX2 in this build or CPU");
   if (!options.near_profile) std::printf("%s", ThroughputHeader().c_str());
   if (options.indexes.empty()) return RunOnGeneratedSphere(options.pairs);
+  // A --<table>-only option (or --field-only) leaves out every other table.
+  const auto only = [&](const std::string& flag) {
+    const auto it = options.table_only.find(flag);
+    return it != options.table_only.end() && it->second;
+  };
+  bool some_only = options.field_only;
+  for (const QueryBenchTable* table : QueryBenchTables()) some_only |= only(table->flag);
   std::vector<std::shared_ptr<const index::Index>> loaded;
   for (const std::string& path : options.indexes) {
     auto ix = index::Index::Open(path);
@@ -632,12 +624,12 @@ int RunQueryBench(const QueryBenchOptions& options) {
       BenchNearProfile(path, *ix, std::min(options.pairs, 200'000));
       continue;
     }
-    if (!options.expmap_only && !options.field_only) {
+    if (!some_only) {
       std::printf("%s\n", ThroughputRow(path, MeasureThroughput(*ix, options.pairs)).c_str());
     }
   }
   if (options.near_profile) return 0;
-  if (!options.expmap_only && !options.field_only) {
+  if (!some_only) {
     std::printf("%s", RefinementHeader().c_str());
     for (size_t i = 0; i < loaded.size(); ++i) {
       BenchRefinement(options.indexes[i], loaded[i], std::min(options.pairs, 200'000));
@@ -649,11 +641,12 @@ int RunQueryBench(const QueryBenchOptions& options) {
       }
     }
   }
-  if (!options.field_only) {
-    std::printf("\nExponential map (5 interior centres)\n%s", ExpMapHeader().c_str());
-    for (size_t i = 0; i < loaded.size(); ++i) BenchExpMap(options.indexes[i], loaded[i]);
+  for (const QueryBenchTable* table : QueryBenchTables()) {
+    if (some_only && !only(table->flag)) continue;
+    std::printf("\n%s\n%s", table->title.c_str(), table->header().c_str());
+    for (size_t i = 0; i < loaded.size(); ++i) table->run(options.indexes[i], loaded[i]);
   }
-  if (!options.expmap_only) {
+  if (!some_only || options.field_only) {
     std::printf("\nDistance fields (5 interior sources, one at a time)\n%s", FieldHeader().c_str());
     for (size_t i = 0; i < loaded.size(); ++i) {
       if (const absl::Status status = BenchField(options.indexes[i], loaded[i]); !status.ok()) {

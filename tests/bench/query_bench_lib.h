@@ -1,13 +1,16 @@
 #pragma once
 
 // The pieces of query_bench (query_bench.cc): its flags, the pairs it draws,
-// the measurements, and the rows of its four tables.
+// the measurements, and the rows of its tables; and the registry of the
+// tables that a query's own bench file adds (QueryBenchTable).
 //
 // Rates are single-thread and per CPU-second of the measuring thread
 // (ThreadCpuSeconds). Not thread-safe.
 
 #include <cstddef>
 #include <cstdint>
+#include <functional>
+#include <map>
 #include <memory>
 #include <string>
 #include <vector>
@@ -22,8 +25,9 @@ namespace geodex::bench {
 struct QueryBenchOptions {
   std::vector<std::string> indexes;  // empty: a generated sphere
   int pairs = 1'000'000;             // pairs per measurement
-  bool expmap_only = false;          // only the exponential map table
   bool field_only = false;           // only the distance field table
+  // --<flag>-only of each registered QueryBenchTable: only those tables.
+  std::map<std::string, bool> table_only = {};
   int accuracy_pairs = 1000;         // per row of the table against the exact engine
   bool near_profile = false;         // only the near pairs' rates and profile
 };
@@ -99,20 +103,29 @@ void BenchRefinement(const std::string& label, std::shared_ptr<const index::Inde
 std::string RefinementHeader();
 std::string RefinementRow(const std::string& label, const RefinementFigures& f);
 
-// One row of the exponential map table: one radius.
-struct ExpMapFigures {
-  std::string radius;     // "3 L", "10 L" or "whole mesh"
-  double per_map = 0;     // vertices mapped, mean over the centres
-  double default_ms = 0;  // one map, default mode
-  double pure_ms = 0;     // one map, r from the pure O(1) distance
+// A table of one query's timings, registered by the query's own file (one of
+// the OBJECT library geodex_query_bench_tables in tests/CMakeLists.txt), so
+// that adding a query leaves this library alone.
+// query_bench prints every registered table, by flag, after the refinement
+// tables and before the distance field table, and gives each a
+// --<flag>-only option.
+struct QueryBenchTable {
+  std::string flag;   // "--<flag>-only" prints only the tables so chosen
+  std::string help;   // of that option
+  std::string title;  // the line above the header, with --index
+  std::function<std::string()> header;
+  // Measures and prints the rows of `ix`, labelled `label`.
+  std::function<void(const std::string& label, std::shared_ptr<const index::Index> ix)> run;
 };
 
-// Measures and prints the exponential map rows of `ix`.
-void BenchExpMap(const std::string& label, std::shared_ptr<const index::Index> ix);
+// Adds `table`; for a namespace-scope initializer in the table's file
+// (`const bool kRegistered = RegisterQueryBenchTable({...});`), whose
+// object file the target must link in whole (an OBJECT library). Returns
+// true.
+bool RegisterQueryBenchTable(QueryBenchTable table);
 
-// The exponential map table's header, and one row of it (no newline).
-std::string ExpMapHeader();
-std::string ExpMapRow(const std::string& label, const ExpMapFigures& f);
+// The registered tables, by flag.
+std::vector<const QueryBenchTable*> QueryBenchTables();
 
 // One row of the distance field table: one radius.
 struct FieldFigures {
@@ -134,15 +147,15 @@ std::string FieldRow(const std::string& label, const FieldFigures& f);
 // One row of the near-pair profile: the pairs at L-3L of the O(1) answer that
 // the default mode answered one way, and what they cost.
 struct NearProfileRow {
-  std::string how;                 // "straight walk", "walk with releases", ...
-  size_t count = 0;                // pairs answered this way
-  double share = 0;                // of the bin's pairs
-  double us = 0;                   // microseconds a pair (one Distance call)
-  double faces_crossed = 0;        // faces of the walked corridors a pair
-  double faces_unfolded = 0;       // faces laid out a pair, releases included
-  double releases = 0;             // a pair
-  double exact_rounds = 0;         // exact propagations a pair
-  double exact_region_faces = 0;   // faces of the exact solver's last region a pair
+  std::string how;                // "straight walk", "walk with releases", ...
+  size_t count = 0;               // pairs answered this way
+  double share = 0;               // of the bin's pairs
+  double us = 0;                  // microseconds a pair (one Distance call)
+  double faces_crossed = 0;       // faces of the walked corridors a pair
+  double faces_unfolded = 0;      // faces laid out a pair, releases included
+  double releases = 0;            // a pair
+  double exact_rounds = 0;        // exact propagations a pair
+  double exact_region_faces = 0;  // faces of the exact solver's last region a pair
 };
 
 // The near pairs of `ix` (the d<L and L-3L bins of the refinement table, at

@@ -49,25 +49,34 @@ TEST(QueryBenchFlagsTest, DefaultsAndValues) {
   ASSERT_EQ(ParseFlags(*app, {"query_bench"}, out, err), std::nullopt);
   EXPECT_TRUE(options.indexes.empty());
   EXPECT_EQ(options.pairs, 1'000'000);
-  EXPECT_FALSE(options.expmap_only);
+  EXPECT_FALSE(options.field_only);
+  ASSERT_FALSE(QueryBenchTables().empty());  // the registered tables are linked in
+  for (const QueryBenchTable* table : QueryBenchTables()) {
+    EXPECT_FALSE(options.table_only.at(table->flag)) << table->flag;
 
-  QueryBenchOptions set;
-  auto app2 = QueryBenchFlags(&set);
-  ASSERT_EQ(ParseFlags(*app2,
-                       {"query_bench", "--index", "a.gdx", "--index", "b.gdx", "--pairs", "20",
-                        "--expmap-only"},
-                       out, err),
-            std::nullopt);
-  EXPECT_EQ(set.indexes, (std::vector<std::string>{"a.gdx", "b.gdx"}));
-  EXPECT_EQ(set.pairs, 20);
-  EXPECT_TRUE(set.expmap_only);
+    QueryBenchOptions set;
+    auto app2 = QueryBenchFlags(&set);
+    const std::string only = "--" + table->flag + "-only";
+    ASSERT_EQ(ParseFlags(*app2,
+                         {"query_bench", "--index", "a.gdx", "--index", "b.gdx", "--pairs", "20",
+                          only.c_str()},
+                         out, err),
+              std::nullopt);
+    EXPECT_EQ(set.indexes, (std::vector<std::string>{"a.gdx", "b.gdx"}));
+    EXPECT_EQ(set.pairs, 20);
+    EXPECT_TRUE(set.table_only.at(table->flag)) << only;
+  }
 }
 
 TEST(QueryBenchFlagsTest, HelpAndBadValues) {
   QueryBenchOptions options;
   const std::string help = QueryBenchFlags(&options)->help();
   EXPECT_THAT(help, HasSubstr("query_bench: constant-time query throughput, one thread."));
-  EXPECT_THAT(help, HasSubstr("--expmap-only"));
+  EXPECT_THAT(help, HasSubstr("--field-only"));
+  for (const QueryBenchTable* table : QueryBenchTables()) {
+    EXPECT_THAT(help, HasSubstr("--" + table->flag + "-only"));
+    EXPECT_THAT(help, HasSubstr(table->help));
+  }
   auto app = QueryBenchFlags(&options);
   std::ostringstream out, err;
   EXPECT_NE(ParseFlags(*app, {"query_bench", "--pairs", "many"}, out, err).value_or(0), 0);
@@ -155,11 +164,19 @@ TEST(QueryBenchTablesTest, RefinementRowLayout) {
   EXPECT_THAT(Lines(RefinementHeader())[0], StartsWith("Refinement (DistanceOptions)"));
 }
 
-TEST(QueryBenchTablesTest, ExpMapRowLayout) {
-  const ExpMapFigures f{.radius = "3 L", .per_map = 904, .default_ms = 21.3, .pure_ms = 1.38};
-  const std::string row = ExpMapRow("t.gdx", f);
-  EXPECT_EQ(row, "| t.gdx | 3 L | 904 | 21.30 ms | 1.38 ms | 23.56 us |");
-  ExpectTable(ExpMapHeader(), 0, row);
+// Every registered table prints rows as wide as its header on a small index.
+TEST(QueryBenchTablesTest, RegisteredTablesRowsFitTheirHeaders) {
+  const auto ix = SmallIndex(false);
+  for (const QueryBenchTable* table : QueryBenchTables()) {
+    ::testing::internal::CaptureStdout();
+    table->run("t.gdx", ix);
+    const std::vector<std::string> rows = Lines(::testing::internal::GetCapturedStdout());
+    ASSERT_FALSE(rows.empty()) << table->flag;
+    for (const std::string& row : rows) {
+      EXPECT_THAT(row, StartsWith("| t.gdx | ")) << table->flag;
+      ExpectTable(table->header(), 0, row);
+    }
+  }
 }
 
 TEST(QueryBenchTablesTest, FieldRowLayout) {
@@ -182,7 +199,7 @@ TEST(QueryBenchRunTest, MeasuresASmallIndex) {
 
 // The whole run on a calibrated index in a file: its five tables, each row
 // as wide as its header.
-TEST(QueryBenchRunTest, PrintsFiveTables) {
+TEST(QueryBenchRunTest, PrintsEveryTable) {
   const auto path = std::filesystem::temp_directory_path() /
                     ("query_bench_lib_test_" + std::to_string(getpid()) + ".gdx");
   {
@@ -202,13 +219,18 @@ TEST(QueryBenchRunTest, PrintsFiveTables) {
   }
   // Header and rule, one row; header and rule, uniform and four bins;
   // header and rule, vertex and interior points in four bins, uniform pairs
-  // and two tolerances; header and rule, three radii; header and rule, four
-  // fields.
-  EXPECT_EQ(widths, (std::vector<int>{14, 14, 14, 11, 11, 11, 11, 11, 11, 11, 9, 9, 9, 9,
-                                      9,  9,  9,  9,  9,  9,  9,  9,  9,  6,  6,  6, 6, 6,
-                                      5,  5,  5,  5,  5,  5}));
+  // and two tolerances; then the registered tables (their rows are checked
+  // above); last header and rule, four fields.
+  const std::vector<int> first = {14, 14, 14, 11, 11, 11, 11, 11, 11, 11, 9, 9,
+                                  9,  9,  9,  9,  9,  9,  9,  9,  9,  9,  9};
+  const std::vector<int> last = {5, 5, 5, 5, 5, 5};
+  ASSERT_GT(widths.size(), first.size() + last.size());
+  EXPECT_EQ(std::vector<int>(widths.begin(), widths.begin() + first.size()), first);
+  EXPECT_EQ(std::vector<int>(widths.end() - last.size(), widths.end()), last);
   EXPECT_THAT(out, HasSubstr("\nRefined answers against the exact engine"));
-  EXPECT_THAT(out, HasSubstr("\nExponential map (5 interior centres)\n"));
+  for (const QueryBenchTable* table : QueryBenchTables()) {
+    EXPECT_THAT(out, HasSubstr("\n" + table->title + "\n" + table->header()));
+  }
   EXPECT_THAT(out, HasSubstr("\nDistance fields (5 interior sources, one at a time)\n"));
   EXPECT_THAT(out, HasSubstr("| whole mesh, exact | 642 |"));
 }

@@ -27,12 +27,22 @@ void Soak::Run(uint32_t seed, std::chrono::steady_clock::time_point until) {
   while (std::chrono::steady_clock::now() < until) Step(rng);
 }
 
+// Draws 0-9: two in ten valid Distance calls, then one each of the invalid
+// Distance, StreamDistances, Path, every streamed call in turn and GetModel,
+// the rest valid Distance calls again.
 void Soak::Step(std::mt19937& rng) {
-  switch (rng() % 10) {
-    case 0:
-    case 1:
-      ValidDistance(rng);
-      break;
+  const uint32_t kind = rng() % 10;
+  const std::vector<StreamedCall>& streamed = StreamedCalls();
+  constexpr uint32_t kFirstStreamed = 5;
+  if (kind >= kFirstStreamed && kind - kFirstStreamed < streamed.size()) {
+    streamed[kind - kFirstStreamed](*this, rng);
+    return;
+  }
+  if (kind == kFirstStreamed + streamed.size()) {
+    Model();
+    return;
+  }
+  switch (kind) {
     case 2:
       InvalidDistance(rng);
       break;
@@ -41,15 +51,6 @@ void Soak::Step(std::mt19937& rng) {
       break;
     case 4:
       Path(rng);
-      break;
-    case 5:
-      Field(rng);
-      break;
-    case 6:
-      ExpMap(rng);
-      break;
-    case 7:
-      Model();
       break;
     default:
       ValidDistance(rng);
@@ -283,50 +284,61 @@ Soak::Answered Soak::ReadStream(const char* call, Open open, Take take) {
   return answered;
 }
 
-void Soak::Field(std::mt19937& rng) {
-  const auto sources = Points(rng, 1 + static_cast<int>(rng() % 3));
-  v1::DistanceFieldRequest request;
-  *request.mutable_model() = Ref();
-  *request.mutable_sources() = ToProto(sources);
-  std::vector<double> got;
-  const Answered answered = ReadStream<v1::DistanceFieldChunk>(
-      "DistanceField", [&](grpc::ClientContext* c) { return stub_->DistanceField(c, request); },
-      [&](const v1::DistanceFieldChunk& chunk) {
-        got.insert(got.end(), chunk.distances().begin(), chunk.distances().end());
-      });
-  if (answered.engine == nullptr) return;
-  auto field = answered.engine->Field(sources);
-  if (!field.ok() || field->distance != got) {
-    Violation(absl::StrFormat("DistanceField differs from offline (version %d)", answered.version));
-  }
-}
-
-void Soak::ExpMap(std::mt19937& rng) {
-  const auto centre = Points(rng, 1);
-  const double radius = 0.2 + 0.6 * std::uniform_real_distribution<double>(0, 1)(rng);
-  v1::ExpMapRequest request;
-  *request.mutable_model() = Ref();
-  *request.mutable_center() = ToProto(centre);
-  request.set_radius(radius);
-  std::vector<int32_t> vertices;
-  std::vector<double> theta;
-  const Answered answered = ReadStream<v1::ExpMapChunk>(
-      "ExpMap", [&](grpc::ClientContext* c) { return stub_->ExpMap(c, request); },
-      [&](const v1::ExpMapChunk& chunk) {
-        vertices.insert(vertices.end(), chunk.vertices().begin(), chunk.vertices().end());
-        theta.insert(theta.end(), chunk.theta().begin(), chunk.theta().end());
-      });
-  if (answered.engine == nullptr) return;
-  query::ExpMapOptions options;
-  options.radius = radius;
-  auto map = answered.engine->ExpMap(centre[0], options);
-  bool same = map.ok() && map->size() == vertices.size();
-  for (size_t i = 0; same && i < vertices.size(); ++i) {
-    same = (*map)[i].vertex == vertices[i] && (*map)[i].theta == theta[i];
-  }
-  if (!same) {
-    Violation(absl::StrFormat("ExpMap differs from offline (version %d)", answered.version));
-  }
+// The lambdas are the class's own code (a static member's), so they reach
+// its private helpers.
+const std::vector<Soak::StreamedCall>& Soak::StreamedCalls() {
+  static const std::vector<StreamedCall> kCalls = {
+      // DistanceField from one to three sources: every vertex's distance.
+      [](Soak& soak, std::mt19937& rng) {
+        const auto sources = soak.Points(rng, 1 + static_cast<int>(rng() % 3));
+        v1::DistanceFieldRequest request;
+        *request.mutable_model() = soak.Ref();
+        *request.mutable_sources() = ToProto(sources);
+        std::vector<double> got;
+        const Answered answered = soak.ReadStream<v1::DistanceFieldChunk>(
+            "DistanceField",
+            [&](grpc::ClientContext* c) { return soak.stub_->DistanceField(c, request); },
+            [&](const v1::DistanceFieldChunk& chunk) {
+              got.insert(got.end(), chunk.distances().begin(), chunk.distances().end());
+            });
+        if (answered.engine == nullptr) return;
+        auto field = answered.engine->Field(sources);
+        if (!field.ok() || field->distance != got) {
+          soak.Violation(
+              absl::StrFormat("DistanceField differs from offline (version %d)", answered.version));
+        }
+      },
+      // ExpMap round one point, radius 0.2-0.8: the vertices and their angles.
+      [](Soak& soak, std::mt19937& rng) {
+        const auto centre = soak.Points(rng, 1);
+        const double radius = 0.2 + 0.6 * std::uniform_real_distribution<double>(0, 1)(rng);
+        v1::ExpMapRequest request;
+        *request.mutable_model() = soak.Ref();
+        *request.mutable_center() = ToProto(centre);
+        request.set_radius(radius);
+        std::vector<int32_t> vertices;
+        std::vector<double> theta;
+        const Answered answered = soak.ReadStream<v1::ExpMapChunk>(
+            "ExpMap", [&](grpc::ClientContext* c) { return soak.stub_->ExpMap(c, request); },
+            [&](const v1::ExpMapChunk& chunk) {
+              vertices.insert(vertices.end(), chunk.vertices().begin(), chunk.vertices().end());
+              theta.insert(theta.end(), chunk.theta().begin(), chunk.theta().end());
+            });
+        if (answered.engine == nullptr) return;
+        query::ExpMapOptions options;
+        options.radius = radius;
+        auto map = answered.engine->ExpMap(centre[0], options);
+        bool same = map.ok() && map->size() == vertices.size();
+        for (size_t i = 0; same && i < vertices.size(); ++i) {
+          same = (*map)[i].vertex == vertices[i] && (*map)[i].theta == theta[i];
+        }
+        if (!same) {
+          soak.Violation(
+              absl::StrFormat("ExpMap differs from offline (version %d)", answered.version));
+        }
+      },
+  };
+  return kCalls;
 }
 
 void Soak::Model() {

@@ -1,12 +1,11 @@
 #pragma once
 
 // One soak client set (soak_driver.cc): threads that send a geodex-server a
-// random mix of valid requests (Distance, StreamDistances, Path,
-// DistanceField, ExpMap, GetModel) and invalid ones (faces past the end, NaN
-// and negative weights, wrong lengths, an unknown model, too many pairs, a
-// bad batch inside a good stream). Every valid answer is compared, to the
-// bit, with the offline engine of the version that answered it; every
-// invalid request must be refused with its code while the rest of the call
+// random mix of valid requests (Distance, StreamDistances, Path, the
+// server-streaming calls of Soak::StreamedCalls, GetModel) and invalid ones (faces past the end,
+// NaN and negative weights, wrong lengths, an unknown model, too many pairs, a bad batch inside a
+// good stream). Every valid answer is compared, to the bit, with the offline engine of the version
+// that answered it; every invalid request must be refused with its code while the rest of the call
 // (the other batches of a stream) is answered.
 
 #include <atomic>
@@ -77,9 +76,13 @@ class Soak {
   void InvalidDistance(std::mt19937& rng);
   void Stream(std::mt19937& rng);
   void Path(std::mt19937& rng);
-  void Field(std::mt19937& rng);
-  void ExpMap(std::mt19937& rng);
   void Model();
+
+  // The server-streaming calls of the mix, one entry each (soak_client.cc):
+  // an entry sends a random request, reads the stream to its end
+  // (ReadStream) and compares the answer with the offline engine's.
+  using StreamedCall = void (*)(Soak& soak, std::mt19937& rng);
+  static const std::vector<StreamedCall>& StreamedCalls();
 
   std::unique_ptr<v1::Geodex::Stub> stub_;
   const std::string model_;

@@ -1,5 +1,6 @@
 #include "client/cli/web/web_gateway.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -9,6 +10,7 @@
 #include <sstream>
 #include <utility>
 
+#include "absl/strings/ascii.h"
 #include "absl/strings/match.h"
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
@@ -16,6 +18,7 @@
 #include "absl/strings/string_view.h"
 #include "client/cli/outputs.h"
 #include "google/protobuf/util/json_util.h"
+#include "google/protobuf/util/message_differencer.h"
 
 namespace geodex::client::cli {
 namespace {
@@ -103,6 +106,70 @@ std::string MeshToJson(const v1::MeshChunk& mesh) {
   return out;
 }
 
+absl::Status MergeChunks(const std::vector<const google::protobuf::Message*>& chunks,
+                         google::protobuf::Message* out) {
+  out->Clear();
+  if (chunks.empty()) return absl::OkStatus();
+  const google::protobuf::Descriptor* type = out->GetDescriptor();
+  const google::protobuf::Reflection* reflection = out->GetReflection();
+  const std::string what = type->name();
+  // A chunk without its arrays: what every chunk must repeat.
+  auto totals = [&](const google::protobuf::Message& chunk) {
+    std::unique_ptr<google::protobuf::Message> copy(chunk.New());
+    copy->CopyFrom(chunk);
+    for (int i = 0; i < type->field_count(); ++i) {
+      if (type->field(i)->is_repeated()) reflection->ClearField(copy.get(), type->field(i));
+    }
+    return copy;
+  };
+  const std::unique_ptr<google::protobuf::Message> first = totals(*chunks[0]);
+  int64_t entries = 0;
+  for (const google::protobuf::Message* chunk : chunks) {
+    if (chunk->GetDescriptor() != type) {
+      return absl::InternalError(absl::StrCat("MergeChunks: a ", chunk->GetTypeName(),
+                                              " among chunks of ", type->full_name()));
+    }
+    if (!google::protobuf::util::MessageDifferencer::Equals(*first, *totals(*chunk))) {
+      return DataLoss(what, "disagree on their totals or the version");
+    }
+    int length = -1;
+    for (int i = 0; i < type->field_count(); ++i) {
+      const google::protobuf::FieldDescriptor* field = type->field(i);
+      if (!field->is_repeated()) continue;
+      const int n = reflection->FieldSize(*chunk, field);
+      if (length >= 0 && n != length) return DataLoss(what, "have arrays of different lengths");
+      length = n;
+    }
+    entries += std::max(length, 0);
+    out->MergeFrom(*chunk);
+  }
+  for (int i = 0; i < type->field_count(); ++i) {
+    const google::protobuf::FieldDescriptor* field = type->field(i);
+    if (field->is_repeated() || !absl::StartsWith(field->name(), "num_")) continue;
+    int64_t total = 0;
+    switch (field->cpp_type()) {
+      case google::protobuf::FieldDescriptor::CPPTYPE_INT32:
+        total = reflection->GetInt32(*out, field);
+        break;
+      case google::protobuf::FieldDescriptor::CPPTYPE_INT64:
+        total = reflection->GetInt64(*out, field);
+        break;
+      case google::protobuf::FieldDescriptor::CPPTYPE_UINT32:
+        total = reflection->GetUInt32(*out, field);
+        break;
+      case google::protobuf::FieldDescriptor::CPPTYPE_UINT64:
+        total = static_cast<int64_t>(reflection->GetUInt64(*out, field));
+        break;
+      default:
+        continue;
+    }
+    if (total != entries) {
+      return DataLoss(what, absl::StrCat("do not add up to its ", field->name()));
+    }
+  }
+  return absl::OkStatus();
+}
+
 namespace {
 
 // --- merging the chunks of a server stream into one message --------------------
@@ -185,29 +252,31 @@ absl::StatusOr<v1::MatrixBlock> MergeMatrix(const std::vector<v1::MatrixBlock>& 
   return out;
 }
 
-absl::StatusOr<v1::ExpMapChunk> MergeExpMap(const std::vector<v1::ExpMapChunk>& in) {
-  v1::ExpMapChunk out;
-  if (in.empty()) return out;
-  out.set_num_vertices(in[0].num_vertices());
-  out.set_version(in[0].version());
-  for (const v1::ExpMapChunk& c : in) {
-    if (c.num_vertices() != out.num_vertices() || c.version() != out.version()) {
-      return DataLoss("exponential map", "disagree on the count or the version");
-    }
-    const int n = c.vertices_size();
-    if (c.r_size() != n || c.theta_size() != n || c.u_size() != n || c.v_size() != n) {
-      return DataLoss("exponential map", "have arrays of different lengths");
-    }
-    out.mutable_vertices()->MergeFrom(c.vertices());
-    out.mutable_r()->MergeFrom(c.r());
-    out.mutable_theta()->MergeFrom(c.theta());
-    out.mutable_u()->MergeFrom(c.u());
-    out.mutable_v()->MergeFrom(c.v());
-  }
-  if (out.vertices_size() != out.num_vertices()) {
-    return DataLoss("exponential map", "do not add up to its count");
-  }
+// Chunks of another stream (one with no merge of its own above), by the
+// generic rule of MergeChunks.
+template <class Chunk>
+absl::StatusOr<Chunk> MergeGeneric(const std::vector<Chunk>& in) {
+  std::vector<const google::protobuf::Message*> chunks;
+  chunks.reserve(in.size());
+  for (const Chunk& c : in) chunks.push_back(&c);
+  Chunk out;
+  if (absl::Status s = MergeChunks(chunks, &out); !s.ok()) return s;
   return out;
+}
+
+// One stream's chunks merged, by the stream's request: the field's and the
+// matrix's checks depend on what was asked.
+absl::StatusOr<v1::DistanceFieldChunk> Merge(const v1::DistanceFieldRequest& request,
+                                             const std::vector<v1::DistanceFieldChunk>& in) {
+  return MergeField(in, request.with_nearest_source(), request.radius() != 0);
+}
+absl::StatusOr<v1::MatrixBlock> Merge(const v1::MatrixRequest& request,
+                                      const std::vector<v1::MatrixBlock>& in) {
+  return MergeMatrix(in, request.error_bounds());
+}
+template <class Request, class Chunk>
+absl::StatusOr<Chunk> Merge(const Request& /*request*/, const std::vector<Chunk>& in) {
+  return MergeGeneric(in);
 }
 
 // --- requests -------------------------------------------------------------------
@@ -264,7 +333,76 @@ absl::StatusOr<Request> PostRequest(const std::string& name, const HttpRequest& 
   return request;
 }
 
+template <class T>
+constexpr bool kIsStream = false;
+template <class Chunk>
+constexpr bool kIsStream<std::vector<Chunk>> = true;
+
+// A POST route: the request from the body, the connection's call `kRpc`,
+// and its answer (a stream's chunks merged).
+template <class Request, class Result,
+          absl::StatusOr<Result> (GeodexConnection::*kRpc)(const Request&)>
+HttpResponse CallRpc(GeodexConnection& connection, const std::string& name,
+                     const HttpRequest& http) {
+  absl::StatusOr<Request> request = PostRequest<Request>(name, http);
+  if (!request.ok()) return ErrorResponse(request.status());
+  absl::StatusOr<Result> result = (connection.*kRpc)(*request);
+  if (!result.ok()) return ErrorResponse(result.status());
+  if constexpr (kIsStream<Result>) {
+    return Answer(Merge(*request, *result));
+  } else {
+    return JsonResponse(ToJson(*result));
+  }
+}
+
+// The calls with a GET route of their own (WebGateway::HandleApi), which
+// have no POST route.
+bool HasGetRoute(absl::string_view rpc) {
+  return rpc == "ListModels" || rpc == "GetModel" || rpc == "GetMesh" || rpc == "GetTriangulation";
+}
+
+using PostHandler = HttpResponse (*)(GeodexConnection& connection, const std::string& name,
+                                     const HttpRequest& http);
+
+// Adds the POST route of call `rpc` to `routes` unless it has a GET route
+// (a request naming no model, as ListModels', has one).
+template <class Request, class Result,
+          absl::StatusOr<Result> (GeodexConnection::*kRpc)(const Request&)>
+void AddPostRoute(absl::string_view rpc, std::map<std::string, PostHandler>* routes) {
+  if constexpr (requires(const Request& r) { r.model(); }) {
+    if (!HasGetRoute(rpc)) (*routes)[PostVerb(rpc)] = &CallRpc<Request, Result, kRpc>;
+  }
+}
+
+// The POST routes by verb, from GEODEX_CLIENT_RPCS.
+const std::map<std::string, PostHandler>& PostRoutes() {
+  static const auto* const routes = [] {
+    auto* out = new std::map<std::string, PostHandler>;
+#define GEODEX_WEB_POST_ROUTE(Name, Request, Result) \
+  AddPostRoute<Request, Result, &GeodexConnection::Name>(#Name, out);
+    GEODEX_CLIENT_RPCS(GEODEX_WEB_POST_ROUTE)
+#undef GEODEX_WEB_POST_ROUTE
+    return out;
+  }();
+  return *routes;
+}
+
 }  // namespace
+
+std::string PostVerb(absl::string_view rpc) {
+  // The viewer's name for DistanceField predates this rule.
+  if (rpc == "DistanceField") return "field";
+  return absl::AsciiStrToLower(rpc);
+}
+
+std::vector<std::string> PostRpcs() {
+  std::vector<std::string> out;
+#define GEODEX_WEB_POST_RPC(Name, Request, Result) \
+  if (!HasGetRoute(#Name)) out.push_back(#Name);
+  GEODEX_CLIENT_RPCS(GEODEX_WEB_POST_RPC)
+#undef GEODEX_WEB_POST_RPC
+  return out;
+}
 
 int HttpStatusFromCode(absl::StatusCode code) {
   switch (code) {
@@ -430,45 +568,10 @@ HttpResponse WebGateway::HandleApi(const HttpRequest& request) const {
     return ErrorResponse(absl::NotFoundError(absl::StrCat("no such API path: ", path)));
   }
 
-  if (verb == "distance" || verb == "path" || verb == "field" || verb == "locate" ||
-      verb == "matrix" || verb == "expmap") {
+  const auto route = PostRoutes().find(verb);
+  if (route != PostRoutes().end()) {
     if (request.method != "POST") return wrong_method("POST");
-  }
-  if (verb == "distance") {
-    auto r = PostRequest<v1::DistanceRequest>(name, request);
-    if (!r.ok()) return ErrorResponse(r.status());
-    return Answer(connection_->Distance(*r));
-  }
-  if (verb == "path") {
-    auto r = PostRequest<v1::PathRequest>(name, request);
-    if (!r.ok()) return ErrorResponse(r.status());
-    return Answer(connection_->Path(*r));
-  }
-  if (verb == "locate") {
-    auto r = PostRequest<v1::LocateRequest>(name, request);
-    if (!r.ok()) return ErrorResponse(r.status());
-    return Answer(connection_->Locate(*r));
-  }
-  if (verb == "field") {
-    auto r = PostRequest<v1::DistanceFieldRequest>(name, request);
-    if (!r.ok()) return ErrorResponse(r.status());
-    auto chunks = connection_->DistanceField(*r);
-    if (!chunks.ok()) return ErrorResponse(chunks.status());
-    return Answer(MergeField(*chunks, r->with_nearest_source(), r->radius() != 0));
-  }
-  if (verb == "matrix") {
-    auto r = PostRequest<v1::MatrixRequest>(name, request);
-    if (!r.ok()) return ErrorResponse(r.status());
-    auto blocks = connection_->Matrix(*r);
-    if (!blocks.ok()) return ErrorResponse(blocks.status());
-    return Answer(MergeMatrix(*blocks, r->error_bounds()));
-  }
-  if (verb == "expmap") {
-    auto r = PostRequest<v1::ExpMapRequest>(name, request);
-    if (!r.ok()) return ErrorResponse(r.status());
-    auto chunks = connection_->ExpMap(*r);
-    if (!chunks.ok()) return ErrorResponse(chunks.status());
-    return Answer(MergeExpMap(*chunks));
+    return route->second(*connection_, name, request);
   }
   return ErrorResponse(absl::NotFoundError(absl::StrCat("no such method: ", verb)));
 }

@@ -14,13 +14,14 @@
 //   GET  /v1/models/{name}                   GetModel            -> ModelInfo
 //   GET  /v1/models/{name}/mesh              GetMesh             -> MeshChunk (all chunks merged)
 //   GET  /v1/models/{name}/triangulation     GetTriangulation    -> TriangulationResponse
-//   POST /v1/models/{name}:distance          DistanceRequest     -> DistanceResponse
-//   POST /v1/models/{name}:path              PathRequest         -> PathResponse
-//   POST /v1/models/{name}:field             DistanceFieldRequest-> DistanceFieldChunk (merged)
-//   POST /v1/models/{name}:locate            LocateRequest       -> LocateResponse
-//   POST /v1/models/{name}:matrix            MatrixRequest       -> MatrixBlock (merged)
-//   POST /v1/models/{name}:expmap            ExpMapRequest       -> ExpMapChunk (merged)
+//   POST /v1/models/{name}:<verb>            the call's request  -> its answer (chunks merged)
 //   GET  /  and the viewer's files (WebAssetNames)
+//
+// The POST routes are every other call of GEODEX_CLIENT_RPCS
+// (geodex/client/connection.h), <verb> being PostVerb of its name: e.g.
+// :distance (DistanceRequest -> DistanceResponse), :path, :locate, :matrix
+// (MatrixRequest -> MatrixBlock, merged) and :field (DistanceFieldRequest ->
+// DistanceFieldChunk, merged). A call added to that list has its route.
 //
 // The model's name comes from the path; a POST body is the request message
 // without it (a body naming another model is INVALID_ARGUMENT; it may set
@@ -31,7 +32,8 @@
 // stream's type holding every chunk: repeated fields concatenated in order,
 // offsets 0, counts the totals (MatrixBlock.rows = all rows). The chunks are
 // checked to tile the whole (contiguous offsets, same totals and version);
-// otherwise DATA_LOSS.
+// otherwise DATA_LOSS. Matrix blocks, field chunks and mesh chunks have
+// checks of their own; other streams' chunks follow MergeChunks.
 //
 // Errors: HTTP status from HttpStatusFromCode (grpc-gateway's table) and the
 // body {"code": <google.rpc.Code>, "message": "...", "details": []}. Bad
@@ -50,7 +52,9 @@
 
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
+#include "absl/strings/string_view.h"
 #include "geodex/client/connection.h"
+#include "google/protobuf/message.h"
 
 namespace geodex::client::cli {
 
@@ -82,6 +86,23 @@ HttpResponse ErrorResponse(const absl::Status& status, int http_status = 0);
 // prints with always_print_primitive_fields, several times faster (the mesh
 // is the largest answer the viewer asks for: 6.5 MB for 100K vertices).
 std::string MeshToJson(const v1::MeshChunk& mesh);
+
+// The verb of a call's POST route: its name in lower case ("Distance" ->
+// "distance"), but "field" for DistanceField.
+std::string PostVerb(absl::string_view rpc);
+
+// The calls of GEODEX_CLIENT_RPCS that have a POST route (all but those with
+// a GET route: ListModels, GetModel, GetMesh, GetTriangulation), by name.
+std::vector<std::string> PostRpcs();
+
+// Merges the chunks of a server stream into `out` (of the chunks' type), by
+// the generic rule: each chunk's repeated fields are parallel arrays of one
+// length, concatenated in order; every other field (the totals, the
+// version) is the same in every chunk; and a singular integer field named
+// num_* counts the merged entries. No chunks: `out` cleared. Errors:
+// DATA_LOSS naming the rule a chunk breaks.
+absl::Status MergeChunks(const std::vector<const google::protobuf::Message*>& chunks,
+                         google::protobuf::Message* out);
 
 // A file of the viewer: its bytes and MIME type.
 struct WebAsset {

@@ -3,6 +3,7 @@
 
 #include "client/cli/web/web_gateway.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -13,7 +14,12 @@
 
 #include "geodex/client/mocks/mock_geodex_connection.h"
 #include "gmock/gmock.h"
+#include "google/protobuf/descriptor.h"
+#include "google/protobuf/descriptor.pb.h"
+#include "google/protobuf/dynamic_message.h"
+#include "google/protobuf/text_format.h"
 #include "google/protobuf/util/json_util.h"
+#include "google/protobuf/util/message_differencer.h"
 #include "gtest/gtest.h"
 
 namespace geodex::client::cli {
@@ -327,7 +333,7 @@ TEST_F(WebGatewayTest, MeshChunksAreMerged) {
   EXPECT_EQ(mesh.vertex_offset(), 0u);
 }
 
-TEST_F(WebGatewayTest, MatrixExpMapAndTriangulation) {
+TEST_F(WebGatewayTest, MatrixAndTriangulation) {
   v1::MatrixBlock b0, b1;
   for (auto* b : {&b0, &b1}) {
     b->set_rows(1);
@@ -343,16 +349,6 @@ TEST_F(WebGatewayTest, MatrixExpMapAndTriangulation) {
   EXPECT_EQ(matrix.rows(), 2);
   EXPECT_EQ(matrix.values(3), 4);
 
-  v1::ExpMapChunk e;
-  e.set_num_vertices(1);
-  e.add_vertices(7);
-  e.add_r(0.5);
-  e.add_theta(0.1);
-  e.add_u(0.4);
-  e.add_v(0.05);
-  EXPECT_CALL(*mock_, ExpMap).WillOnce(Return(std::vector<v1::ExpMapChunk>{e}));
-  EXPECT_EQ(Parse<v1::ExpMapChunk>(Post("/v1/models/t:expmap", "{}")).vertices(0), 7);
-
   v1::TriangulationResponse t;
   t.add_vertex_triangles(-1);
   t.add_triangle_corners(0);
@@ -363,6 +359,120 @@ TEST_F(WebGatewayTest, MatrixExpMapAndTriangulation) {
   const HttpResponse r = Get("/v1/models/t/triangulation");
   ASSERT_EQ(r.status, 200) << r.body;
   EXPECT_EQ(Parse<v1::TriangulationResponse>(r).vertex_triangles(0), -1);
+}
+
+// The model a request names ("" for a request without one).
+template <class Request>
+std::string ModelName(const Request& request) {
+  if constexpr (requires { request.model(); }) {
+    return request.model().name();
+  } else {
+    return "";
+  }
+}
+
+// Every call of GEODEX_CLIENT_RPCS but those with a GET route answers POST
+// /v1/models/{name}:<verb> (an empty answer, or no chunks, is 200) and
+// refuses GET there.
+TEST_F(WebGatewayTest, EveryCallWithoutAGetRouteHasAPostRoute) {
+  const std::vector<std::string> post = PostRpcs();
+  for (const char* rpc : {"Distance", "Path", "Locate", "Matrix", "DistanceField"}) {
+    EXPECT_THAT(post, ::testing::Contains(rpc));
+  }
+  for (const char* rpc : {"ListModels", "GetModel", "GetMesh", "GetTriangulation"}) {
+    EXPECT_THAT(post, ::testing::Not(::testing::Contains(rpc)));
+  }
+  EXPECT_EQ(PostVerb("DistanceField"), "field");
+  EXPECT_EQ(PostVerb("Distance"), "distance");
+  int routed = 0;
+#define GEODEX_TEST_POST_ROUTE(Name, Request, Result)                          \
+  if (std::find(post.begin(), post.end(), #Name) != post.end()) {              \
+    EXPECT_CALL(*mock_, Name).WillOnce([](const Request& request) -> Result {  \
+      EXPECT_EQ(ModelName(request), "t");                                      \
+      return Result{};                                                         \
+    });                                                                        \
+    const std::string path = "/v1/models/t:" + PostVerb(#Name);                \
+    const HttpResponse r = Post(path, "{}");                                   \
+    EXPECT_EQ(r.status, 200) << #Name << ": " << r.body;                       \
+    EXPECT_EQ(r.content_type, "application/json");                             \
+    ExpectError(Get(path), 405, absl::StatusCode::kUnimplemented, "use POST"); \
+    ++routed;                                                                  \
+  }
+  GEODEX_CLIENT_RPCS(GEODEX_TEST_POST_ROUTE)
+#undef GEODEX_TEST_POST_ROUTE
+  EXPECT_EQ(routed, static_cast<int>(post.size()));
+  ExpectError(Post("/v1/models/t:getmodel", "{}"), 404, absl::StatusCode::kNotFound,
+              "no such method");
+}
+
+// A chunk type of no query, for the generic merge: parallel arrays, their
+// count and a version.
+class MergeChunksTest : public ::testing::Test {
+ protected:
+  MergeChunksTest() {
+    google::protobuf::FileDescriptorProto file;
+    EXPECT_TRUE(google::protobuf::TextFormat::ParseFromString(
+        R"pb(
+          name: "merge_chunks_test.proto"
+          package: "test"
+          syntax: "proto3"
+          message_type {
+            name: "Chunk"
+            field { name: "ids" number: 1 label: LABEL_REPEATED type: TYPE_INT32 }
+            field { name: "values" number: 2 label: LABEL_REPEATED type: TYPE_DOUBLE }
+            field { name: "num_entries" number: 3 label: LABEL_OPTIONAL type: TYPE_INT64 }
+            field { name: "version" number: 4 label: LABEL_OPTIONAL type: TYPE_INT64 }
+          })pb",
+        &file));
+    EXPECT_NE(pool_.BuildFile(file), nullptr);
+    prototype_ = factory_.GetPrototype(pool_.FindMessageTypeByName("test.Chunk"));
+  }
+  std::unique_ptr<google::protobuf::Message> Chunk(const std::string& text) {
+    std::unique_ptr<google::protobuf::Message> chunk(prototype_->New());
+    EXPECT_TRUE(google::protobuf::TextFormat::ParseFromString(text, chunk.get())) << text;
+    return chunk;
+  }
+  absl::Status Merge(const std::vector<std::string>& texts, google::protobuf::Message* out) {
+    std::vector<std::unique_ptr<google::protobuf::Message>> owned;
+    std::vector<const google::protobuf::Message*> chunks;
+    for (const std::string& text : texts) {
+      owned.push_back(Chunk(text));
+      chunks.push_back(owned.back().get());
+    }
+    return MergeChunks(chunks, out);
+  }
+
+  google::protobuf::DescriptorPool pool_;
+  google::protobuf::DynamicMessageFactory factory_;
+  const google::protobuf::Message* prototype_ = nullptr;
+};
+
+TEST_F(MergeChunksTest, ConcatenatesTheArraysAndKeepsTheTotals) {
+  std::unique_ptr<google::protobuf::Message> out(prototype_->New());
+  ASSERT_TRUE(Merge({"ids: [4, 9] values: [0.5, 1.25] num_entries: 3 version: 2",
+                     "ids: [17] values: [0.75] num_entries: 3 version: 2"},
+                    out.get())
+                  .ok());
+  const auto want = Chunk("ids: [4, 9, 17] values: [0.5, 1.25, 0.75] num_entries: 3 version: 2");
+  EXPECT_TRUE(google::protobuf::util::MessageDifferencer::Equals(*out, *want))
+      << out->DebugString();
+  ASSERT_TRUE(Merge({}, out.get()).ok());
+  EXPECT_EQ(out->ByteSizeLong(), 0u);
+}
+
+TEST_F(MergeChunksTest, RefusesChunksThatDoNotTile) {
+  std::unique_ptr<google::protobuf::Message> out(prototype_->New());
+  absl::Status s = Merge({"ids: [4] values: [0.5] num_entries: 2 version: 2",
+                          "ids: [9] values: [1] num_entries: 2 version: 3"},
+                         out.get());
+  EXPECT_EQ(s.code(), absl::StatusCode::kDataLoss);
+  EXPECT_THAT(s.message(), HasSubstr("the server's Chunk chunks disagree"));
+  s = Merge({"ids: [4, 9] values: [0.5] num_entries: 2"}, out.get());
+  EXPECT_EQ(s.code(), absl::StatusCode::kDataLoss);
+  EXPECT_THAT(s.message(), HasSubstr("arrays of different lengths"));
+  s = Merge({"ids: [4] values: [0.5] num_entries: 2"}, out.get());
+  EXPECT_EQ(s.code(), absl::StatusCode::kDataLoss);
+  EXPECT_THAT(s.message(), HasSubstr("do not add up to its num_entries"));
 }
 
 TEST_F(WebGatewayTest, ExceptionsBecomeInternalErrors) {
