@@ -282,7 +282,8 @@ CHILDREN+=("$BENCH_PID")
     elif ! cmp -s loop-answer.txt expected-v1.txt; then
       echo "call $n: answers differ from geodex-query" >> loop-failures.txt
     fi
-    echo "$n" > loop-count.txt
+    # Renamed into place: a reader never sees the file empty mid-write.
+    echo "$n" > loop-count.tmp && mv loop-count.tmp loop-count.txt
   done
 ) &
 LOOP_PID=$!

@@ -37,8 +37,8 @@
 namespace geodex::builder {
 
 struct PipelineOptions {
-  // m (the first round's with a target error), seed, threads, the flat
-  // refinement, progress.
+  // m (the first round's with a target error), seed, threads, the
+  // long-edge split, progress.
   BuildOptions build;
   // How the input mesh is repaired (strict: refused instead).
   mesh::RepairOptions repair;

@@ -67,8 +67,8 @@ struct RoundsOptions {
   double target = validation::kDefaultTargetError;
   // No index over this many bytes is written (geodex-build --max-index-mib).
   int64_t max_index_bytes = validation::kMaxIndexBytes;
-  // Cap on m; 0: validation::kDefaultMaxSamples, and without the flat
-  // refinement at most half the referenced vertices.
+  // Cap on m; 0: validation::kDefaultMaxSamples, and without the
+  // long-edge split at most half the referenced vertices.
   int32_t max_samples = 0;
   // Held-out sources of each round's validation (and of the index's
   // calibration). A source's pairs err together and sources differ a lot,

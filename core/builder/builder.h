@@ -49,7 +49,7 @@ struct BuildOptions {
   // (triangulation::RepairOptions::check_edges).
   bool check_edges = true;
   // Split long mesh edges flat before sampling (PrepareMesh in
-  // core/builder/mesh_arrays.h; geodex-build --no-refinement turns it off).
+  // core/builder/mesh_arrays.h; geodex-build --no-split turns it off).
   bool refine_long_edges = true;
   // Error-driven placement (core/validation/error_map.h): one weight per
   // vertex of the mesh being built; farthest-point sampling then spaces the
@@ -57,7 +57,7 @@ struct BuildOptions {
   // farthest-point sampling.
   std::vector<double> spacing_weight;
   // For refusal messages: the input file's id of each vertex of the mesh
-  // being built (kNone for a midpoint of the flat refinement); empty when the
+  // being built (kNone for a midpoint of the long-edge split); empty when the
   // mesh's ids are the file's (InputVertexIds in mesh_arrays.h).
   std::vector<int32_t> input_vertex_ids;
   // Called from builder threads (serialised by the builder) as work advances.

@@ -209,10 +209,10 @@ TEST(BuilderTest, MergeRejectsMissingRows) {
   EXPECT_EQ(Merge(m, *plan, *rows, &summary).status().code(), absl::StatusCode::kInvalidArgument);
 }
 
-// The refinement for more samples only adds midpoints after the vertices of
+// The split for more samples only adds midpoints after the vertices of
 // the split for fewer: a target-error build's rounds carry their
 // samples (vertex ids) over.
-TEST(BuilderTest, RefinementForMoreSamplesKeepsTheVerticesOfFewer) {
+TEST(BuilderTest, SplitForMoreSamplesKeepsTheVerticesOfFewer) {
   const mesh::Mesh coarse = gen::Cube(2, 2.0);  // long edges: every m refines it
   int32_t last_vertices = coarse.num_vertices();
   absl::StatusOr<PreparedMesh> fewer = PrepareMesh(coarse, {}, 40, true);

@@ -66,8 +66,8 @@ absl::Status RemoveRows(const std::string& workdir);
 
 // A target-error build's work directory also holds, between its rounds:
 //
-//   coarse.ply, coarse-repair.bin   the repaired input before the flat
-//                                   refinement, refined again for each round
+//   coarse.ply, coarse-repair.bin   the repaired input before the
+//                                   long-edge split, split again for each round
 //   carried.bin                     the rows the current plan carries from
 //                                   the round before (ComputeRows' carried)
 //   target.bin                      the target and the figures of the rounds

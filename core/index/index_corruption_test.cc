@@ -338,22 +338,22 @@ TEST(IndexTest, RefinementCorruptionWithValidChecksumsIsDataLoss) {
   auto weight = [](int32_t face, int corner, int k) { return 10 * face + 1 + 3 * corner + k; };
   const std::vector<Case> cases = {
       {"piece of a coarse face out of range",
-       [&](Image& i) { i.Set<int32_t>(SectionId::kSplitFaces, 10 * 3, 80); }, "refined face 3"},
+       [&](Image& i) { i.Set<int32_t>(SectionId::kSplitFaces, 10 * 3, 80); }, "piece 3"},
       {"NaN weight",
        [&](Image& i) {
          i.Set<float>(SectionId::kSplitFaces, weight(4, 1, 1),
                       std::numeric_limits<float>::quiet_NaN());
        },
-       "refined face 4"},
+       "piece 4"},
       {"weights not summing to 1",
        [&](Image& i) { i.Set<float>(SectionId::kSplitFaces, weight(5, 2, 0), 0.5f); },
-       "refined face 5"},
+       "piece 5"},
       {"negative weight",
        [&](Image& i) {
          i.Set<float>(SectionId::kSplitFaces, weight(6, 0, 0), 1.5f);
          i.Set<float>(SectionId::kSplitFaces, weight(6, 0, 1), -0.5f);
        },
-       "refined face 6"},
+       "piece 6"},
       {"coarse face without a piece",
        [&](Image& i) { i.Set<int32_t>(SectionId::kSplitFaces, 0, 1); }, "coarse face 0 has no"},
       {"coarse face on a midpoint",

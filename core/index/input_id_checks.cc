@@ -33,24 +33,24 @@ absl::Status CheckInputIds(const InputIdSections& c, absl::StatusCode code) {
                                   c.vertex_copies[i], num_input_vertices));
     }
   }
-  // A refined index: every face is a piece of one coarse face, given by
-  // weights in it, and every coarse face has a piece.
-  const bool refined = !c.split_faces.empty();
-  if (refined != !c.coarse_faces.empty() || (c.split_vertices > 0 && !refined) ||
-      (refined && static_cast<int64_t>(c.split_faces.size()) != nf) ||
+  // An index of a split mesh: every face is a piece of one coarse face,
+  // given by weights in it, and every coarse face has a piece.
+  const bool split = !c.split_faces.empty();
+  if (split != !c.coarse_faces.empty() || (c.split_vertices > 0 && !split) ||
+      (split && static_cast<int64_t>(c.split_faces.size()) != nf) ||
       c.coarse_faces.size() % 3 != 0) {
     return fail(absl::StrFormat(
-        "refinement: %d refined face records for %d faces, %d coarse face ids, %d midpoints",
+        "split: %d piece records for %d faces, %d coarse face ids, %d midpoints",
         c.split_faces.size(), nf, c.coarse_faces.size(), c.split_vertices));
   }
-  const int64_t num_coarse_faces = refined ? static_cast<int64_t>(c.coarse_faces.size() / 3) : nf;
+  const int64_t num_coarse_faces = split ? static_cast<int64_t>(c.coarse_faces.size() / 3) : nf;
   for (size_t i = 0; i < c.coarse_faces.size(); ++i) {
     if (!InRange(c.coarse_faces[i], 0, num_coarse_vertices)) {
       return fail(absl::StrFormat("coarse face %d: vertex id %d out of range [0, %d)", i / 3,
                                   c.coarse_faces[i], num_coarse_vertices));
     }
   }
-  if (refined) {
+  if (split) {
     std::vector<uint8_t> has_piece(num_coarse_faces, 0);
     for (size_t f = 0; f < c.split_faces.size(); ++f) {
       const SplitFaceRecord& r = c.split_faces[f];
@@ -62,7 +62,7 @@ absl::Status CheckInputIds(const InputIdSections& c, absl::StatusCode code) {
       }
       if (!ok) {
         return fail(
-            absl::StrFormat("refined face %d: coarse face %d (of %d) or corner weights invalid", f,
+            absl::StrFormat("piece %d: coarse face %d (of %d) or corner weights invalid", f,
                             r.coarse_face, num_coarse_faces));
       }
       has_piece[r.coarse_face] = 1;

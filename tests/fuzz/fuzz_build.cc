@@ -82,7 +82,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   if (!repaired.ok()) return 0;  // fuzz_repair checks the repair's refusals
   const absl::StatusOr<builder::PreparedMesh> prepared = builder::PrepareMesh(
       repaired->mesh, builder::RecordRepair(*repaired), samples, /*refine=*/true);
-  if (!prepared.ok()) Fail("refinement failed: " + prepared.status().ToString());
+  if (!prepared.ok()) Fail("the long-edge split failed: " + prepared.status().ToString());
   builder::BuildOptions options;
   options.num_samples = samples;
   options.threads = 1;
