@@ -75,7 +75,11 @@ free_port() {
 }
 PORT="$(free_port)"
 ADDR="127.0.0.1:$PORT"
-"$SERVER_BIN" --models "$REPO" --listen "$ADDR" --poll-seconds 0.2 --max-pairs 1000 \
+# One malloc arena: glibc opens another arena whenever a thread finds its own
+# locked, up to 8 per core, and each new one shows as a step in RssAnon that
+# then stays flat. Those steps reached +7% in 20 s of a server that leaked
+# nothing, +1.3-3.6% with one arena. A leak grows with every call either way.
+MALLOC_ARENA_MAX=1 "$SERVER_BIN" --models "$REPO" --listen "$ADDR" --poll-seconds 0.2 --max-pairs 1000 \
   --log-level warn > "$WORK/server.log" 2>&1 &
 SERVER_PID=$!
 for _ in $(seq 100); do
