@@ -204,11 +204,17 @@ absl::StatusOr<RoundResult> FinishRound(const RoundPlan& round, std::vector<Samp
   validation::CalibrationOptions calibration_options;
   calibration_options.pairs.threads = options.build.threads;
   calibration_options.pairs.num_sources = options.validation_sources;
+  const int32_t m = round.plan.num_samples();
+  auto settled = [&](const validation::Calibration& c) {
+    return validation::TargetSettled(validation::FiguresOf(c, m), options.target);
+  };
   validation::Calibration calibration;
-  GEODEX_RETURN_IF_ERROR(validation::AddCalibration(round.prepared.mesh, result.data,
-                                                    calibration_options, &calibration));
+  GEODEX_RETURN_IF_ERROR(validation::AddCalibrationUntil(
+      round.prepared.mesh, result.data, calibration_options,
+      std::max(options.validation_sources, options.max_validation_sources), settled,
+      &calibration));
   result.validation_seconds = SecondsSince(start);
-  result.figures = validation::FiguresOf(calibration, round.plan.num_samples());
+  result.figures = validation::FiguresOf(calibration, m);
   return result;
 }
 

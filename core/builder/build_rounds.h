@@ -71,10 +71,13 @@ struct RoundsOptions {
   // long-edge split at most half the referenced vertices.
   int32_t max_samples = 0;
   // Held-out sources of each round's validation (and of the index's
-  // calibration). A source's pairs err together and sources differ a lot,
-  // so the figures vary with the draw: twice the calibration's default 64
-  // halves their variance.
-  int32_t validation_sources = 128;
+  // calibration): a sequential measurement (validation::TargetSettled)
+  // starts with validation_sources and doubles them, up to
+  // max_validation_sources, while the round's figures are too close to the
+  // target's limits to decide it. A source's pairs err together and sources
+  // differ a lot, so the figures vary with the draw.
+  int32_t validation_sources = 64;
+  int32_t max_validation_sources = 512;
 };
 
 // "32 MiB", or "1.50 MiB" for a budget that is no whole number of MiB.

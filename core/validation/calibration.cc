@@ -232,16 +232,22 @@ double P99UpperLimit(std::vector<double> x) {
   return x.empty() ? 0 : UpperQuantile(std::move(x), 0.99);
 }
 
-absl::StatusOr<Calibration> Calibrate(const mesh::Mesh& mesh,
-                                      std::shared_ptr<const index::Index> index,
-                                      const CalibrationOptions& options) {
-  if (index->num_vertices() != mesh.num_vertices() || index->num_faces() != mesh.num_faces()) {
+namespace {
+
+absl::Status CheckBuiltFrom(const mesh::Mesh& mesh, const index::Index& index) {
+  if (index.num_vertices() != mesh.num_vertices() || index.num_faces() != mesh.num_faces()) {
     return absl::FailedPreconditionError("the index was not built from this mesh");
   }
+  return absl::OkStatus();
+}
+
+// Calibrate on `pairs` (HeldOutPairs of options.pairs' sources).
+absl::StatusOr<Calibration> CalibrateOn(const mesh::Mesh& mesh,
+                                        std::shared_ptr<const index::Index> index,
+                                        const std::vector<ExactPair>& pairs,
+                                        const CalibrationOptions& options) {
   GEODEX_ASSIGN_OR_RETURN(auto engine, query::QueryEngine::Create(index));
   const double scale = engine->scale_length();
-  GEODEX_ASSIGN_OR_RETURN(const std::vector<ExactPair> pairs,
-                          HeldOutPairs(mesh, *index, options.pairs));
   std::vector<double> unfold[2][index::kAccuracyBins], trace[4][index::kAccuracyBins];
   std::vector<SpreadSample> spread[2][index::kAccuracyBins];
   std::vector<double> relative[kNumScaleBins], uniform, uniform_far;
@@ -359,17 +365,48 @@ absl::StatusOr<Calibration> Calibrate(const mesh::Mesh& mesh,
   return result;
 }
 
+}  // namespace
+
+absl::StatusOr<Calibration> Calibrate(const mesh::Mesh& mesh,
+                                      std::shared_ptr<const index::Index> index,
+                                      const CalibrationOptions& options) {
+  GEODEX_RETURN_IF_ERROR(CheckBuiltFrom(mesh, *index));
+  GEODEX_ASSIGN_OR_RETURN(const std::vector<ExactPair> pairs,
+                          HeldOutPairs(mesh, *index, options.pairs));
+  return CalibrateOn(mesh, std::move(index), pairs, options);
+}
+
 absl::Status AddCalibration(const mesh::Mesh& mesh, index::IndexData& data,
                             const CalibrationOptions& options, Calibration* out) {
+  return AddCalibrationUntil(mesh, data, options, options.pairs.num_sources, nullptr, out);
+}
+
+absl::Status AddCalibrationUntil(const mesh::Mesh& mesh, index::IndexData& data,
+                                 const CalibrationOptions& options, int32_t max_sources,
+                                 const std::function<bool(const Calibration&)>& settled,
+                                 Calibration* out) {
   data.accuracy.clear();
   data.spread_bounds.clear();
   GEODEX_ASSIGN_OR_RETURN(std::string bytes, index::SerializeIndex(data));
-  GEODEX_ASSIGN_OR_RETURN(auto index, index::Index::FromBytes(std::move(bytes)));
-  GEODEX_ASSIGN_OR_RETURN(const Calibration calibration,
-                          Calibrate(mesh, std::move(index), options));
+  GEODEX_ASSIGN_OR_RETURN(std::shared_ptr<const index::Index> index,
+                          index::Index::FromBytes(std::move(bytes)));
+  GEODEX_RETURN_IF_ERROR(CheckBuiltFrom(mesh, *index));
+  CalibrationOptions drawn = options;
+  GEODEX_ASSIGN_OR_RETURN(std::vector<ExactPair> pairs, HeldOutPairs(mesh, *index, drawn.pairs));
+  GEODEX_ASSIGN_OR_RETURN(Calibration calibration, CalibrateOn(mesh, index, pairs, drawn));
+  while (settled != nullptr && drawn.pairs.num_sources < max_sources && !settled(calibration)) {
+    // The sources drawn so far keep their pairs; only the new ones propagate.
+    PairOptions more = drawn.pairs;
+    more.first_source = drawn.pairs.first_source + drawn.pairs.num_sources;
+    more.num_sources = std::min(drawn.pairs.num_sources, max_sources - drawn.pairs.num_sources);
+    GEODEX_ASSIGN_OR_RETURN(std::vector<ExactPair> added, HeldOutPairs(mesh, *index, more));
+    pairs.insert(pairs.end(), added.begin(), added.end());
+    drawn.pairs.num_sources += more.num_sources;
+    GEODEX_ASSIGN_OR_RETURN(calibration, CalibrateOn(mesh, index, pairs, drawn));
+  }
   data.accuracy = {calibration.record};
   data.spread_bounds = {calibration.spread};
-  if (out != nullptr) *out = calibration;
+  if (out != nullptr) *out = std::move(calibration);
   return absl::OkStatus();
 }
 

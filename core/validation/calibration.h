@@ -14,6 +14,7 @@
 // Thread safety: reentrant.
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <vector>
 
@@ -109,6 +110,18 @@ absl::StatusOr<Calibration> Calibrate(const mesh::Mesh& mesh,
 absl::Status AddCalibration(const mesh::Mesh& mesh, index::IndexData& data,
                             const CalibrationOptions& options = {},
                             Calibration* calibration = nullptr);
+
+// AddCalibration as a sequential measurement: options.pairs.num_sources
+// held-out sources first, then as many again (the ones drawn keep their
+// pairs; every answer is measured again on all of them) until `settled`
+// says the calibration so far decides what it is measured for, or
+// `max_sources` are drawn. Sources, not pairs, are the independent draws
+// (UniformConfidence), so each doubling narrows the confidence limits by
+// about 1/sqrt(2). `calibration` gets the last measurement.
+absl::Status AddCalibrationUntil(const mesh::Mesh& mesh, index::IndexData& data,
+                                 const CalibrationOptions& options, int32_t max_sources,
+                                 const std::function<bool(const Calibration&)>& settled,
+                                 Calibration* calibration = nullptr);
 
 // The held-out pairs Calibrate measures `index` (built from `mesh`) on, in
 // the index's internal ids: DrawPairs with `options`, vertex pairs among

@@ -47,6 +47,42 @@ TEST(CalibrationTest, BoundsAreSaneAndDeterministic) {
   EXPECT_EQ(std::memcmp(&again.accuracy[0], &r, sizeof(r)), 0);
 }
 
+// A sequential calibration draws more sources while it is not settled, and
+// the sources it adds are the ones a calibration of that many sources draws
+// at once: the same record to the bit.
+TEST(CalibrationTest, SequentialCalibrationAddsTheSourcesOfALargerOne) {
+  const mesh::Mesh m = mesh::gen::Sphere(3, 1.0);
+  CalibrationOptions options;
+  options.pairs.num_sources = 24;
+  options.pairs.threads = 2;
+  index::IndexData at_once = IndexDataOf(m);
+  ASSERT_TRUE(AddCalibration(m, at_once, options).ok());
+
+  options.pairs.num_sources = 6;
+  std::vector<int32_t> seen;
+  index::IndexData grown = IndexDataOf(m);
+  ASSERT_TRUE(AddCalibrationUntil(m, grown, options, 24,
+                                  [&](const Calibration& c) {
+                                    seen.push_back(static_cast<int32_t>(c.record.num_sources));
+                                    return false;
+                                  })
+                  .ok());
+  EXPECT_EQ(seen, (std::vector<int32_t>{6, 12}));  // 24 is the most: not asked again
+  ASSERT_EQ(grown.accuracy.size(), 1u);
+  EXPECT_EQ(grown.accuracy[0].num_sources, 24u);
+  EXPECT_EQ(std::memcmp(&grown.accuracy[0], &at_once.accuracy[0], sizeof(index::AccuracyRecord)),
+            0);
+  EXPECT_EQ(std::memcmp(&grown.spread_bounds[0], &at_once.spread_bounds[0],
+                        sizeof(index::SpreadBoundRecord)),
+            0);
+
+  // Settled at once: the first sources only.
+  index::IndexData first = IndexDataOf(m);
+  ASSERT_TRUE(
+      AddCalibrationUntil(m, first, options, 24, [](const Calibration&) { return true; }).ok());
+  EXPECT_EQ(first.accuracy[0].num_sources, 6u);
+}
+
 TEST(CalibrationTest, BoundsCoverHeldOutPairsOfAnotherSeed) {
   const mesh::Mesh m = mesh::gen::Sphere(4, 1.0);
   index::IndexData data = IndexDataOf(m);

@@ -215,7 +215,7 @@ std::vector<ExactPair> DrawPairs(const mesh::Mesh& mesh, int32_t num_samples,
     // evaluated as the windows pass their faces.
     geodesic::VertexGeodesicSolver solver(mesh);
     for (int32_t s; (s = next.fetch_add(1)) < options.num_sources;) {
-      by_source[s] = PairsOfSource(c, solver, s);
+      by_source[s] = PairsOfSource(c, solver, options.first_source + s);
     }
   };
   const int threads = std::clamp(common::ThreadCount(options.threads), 1, options.num_sources);

@@ -69,6 +69,10 @@ struct PairOptions {
   // vertex pairs stand for the file's vertices, the mesh's corners, where
   // the O(1) answer errs most.
   int32_t vertex_limit = 0;
+  // The number of the first source: sources first_source ..
+  // first_source + num_sources - 1 are drawn, each the same pairs whatever
+  // the range, so a measurement can draw more sources later and add them.
+  int32_t first_source = 0;
 };
 
 // Draws pairs for an index of `num_samples` samples (which fixes L) on a

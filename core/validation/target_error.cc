@@ -64,6 +64,18 @@ double Distance(const TargetFigures& f, double target) {
   return f.upper[worst] / TargetLimit(worst, target);
 }
 
+bool TargetSettled(const TargetFigures& f, double target) {
+  bool clear_of_every_limit = true;
+  for (int c = 0; c < kNumTargetChecks; ++c) {
+    if (f.pairs[c] == 0) continue;
+    const double limit = TargetLimit(c, target);
+    // The lower limit mirrors the upper one about the measured figure.
+    if (2 * f.measured[c] - f.upper[c] > limit) return true;
+    if (!(f.upper[c] <= kSettledShare * limit)) clear_of_every_limit = false;
+  }
+  return clear_of_every_limit;
+}
+
 std::string BandsLine(const TargetFigures& f) {
   std::string out = "p99 by L1000 band, vertex / interior:";
   for (int b = 0; b < kNumFixedBins; ++b) {

@@ -83,6 +83,17 @@ int WorstCheck(const TargetFigures& figures, double target);
 // That largest upper / limit: how far a round is from the target (<= 1:
 // met). A round is closer than another when this is smaller.
 double Distance(const TargetFigures& figures, double target);
+// Whether a round's figures settle it, the stopping rule of its sequential
+// validation (calibration.h, AddCalibrationUntil): settled when some check
+// misses its limit beyond doubt (its lower confidence limit, the upper one
+// mirrored about the measured figure, is over the limit), or when every
+// check's upper limit is at most kSettledShare of its limit. Between the two
+// the round draws more held-out sources: an index that only just meets its
+// target on some sources misses it on others about as often, and a round
+// that only just misses it may meet it once the limits narrow, which costs
+// far less than another round.
+inline constexpr double kSettledShare = 0.9;
+bool TargetSettled(const TargetFigures& figures, double target);
 // One line: m, then each check's measured (upper) / limit, unmet ones marked.
 std::string FiguresText(const TargetFigures& figures, double target);
 // One line: the band p99s by fixed bin, vertex / interior.

@@ -53,6 +53,29 @@ TEST(TargetErrorTest, EveryJudgedCheckMustBeMetByItsUpperLimit) {
   EXPECT_TRUE(TargetMet(f, kE));
 }
 
+// The sequential validation's stopping rule: a round far under every limit
+// or beyond doubt over one is settled; one whose upper limits come within
+// kSettledShare of a limit, met or not, draws more sources.
+TEST(TargetErrorTest, SettledFarFromTheLimitsAndUndecidedNearThem) {
+  EXPECT_TRUE(TargetSettled(AtShare(1000, 0.5), kE));
+  EXPECT_TRUE(TargetSettled(AtShare(1000, kSettledShare), kE));
+  EXPECT_FALSE(TargetSettled(AtShare(1000, 0.95), kE));  // met, but only just
+  EXPECT_TRUE(TargetMet(AtShare(1000, 0.95), kE));
+  EXPECT_FALSE(TargetSettled(AtShare(1000, 1.05), kE));  // missed, but not beyond doubt
+  // Measured over the limit with a lower limit (2 measured - upper) over it too.
+  TargetFigures f = AtShare(1000, 0.5);
+  const int c = FarCheck(BinConfidence::kVertex);
+  f.measured[c] = 1.2 * TargetLimit(c, kE);
+  f.upper[c] = 1.3 * TargetLimit(c, kE);
+  EXPECT_TRUE(TargetSettled(f, kE));
+  // Measured over it, but within the margin of noise: not settled.
+  f.upper[c] = 1.5 * TargetLimit(c, kE);
+  EXPECT_FALSE(TargetSettled(f, kE));
+  // A check without pairs is not judged.
+  f.pairs[c] = 0;
+  EXPECT_TRUE(TargetSettled(f, kE));
+}
+
 TEST(TargetErrorTest, BandsAreReportedNotJudged) {
   TargetFigures f = AtShare(1000, 0.5);
   f.unit = 0.01;
