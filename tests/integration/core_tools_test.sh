@@ -39,10 +39,10 @@ within() {
 }
 
 # geodex-build: one process, and the sharded pipeline.
-"$tools/geodex-build" builtin:sphere -o "$work/one.gdx" --samples 40 --threads 2 >"$work/build.out" 2>&1
+"$tools/geodex-build" builtin:sphere -o "$work/one.gdx" --samples 100 --threads 2 >"$work/build.out" 2>&1
 exits 0 "geodex-build"
-check "build prints its report" sh -c "grep -q '^  samples       m = [0-9]*: 40 requested' '$work/build.out' && grep -q '^  time  ' '$work/build.out'"
-"$tools/geodex-build" plan builtin:sphere --samples 40 -o "$work/wd" >/dev/null 2>&1
+check "build prints its report" sh -c "grep -q '^  samples       m = [0-9]*: 100 requested' '$work/build.out' && grep -q '^  time  ' '$work/build.out'"
+"$tools/geodex-build" plan builtin:sphere --samples 100 -o "$work/wd" >/dev/null 2>&1
 exits 0 "geodex-build plan"
 for i in 0 1 2; do
   "$tools/geodex-build" rows "$work/wd" --shard "$i/3" --threads 1 >/dev/null 2>&1
@@ -98,11 +98,11 @@ for b in r["accuracy"]["bins"]:
     assert cells[:3] == [pct(b["rms"]), pct(b["p99"]), pct(b["p99_limit"])], (b, cells)
 assert "m = %d:" % r["samples"]["final"] in text
 ' "$work/info.json" "$work/info.txt"
-"$tools/geodex-build" builtin:sphere -o "$work/charted.gdx" --samples 40 --threads 2 \
+"$tools/geodex-build" builtin:sphere -o "$work/charted.gdx" --samples 100 --threads 2 \
   --report-png "$work/chart.png" >/dev/null 2>&1
 exits 0 "geodex-build --report-png"
 check "--report-png writes a PNG" sh -c "head -c 8 '$work/chart.png' | od -An -c | grep -q 'P   N   G'"
-"$tools/geodex-build" builtin:sphere -o "$work/plain.gdx" --samples 40 --threads 2 --no-calibration >/dev/null 2>&1
+"$tools/geodex-build" builtin:sphere -o "$work/plain.gdx" --samples 100 --threads 2 --no-calibration >/dev/null 2>&1
 exits 0 "geodex-build --no-calibration"
 "$tools/geodex-query" "$work/plain.gdx" --pairs "$work/pairs.txt" --error-bounds >/dev/null 2>"$work/err"
 exits 1 "bounds without calibration"
