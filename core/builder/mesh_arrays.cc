@@ -1,6 +1,7 @@
 #include "core/builder/mesh_arrays.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 
@@ -49,31 +50,39 @@ void AddRepair(const RepairRecord& record, index::IndexData* data) {
   data->report = record.report + data->report;
 }
 
-absl::StatusOr<std::optional<CoarseSurface>> CoarseSurfaceOf(
-    const mesh::Mesh& split, std::span<const int32_t> coarse_faces,
-    std::span<const index::SplitFaceRecord> split_faces, int32_t split_vertices) {
-  if (split_vertices == 0 && split_faces.empty()) return std::nullopt;
+absl::StatusOr<std::optional<CoarseSurface>> CoarseSurfaceOf(const mesh::Mesh& split,
+                                                             const RepairRecord& record) {
+  GEODEX_ASSIGN_OR_RETURN(
+      const index::SplitView view,
+      index::SplitView::Dense(record.coarse_faces, record.split_faces, split.num_faces(),
+                              absl::StatusCode::kInvalidArgument));
+  return CoarseSurfaceOf(split, view, record.split_vertices);
+}
+
+absl::StatusOr<std::optional<CoarseSurface>> CoarseSurfaceOf(const mesh::Mesh& split,
+                                                             const index::SplitView& view,
+                                                             int32_t split_vertices) {
+  if (split_vertices == 0 && !view.split()) return std::nullopt;
   const int32_t coarse_vertices = split.num_vertices() - split_vertices;
-  if (split_vertices <= 0 || coarse_vertices <= 0 || coarse_faces.size() % 3 != 0 ||
-      static_cast<int64_t>(split_faces.size()) != split.num_faces()) {
+  if (split_vertices <= 0 || coarse_vertices <= 0 || !view.split()) {
     return absl::InvalidArgumentError(absl::StrFormat(
-        "the split sections (%d faces, %d pieces, %d added vertices) are not of a mesh of %d "
-        "vertices and %d faces",
-        coarse_faces.size() / 3, split_faces.size(), split_vertices, split.num_vertices(),
-        split.num_faces()));
+        "the split (%d coarse faces, %d added vertices) is not of a mesh of %d vertices and %d "
+        "faces",
+        view.num_coarse_faces(), split_vertices, split.num_vertices(), split.num_faces()));
   }
-  for (int32_t v : coarse_faces) {
-    if (v < 0 || v >= coarse_vertices) {
-      return absl::InvalidArgumentError(
-          absl::StrFormat("a coarse face names vertex %d of %d", v, coarse_vertices));
-    }
-  }
-  const int32_t num_coarse_faces = static_cast<int32_t>(coarse_faces.size() / 3);
+  const int32_t num_coarse_faces = view.num_coarse_faces();
   std::vector<mesh::Vec3> positions(split.positions().begin(),
                                     split.positions().begin() + coarse_vertices);
   std::vector<mesh::Triangle> faces(num_coarse_faces);
   for (int32_t f = 0; f < num_coarse_faces; ++f) {
-    faces[f] = {coarse_faces[3 * f], coarse_faces[3 * f + 1], coarse_faces[3 * f + 2]};
+    const std::array<int32_t, 3> corners = view.CoarseFace(f);
+    for (int32_t v : corners) {
+      if (v < 0 || v >= coarse_vertices) {
+        return absl::InvalidArgumentError(
+            absl::StrFormat("a coarse face names vertex %d of %d", v, coarse_vertices));
+      }
+    }
+    faces[f] = {corners[0], corners[1], corners[2]};
   }
   // The repaired input may keep faces of zero area.
   GEODEX_ASSIGN_OR_RETURN(
@@ -82,7 +91,7 @@ absl::StatusOr<std::optional<CoarseSurface>> CoarseSurfaceOf(
                          mesh::MeshOptions{.allow_zero_area_faces = true}));
   std::vector<mesh::SurfacePoint> points(split.num_vertices());
   for (int32_t f = 0; f < split.num_faces(); ++f) {
-    const index::SplitFaceRecord& r = split_faces[f];
+    const index::SplitFaceRecord r = view.Piece(f);
     if (r.coarse_face < 0 || r.coarse_face >= num_coarse_faces) {
       return absl::InvalidArgumentError(
           absl::StrFormat("piece %d lies in coarse face %d of %d", f, r.coarse_face,

@@ -81,17 +81,15 @@ struct CoarseSurface {
   // an unreferenced vertex).
   std::vector<mesh::SurfacePoint> points;
 };
-// The coarse surface of `split`, a mesh split by the sections `coarse_faces`
-// and `split_faces` (RepairRecord's, or an index's) after `split_vertices`
-// added vertices; nullopt when nothing was split. Errors: InvalidArgument
-// when the sections are not of `split`.
-absl::StatusOr<std::optional<CoarseSurface>> CoarseSurfaceOf(
-    const mesh::Mesh& split, std::span<const int32_t> coarse_faces,
-    std::span<const index::SplitFaceRecord> split_faces, int32_t split_vertices);
-inline absl::StatusOr<std::optional<CoarseSurface>> CoarseSurfaceOf(const mesh::Mesh& split,
-                                                                    const RepairRecord& record) {
-  return CoarseSurfaceOf(split, record.coarse_faces, record.split_faces, record.split_vertices);
-}
+// The coarse surface of `split`, a mesh split as `view` says (a
+// RepairRecord's, or an index's) after `split_vertices` added vertices;
+// nullopt when nothing was split. Errors: InvalidArgument when the split is
+// not of `split`.
+absl::StatusOr<std::optional<CoarseSurface>> CoarseSurfaceOf(const mesh::Mesh& split,
+                                                             const index::SplitView& view,
+                                                             int32_t split_vertices);
+absl::StatusOr<std::optional<CoarseSurface>> CoarseSurfaceOf(const mesh::Mesh& split,
+                                                             const RepairRecord& record);
 
 // The input file's id of each vertex of `prepared.mesh`: its own below the
 // repair's copies, the vertex a copy stands for, mesh::kNone for a midpoint

@@ -116,10 +116,11 @@ absl::StatusOr<FileHeader> ValidateHeader(const uint8_t* p, size_t n) {
         absl::StrFormat("bad byte order mark 0x%08x", h.byte_order_mark));
   }
   if (h.format_major != kFormatMajor && h.format_major != kSplitFormatMajor &&
-      h.format_major != kPackedFormatMajor && h.format_major != kCodedFormatMajor) {
+      h.format_major != kPackedFormatMajor && h.format_major != kCodedFormatMajor &&
+      h.format_major != kSparseSplitFormatMajor) {
     return absl::FailedPreconditionError(absl::StrFormat(
         "index format version %d.%d is not supported by this reader (version %d.%d)",
-        h.format_major, h.format_minor, kCodedFormatMajor, kCodedFormatMinor));
+        h.format_major, h.format_minor, kSparseSplitFormatMajor, kSparseSplitFormatMinor));
   }
   if (h.header_size < kHeaderSize || h.header_size % 8 != 0) {
     return absl::DataLossError(absl::StrFormat("bad header size %d", h.header_size));
@@ -356,13 +357,30 @@ absl::Status Index::Validate() {
   accuracy_ = SectionView<AccuracyRecord>(p, entry(SectionId::kAccuracy));
   input_faces_ = SectionView<InputFaceRecord>(p, entry(SectionId::kInputFaces));
   vertex_copies_ = SectionView<int32_t>(p, entry(SectionId::kVertexCopies));
-  coarse_faces_ = SectionView<int32_t>(p, entry(SectionId::kCoarseFaces));
-  split_faces_ = SectionView<SplitFaceRecord>(p, entry(SectionId::kSplitFaces));
+  const std::span<const int32_t> coarse_faces =
+      SectionView<int32_t>(p, entry(SectionId::kCoarseFaces));
+  const std::span<const SplitFaceRecord> split_faces =
+      SectionView<SplitFaceRecord>(p, entry(SectionId::kSplitFaces));
+  const std::span<const SplitCoarseRecord> split_coarse =
+      SectionView<SplitCoarseRecord>(p, entry(SectionId::kSplitCoarseFaces));
+  const std::span<const SplitPieceRecord> split_pieces =
+      SectionView<SplitPieceRecord>(p, entry(SectionId::kSplitPieces));
   spread_bounds_ = SectionView<SpreadBoundRecord>(p, entry(SectionId::kSpreadBounds));
-  if (h.format_major < kSplitFormatMajor &&
-      (!split_faces_.empty() || !coarse_faces_.empty() || h.params.split_vertices != 0)) {
-    return absl::DataLossError(absl::StrFormat("a format %d.%d index with split sections",
-                                               h.format_major, h.format_minor));
+  const bool dense_split = !split_faces.empty() || !coarse_faces.empty();
+  const bool sparse_split = !split_coarse.empty() || !split_pieces.empty();
+  if ((h.format_major < kSplitFormatMajor && (dense_split || h.params.split_vertices != 0)) ||
+      (h.format_major < kSparseSplitFormatMajor && sparse_split) ||
+      (h.format_major >= kSparseSplitFormatMajor && dense_split)) {
+    return absl::DataLossError(absl::StrFormat("a format %d.%d index with %s split sections",
+                                               h.format_major, h.format_minor,
+                                               sparse_split ? "sparse" : "dense"));
+  }
+  if (sparse_split) {
+    GEODEX_ASSIGN_OR_RETURN(
+        split_, SplitView::Sparse(faces_, split_coarse, split_pieces, absl::StatusCode::kDataLoss));
+  } else {
+    GEODEX_ASSIGN_OR_RETURN(split_, SplitView::Dense(coarse_faces, split_faces, faces_.size() / 3,
+                                                     absl::StatusCode::kDataLoss));
   }
   GEODEX_RETURN_IF_ERROR(CheckAccuracy(accuracy_, absl::StatusCode::kDataLoss));
   GEODEX_RETURN_IF_ERROR(
@@ -374,7 +392,7 @@ absl::Status Index::Validate() {
   GEODEX_RETURN_IF_ERROR(CheckContents(
       Contents{counts, positions_, faces_, twins_, samples_, sample_distances_,
                sample_distances_lower_, distance_code, vertices_, triangles_, bvh_nodes_,
-               bvh_faces_, input_faces_, vertex_copies_, coarse_faces_, split_faces_,
+               bvh_faces_, input_faces_, vertex_copies_, split_,
                h.params.split_vertices},
       absl::StatusCode::kDataLoss));
   const int32_t m = num_samples();
@@ -421,8 +439,14 @@ IndexData ToIndexData(const Index& index) {
   if (index.spread_bounds() != nullptr) d.spread_bounds = {*index.spread_bounds()};
   d.input_faces = copy(index.input_faces());
   d.vertex_copies = copy(index.vertex_copies());
-  d.coarse_faces = copy(index.coarse_faces());
-  d.split_faces = copy(index.split_faces());
+  // IndexData holds the split dense, whichever layout the file has.
+  const SplitView& split = index.split();
+  for (int32_t c = 0; c < split.num_coarse_faces(); ++c) {
+    for (int32_t v : split.CoarseFace(c)) d.coarse_faces.push_back(v);
+  }
+  for (int32_t f = 0; split.split() && f < index.num_faces(); ++f) {
+    d.split_faces.push_back(split.Piece(f));
+  }
   return d;
 }
 

@@ -22,6 +22,7 @@
 #include "absl/status/statusor.h"
 #include "core/index/index_format.h"
 #include "core/index/sample_matrix.h"
+#include "core/index/split_view.h"
 
 namespace geodex::index {
 
@@ -150,9 +151,9 @@ class Index {
   // of a mesh that needed no repair, or one older than 1.2.
   std::span<const InputFaceRecord> input_faces() const { return input_faces_; }
   std::span<const int32_t> vertex_copies() const { return vertex_copies_; }
-  // The long-edge split (format 2.0); empty for an index of a mesh not split.
-  std::span<const int32_t> coarse_faces() const { return coarse_faces_; }
-  std::span<const SplitFaceRecord> split_faces() const { return split_faces_; }
+  // The long-edge split (format 2.0, sparse from 5.0); split() is false for
+  // an index of a mesh not split.
+  const SplitView& split() const { return split_; }
   int32_t split_vertices() const { return static_cast<int32_t>(header_->params.split_vertices); }
 
   // d(sample i, sample j) from the matrix, in any layout; i and j in
@@ -192,8 +193,7 @@ class Index {
   std::span<const SpreadBoundRecord> spread_bounds_;
   std::span<const InputFaceRecord> input_faces_;
   std::span<const int32_t> vertex_copies_;
-  std::span<const int32_t> coarse_faces_;
-  std::span<const SplitFaceRecord> split_faces_;
+  SplitView split_;
 };
 
 }  // namespace geodex::index

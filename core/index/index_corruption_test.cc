@@ -78,13 +78,13 @@ TEST(IndexTest, WrongMagicIsFailedPrecondition) {
 
 TEST(IndexTest, WrongMajorVersionIsFailedPrecondition) {
   Image image = Image::Parse(Serialize(MakeSphereIndex()));
-  image.header.format_major = kCodedFormatMajor + 1;
+  image.header.format_major = kSparseSplitFormatMajor + 1;
   image.header.format_minor = 3;
   const absl::Status status = Index::FromBytes(image.Layout()).status();
   EXPECT_EQ(status.code(), absl::StatusCode::kFailedPrecondition);
-  EXPECT_THAT(status.message(), HasSubstr(absl::StrCat(kCodedFormatMajor + 1, ".3")));
+  EXPECT_THAT(status.message(), HasSubstr(absl::StrCat(kSparseSplitFormatMajor + 1, ".3")));
   EXPECT_THAT(status.message(),
-              HasSubstr(absl::StrCat(kCodedFormatMajor, ".", kCodedFormatMinor)));
+              HasSubstr(absl::StrCat(kSparseSplitFormatMajor, ".", kSparseSplitFormatMinor)));
 }
 
 // A 4.x file has the coded triangle and its scale, a 3.x file the float
@@ -320,8 +320,8 @@ TEST(IndexTest, RefinedIndexIsWrittenAsVersion2AndReadBack) {
   ASSERT_TRUE(index.ok()) << index.status();
   EXPECT_EQ((*index)->header().format_major, kSplitFormatMajor);
   EXPECT_EQ((*index)->split_vertices(), 1);
-  EXPECT_EQ((*index)->split_faces().size(), 80u);
-  EXPECT_EQ((*index)->coarse_faces().size(), 240u);
+  EXPECT_TRUE((*index)->split().split());
+  EXPECT_EQ((*index)->split().num_coarse_faces(), 80);
   // Written again, the same bytes.
   EXPECT_EQ(Serialize(ToIndexData(**index)), Serialize(MakeRefinedSphereIndex()));
   // Without refinement, still the 1.x layout older readers take.
@@ -329,6 +329,73 @@ TEST(IndexTest, RefinedIndexIsWrittenAsVersion2AndReadBack) {
       Index::FromBytes(Serialize(MakeSphereIndex()));
   ASSERT_TRUE(plain.ok());
   EXPECT_EQ((*plain)->header().format_major, kFormatMajor);
+}
+
+// The sphere index as if its last face were a piece split off coarse face 0
+// (79 coarse faces, the first of them with another corner), with the coded
+// matrix: written sparse, as 5.0.
+IndexData MakeSparseSplitSphereIndex() {
+  IndexData d = MakeSphereIndex();
+  d.sample_matrix = MatrixLayout::kCoded;
+  const int32_t nf = static_cast<int32_t>(d.faces.size() / 3);
+  d.coarse_faces.assign(d.faces.begin(), d.faces.end() - 3);
+  d.coarse_faces[2] = (d.faces[2] + 1) % 42;  // a corner that is no corner of face 0
+  for (int32_t f = 0; f < nf; ++f) {
+    SplitFaceRecord r{};
+    r.coarse_face = f == nf - 1 ? 0 : f;
+    for (int i = 0; i < 3; ++i) r.weight[i][i] = 1;
+    d.split_faces.push_back(r);
+  }
+  d.split_faces[0].weight[2][0] = d.split_faces[0].weight[2][2] = 0.5f;
+  d.split_faces[nf - 1].weight[0][0] = d.split_faces[nf - 1].weight[0][2] = 0.5f;
+  d.params.split_vertices = 1;
+  return d;
+}
+
+TEST(IndexTest, SplitWithCodedMatrixIsWrittenSparseAsVersion5AndReadBack) {
+  const IndexData d = MakeSparseSplitSphereIndex();
+  const std::string bytes = Serialize(d);
+  absl::StatusOr<std::shared_ptr<const Index>> index = Index::FromBytes(bytes);
+  ASSERT_TRUE(index.ok()) << index.status();
+  EXPECT_EQ((*index)->header().format_major, kSparseSplitFormatMajor);
+  const SplitView& split = (*index)->split();
+  ASSERT_TRUE(split.split());
+  EXPECT_EQ(split.num_coarse_faces(), 79);
+  EXPECT_EQ(split.CoarseFace(0)[2], d.coarse_faces[2]);
+  EXPECT_EQ(split.CoarseFace(5)[1], d.faces[3 * 5 + 1]);
+  EXPECT_EQ(split.Piece(79).coarse_face, 0);
+  EXPECT_EQ(split.Piece(0).weight[2][2], 0.5f);
+  EXPECT_EQ(split.Piece(7).coarse_face, 7);
+  EXPECT_EQ(split.Piece(7).weight[1][1], 1.0f);
+  // Two piece records and one coarse record, not one of each per face.
+  Image image = Image::Parse(bytes);
+  EXPECT_EQ(image.Payload(SectionId::kSplitPieces).size(), 2 * sizeof(SplitPieceRecord));
+  EXPECT_EQ(image.Payload(SectionId::kSplitCoarseFaces).size(), sizeof(SplitCoarseRecord));
+  for (const SectionEntry& e : image.entries) {
+    EXPECT_NE(e.id, static_cast<uint32_t>(SectionId::kSplitFaces));
+    EXPECT_NE(e.id, static_cast<uint32_t>(SectionId::kCoarseFaces));
+  }
+  // Read back dense, the same split; written again, the same bytes.
+  const IndexData again = ToIndexData(**index);
+  EXPECT_EQ(again.coarse_faces, d.coarse_faces);
+  ASSERT_EQ(again.split_faces.size(), d.split_faces.size());
+  EXPECT_EQ(std::memcmp(again.split_faces.data(), d.split_faces.data(),
+                        d.split_faces.size() * sizeof(SplitFaceRecord)),
+            0);
+  EXPECT_EQ(Serialize(again), bytes);
+  EXPECT_EQ(PredictIndexBytes(d), bytes.size());
+  // Corrupt records (valid checksums) are DataLoss naming the record.
+  const std::vector<Case> cases = {
+      {"pieces out of order",
+       [&](Image& i) { i.Set<int32_t>(SectionId::kSplitPieces, 11, 0); }, "split piece record 1"},
+      {"a coarse record out of range",
+       [&](Image& i) { i.Set<int32_t>(SectionId::kSplitCoarseFaces, 0, 79); },
+       "split coarse record 0"},
+      {"an appended piece of no coarse face",
+       [&](Image& i) { i.Set<int32_t>(SectionId::kSplitPieces, 11 + 1, 100); },
+       "split piece record 1"},
+  };
+  ExpectDataLoss(bytes, cases);
 }
 
 TEST(IndexTest, RefinementCorruptionWithValidChecksumsIsDataLoss) {

@@ -49,8 +49,20 @@
 //        order; sample_matrix.h: at most 2.4e-7 of a distance off), with
 //        the codes' scale (DistanceCodeRecord): 3/4 of the bytes of 3.0, what
 //        the builder writes by default. A 3.x reader has no matrix to read
-//        in it, hence the major version. This reader reads 1.x to 4.x
+//        in it, hence the major version. This reader reads 1.x to 5.x
 //        (Index::matrix() and SampleDistance read every layout).
+//   5.0  a split index's split sections sparse: SplitCoarseRecord for
+//        each coarse face that was split (the others are the index's face
+//        of the same id) and SplitPieceRecord for each face that is not a
+//        coarse face whole (every other face f is coarse face f, with
+//        identity weights), instead of CoarseFaces and SplitFaces, which
+//        held both for every face. A split that adds a few hundred
+//        midpoints to a mesh of 70K faces stored 3.4 MiB of records for
+//        them; now a few KiB. Written for a split index with the coded
+//        matrix when it is the smaller (a split of a coarse mesh makes
+//        pieces of nearly every face, and a piece record is 4 bytes more);
+//        else, and for an index not split, 4.0. A 4.x reader would find no
+//        split sections, hence the major version.
 
 #include <cstdint>
 
@@ -69,6 +81,9 @@ inline constexpr uint32_t kPackedFormatMinor = 0;
 // The version of an index whose matrix is stored once, in 24-bit codes.
 inline constexpr uint32_t kCodedFormatMajor = 4;
 inline constexpr uint32_t kCodedFormatMinor = 0;
+// The version of a split index with the coded matrix: the split sparse.
+inline constexpr uint32_t kSparseSplitFormatMajor = 5;
+inline constexpr uint32_t kSparseSplitFormatMinor = 0;
 inline constexpr uint32_t kByteOrderMark = 0x01020304;  // reads 0x04030201 when swapped
 inline constexpr uint64_t kAlignment = 64;
 
@@ -97,6 +112,12 @@ enum class SectionId : uint32_t {
   // codes, little-endian (4.x, instead of the float sections; sample_matrix.h).
   kSampleDistancesCoded = 18,
   kDistanceCode = 19,  // DistanceCodeRecord[1] (4.x): the codes' scale
+  // SplitCoarseRecord[k] (5.x), by increasing coarse_face: the coarse faces
+  // that were split.
+  kSplitCoarseFaces = 20,
+  // SplitPieceRecord[k] (5.x), by increasing face: the faces that are not a
+  // coarse face whole.
+  kSplitPieces = 21,
 };
 
 // Build parameters recorded in the header.
@@ -182,6 +203,23 @@ struct SplitFaceRecord {
   float weight[3][3];
 };
 static_assert(sizeof(SplitFaceRecord) == 40);
+
+// A coarse face that was split (5.0), and its corners; a coarse face c
+// without one is the index's face c.
+struct SplitCoarseRecord {
+  int32_t coarse_face;
+  int32_t corner[3];
+};
+static_assert(sizeof(SplitCoarseRecord) == 16);
+
+// A face that is not a coarse face whole (5.0): a part of coarse face f
+// that kept the id f, or a piece appended after the coarse faces. A face f
+// without one is coarse face f, its corners at identity weights.
+struct SplitPieceRecord {
+  int32_t face;
+  SplitFaceRecord piece;
+};
+static_assert(sizeof(SplitPieceRecord) == 44);
 
 // Axis-aligned bounding-box hierarchy over the mesh faces. A leaf has
 // count > 0 and covers bvh_faces[first, first+count); an inner node has

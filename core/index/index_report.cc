@@ -52,7 +52,10 @@ const std::vector<SectionGroup>& Groups() {
       {"triangles", "samples, triangles", {SectionId::kSamples, SectionId::kTriangles}},
       {"face_bvh", "face BVH", {SectionId::kFaceBvh, SectionId::kBvhFaces}},
       {"input_ids", "input ids", {SectionId::kInputFaces, SectionId::kVertexCopies}},
-      {"split", "split", {SectionId::kCoarseFaces, SectionId::kSplitFaces}},
+      {"split",
+       "split",
+       {SectionId::kCoarseFaces, SectionId::kSplitFaces, SectionId::kSplitCoarseFaces,
+        SectionId::kSplitPieces}},
       {"calibration", "calibration", {SectionId::kAccuracy, SectionId::kSpreadBounds}},
       {"report", "build report", {SectionId::kReport}},
   };
@@ -356,8 +359,8 @@ IndexReport MakeIndexReport(const Index& index) {
   r.vertices = r.index_vertices - r.split_midpoints -
                static_cast<int64_t>(index.vertex_copies().size());
   r.faces = !index.input_faces().empty()   ? static_cast<int64_t>(index.input_faces().size())
-            : !index.split_faces().empty() ? static_cast<int64_t>(index.coarse_faces().size() / 3)
-                                           : r.index_faces;
+            : index.split().split() ? static_cast<int64_t>(index.split().num_coarse_faces())
+                                    : r.index_faces;
   r.repairs = RepairsMade(Find(r, "mesh_repairs"));
   for (const auto& [key, value] : r.entries) {
     double count = 0;

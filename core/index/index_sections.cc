@@ -58,6 +58,8 @@ std::optional<uint64_t> ExpectedCount(SectionId id, const Counts& c) {
     case SectionId::kVertexCopies:
     case SectionId::kCoarseFaces:
     case SectionId::kSplitFaces:
+    case SectionId::kSplitCoarseFaces:
+    case SectionId::kSplitPieces:
     case SectionId::kSpreadBounds:
     case SectionId::kDistanceCode:
       return std::nullopt;
@@ -236,7 +238,7 @@ absl::Status CheckContents(const Contents& c, absl::StatusCode code) {
     }
   }
   GEODEX_RETURN_IF_ERROR(CheckInputIds(
-      {nv, nf, c.input_faces, c.vertex_copies, c.coarse_faces, c.split_faces, c.split_vertices},
+      {nv, nf, c.input_faces, c.vertex_copies, c.split, c.split_vertices},
       code));
   if (!c.bvh_faces.empty()) {
     std::vector<bool> seen(nf, false);

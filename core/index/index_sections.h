@@ -17,6 +17,7 @@
 #include "absl/status/status.h"
 #include "core/index/index_format.h"
 #include "core/index/sample_matrix.h"
+#include "core/index/split_view.h"
 
 namespace geodex::index::internal {
 
@@ -53,6 +54,8 @@ constexpr SectionSpec kSpecs[] = {
     {SectionId::kSampleDistancesLower, sizeof(float), "sample distances (lower triangle)", false},
     {SectionId::kSampleDistancesCoded, sizeof(PackedCode), "sample distances (24-bit codes)", false},
     {SectionId::kDistanceCode, sizeof(DistanceCodeRecord), "distance code", false},
+    {SectionId::kSplitCoarseFaces, sizeof(SplitCoarseRecord), "split coarse faces", false},
+    {SectionId::kSplitPieces, sizeof(SplitPieceRecord), "split pieces", false},
 };
 constexpr size_t kNumSpecs = std::size(kSpecs);
 
@@ -97,8 +100,7 @@ struct Contents {
   std::span<const int32_t> bvh_faces;
   std::span<const InputFaceRecord> input_faces;
   std::span<const int32_t> vertex_copies;
-  std::span<const int32_t> coarse_faces;
-  std::span<const SplitFaceRecord> split_faces;
+  SplitView split;  // dense or sparse, its layout's records checked
   uint64_t split_vertices = 0;
 };
 // The accuracy records (at most one, finite, non-negative); errors with `code`.

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cstring>
 #include <string>
+#include <vector>
 
 #include "absl/strings/str_format.h"
 #include "core/common/file_util.h"
@@ -11,6 +12,7 @@
 #include "core/index/index.h"
 #include "core/index/index_sections.h"
 #include "core/index/input_id_checks.h"
+#include "core/index/split_view.h"
 
 namespace geodex::index {
 
@@ -33,9 +35,43 @@ struct Piece {
   uint64_t size;
 };
 
+// How the split is written: sparse (5.0) for a split index with the coded
+// matrix whose split the sparse records give back as it is, when that takes
+// fewer bytes, else dense. A split of a coarse mesh makes pieces of nearly
+// every face, and a piece record is 4 bytes more than a dense one.
+struct SplitLayout {
+  bool sparse = false;
+  std::vector<SplitCoarseRecord> coarse;
+  std::vector<SplitPieceRecord> pieces;
+};
+
+absl::StatusOr<SplitLayout> SplitLayoutOf(const IndexData& d) {
+  const int64_t nf = static_cast<int64_t>(d.faces.size() / 3);
+  GEODEX_ASSIGN_OR_RETURN(const SplitView dense,
+                          SplitView::Dense(d.coarse_faces, d.split_faces, nf,
+                                           absl::StatusCode::kInvalidArgument));
+  SplitLayout out;
+  if (d.sample_matrix != MatrixLayout::kCoded || !dense.split()) return out;
+  SplitView::ToSparse(dense, d.faces, &out.coarse, &out.pieces);
+  // A split the builder did not make (a part that does not keep its coarse
+  // face's id) has no sparse form: it stays dense.
+  const absl::StatusOr<SplitView> sparse =
+      SplitView::Sparse(d.faces, out.coarse, out.pieces, absl::StatusCode::kInvalidArgument);
+  const uint64_t dense_bytes = d.coarse_faces.size() * sizeof(int32_t) +
+                               d.split_faces.size() * sizeof(SplitFaceRecord);
+  const uint64_t sparse_bytes = out.coarse.size() * sizeof(SplitCoarseRecord) +
+                                out.pieces.size() * sizeof(SplitPieceRecord);
+  out.sparse = sparse.ok() && sparse->num_coarse_faces() == dense.num_coarse_faces() &&
+               sparse_bytes < dense_bytes;
+  if (!out.sparse) out.coarse.clear(), out.pieces.clear();
+  return out;
+}
+
 // The sections of `d` in kSpecs order, the matrix's from `matrix` (full,
 // lower, coded, code).
-void LayOut(const IndexData& d, const Piece (&matrix)[4], Piece (&pieces)[kNumSpecs]) {
+void LayOut(const IndexData& d, const Piece (&matrix)[4], const SplitLayout& split,
+            Piece (&pieces)[kNumSpecs]) {
+  const bool dense = !split.sparse;
   const Piece all[kNumSpecs] = {
       {d.positions.data(), d.positions.size() * sizeof(double)},
       {d.faces.data(), d.faces.size() * sizeof(int32_t)},
@@ -50,12 +86,14 @@ void LayOut(const IndexData& d, const Piece (&matrix)[4], Piece (&pieces)[kNumSp
       {d.accuracy.data(), d.accuracy.size() * sizeof(AccuracyRecord)},
       {d.input_faces.data(), d.input_faces.size() * sizeof(InputFaceRecord)},
       {d.vertex_copies.data(), d.vertex_copies.size() * sizeof(int32_t)},
-      {d.coarse_faces.data(), d.coarse_faces.size() * sizeof(int32_t)},
-      {d.split_faces.data(), d.split_faces.size() * sizeof(SplitFaceRecord)},
+      {d.coarse_faces.data(), dense ? d.coarse_faces.size() * sizeof(int32_t) : 0},
+      {d.split_faces.data(), dense ? d.split_faces.size() * sizeof(SplitFaceRecord) : 0},
       {d.spread_bounds.data(), d.spread_bounds.size() * sizeof(SpreadBoundRecord)},
       matrix[1],
       matrix[2],
       matrix[3],
+      {split.coarse.data(), split.coarse.size() * sizeof(SplitCoarseRecord)},
+      {split.pieces.data(), split.pieces.size() * sizeof(SplitPieceRecord)},
   };
   std::copy(std::begin(all), std::end(all), std::begin(pieces));
 }
@@ -74,7 +112,8 @@ bool Written(size_t i, const Piece (&pieces)[kNumSpecs], MatrixLayout layout) {
   }
   return pieces[i].size > 0 || (id != SectionId::kInputFaces && id != SectionId::kVertexCopies &&
                                 id != SectionId::kCoarseFaces && id != SectionId::kSplitFaces &&
-                                id != SectionId::kSpreadBounds);
+                                id != SectionId::kSplitCoarseFaces &&
+                                id != SectionId::kSplitPieces && id != SectionId::kSpreadBounds);
 }
 
 // The file's size: header, table and every written section aligned.
@@ -91,6 +130,8 @@ uint64_t FileSize(const Piece (&pieces)[kNumSpecs], MatrixLayout layout) {
 }  // namespace
 
 uint64_t PredictIndexBytes(const IndexData& d) {
+  // A split SerializeIndex would refuse is predicted as written dense.
+  const SplitLayout split = SplitLayoutOf(d).value_or(SplitLayout{});
   const uint64_t m = d.samples.size();
   const uint64_t lower = m * (m - std::min<uint64_t>(m, 1)) / 2;
   const MatrixLayout layout = d.sample_matrix;
@@ -101,7 +142,7 @@ uint64_t PredictIndexBytes(const IndexData& d) {
       {nullptr, layout == MatrixLayout::kCoded ? sizeof(DistanceCodeRecord) : 0},
   };
   Piece pieces[kNumSpecs];
-  LayOut(d, matrix, pieces);
+  LayOut(d, matrix, split, pieces);
   return FileSize(pieces, layout);
 }
 
@@ -193,11 +234,15 @@ absl::StatusOr<std::string> SerializeIndex(const IndexData& d) {
     return bad(absl::StrFormat("builder_version must be under %d bytes without NULs: \"%s\"",
                                sizeof(FileHeader::builder_version), d.builder_version));
   }
+  GEODEX_ASSIGN_OR_RETURN(const SplitView split_view,
+                          SplitView::Dense(d.coarse_faces, d.split_faces, counts.num_faces,
+                                           absl::StatusCode::kInvalidArgument));
   GEODEX_RETURN_IF_ERROR(CheckContents(
       Contents{counts, d.positions, d.faces, d.twins, d.samples, full_matrix, lower, code,
                d.vertices, d.triangles, d.bvh_nodes, d.bvh_faces, d.input_faces, d.vertex_copies,
-               d.coarse_faces, d.split_faces, d.params.split_vertices},
+               split_view, d.params.split_vertices},
       absl::StatusCode::kInvalidArgument));
+  GEODEX_ASSIGN_OR_RETURN(const SplitLayout split, SplitLayoutOf(d));
   GEODEX_RETURN_IF_ERROR(CheckAccuracy(d.accuracy, absl::StatusCode::kInvalidArgument));
   GEODEX_RETURN_IF_ERROR(
       CheckSpreadBounds(d.spread_bounds, d.accuracy.size(), absl::StatusCode::kInvalidArgument));
@@ -209,7 +254,7 @@ absl::StatusOr<std::string> SerializeIndex(const IndexData& d) {
       {code.data(), code.size() * sizeof(DistanceCodeRecord)},
   };
   Piece pieces[kNumSpecs];
-  LayOut(d, matrix, pieces);
+  LayOut(d, matrix, split, pieces);
   auto written = [&pieces, layout](size_t i) { return Written(i, pieces, layout); };
   const bool refined = !d.split_faces.empty();
   size_t num_sections = 0;
@@ -239,8 +284,8 @@ absl::StatusOr<std::string> SerializeIndex(const IndexData& d) {
   std::memcpy(h.magic, kMagic, sizeof(kMagic));
   switch (layout) {
     case MatrixLayout::kCoded:
-      h.format_major = kCodedFormatMajor;
-      h.format_minor = kCodedFormatMinor;
+      h.format_major = split.sparse ? kSparseSplitFormatMajor : kCodedFormatMajor;
+      h.format_minor = split.sparse ? kSparseSplitFormatMinor : kCodedFormatMinor;
       break;
     case MatrixLayout::kLower:
       h.format_major = kPackedFormatMajor;

@@ -1,6 +1,7 @@
 #include "core/index/input_id_checks.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <string>
 #include <vector>
@@ -35,25 +36,25 @@ absl::Status CheckInputIds(const InputIdSections& c, absl::StatusCode code) {
   }
   // An index of a split mesh: every face is a piece of one coarse face,
   // given by weights in it, and every coarse face has a piece.
-  const bool split = !c.split_faces.empty();
-  if (split != !c.coarse_faces.empty() || (c.split_vertices > 0 && !split) ||
-      (split && static_cast<int64_t>(c.split_faces.size()) != nf) ||
-      c.coarse_faces.size() % 3 != 0) {
-    return fail(absl::StrFormat(
-        "split: %d piece records for %d faces, %d coarse face ids, %d midpoints",
-        c.split_faces.size(), nf, c.coarse_faces.size(), c.split_vertices));
+  // (SplitView::Dense and Sparse checked the records' sizes and order.)
+  const bool split = c.split.split();
+  if (c.split_vertices > 0 && !split) {
+    return fail(absl::StrFormat("split: no split records for %d midpoints", c.split_vertices));
   }
-  const int64_t num_coarse_faces = split ? static_cast<int64_t>(c.coarse_faces.size() / 3) : nf;
-  for (size_t i = 0; i < c.coarse_faces.size(); ++i) {
-    if (!InRange(c.coarse_faces[i], 0, num_coarse_vertices)) {
-      return fail(absl::StrFormat("coarse face %d: vertex id %d out of range [0, %d)", i / 3,
-                                  c.coarse_faces[i], num_coarse_vertices));
+  const int64_t num_coarse_faces = split ? c.split.num_coarse_faces() : nf;
+  for (int32_t f = 0; split && f < num_coarse_faces; ++f) {
+    const std::array<int32_t, 3> corners = c.split.CoarseFace(f);
+    for (int32_t v : corners) {
+      if (!InRange(v, 0, num_coarse_vertices)) {
+        return fail(absl::StrFormat("coarse face %d: vertex id %d out of range [0, %d)", f, v,
+                                    num_coarse_vertices));
+      }
     }
   }
   if (split) {
     std::vector<uint8_t> has_piece(num_coarse_faces, 0);
-    for (size_t f = 0; f < c.split_faces.size(); ++f) {
-      const SplitFaceRecord& r = c.split_faces[f];
+    for (int32_t f = 0; f < nf; ++f) {
+      const SplitFaceRecord r = c.split.Piece(f);
       bool ok = InRange(r.coarse_face, 0, num_coarse_faces);
       for (int i = 0; i < 3 && ok; ++i) {
         const float* w = r.weight[i];

@@ -10,6 +10,7 @@
 
 #include "absl/status/status.h"
 #include "core/index/index_format.h"
+#include "core/index/split_view.h"
 
 namespace geodex::index {
 
@@ -18,8 +19,7 @@ struct InputIdSections {
   int64_t num_faces = 0;
   std::span<const InputFaceRecord> input_faces;
   std::span<const int32_t> vertex_copies;
-  std::span<const int32_t> coarse_faces;
-  std::span<const SplitFaceRecord> split_faces;
+  SplitView split;
   uint64_t split_vertices = 0;
 };
 

@@ -183,10 +183,10 @@ absl::StatusOr<std::vector<ExactPair>> HeldOutPairs(const mesh::Mesh& mesh,
                                                     const index::Index& index,
                                                     PairOptions options) {
   options.vertex_limit = index.num_vertices() - index.split_vertices();
-  if (index.split_faces().empty()) return DrawPairs(mesh, index.num_samples(), options);
-  GEODEX_ASSIGN_OR_RETURN(const std::optional<builder::CoarseSurface> surface,
-                          builder::CoarseSurfaceOf(mesh, index.coarse_faces(), index.split_faces(),
-                                                   index.split_vertices()));
+  if (!index.split().split()) return DrawPairs(mesh, index.num_samples(), options);
+  GEODEX_ASSIGN_OR_RETURN(
+      const std::optional<builder::CoarseSurface> surface,
+      builder::CoarseSurfaceOf(mesh, index.split(), index.split_vertices()));
   const mesh::Mesh& coarse = surface->mesh;
   std::vector<ExactPair> pairs = DrawPairs(coarse, index.num_samples(), options);
   const query::InputIds ids(index);

@@ -1,6 +1,7 @@
 #include "core/query/internal/input_ids.h"
 
 #include <algorithm>
+#include <array>
 #include <limits>
 #include <utility>
 
@@ -15,23 +16,20 @@ InputIds::InputIds(const index::Index& index)
       vertex_copies_(index.vertex_copies()),
       num_input_vertices_(index.num_vertices() - index.split_vertices() -
                           static_cast<int32_t>(index.vertex_copies().size())),
-      coarse_faces_(index.coarse_faces()),
-      split_faces_(index.split_faces()) {
-  const int32_t num_coarse_faces =
-      split_faces_.empty() ? index.num_faces() : static_cast<int32_t>(coarse_faces_.size() / 3);
+      split_(&index.split()) {
+  const int32_t num_coarse_faces = split() ? split_->num_coarse_faces() : index.num_faces();
   num_input_faces_ =
       input_faces_.empty() ? num_coarse_faces : static_cast<int32_t>(input_faces_.size());
-  if (!split_faces_.empty()) {
+  if (split()) {
     // Index::Open checked that every piece names a coarse face and every
     // coarse face has one.
+    const int32_t nf = index.num_faces();
     piece_offset_.assign(num_coarse_faces + 1, 0);
-    for (const index::SplitFaceRecord& r : split_faces_) ++piece_offset_[r.coarse_face + 1];
+    for (int32_t f = 0; f < nf; ++f) ++piece_offset_[split_->Piece(f).coarse_face + 1];
     for (int32_t c = 0; c < num_coarse_faces; ++c) piece_offset_[c + 1] += piece_offset_[c];
-    pieces_.resize(split_faces_.size());
+    pieces_.resize(nf);
     std::vector<int32_t> cursor(piece_offset_.begin(), piece_offset_.end() - 1);
-    for (int32_t f = 0; f < static_cast<int32_t>(split_faces_.size()); ++f) {
-      pieces_[cursor[split_faces_[f].coarse_face]++] = f;
-    }
+    for (int32_t f = 0; f < nf; ++f) pieces_[cursor[split_->Piece(f).coarse_face]++] = f;
   }
   if (input_faces_.empty()) return;
   // Index::Open checked that every coarse face is kept for exactly one
@@ -57,14 +55,14 @@ absl::StatusOr<mesh::SurfacePoint> InputIds::ToInternal(const mesh::SurfacePoint
 
 absl::StatusOr<mesh::SurfacePoint> InputIds::CoarseToInternal(
     const mesh::SurfacePoint& coarse) const {
-  if (split_faces_.empty()) return coarse;
+  if (!split()) return coarse;
   // The piece whose smallest weight of the point is the largest: the one
   // holding it (on a shared edge either is right; rounding may leave the
   // point a hair outside every piece).
   mesh::SurfacePoint best{mesh::kNone, {0, 0, 0}};
   double best_min = -std::numeric_limits<double>::infinity();
   for (int32_t k = piece_offset_[coarse.face]; k < piece_offset_[coarse.face + 1]; ++k) {
-    const index::SplitFaceRecord& r = split_faces_[pieces_[k]];
+    const index::SplitFaceRecord r = split_->Piece(pieces_[k]);
     // coarse.w = a0 W0 + a1 W1 + a2 W2 with a0 + a1 + a2 = 1: two
     // equations in the first two weights (the third follows).
     const double e00 = r.weight[0][0] - r.weight[2][0], e01 = r.weight[1][0] - r.weight[2][0];
@@ -92,8 +90,8 @@ absl::StatusOr<mesh::SurfacePoint> InputIds::CoarseToInternal(
 
 mesh::SurfacePoint InputIds::ToInput(const mesh::SurfacePoint& p) const {
   mesh::SurfacePoint coarse = p;
-  if (!split_faces_.empty()) {
-    const index::SplitFaceRecord& r = split_faces_[p.face];
+  if (split()) {
+    const index::SplitFaceRecord r = split_->Piece(p.face);
     coarse = {r.coarse_face, {0, 0, 0}};
     for (int i = 0; i < 3; ++i) {
       for (int j = 0; j < 3; ++j) coarse.w[j] += p.w[i] * r.weight[i][j];
@@ -112,19 +110,25 @@ bool InputIds::Reoriented(int32_t f) const {
 }
 
 mesh::Triangle InputIds::InputFace(int32_t f) const {
-  const std::span<const int32_t> faces = split_faces_.empty() ? index_->faces() : coarse_faces_;
+  auto corners = [&](int32_t c) -> std::array<int32_t, 3> {
+    if (split()) return split_->CoarseFace(c);
+    const std::span<const int32_t> faces = index_->faces();
+    return {faces[3 * c], faces[3 * c + 1], faces[3 * c + 2]};
+  };
   mesh::Triangle out;
   if (input_faces_.empty()) {
-    for (int i = 0; i < 3; ++i) out[i] = InputVertex(faces[3 * f + i]);
+    const std::array<int32_t, 3> c = corners(f);
+    for (int i = 0; i < 3; ++i) out[i] = InputVertex(c[i]);
     return out;
   }
   const index::InputFaceRecord& r = input_faces_[f];
-  for (int i = 0; i < 3; ++i) out[i] = InputVertex(faces[3 * r.face + r.corner[i]]);
+  const std::array<int32_t, 3> c = corners(r.face);
+  for (int i = 0; i < 3; ++i) out[i] = InputVertex(c[r.corner[i]]);
   return out;
 }
 
 DistanceField InputIds::FieldToInput(DistanceField field) const {
-  if (vertex_copies_.empty() && split_faces_.empty()) return field;
+  if (vertex_copies_.empty() && !split()) return field;
   for (size_t k = 0; k < vertex_copies_.size(); ++k) {
     const size_t copy = num_input_vertices_ + k, v = vertex_copies_[k];
     if (field.distance[copy] < field.distance[v]) {
@@ -138,7 +142,7 @@ DistanceField InputIds::FieldToInput(DistanceField field) const {
 }
 
 void InputIds::PathToInput(std::span<PathPoint> path) const {
-  if (input_faces_.empty() && split_faces_.empty()) return;
+  if (input_faces_.empty() && !split()) return;
   for (PathPoint& p : path) p.point = ToInput(p.point);
 }
 

@@ -51,10 +51,10 @@ class InputIds {
 
   // True when input ids are internal ids.
   bool identity() const {
-    return input_faces_.empty() && vertex_copies_.empty() && split_faces_.empty();
+    return input_faces_.empty() && vertex_copies_.empty() && !split();
   }
   // True for an index of a mesh whose long edges were split (format 2.0).
-  bool split() const { return !split_faces_.empty(); }
+  bool split() const { return split_->split(); }
   int32_t num_input_faces() const { return num_input_faces_; }
   int32_t num_input_vertices() const { return num_input_vertices_; }
 
@@ -103,8 +103,7 @@ class InputIds {
   std::vector<int32_t> kept_input_face_;
   // The long-edge split (empty without): per coarse face, its pieces
   // pieces_[piece_offset_[c], piece_offset_[c + 1]).
-  std::span<const int32_t> coarse_faces_;
-  std::span<const index::SplitFaceRecord> split_faces_;
+  const index::SplitView* split_;
   std::vector<int32_t> piece_offset_;
   std::vector<int32_t> pieces_;
 };

@@ -1,0 +1,136 @@
+#include "core/index/split_view.h"
+
+#include <algorithm>
+#include <string>
+
+#include "absl/strings/str_format.h"
+
+namespace geodex::index {
+namespace {
+
+SplitFaceRecord Whole(int32_t f) {
+  SplitFaceRecord r{f, {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}}};
+  return r;
+}
+
+bool IsWhole(const SplitFaceRecord& r, int32_t f) {
+  if (r.coarse_face != f) return false;
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) {
+      if (r.weight[i][j] != (i == j ? 1.0f : 0.0f)) return false;
+    }
+  }
+  return true;
+}
+
+}  // namespace
+
+absl::StatusOr<SplitView> SplitView::Dense(std::span<const int32_t> coarse_faces,
+                                           std::span<const SplitFaceRecord> pieces,
+                                           int64_t num_faces, absl::StatusCode code) {
+  SplitView v;
+  if (coarse_faces.empty() && pieces.empty()) return v;
+  if (coarse_faces.empty() || coarse_faces.size() % 3 != 0 ||
+      static_cast<int64_t>(pieces.size()) != num_faces) {
+    return absl::Status(
+        code, absl::StrFormat("split: %d piece records for %d faces, %d coarse face ids",
+                              pieces.size(), num_faces, coarse_faces.size()));
+  }
+  v.num_coarse_faces_ = static_cast<int32_t>(coarse_faces.size() / 3);
+  v.num_faces_ = num_faces;
+  v.dense_coarse_ = coarse_faces;
+  v.dense_pieces_ = pieces;
+  return v;
+}
+
+absl::StatusOr<SplitView> SplitView::Sparse(std::span<const int32_t> faces,
+                                            std::span<const SplitCoarseRecord> coarse,
+                                            std::span<const SplitPieceRecord> pieces,
+                                            absl::StatusCode code) {
+  SplitView v;
+  if (coarse.empty() && pieces.empty()) return v;
+  auto fail = [code](std::string message) { return absl::Status(code, message); };
+  const int64_t nf = static_cast<int64_t>(faces.size() / 3);
+  // Pieces appended after the coarse faces name another face than their own.
+  int64_t appended = 0;
+  for (size_t k = 0; k < pieces.size(); ++k) {
+    const SplitPieceRecord& p = pieces[k];
+    if (p.face < 0 || p.face >= nf || (k > 0 && p.face <= pieces[k - 1].face)) {
+      return fail(absl::StrFormat("split piece record %d: face %d out of order or of range [0, %d)",
+                                  k, p.face, nf));
+    }
+    appended += p.piece.coarse_face != p.face ? 1 : 0;
+  }
+  const int64_t num_coarse = nf - appended;
+  if (num_coarse <= 0 || pieces.empty()) {
+    return fail(absl::StrFormat("split: %d piece records and %d coarse records for %d faces",
+                                pieces.size(), coarse.size(), nf));
+  }
+  for (size_t k = 0; k < pieces.size(); ++k) {
+    const SplitPieceRecord& p = pieces[k];
+    const bool part = p.piece.coarse_face == p.face && p.face < num_coarse;
+    const bool added =
+        p.face >= num_coarse && p.piece.coarse_face >= 0 && p.piece.coarse_face < num_coarse;
+    if (!part && !added) {
+      return fail(absl::StrFormat("split piece record %d: face %d in coarse face %d (of %d)", k,
+                                  p.face, p.piece.coarse_face, num_coarse));
+    }
+  }
+  for (size_t k = 0; k < coarse.size(); ++k) {
+    const int32_t c = coarse[k].coarse_face;
+    if (c < 0 || c >= num_coarse || (k > 0 && c <= coarse[k - 1].coarse_face)) {
+      return fail(absl::StrFormat(
+          "split coarse record %d: coarse face %d out of order or of range [0, %d)", k, c,
+          num_coarse));
+    }
+  }
+  v.num_coarse_faces_ = static_cast<int32_t>(num_coarse);
+  v.num_faces_ = nf;
+  v.sparse_ = true;
+  v.faces_ = faces;
+  v.coarse_ = coarse;
+  v.pieces_ = pieces;
+  return v;
+}
+
+std::array<int32_t, 3> SplitView::CoarseFace(int32_t c) const {
+  if (!sparse_) return {dense_coarse_[3 * c], dense_coarse_[3 * c + 1], dense_coarse_[3 * c + 2]};
+  const auto it = std::lower_bound(
+      coarse_.begin(), coarse_.end(), c,
+      [](const SplitCoarseRecord& r, int32_t id) { return r.coarse_face < id; });
+  if (it != coarse_.end() && it->coarse_face == c) {
+    return {it->corner[0], it->corner[1], it->corner[2]};
+  }
+  return {faces_[3 * c], faces_[3 * c + 1], faces_[3 * c + 2]};
+}
+
+SplitFaceRecord SplitView::Piece(int32_t f) const {
+  if (!sparse_) return dense_pieces_[f];
+  const auto it =
+      std::lower_bound(pieces_.begin(), pieces_.end(), f,
+                       [](const SplitPieceRecord& r, int32_t id) { return r.face < id; });
+  if (it != pieces_.end() && it->face == f) return it->piece;
+  return Whole(f);
+}
+
+void SplitView::ToSparse(const SplitView& dense, std::span<const int32_t> faces,
+                         std::vector<SplitCoarseRecord>* coarse,
+                         std::vector<SplitPieceRecord>* pieces) {
+  coarse->clear();
+  pieces->clear();
+  if (!dense.split()) return;
+  const int64_t nf = static_cast<int64_t>(faces.size() / 3);
+  for (int32_t c = 0; c < dense.num_coarse_faces(); ++c) {
+    const std::array<int32_t, 3> corners = dense.CoarseFace(c);
+    if (c >= nf || corners[0] != faces[3 * c] || corners[1] != faces[3 * c + 1] ||
+        corners[2] != faces[3 * c + 2]) {
+      coarse->push_back({c, {corners[0], corners[1], corners[2]}});
+    }
+  }
+  for (int32_t f = 0; f < nf; ++f) {
+    const SplitFaceRecord r = dense.Piece(f);
+    if (!IsWhole(r, f)) pieces->push_back({f, r});
+  }
+}
+
+}  // namespace geodex::index
