@@ -11,8 +11,8 @@
 #include <vector>
 
 #include "absl/strings/str_format.h"
-#include "core/common/status_macros.h"
 #include "core/builder/mesh_arrays.h"
+#include "core/common/status_macros.h"
 #include "core/common/threads.h"
 #include "core/query/internal/input_ids.h"
 #include "core/query/internal/query_engine.h"
@@ -161,7 +161,8 @@ void FitSpreadBounds(const std::vector<SpreadSample> (&samples)[index::kAccuracy
 
 // fn(k) for k in [0, n) on `threads` threads (0: all), each k once.
 void ForEachPair(size_t n, int threads, const std::function<void(size_t)>& fn) {
-  const int count = std::min<int>(common::ThreadCount(threads), static_cast<int>(std::max<size_t>(n, 1)));
+  const int count =
+      std::min<int>(common::ThreadCount(threads), static_cast<int>(std::max<size_t>(n, 1)));
   std::atomic<size_t> next{0};
   auto work = [&] {
     for (size_t k = next++; k < n; k = next++) fn(k);
@@ -184,9 +185,8 @@ absl::StatusOr<std::vector<ExactPair>> HeldOutPairs(const mesh::Mesh& mesh,
                                                     PairOptions options) {
   options.vertex_limit = index.num_vertices() - index.split_vertices();
   if (!index.split().split()) return DrawPairs(mesh, index.num_samples(), options);
-  GEODEX_ASSIGN_OR_RETURN(
-      const std::optional<builder::CoarseSurface> surface,
-      builder::CoarseSurfaceOf(mesh, index.split(), index.split_vertices()));
+  GEODEX_ASSIGN_OR_RETURN(const std::optional<builder::CoarseSurface> surface,
+                          builder::CoarseSurfaceOf(mesh, index.split(), index.split_vertices()));
   const mesh::Mesh& coarse = surface->mesh;
   std::vector<ExactPair> pairs = DrawPairs(coarse, index.num_samples(), options);
   const query::InputIds ids(index);
@@ -241,11 +241,22 @@ absl::Status CheckBuiltFrom(const mesh::Mesh& mesh, const index::Index& index) {
   return absl::OkStatus();
 }
 
-// Calibrate on `pairs` (HeldOutPairs of options.pairs' sources).
+// The answers of the uncalibrated index to one held-out pair, which the
+// bounds are fitted on.
+struct Answers {
+  absl::StatusOr<double> unfolded = absl::UnknownError("");
+  absl::StatusOr<double> walked = absl::UnknownError("");
+  bool wraps = false;
+  double spread = 0;
+};
+
+// Calibrate on `pairs` (HeldOutPairs of options.pairs' sources);
+// `uncalibrated` holds the answers of a prefix of them, and gets all.
 absl::StatusOr<Calibration> CalibrateOn(const mesh::Mesh& mesh,
                                         std::shared_ptr<const index::Index> index,
                                         const std::vector<ExactPair>& pairs,
-                                        const CalibrationOptions& options) {
+                                        const CalibrationOptions& options,
+                                        std::vector<Answers>* uncalibrated) {
   GEODEX_ASSIGN_OR_RETURN(auto engine, query::QueryEngine::Create(index));
   const double scale = engine->scale_length();
   std::vector<double> unfold[2][index::kAccuracyBins], trace[4][index::kAccuracyBins];
@@ -255,15 +266,13 @@ absl::StatusOr<Calibration> CalibrateOn(const mesh::Mesh& mesh,
   std::vector<int32_t> uniform_source;
   const query::DistanceOptions pure{.near_pairs = query::NearPairs::kUnfold};
   // Each pair's answers in its own slot, gathered in order below: the
-  // calibration does not depend on the thread count.
-  struct Answers {
-    absl::StatusOr<double> unfolded = absl::UnknownError("");
-    absl::StatusOr<double> walked = absl::UnknownError("");
-    bool wraps = false;
-    double spread = 0;
-  };
-  std::vector<Answers> answers(pairs.size());
-  ForEachPair(pairs.size(), options.pairs.threads, [&](size_t k) {
+  // calibration does not depend on the thread count. Those of the pairs
+  // measured before (a sequential calibration's earlier sources) are kept.
+  std::vector<Answers>& answers = *uncalibrated;
+  const size_t known = answers.size();
+  answers.resize(pairs.size());
+  ForEachPair(pairs.size() - known, options.pairs.threads, [&](size_t j) {
+    const size_t k = known + j;
     Answers& a = answers[k];
     a.unfolded = engine->Distance(pairs[k].p, pairs[k].q, pure);
     a.walked = engine->WalkedDistance(pairs[k].p, pairs[k].q, &a.wraps);
@@ -280,7 +289,8 @@ absl::StatusOr<Calibration> CalibrateOn(const mesh::Mesh& mesh,
     if (t.ok() && std::isfinite(*t)) largest_answer = std::max(largest_answer, *t);
     const int bin = AccuracyBinOf(*u, scale);
     unfold[pair.vertices ? 0 : 1][bin].push_back(std::abs(*u - pair.exact));
-    spread[pair.vertices ? 0 : 1][bin].push_back({std::abs(*u - pair.exact), answers[k].spread, *u});
+    spread[pair.vertices ? 0 : 1][bin].push_back(
+        {std::abs(*u - pair.exact), answers[k].spread, *u});
     if (t.ok()) {
       trace[2 * pair.vertices + wraps][AccuracyBinOf(*t, scale)].push_back(
           std::abs(*t - pair.exact));
@@ -373,7 +383,8 @@ absl::StatusOr<Calibration> Calibrate(const mesh::Mesh& mesh,
   GEODEX_RETURN_IF_ERROR(CheckBuiltFrom(mesh, *index));
   GEODEX_ASSIGN_OR_RETURN(const std::vector<ExactPair> pairs,
                           HeldOutPairs(mesh, *index, options.pairs));
-  return CalibrateOn(mesh, std::move(index), pairs, options);
+  std::vector<Answers> answers;
+  return CalibrateOn(mesh, std::move(index), pairs, options, &answers);
 }
 
 absl::Status AddCalibration(const mesh::Mesh& mesh, index::IndexData& data,
@@ -393,7 +404,9 @@ absl::Status AddCalibrationUntil(const mesh::Mesh& mesh, index::IndexData& data,
   GEODEX_RETURN_IF_ERROR(CheckBuiltFrom(mesh, *index));
   CalibrationOptions drawn = options;
   GEODEX_ASSIGN_OR_RETURN(std::vector<ExactPair> pairs, HeldOutPairs(mesh, *index, drawn.pairs));
-  GEODEX_ASSIGN_OR_RETURN(Calibration calibration, CalibrateOn(mesh, index, pairs, drawn));
+  std::vector<Answers> answers;
+  GEODEX_ASSIGN_OR_RETURN(Calibration calibration,
+                          CalibrateOn(mesh, index, pairs, drawn, &answers));
   while (settled != nullptr && drawn.pairs.num_sources < max_sources && !settled(calibration)) {
     // The sources drawn so far keep their pairs; only the new ones propagate.
     PairOptions more = drawn.pairs;
@@ -402,7 +415,7 @@ absl::Status AddCalibrationUntil(const mesh::Mesh& mesh, index::IndexData& data,
     GEODEX_ASSIGN_OR_RETURN(std::vector<ExactPair> added, HeldOutPairs(mesh, *index, more));
     pairs.insert(pairs.end(), added.begin(), added.end());
     drawn.pairs.num_sources += more.num_sources;
-    GEODEX_ASSIGN_OR_RETURN(calibration, CalibrateOn(mesh, index, pairs, drawn));
+    GEODEX_ASSIGN_OR_RETURN(calibration, CalibrateOn(mesh, index, pairs, drawn, &answers));
   }
   data.accuracy = {calibration.record};
   data.spread_bounds = {calibration.spread};

@@ -24,12 +24,14 @@ InputIds::InputIds(const index::Index& index)
     // Index::Open checked that every piece names a coarse face and every
     // coarse face has one.
     const int32_t nf = index.num_faces();
+    std::vector<int32_t> coarse_of(nf);
     piece_offset_.assign(num_coarse_faces + 1, 0);
-    for (int32_t f = 0; f < nf; ++f) ++piece_offset_[split_->Piece(f).coarse_face + 1];
+    for (int32_t f = 0; f < nf; ++f)
+      ++piece_offset_[(coarse_of[f] = split_->Piece(f).coarse_face) + 1];
     for (int32_t c = 0; c < num_coarse_faces; ++c) piece_offset_[c + 1] += piece_offset_[c];
     pieces_.resize(nf);
     std::vector<int32_t> cursor(piece_offset_.begin(), piece_offset_.end() - 1);
-    for (int32_t f = 0; f < nf; ++f) pieces_[cursor[split_->Piece(f).coarse_face]++] = f;
+    for (int32_t f = 0; f < nf; ++f) pieces_[cursor[coarse_of[f]]++] = f;
   }
   if (input_faces_.empty()) return;
   // Index::Open checked that every coarse face is kept for exactly one
