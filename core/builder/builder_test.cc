@@ -52,15 +52,14 @@ TEST(BuilderTest, SphereIndexIsValidAndComplete) {
       EXPECT_EQ(data->sample_distances[a * ms + b], data->sample_distances[b * ms + a]);
     }
   }
-  // Every vertex record: its corners form its triangle, and its distances
-  // match an exact propagation from each corner.
+  // Every vertex record: its distances match an exact propagation from each
+  // corner of its triangle.
   geodesic::ExactGeodesicSolver solver(m);
   for (int32_t check : {0, 17, 500, m.num_vertices() - 1}) {
     const index::VertexRecord& r = data->vertices[check];
     ASSERT_GE(r.triangle, 0);
     for (int i = 0; i < 3; ++i) {
-      EXPECT_EQ(r.corner[i], data->triangles[r.triangle].corner[i]);
-      const int32_t sample_vertex = data->samples[r.corner[i]];
+      const int32_t sample_vertex = data->samples[data->triangles[r.triangle].corner[i]];
       ASSERT_TRUE(solver.Propagate({*mesh::VertexPoint(m, sample_vertex)}).ok());
       EXPECT_NEAR(r.distance[i], solver.VertexDistance(check), 1e-6);
     }

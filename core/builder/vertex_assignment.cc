@@ -26,7 +26,7 @@ AssignmentCounts AssignVerticesToTriangles(
   AssignmentCounts counts;
   for (int32_t v = 0; v < nv; ++v) {
     index::VertexRecord& record = (*records)[v];
-    record = {kNone, {kNone, kNone, kNone}, {0, 0, 0}, 0};
+    record = {kNone, {0, 0, 0}};
     const int32_t a = plan.nearest[v];
     if (!mesh.IsReferenced(v) || a == kNone) continue;
     ++counts.referenced;
@@ -44,10 +44,7 @@ AssignmentCounts AssignVerticesToTriangles(
         best_score = score;
         best_max = std::max({lambda[0], lambda[1], lambda[2]});
         record.triangle = t;
-        for (int i = 0; i < 3; ++i) {
-          record.corner[i] = corners[i];
-          record.distance[i] = static_cast<float>(d[i]);
-        }
+        for (int i = 0; i < 3; ++i) record.distance[i] = static_cast<float>(d[i]);
       }
     }
     if (record.triangle == kNone) {

@@ -21,6 +21,8 @@
 #include "absl/strings/str_format.h"
 #include "core/common/file_util.h"
 #include "core/common/status_macros.h"
+#include "core/index/derived_sections.h"
+#include "core/index/face_bvh.h"
 #include "core/index/index_sections.h"
 #include "core/index/input_id_checks.h"
 
@@ -44,6 +46,7 @@ static_assert(sizeof(BuildParams) == 24);
 static_assert(std::is_trivially_copyable_v<FileHeader> &&
               std::is_trivially_copyable_v<SectionEntry> &&
               std::is_trivially_copyable_v<VertexRecord> &&
+              std::is_trivially_copyable_v<VertexRecordWithCorners> &&
               std::is_trivially_copyable_v<GeodesicTriangle> &&
               std::is_trivially_copyable_v<BvhNode>);
 
@@ -54,6 +57,7 @@ using internal::CheckSpreadBounds;
 using internal::Checksum;
 using internal::Contents;
 using internal::Counts;
+using internal::DeriveTwins;
 using internal::ExpectedCount;
 using internal::HeaderChecksum;
 using internal::kInt32Max;
@@ -87,6 +91,38 @@ std::vector<SectionId> MatrixSections(uint32_t major) {
   return {SectionId::kSampleDistances};
 }
 
+// Whether a file of major version `major` must have, may have or must not
+// have a section: the matrix sections of its layout, the vertex records with
+// corners before 6.0 and without from 6.0, the twins and the BVH optional
+// from 6.0 (derived when absent); the others by their spec, and required
+// whenever they must hold elements.
+enum class Presence { kRequired, kOptional, kAbsent };
+Presence PresenceIn(uint32_t major, size_t spec, const Counts& counts) {
+  const SectionId id = kSpecs[spec].id;
+  const bool derived_format = major >= kDerivedFormatMajor;
+  if (IsMatrixSection(id)) {
+    const std::vector<SectionId> layout = MatrixSections(major);
+    return std::find(layout.begin(), layout.end(), id) != layout.end() ? Presence::kRequired
+                                                                        : Presence::kAbsent;
+  }
+  switch (id) {
+    case SectionId::kVertexRecords:
+      return derived_format ? Presence::kAbsent : Presence::kRequired;
+    case SectionId::kCompactVertexRecords:
+      return derived_format ? Presence::kRequired : Presence::kAbsent;
+    case SectionId::kTwins:
+      return derived_format ? Presence::kOptional : Presence::kRequired;
+    case SectionId::kFaceBvh:
+    case SectionId::kBvhFaces:
+      if (derived_format) return Presence::kOptional;
+      break;
+    default:
+      break;
+  }
+  return kSpecs[spec].required || ExpectedCount(id, counts).value_or(0) > 0 ? Presence::kRequired
+                                                                           : Presence::kOptional;
+}
+
 // Validate's steps. Every check happens before the bytes it guards are used;
 // sizes are compared by subtraction so that no sum can overflow.
 
@@ -117,10 +153,10 @@ absl::StatusOr<FileHeader> ValidateHeader(const uint8_t* p, size_t n) {
   }
   if (h.format_major != kFormatMajor && h.format_major != kSplitFormatMajor &&
       h.format_major != kPackedFormatMajor && h.format_major != kCodedFormatMajor &&
-      h.format_major != kSparseSplitFormatMajor) {
+      h.format_major != kSparseSplitFormatMajor && h.format_major != kDerivedFormatMajor) {
     return absl::FailedPreconditionError(absl::StrFormat(
         "index format version %d.%d is not supported by this reader (version %d.%d)",
-        h.format_major, h.format_minor, kSparseSplitFormatMajor, kSparseSplitFormatMinor));
+        h.format_major, h.format_minor, kDerivedFormatMajor, kDerivedFormatMinor));
   }
   if (h.header_size < kHeaderSize || h.header_size % 8 != 0) {
     return absl::DataLossError(absl::StrFormat("bad header size %d", h.header_size));
@@ -224,20 +260,14 @@ absl::Status FindSections(const uint8_t* p, size_t n, const FileHeader& h, const
     found[spec] = e;
   }
   // The matrix: in full before 3.0, its lower triangle in 3.x, in codes
-  // with their scale from 4.0; only the sections of the file's layout.
-  const std::vector<SectionId> layout = MatrixSections(h.format_major);
-  auto in_layout = [&layout](SectionId id) {
-    return std::find(layout.begin(), layout.end(), id) != layout.end();
-  };
+  // with their scale from 4.0; only the sections of the file's layout. The
+  // vertex records of the file's version, and the derivable sections.
   for (size_t s = 0; s < kNumSpecs; ++s) {
-    const SectionId id = kSpecs[s].id;
-    const bool matrix = IsMatrixSection(id);
-    const std::optional<uint64_t> count = ExpectedCount(id, counts);
-    if (!found[s].has_value() &&
-        (kSpecs[s].required || in_layout(id) || (!matrix && count.value_or(0) > 0))) {
+    const Presence presence = PresenceIn(h.format_major, s, counts);
+    if (!found[s].has_value() && presence == Presence::kRequired) {
       return absl::DataLossError(absl::StrFormat("missing section: %s", kSpecs[s].name));
     }
-    if (found[s].has_value() && matrix && !in_layout(id)) {
+    if (found[s].has_value() && presence == Presence::kAbsent) {
       return absl::DataLossError(absl::StrFormat("a format %d.%d index with the section %s",
                                                  h.format_major, h.format_minor, kSpecs[s].name));
     }
@@ -348,8 +378,31 @@ absl::Status Index::Validate() {
   sample_distances_coded_ = SectionView<PackedCode>(p, entry(SectionId::kSampleDistancesCoded));
   const std::span<const DistanceCodeRecord> distance_code =
       SectionView<DistanceCodeRecord>(p, entry(SectionId::kDistanceCode));
-  vertices_ = SectionView<VertexRecord>(p, entry(SectionId::kVertexRecords));
   triangles_ = SectionView<GeodesicTriangle>(p, entry(SectionId::kTriangles));
+  const bool derived_format = h.format_major >= kDerivedFormatMajor;
+  std::span<const VertexRecordWithCorners> legacy_vertices;
+  if (derived_format) {
+    vertices_ = SectionView<VertexRecord>(p, entry(SectionId::kCompactVertexRecords));
+  } else {
+    // 1.x-5.x copied each record's corners in: checked against its
+    // triangle's and left out, so that every version answers from one kind
+    // of record.
+    legacy_vertices = SectionView<VertexRecordWithCorners>(p, entry(SectionId::kVertexRecords));
+    derived_vertices_ = internal::WithoutCorners(legacy_vertices);
+    vertices_ = derived_vertices_;
+  }
+  // From 6.0 the twins and the BVH may be left out, to be derived here (the
+  // BVH below, once the positions and faces it reads are checked).
+  const bool derive_twins = derived_format && !entry(SectionId::kTwins).has_value();
+  const bool derive_bvh = derived_format && !entry(SectionId::kFaceBvh).has_value();
+  if (derived_format && entry(SectionId::kFaceBvh).has_value() !=
+                            entry(SectionId::kBvhFaces).has_value()) {
+    return absl::DataLossError("a format 6 index with one of the two BVH sections");
+  }
+  if (derive_twins) {
+    GEODEX_ASSIGN_OR_RETURN(derived_twins_, DeriveTwins(faces_, absl::StatusCode::kDataLoss));
+    twins_ = derived_twins_;
+  }
   bvh_nodes_ = SectionView<BvhNode>(p, entry(SectionId::kFaceBvh));
   bvh_faces_ = SectionView<int32_t>(p, entry(SectionId::kBvhFaces));
   const std::span<const char> report = SectionView<char>(p, entry(SectionId::kReport));
@@ -368,9 +421,12 @@ absl::Status Index::Validate() {
   spread_bounds_ = SectionView<SpreadBoundRecord>(p, entry(SectionId::kSpreadBounds));
   const bool dense_split = !split_faces.empty() || !coarse_faces.empty();
   const bool sparse_split = !split_coarse.empty() || !split_pieces.empty();
+  if (dense_split && sparse_split) {
+    return absl::DataLossError("an index with both dense and sparse split sections");
+  }
   if ((h.format_major < kSplitFormatMajor && (dense_split || h.params.split_vertices != 0)) ||
       (h.format_major < kSparseSplitFormatMajor && sparse_split) ||
-      (h.format_major >= kSparseSplitFormatMajor && dense_split)) {
+      (h.format_major == kSparseSplitFormatMajor && dense_split)) {
     return absl::DataLossError(absl::StrFormat("a format %d.%d index with %s split sections",
                                                h.format_major, h.format_minor,
                                                sparse_split ? "sparse" : "dense"));
@@ -393,8 +449,18 @@ absl::Status Index::Validate() {
       Contents{counts, positions_, faces_, twins_, samples_, sample_distances_,
                sample_distances_lower_, distance_code, vertices_, triangles_, bvh_nodes_,
                bvh_faces_, input_faces_, vertex_copies_, split_,
-               h.params.split_vertices},
+               h.params.split_vertices, legacy_vertices},
       absl::StatusCode::kDataLoss));
+  if (derive_bvh) {
+    BuildFaceBvh(positions_, faces_, &derived_bvh_nodes_, &derived_bvh_faces_);
+    if (derived_bvh_nodes_.size() != counts.num_bvh_nodes) {
+      return absl::DataLossError(absl::StrFormat(
+          "face BVH: the header counts %d nodes, the BVH derived from the faces has %d",
+          counts.num_bvh_nodes, derived_bvh_nodes_.size()));
+    }
+    bvh_nodes_ = derived_bvh_nodes_;
+    bvh_faces_ = derived_bvh_faces_;
+  }
   const int32_t m = num_samples();
   if (h.format_major >= kCodedFormatMajor) {
     matrix_ = SampleMatrix::Coded(sample_distances_coded_, m, distance_code[0].scale);
@@ -417,6 +483,7 @@ IndexData ToIndexData(const Index& index) {
   d.twins = copy(index.twins());
   d.samples = copy(index.samples());
   d.sample_matrix = index.matrix().layout();
+  d.coded_as_version_5 = index.header().format_major < kDerivedFormatMajor;
   d.sample_distance_scale = index.matrix().scale();
   if (d.sample_matrix == MatrixLayout::kFull) {
     d.sample_distances = copy(index.sample_distances());

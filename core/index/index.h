@@ -44,7 +44,11 @@ struct IndexData {
   // the largest distance. A loaded index's is kept, so that writing it
   // again gives the same codes.
   double sample_distance_scale = 0;
-  std::vector<VertexRecord> vertices;
+  // kCoded is written as 6.0 (index_format.h); true writes it as older
+  // builders did, 5.0 or 4.0 (the split sparse when that is smaller), so
+  // that tests can check what this reader makes of their files.
+  bool coded_as_version_5 = false;
+  std::vector<VertexRecord> vertices;  // one per vertex
   std::vector<GeodesicTriangle> triangles;
   std::vector<BvhNode> bvh_nodes;
   std::vector<int32_t> bvh_faces;
@@ -121,6 +125,7 @@ class Index {
 
   std::span<const double> positions() const { return positions_; }
   std::span<const int32_t> faces() const { return faces_; }
+  // Derived at load when a 6.x file leaves them out (index_format.h).
   std::span<const int32_t> twins() const { return twins_; }
   std::span<const int32_t> samples() const { return samples_; }
   // The sample distance matrix, in the file's layout: what queries read.
@@ -133,8 +138,11 @@ class Index {
   std::span<const float> sample_distances_lower() const { return sample_distances_lower_; }
   // The same triangle in 24-bit codes, of a 4.x file; empty for others.
   std::span<const PackedCode> sample_distances_coded() const { return sample_distances_coded_; }
+  // One per vertex, in every version (the corners of 1.x-5.x's records left
+  // out: they are those of the record's triangle).
   std::span<const VertexRecord> vertices() const { return vertices_; }
   std::span<const GeodesicTriangle> triangles() const { return triangles_; }
+  // Derived at load when a 6.x file leaves it out (index_format.h).
   std::span<const BvhNode> bvh_nodes() const { return bvh_nodes_; }
   std::span<const int32_t> bvh_faces() const { return bvh_faces_; }
   std::string_view report() const { return report_; }
@@ -185,6 +193,13 @@ class Index {
   std::span<const PackedCode> sample_distances_coded_;
   SampleMatrix matrix_;
   std::span<const VertexRecord> vertices_;
+  // What the reader derived (index_format.h, 6.0): the records of an older
+  // file without their corners; the twins and the BVH of a 6.x file that
+  // left them out. Empty otherwise; the spans above then view the image.
+  std::vector<VertexRecord> derived_vertices_;
+  std::vector<int32_t> derived_twins_;
+  std::vector<BvhNode> derived_bvh_nodes_;
+  std::vector<int32_t> derived_bvh_faces_;
   std::span<const GeodesicTriangle> triangles_;
   std::span<const BvhNode> bvh_nodes_;
   std::span<const int32_t> bvh_faces_;

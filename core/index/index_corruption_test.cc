@@ -78,13 +78,13 @@ TEST(IndexTest, WrongMagicIsFailedPrecondition) {
 
 TEST(IndexTest, WrongMajorVersionIsFailedPrecondition) {
   Image image = Image::Parse(Serialize(MakeSphereIndex()));
-  image.header.format_major = kSparseSplitFormatMajor + 1;
+  image.header.format_major = kDerivedFormatMajor + 1;
   image.header.format_minor = 3;
   const absl::Status status = Index::FromBytes(image.Layout()).status();
   EXPECT_EQ(status.code(), absl::StatusCode::kFailedPrecondition);
-  EXPECT_THAT(status.message(), HasSubstr(absl::StrCat(kSparseSplitFormatMajor + 1, ".3")));
+  EXPECT_THAT(status.message(), HasSubstr(absl::StrCat(kDerivedFormatMajor + 1, ".3")));
   EXPECT_THAT(status.message(),
-              HasSubstr(absl::StrCat(kSparseSplitFormatMajor, ".", kSparseSplitFormatMinor)));
+              HasSubstr(absl::StrCat(kDerivedFormatMajor, ".", kDerivedFormatMinor)));
 }
 
 // A 4.x file has the coded triangle and its scale, a 3.x file the float
@@ -109,6 +109,7 @@ TEST(IndexTest, MatrixLayoutMustMatchTheVersion) {
   EXPECT_EQ(status.code(), absl::StatusCode::kDataLoss);
   EXPECT_THAT(status.message(), HasSubstr("sample distances"));
   d.sample_matrix = MatrixLayout::kCoded;
+  d.coded_as_version_5 = true;  // 4.0: otherwise as the packed file
   Image coded = Image::Parse(Serialize(d));
   coded.header.format_major = kPackedFormatMajor;
   status = Index::FromBytes(coded.Layout()).status();
@@ -205,35 +206,35 @@ TEST(IndexTest, SemanticCorruptionWithValidChecksumsIsDataLoss) {
        "sample distance (1, 2)"},
       {"vertex triangle out of range",
        [&](Image& i) {
-         VertexRecord r = i.Get<VertexRecord>(SectionId::kVertexRecords, 9);
+         VertexRecordWithCorners r = i.Get<VertexRecordWithCorners>(SectionId::kVertexRecords, 9);
          r.triangle = nt;
          i.Set(SectionId::kVertexRecords, 9, r);
        },
        "vertex record 9"},
       {"vertex corner out of range",
        [&](Image& i) {
-         VertexRecord r = i.Get<VertexRecord>(SectionId::kVertexRecords, 9);
+         VertexRecordWithCorners r = i.Get<VertexRecordWithCorners>(SectionId::kVertexRecords, 9);
          r.corner[2] = m;
          i.Set(SectionId::kVertexRecords, 9, r);
        },
        "vertex record 9"},
       {"corner of a vertex without triangle",
        [&](Image& i) {
-         VertexRecord r = i.Get<VertexRecord>(SectionId::kVertexRecords, nv - 1);
+         VertexRecordWithCorners r = i.Get<VertexRecordWithCorners>(SectionId::kVertexRecords, nv - 1);
          r.corner[0] = 0;
          i.Set(SectionId::kVertexRecords, nv - 1, r);
        },
        "vertex record"},
       {"infinite vertex distance",
        [&](Image& i) {
-         VertexRecord r = i.Get<VertexRecord>(SectionId::kVertexRecords, 9);
+         VertexRecordWithCorners r = i.Get<VertexRecordWithCorners>(SectionId::kVertexRecords, 9);
          r.distance[1] = kInf;
          i.Set(SectionId::kVertexRecords, 9, r);
        },
        "vertex record 9"},
       {"negative vertex distance",
        [&](Image& i) {
-         VertexRecord r = i.Get<VertexRecord>(SectionId::kVertexRecords, 9);
+         VertexRecordWithCorners r = i.Get<VertexRecordWithCorners>(SectionId::kVertexRecords, 9);
          r.distance[1] = -1e-3f;
          i.Set(SectionId::kVertexRecords, 9, r);
        },
@@ -353,7 +354,8 @@ IndexData MakeSparseSplitSphereIndex() {
 }
 
 TEST(IndexTest, SplitWithCodedMatrixIsWrittenSparseAsVersion5AndReadBack) {
-  const IndexData d = MakeSparseSplitSphereIndex();
+  IndexData d = MakeSparseSplitSphereIndex();
+  d.coded_as_version_5 = true;
   const std::string bytes = Serialize(d);
   absl::StatusOr<std::shared_ptr<const Index>> index = Index::FromBytes(bytes);
   ASSERT_TRUE(index.ok()) << index.status();
@@ -396,6 +398,85 @@ TEST(IndexTest, SplitWithCodedMatrixIsWrittenSparseAsVersion5AndReadBack) {
        "split piece record 1"},
   };
   ExpectDataLoss(bytes, cases);
+}
+
+// Format 6.0, what the builder writes: the vertex records without their
+// corners, the twins and the BVH left out and derived at load, the split as
+// in 5.0. It reads back to the spans the 5.0 file of the same index gives,
+// in fewer bytes, and is written again to the same bytes.
+TEST(IndexTest, Version6LeavesOutWhatTheReaderDerives) {
+  const IndexData d = MakeSparseSplitSphereIndex();
+  const std::string bytes = Serialize(d);
+  IndexData v5 = d;
+  v5.coded_as_version_5 = true;
+  const std::string bytes5 = Serialize(v5);
+  EXPECT_LT(bytes.size(), bytes5.size());
+  Image image = Image::Parse(bytes);
+  EXPECT_EQ(image.header.format_major, kDerivedFormatMajor);
+  for (const SectionEntry& e : image.entries) {
+    for (SectionId absent : {SectionId::kTwins, SectionId::kFaceBvh, SectionId::kBvhFaces,
+                             SectionId::kVertexRecords}) {
+      EXPECT_NE(e.id, static_cast<uint32_t>(absent));
+    }
+  }
+  EXPECT_EQ(image.Payload(SectionId::kCompactVertexRecords).size(),
+            d.vertices.size() * sizeof(VertexRecord));
+  absl::StatusOr<std::shared_ptr<const Index>> index = Index::FromBytes(bytes);
+  absl::StatusOr<std::shared_ptr<const Index>> index5 = Index::FromBytes(bytes5);
+  ASSERT_TRUE(index.ok()) << index.status();
+  ASSERT_TRUE(index5.ok()) << index5.status();
+  EXPECT_EQ((*index5)->header().format_major, kSparseSplitFormatMajor);
+  auto same = [](auto a, auto b) {
+    return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size_bytes()) == 0;
+  };
+  EXPECT_TRUE(same((*index)->twins(), std::span<const int32_t>(d.twins)));
+  EXPECT_TRUE(same((*index)->bvh_nodes(), std::span<const BvhNode>(d.bvh_nodes)));
+  EXPECT_TRUE(same((*index)->bvh_faces(), std::span<const int32_t>(d.bvh_faces)));
+  EXPECT_TRUE(same((*index)->vertices(), std::span<const VertexRecord>(d.vertices)));
+  EXPECT_TRUE(same((*index5)->vertices(), (*index)->vertices()));
+  EXPECT_TRUE(same((*index5)->twins(), (*index)->twins()));
+  EXPECT_EQ(Serialize(ToIndexData(**index)), bytes);
+  EXPECT_EQ(Serialize(ToIndexData(**index5)), bytes5);
+  EXPECT_EQ(PredictIndexBytes(d), bytes.size());
+  EXPECT_EQ(PredictIndexBytes(v5), bytes5.size());
+
+  // Twins the reader would not derive so (here a seam left open) are stored,
+  // and read as stored.
+  IndexData seam = d;
+  const int32_t h = 0, twin = seam.twins[0];
+  seam.twins[h] = seam.twins[twin] = -1;
+  const std::string seam_bytes = Serialize(seam);
+  absl::StatusOr<std::shared_ptr<const Index>> seamed = Index::FromBytes(seam_bytes);
+  ASSERT_TRUE(seamed.ok()) << seamed.status();
+  EXPECT_TRUE(same((*seamed)->twins(), std::span<const int32_t>(seam.twins)));
+  EXPECT_EQ(PredictIndexBytes(seam), seam_bytes.size());
+
+  // What the derivations refuse is DataLoss naming it; a 6.0 file with an
+  // older version's records, or relabelled older, is refused.
+  const std::vector<Case> cases = {
+      {"a face repeated: edges run the same way",
+       [&](Image& i) {
+         for (int k = 0; k < 3; ++k) i.Set<int32_t>(SectionId::kFaces, 3 + k, d.faces[k]);
+       },
+       "twins: "},
+      {"a BVH of another size than the header's",
+       [&](Image& i) { i.header.num_bvh_nodes += 1; }, "face BVH"},
+      {"a record's triangle out of range",
+       [&](Image& i) {
+         VertexRecord r = i.Get<VertexRecord>(SectionId::kCompactVertexRecords, 3);
+         r.triangle = static_cast<int32_t>(d.triangles.size());
+         i.Set(SectionId::kCompactVertexRecords, 3, r);
+       },
+       "vertex record 3"},
+      {"relabelled 5.0", [&](Image& i) { i.header.format_major = kSparseSplitFormatMajor; },
+       "missing section: twins"},
+  };
+  ExpectDataLoss(bytes, cases);
+  Image relabelled = Image::Parse(bytes5);
+  relabelled.header.format_major = kDerivedFormatMajor;
+  const absl::Status status = Index::FromBytes(relabelled.Layout()).status();
+  EXPECT_EQ(status.code(), absl::StatusCode::kDataLoss);
+  EXPECT_THAT(status.message(), HasSubstr("the section vertex records"));
 }
 
 TEST(IndexTest, RefinementCorruptionWithValidChecksumsIsDataLoss) {

@@ -48,7 +48,7 @@ const std::vector<SectionGroup>& Groups() {
        {SectionId::kSampleDistances, SectionId::kSampleDistancesLower,
         SectionId::kSampleDistancesCoded, SectionId::kDistanceCode}},
       {"mesh", "mesh", {SectionId::kPositions, SectionId::kFaces, SectionId::kTwins}},
-      {"vertex_records", "vertex records", {SectionId::kVertexRecords}},
+      {"vertex_records", "vertex records", {SectionId::kVertexRecords, SectionId::kCompactVertexRecords}},
       {"triangles", "samples, triangles", {SectionId::kSamples, SectionId::kTriangles}},
       {"face_bvh", "face BVH", {SectionId::kFaceBvh, SectionId::kBvhFaces}},
       {"input_ids", "input ids", {SectionId::kInputFaces, SectionId::kVertexCopies}},
@@ -318,6 +318,14 @@ void ReadSections(const Index& index, IndexReport& r) {
   if (r.bytes > in_sections) {
     r.sections.push_back({"header", "header, table, padding", r.bytes - in_sections});
   }
+  if (h.format_major >= kDerivedFormatMajor) {
+    if (!by_id.contains(static_cast<uint32_t>(SectionId::kTwins))) {
+      r.derived_at_load.push_back("twins");
+    }
+    if (!by_id.contains(static_cast<uint32_t>(SectionId::kFaceBvh))) {
+      r.derived_at_load.push_back("face BVH");
+    }
+  }
   std::stable_sort(
       r.sections.begin(), r.sections.end(),
       [](const ReportSection& a, const ReportSection& b) { return a.bytes > b.bytes; });
@@ -454,6 +462,10 @@ std::string IndexReportText(const IndexReport& r, std::string_view title) {
     absl::StrAppendFormat(&out, "                  %-24s %10s %6s\n", s.label, FormatMiB(s.bytes),
                           share < 0.05 ? "<0.1%" : absl::StrFormat("%.1f%%", share));
   }
+  if (!r.derived_at_load.empty()) {
+    absl::StrAppendFormat(&out, "                  %s: not stored, derived at load\n",
+                          absl::StrJoin(r.derived_at_load, ", "));
+  }
   absl::StrAppendFormat(
       &out, "  error bounds  %s\n",
       r.error_bounds ? "yes (calibrated)" : "no (geodex-build calibrate adds them)");
@@ -524,6 +536,10 @@ std::string IndexReportJson(const IndexReport& r) {
     absl::StrAppend(&out, i ? ",\n" : "\n", "    {\"key\": ", JsonString(r.sections[i].key),
                     ", \"label\": ", JsonString(r.sections[i].label),
                     ", \"bytes\": ", r.sections[i].bytes, "}");
+  }
+  absl::StrAppend(&out, "], \"derived_at_load\": [");
+  for (size_t i = 0; i < r.derived_at_load.size(); ++i) {
+    absl::StrAppend(&out, i ? ", " : "", JsonString(r.derived_at_load[i]));
   }
   absl::StrAppend(&out, "]},\n");
   absl::StrAppend(&out, "  \"error_bounds\": ", r.error_bounds ? "true" : "false", ",\n");

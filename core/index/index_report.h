@@ -116,6 +116,9 @@ struct IndexReport {
   int64_t triangles = 0;
   uint64_t bytes = 0;                   // the whole file
   std::vector<ReportSection> sections;  // non-empty groups, largest first
+  // What the file leaves out and the reader derives at load (format 6.0):
+  // "twins", "face BVH".
+  std::vector<std::string> derived_at_load;
   bool error_bounds = false;            // calibrated: per-answer bounds and tolerances
   // The error target: `target_asked` when the index was built to one
   // (--target-error, or no --samples); otherwise target_error is the default

@@ -45,6 +45,7 @@ std::optional<uint64_t> ExpectedCount(SectionId id, const Counts& c) {
     case SectionId::kSampleDistancesCoded:
       return c.num_samples * (c.num_samples - std::min<uint64_t>(c.num_samples, 1)) / 2;
     case SectionId::kVertexRecords:
+    case SectionId::kCompactVertexRecords:
       return c.num_vertices;
     case SectionId::kTriangles:
       return c.num_triangles;
@@ -191,11 +192,6 @@ absl::Status CheckContents(const Contents& c, absl::StatusCode code) {
                                   r.triangle, nt));
     }
     for (int k = 0; k < 3; ++k) {
-      if (r.triangle == -1 ? r.corner[k] != -1 : !InRange(r.corner[k], 0, m)) {
-        return fail(absl::StrFormat(
-            "vertex record %d: corner %d is %d, expected %s", v, k, r.corner[k],
-            r.triangle == -1 ? "-1 (no triangle)" : absl::StrFormat("a sample in [0, %d)", m)));
-      }
       // Vertices without a triangle may carry +inf; the others need real values.
       const bool ok = r.triangle == -1 ? NonNegative(r.distance[k])
                                        : std::isfinite(r.distance[k]) && r.distance[k] >= 0;
@@ -216,6 +212,17 @@ absl::Status CheckContents(const Contents& c, absl::StatusCode code) {
         return fail(
             absl::StrFormat("geodesic triangle %d: neighbour %d is %d, out of range [-1, %d)", t, k,
                             g.neighbor[k], nt));
+      }
+    }
+  }
+  for (size_t v = 0; v < c.vertices_with_corners.size(); ++v) {
+    const VertexRecordWithCorners& r = c.vertices_with_corners[v];
+    for (int k = 0; k < 3; ++k) {
+      const int32_t expected = r.triangle == -1 ? -1 : c.triangles[r.triangle].corner[k];
+      if (r.corner[k] != expected) {
+        return fail(absl::StrFormat("vertex record %d: corner %d is %d, expected %d (%s)", v, k,
+                                    r.corner[k], expected,
+                                    r.triangle == -1 ? "no triangle" : "its triangle's"));
       }
     }
   }

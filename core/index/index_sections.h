@@ -29,18 +29,22 @@ struct SectionSpec {
   SectionId id;
   uint32_t element_size;
   const char* name;
-  bool required;  // must be present (possibly empty) in every file
+  // Must be present (possibly empty) in every file; the sections of some
+  // versions only are required by version (SectionsOfVersion in index.cc).
+  bool required;
 };
 
 constexpr SectionSpec kSpecs[] = {
     {SectionId::kPositions, sizeof(double), "positions", true},
     {SectionId::kFaces, sizeof(int32_t), "faces", true},
-    {SectionId::kTwins, sizeof(int32_t), "twins", true},
+    // Required before 6.0; from 6.0 left out when derivable (derived_sections.h).
+    {SectionId::kTwins, sizeof(int32_t), "twins", false},
     {SectionId::kSamples, sizeof(int32_t), "samples", true},
     // Required by version: the full matrix before 3.0, its lower triangle
     // from 3.0, in codes with their scale from 4.0.
     {SectionId::kSampleDistances, sizeof(float), "sample distances", false},
-    {SectionId::kVertexRecords, sizeof(VertexRecord), "vertex records", true},
+    // Required by version: with corners before 6.0, without from 6.0.
+    {SectionId::kVertexRecords, sizeof(VertexRecordWithCorners), "vertex records", false},
     {SectionId::kTriangles, sizeof(GeodesicTriangle), "geodesic triangles", true},
     {SectionId::kFaceBvh, sizeof(BvhNode), "face BVH", false},
     {SectionId::kBvhFaces, sizeof(int32_t), "BVH faces", false},
@@ -56,6 +60,7 @@ constexpr SectionSpec kSpecs[] = {
     {SectionId::kDistanceCode, sizeof(DistanceCodeRecord), "distance code", false},
     {SectionId::kSplitCoarseFaces, sizeof(SplitCoarseRecord), "split coarse faces", false},
     {SectionId::kSplitPieces, sizeof(SplitPieceRecord), "split pieces", false},
+    {SectionId::kCompactVertexRecords, sizeof(VertexRecord), "vertex records (6.0)", false},
 };
 constexpr size_t kNumSpecs = std::size(kSpecs);
 
@@ -102,6 +107,9 @@ struct Contents {
   std::span<const int32_t> vertex_copies;
   SplitView split;  // dense or sparse, its layout's records checked
   uint64_t split_vertices = 0;
+  // The records of a 1.x-5.x file, `vertices` with their corners: each
+  // corner must be its triangle's (-1 without one).
+  std::span<const VertexRecordWithCorners> vertices_with_corners = {};
 };
 // The accuracy records (at most one, finite, non-negative); errors with `code`.
 absl::Status CheckAccuracy(std::span<const AccuracyRecord> records, absl::StatusCode code);

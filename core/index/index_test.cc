@@ -85,8 +85,8 @@ TEST(IndexTest, CodedMatrixRoundTrips) {
   const std::string coded = Serialize(d);
   absl::StatusOr<std::shared_ptr<const Index>> index = Index::FromBytes(coded);
   ASSERT_TRUE(index.ok()) << index.status();
-  EXPECT_EQ((*index)->header().format_major, kCodedFormatMajor);
-  EXPECT_EQ((*index)->header().format_minor, kCodedFormatMinor);
+  EXPECT_EQ((*index)->header().format_major, kDerivedFormatMajor);
+  EXPECT_EQ((*index)->header().format_minor, kDerivedFormatMinor);
   EXPECT_EQ((*index)->matrix().layout(), MatrixLayout::kCoded);
   EXPECT_TRUE((*index)->sample_distances().empty());
   EXPECT_TRUE((*index)->sample_distances_lower().empty());
@@ -273,7 +273,7 @@ TEST(IndexTest, LayoutFollowsTheFormat) {
   }
   EXPECT_EQ(image.entries[0].id, static_cast<uint32_t>(SectionId::kPositions));
   EXPECT_EQ(image.entries[0].element_size, sizeof(double));
-  EXPECT_EQ(image.entries[5].element_size, sizeof(VertexRecord));
+  EXPECT_EQ(image.entries[5].element_size, sizeof(VertexRecordWithCorners));
 }
 
 TEST(IndexTest, SerializationIsDeterministic) {

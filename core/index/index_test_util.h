@@ -86,17 +86,13 @@ inline IndexData MakeSphereIndex() {
     }
     EXPECT_GE(r.triangle, 0) << v;
     for (int k = 0; k < 3; ++k) {
-      r.corner[k] = coarse.face(r.triangle)[k];
-      r.distance[k] = GreatCircle(p, fine.position(d.samples[r.corner[k]]));
+      r.distance[k] = GreatCircle(p, fine.position(d.samples[coarse.face(r.triangle)[k]]));
     }
     d.vertices.push_back(r);
   }
   VertexRecord none{};
   none.triangle = -1;
-  for (int k = 0; k < 3; ++k) {
-    none.corner[k] = -1;
-    none.distance[k] = kInf;
-  }
+  for (int k = 0; k < 3; ++k) none.distance[k] = kInf;
   d.vertices.push_back(none);
   BuildFaceBvh(d.positions, d.faces, &d.bvh_nodes, &d.bvh_faces);
   d.mesh_hash = MeshHash(d.positions, d.faces);

@@ -9,6 +9,8 @@
 #include "absl/strings/str_format.h"
 #include "core/common/file_util.h"
 #include "core/common/status_macros.h"
+#include "core/index/derived_sections.h"
+#include "core/index/face_bvh.h"
 #include "core/index/index.h"
 #include "core/index/index_sections.h"
 #include "core/index/input_id_checks.h"
@@ -67,21 +69,52 @@ absl::StatusOr<SplitLayout> SplitLayoutOf(const IndexData& d) {
   return out;
 }
 
+// What a 6.0 file leaves out because the reader derives it as it is
+// (derived_sections.h): the twins, the face BVH. Nothing before 6.0, which
+// the builder writes for the coded matrix only.
+struct Derivable {
+  bool twins = false;
+  bool bvh = false;
+};
+
+// Whether `d` is written as 6.0: the coded matrix, unless asked for the
+// older layout.
+bool Compact(const IndexData& d) {
+  return d.sample_matrix == MatrixLayout::kCoded && !d.coded_as_version_5;
+}
+
+Derivable DerivableOf(const IndexData& d) {
+  Derivable out;
+  if (!Compact(d)) return out;
+  const absl::StatusOr<std::vector<int32_t>> twins =
+      internal::DeriveTwins(d.faces, absl::StatusCode::kInvalidArgument);
+  out.twins = twins.ok() && *twins == d.twins;
+  std::vector<BvhNode> nodes;
+  std::vector<int32_t> faces;
+  BuildFaceBvh(d.positions, d.faces, &nodes, &faces);
+  out.bvh = faces == d.bvh_faces && nodes.size() == d.bvh_nodes.size() &&
+            (nodes.empty() ||
+             std::memcmp(nodes.data(), d.bvh_nodes.data(), nodes.size() * sizeof(BvhNode)) == 0);
+  return out;
+}
+
 // The sections of `d` in kSpecs order, the matrix's from `matrix` (full,
-// lower, coded, code).
+// lower, coded, code), the vertex records from `with_corners` before 6.0.
 void LayOut(const IndexData& d, const Piece (&matrix)[4], const SplitLayout& split,
+            const Derivable& derivable, std::span<const VertexRecordWithCorners> with_corners,
             Piece (&pieces)[kNumSpecs]) {
   const bool dense = !split.sparse;
+  const bool compact = Compact(d);
   const Piece all[kNumSpecs] = {
       {d.positions.data(), d.positions.size() * sizeof(double)},
       {d.faces.data(), d.faces.size() * sizeof(int32_t)},
-      {d.twins.data(), d.twins.size() * sizeof(int32_t)},
+      {d.twins.data(), derivable.twins ? 0 : d.twins.size() * sizeof(int32_t)},
       {d.samples.data(), d.samples.size() * sizeof(int32_t)},
       matrix[0],
-      {d.vertices.data(), d.vertices.size() * sizeof(VertexRecord)},
+      {with_corners.data(), compact ? 0 : d.vertices.size() * sizeof(VertexRecordWithCorners)},
       {d.triangles.data(), d.triangles.size() * sizeof(GeodesicTriangle)},
-      {d.bvh_nodes.data(), d.bvh_nodes.size() * sizeof(BvhNode)},
-      {d.bvh_faces.data(), d.bvh_faces.size() * sizeof(int32_t)},
+      {d.bvh_nodes.data(), derivable.bvh ? 0 : d.bvh_nodes.size() * sizeof(BvhNode)},
+      {d.bvh_faces.data(), derivable.bvh ? 0 : d.bvh_faces.size() * sizeof(int32_t)},
       {d.report.data(), d.report.size()},
       {d.accuracy.data(), d.accuracy.size() * sizeof(AccuracyRecord)},
       {d.input_faces.data(), d.input_faces.size() * sizeof(InputFaceRecord)},
@@ -94,6 +127,7 @@ void LayOut(const IndexData& d, const Piece (&matrix)[4], const SplitLayout& spl
       matrix[3],
       {split.coarse.data(), split.coarse.size() * sizeof(SplitCoarseRecord)},
       {split.pieces.data(), split.pieces.size() * sizeof(SplitPieceRecord)},
+      {d.vertices.data(), compact ? d.vertices.size() * sizeof(VertexRecord) : 0},
   };
   std::copy(std::begin(all), std::end(all), std::begin(pieces));
 }
@@ -102,14 +136,21 @@ void LayOut(const IndexData& d, const Piece (&matrix)[4], const SplitLayout& spl
 // but the input-id sections (1.2, 2.0), written only when the mesh was
 // repaired or split so that the index of a mesh that needed neither keeps
 // the 1.1 layout, and the matrix sections of other layouts. The matrix
-// sections of the layout written are, even when empty (no samples).
-bool Written(size_t i, const Piece (&pieces)[kNumSpecs], MatrixLayout layout) {
+// sections of the layout written are, even when empty (no samples). The
+// vertex records of one version only; the twins and the BVH not when
+// derivable.
+bool Written(size_t i, const Piece (&pieces)[kNumSpecs], MatrixLayout layout, bool compact,
+             const Derivable& derivable) {
   const SectionId id = kSpecs[i].id;
   if (id == SectionId::kSampleDistances) return layout == MatrixLayout::kFull;
   if (id == SectionId::kSampleDistancesLower) return layout == MatrixLayout::kLower;
   if (id == SectionId::kSampleDistancesCoded || id == SectionId::kDistanceCode) {
     return layout == MatrixLayout::kCoded;
   }
+  if (id == SectionId::kVertexRecords) return !compact;
+  if (id == SectionId::kCompactVertexRecords) return compact;
+  if (id == SectionId::kTwins) return !derivable.twins;
+  if (id == SectionId::kFaceBvh || id == SectionId::kBvhFaces) return !derivable.bvh;
   return pieces[i].size > 0 || (id != SectionId::kInputFaces && id != SectionId::kVertexCopies &&
                                 id != SectionId::kCoarseFaces && id != SectionId::kSplitFaces &&
                                 id != SectionId::kSplitCoarseFaces &&
@@ -117,12 +158,15 @@ bool Written(size_t i, const Piece (&pieces)[kNumSpecs], MatrixLayout layout) {
 }
 
 // The file's size: header, table and every written section aligned.
-uint64_t FileSize(const Piece (&pieces)[kNumSpecs], MatrixLayout layout) {
+uint64_t FileSize(const Piece (&pieces)[kNumSpecs], MatrixLayout layout, bool compact,
+                  const Derivable& derivable) {
   uint64_t sections = 0;
-  for (size_t i = 0; i < kNumSpecs; ++i) sections += Written(i, pieces, layout) ? 1 : 0;
+  for (size_t i = 0; i < kNumSpecs; ++i) {
+    sections += Written(i, pieces, layout, compact, derivable) ? 1 : 0;
+  }
   uint64_t cursor = sizeof(FileHeader) + sections * sizeof(SectionEntry);
   for (size_t i = 0; i < kNumSpecs; ++i) {
-    if (Written(i, pieces, layout)) cursor = AlignUp(cursor) + pieces[i].size;
+    if (Written(i, pieces, layout, compact, derivable)) cursor = AlignUp(cursor) + pieces[i].size;
   }
   return cursor;
 }
@@ -141,9 +185,10 @@ uint64_t PredictIndexBytes(const IndexData& d) {
       {nullptr, layout == MatrixLayout::kCoded ? lower * sizeof(PackedCode) : 0},
       {nullptr, layout == MatrixLayout::kCoded ? sizeof(DistanceCodeRecord) : 0},
   };
+  const Derivable derivable = DerivableOf(d);
   Piece pieces[kNumSpecs];
-  LayOut(d, matrix, split, pieces);
-  return FileSize(pieces, layout);
+  LayOut(d, matrix, split, derivable, {}, pieces);
+  return FileSize(pieces, layout, Compact(d), derivable);
 }
 
 absl::StatusOr<std::string> SerializeIndex(const IndexData& d) {
@@ -253,9 +298,14 @@ absl::StatusOr<std::string> SerializeIndex(const IndexData& d) {
       {coded.data(), coded.size() * sizeof(PackedCode)},
       {code.data(), code.size() * sizeof(DistanceCodeRecord)},
   };
+  const Derivable derivable = DerivableOf(d);
+  const bool compact = Compact(d);
+  const std::vector<VertexRecordWithCorners> with_corners =
+      compact ? std::vector<VertexRecordWithCorners>()
+              : internal::WithCorners(d.vertices, d.triangles);
   Piece pieces[kNumSpecs];
-  LayOut(d, matrix, split, pieces);
-  auto written = [&pieces, layout](size_t i) { return Written(i, pieces, layout); };
+  LayOut(d, matrix, split, derivable, with_corners, pieces);
+  auto written = [&](size_t i) { return Written(i, pieces, layout, compact, derivable); };
   const bool refined = !d.split_faces.empty();
   size_t num_sections = 0;
   for (size_t i = 0; i < kNumSpecs; ++i) num_sections += written(i) ? 1 : 0;
@@ -284,8 +334,13 @@ absl::StatusOr<std::string> SerializeIndex(const IndexData& d) {
   std::memcpy(h.magic, kMagic, sizeof(kMagic));
   switch (layout) {
     case MatrixLayout::kCoded:
-      h.format_major = split.sparse ? kSparseSplitFormatMajor : kCodedFormatMajor;
-      h.format_minor = split.sparse ? kSparseSplitFormatMinor : kCodedFormatMinor;
+      if (compact) {
+        h.format_major = kDerivedFormatMajor;
+        h.format_minor = kDerivedFormatMinor;
+      } else {
+        h.format_major = split.sparse ? kSparseSplitFormatMajor : kCodedFormatMajor;
+        h.format_minor = split.sparse ? kSparseSplitFormatMinor : kCodedFormatMinor;
+      }
       break;
     case MatrixLayout::kLower:
       h.format_major = kPackedFormatMajor;

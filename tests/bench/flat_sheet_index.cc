@@ -102,10 +102,8 @@ void AddVertexRecords(int cells, int fine, int n, index::IndexData* d) {
       const int32_t t = 2 * (cj * cells + ci) + (y > x ? 1 : 0);
       index::VertexRecord& r = d->vertices[j * n + i];
       r.triangle = t;
-      r.flags = 0;
       for (int c = 0; c < 3; ++c) {
         const int32_t s = d->triangles[t].corner[c];
-        r.corner[c] = s;
         r.distance[c] =
             static_cast<float>(std::hypot(double(i) / fine - s % m, double(j) / fine - s / m));
       }

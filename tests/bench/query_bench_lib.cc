@@ -47,8 +47,9 @@ struct FullMatrix {
   double operator()(int32_t a, int32_t b) const { return ix.SampleDistance(a, b); }
 };
 
-// The loads of a query: the records and positions of both faces' vertices and
-// the 3x3 block of the sample matrix between the two anchors' corners.
+// The loads of a query: the records and positions of both faces' vertices,
+// the anchors' triangles and the 3x3 block of the sample matrix between their
+// corners.
 template <typename Matrix>
 double Gather(const index::Index& ix, const Matrix& matrix, const mesh::SurfacePoint& p,
               const mesh::SurfacePoint& q) {
@@ -65,8 +66,12 @@ double Gather(const index::Index& ix, const Matrix& matrix, const mesh::SurfaceP
     }
     anchor[k] = &records[f[0]];
   }
+  if (anchor[0]->triangle < 0 || anchor[1]->triangle < 0) return acc;
+  const auto triangles = ix.triangles();
+  const int32_t* c0 = triangles[anchor[0]->triangle].corner;
+  const int32_t* c1 = triangles[anchor[1]->triangle].corner;
   for (int i = 0; i < 3; ++i) {
-    for (int j = 0; j < 3; ++j) acc += matrix(anchor[0]->corner[i], anchor[1]->corner[j]);
+    for (int j = 0; j < 3; ++j) acc += matrix(c0[i], c1[j]);
   }
   return acc;
 }

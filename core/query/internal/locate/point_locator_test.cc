@@ -203,7 +203,7 @@ TEST(PointLocatorTest, WorksOnIndexSpans) {
   for (int32_t h = 0; h < mesh.num_halfedges(); ++h) d.twins.push_back(mesh.Twin(h));
   d.vertices.resize(mesh.num_vertices());
   for (index::VertexRecord& r : d.vertices) {
-    r = index::VertexRecord{.triangle = -1, .corner = {-1, -1, -1}, .distance = {}, .flags = 0};
+    r = index::VertexRecord{.triangle = -1, .distance = {}};
   }
   d.bvh_nodes = flat.nodes;
   d.bvh_faces = flat.leaf_faces;

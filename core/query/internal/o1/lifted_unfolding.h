@@ -49,6 +49,8 @@ class LiftedUnfolding {
 
   // The geodesic distance between samples a and b, as the index stores it.
   double Matrix(int32_t a, int32_t b) const { return matrix_(a, b); }
+  // Geodesic triangle t: its corner samples and neighbours.
+  const index::GeodesicTriangle& Triangle(int32_t t) const { return triangles_[t]; }
   // The frames of triangle t's three edges.
   const kernel::Frame<double>* Frames(int32_t t) const { return &frames_[3 * t]; }
 

@@ -73,12 +73,16 @@ class Lifting {
 
   // The lift of a valid point (see the header comment).
   LiftedPoint Lift(const SurfacePoint& p) const;
-  // The lift of vertex v: its record.
+  // The lift of vertex v: its record, with its triangle's corners (-1
+  // without a triangle).
   LiftedPoint VertexLift(int32_t v) const {
     const index::VertexRecord& r = records_[v];
-    return {r.triangle,
-            {r.corner[0], r.corner[1], r.corner[2]},
-            {r.distance[0], r.distance[1], r.distance[2]}};
+    LiftedPoint out{r.triangle, {-1, -1, -1}, {r.distance[0], r.distance[1], r.distance[2]}};
+    if (r.triangle >= 0) {
+      const index::GeodesicTriangle& t = unfolding_->Triangle(r.triangle);
+      out.corner = {t.corner[0], t.corner[1], t.corner[2]};
+    }
+    return out;
   }
   // Bring in what Lift(p) reads: the face and its FaceLift (prefetched),
   // then, once those are in cache, the ApproxLift (loaded: see Touch in the
