@@ -7,6 +7,7 @@
 #include <cstring>
 #include <limits>
 #include <map>
+#include <set>
 
 #include "absl/strings/ascii.h"
 #include "absl/strings/numbers.h"
@@ -302,12 +303,14 @@ void ReadSections(const Index& index, IndexReport& r) {
   const FileHeader& h = index.header();
   const std::span<const uint8_t> image = index.image();
   std::map<uint32_t, uint64_t> by_id;
+  std::set<uint32_t> present;
   uint64_t in_sections = 0;
   for (uint32_t i = 0; i < h.num_sections; ++i) {
     SectionEntry e;
     // Index::Open checked that the table lies inside the file.
     std::memcpy(&e, image.data() + h.section_table_offset + i * sizeof(SectionEntry), sizeof(e));
     by_id[e.id] += e.size;
+    present.insert(e.id);
     in_sections += e.size;
   }
   for (const SectionGroup& g : Groups()) {
@@ -319,10 +322,10 @@ void ReadSections(const Index& index, IndexReport& r) {
     r.sections.push_back({"header", "header, table, padding", r.bytes - in_sections});
   }
   if (h.format_major >= kDerivedFormatMajor) {
-    if (!by_id.contains(static_cast<uint32_t>(SectionId::kTwins))) {
+    if (!present.contains(static_cast<uint32_t>(SectionId::kTwins))) {
       r.derived_at_load.push_back("twins");
     }
-    if (!by_id.contains(static_cast<uint32_t>(SectionId::kFaceBvh))) {
+    if (!present.contains(static_cast<uint32_t>(SectionId::kFaceBvh))) {
       r.derived_at_load.push_back("face BVH");
     }
   }

@@ -161,5 +161,23 @@ TEST(IndexReportTest, IndexWithoutCalibrationHasNoAccuracy) {
   EXPECT_THAT(IndexReportJson(r), HasSubstr("\"build_report\": {}"));
 }
 
+// A 6.0 file says what it leaves out for the reader to derive; an older one
+// stores everything.
+TEST(IndexReportTest, SaysWhatTheReaderDerivesAtLoad) {
+  IndexData d = MakeSphereIndex();
+  d.sample_matrix = MatrixLayout::kCoded;
+  const auto index = Load(d);
+  ASSERT_NE(index, nullptr);
+  const IndexReport r = MakeIndexReport(*index);
+  EXPECT_EQ(r.derived_at_load, (std::vector<std::string>{"twins", "face BVH"}));
+  EXPECT_THAT(IndexReportText(r, "x"), HasSubstr("twins, face BVH: not stored, derived at load"));
+  EXPECT_THAT(IndexReportJson(r), HasSubstr("\"derived_at_load\": [\"twins\", \"face BVH\"]"));
+  d.coded_as_version_5 = true;
+  const auto older = Load(d);
+  ASSERT_NE(older, nullptr);
+  EXPECT_TRUE(MakeIndexReport(*older).derived_at_load.empty());
+  EXPECT_THAT(IndexReportJson(MakeIndexReport(*older)), HasSubstr("\"derived_at_load\": []"));
+}
+
 }  // namespace
 }  // namespace geodex::index

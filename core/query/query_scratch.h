@@ -30,6 +30,9 @@ struct NearPairStats {
   int64_t exact_rounds = 0;        // its propagations
   int64_t exact_region_faces = 0;  // faces of its last regions
   int64_t exact_windows = 0;       // windows it created
+  // Pairs refined only by a raised threshold whose walks all failed: their
+  // O(1) answer kept.
+  int64_t raised_kept = 0;
 };
 
 class QueryScratch {

@@ -165,6 +165,7 @@ absl::StatusOr<AnswerMode> ParseAnswerMode(const std::string& mode) {
     m.bounds = true;
   } else if (mode.rfind("below", 0) == 0) {
     m.options.refine_below_l1000 = std::stod(mode.substr(5));
+    m.bounds = true;  // the bounds of the raised band's walks, measured too
   } else if (mode.rfind("tol", 0) == 0) {
     m.options.tolerance = std::stod(mode.substr(3));
     m.bounds = true;

@@ -72,7 +72,8 @@ struct AnswerMode {
 };
 
 // unfold, default, exact, bounds, tolX (tolerance X, with bounds), belowX
-// (default, refining below X L1000: DistanceOptions::refine_below_l1000),
+// (default, refining below X L1000: DistanceOptions::refine_below_l1000;
+// with bounds),
 // trace, nowalk; X as std::stod reads it, which throws when it is no number.
 // Errors: InvalidArgument "unknown mode M".
 absl::StatusOr<AnswerMode> ParseAnswerMode(const std::string& mode);

@@ -122,7 +122,7 @@ TEST(AccuracyHarnessTest, AnswerModes) {
   EXPECT_EQ(mode->options.tolerance, 0.01);
   mode = ParseAnswerMode("below8");
   EXPECT_EQ(mode->options.refine_below_l1000, 8);
-  EXPECT_FALSE(mode->bounds);
+  EXPECT_TRUE(mode->bounds);
   mode = ParseAnswerMode("trace");
   EXPECT_TRUE(mode->trace);
   EXPECT_FALSE(mode->nowalk);

@@ -7,6 +7,7 @@
 #include <span>
 #include <utility>
 
+#include "Eigen/Geometry"
 #include "absl/status/status.h"
 #include "absl/strings/str_format.h"
 #include "core/builder/builder.h"
@@ -298,6 +299,10 @@ std::unique_ptr<CLI::App> QueryBenchFlags(QueryBenchOptions* options) {
                   "Pairs per row of the table against the exact engine");
   app->add_flag("--near-profile", options->near_profile,
                 "Only the near pairs' rates and where their time goes");
+  app->add_option("--every-distance", options->every_distance,
+                  "Only the every-distance table: area-uniform pairs, default mode with the "
+                  "refinement threshold raised to X L1000, against default and pure O(1)")
+      ->check(CLI::PositiveNumber);
   return app;
 }
 
@@ -603,7 +608,92 @@ std::vector<const QueryBenchTable*> QueryBenchTables() {
   return out;
 }
 
+// `n` interior points drawn uniformly by area: a face with probability
+// proportional to its area, uniform barycentric weights.
+std::vector<mesh::SurfacePoint> AreaUniformPoints(const index::Index& ix, int n, uint64_t seed) {
+  const auto pos = ix.positions();
+  const auto faces = ix.faces();
+  std::vector<double> cumulative(ix.num_faces());
+  double total = 0;
+  for (int32_t f = 0; f < ix.num_faces(); ++f) {
+    Eigen::Vector3d c[3];
+    for (int k = 0; k < 3; ++k) {
+      const int32_t v = faces[3 * f + k];
+      c[k] = {pos[3 * v], pos[3 * v + 1], pos[3 * v + 2]};
+    }
+    total += (c[1] - c[0]).cross(c[2] - c[0]).norm();
+    cumulative[f] = total;
+  }
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> u(0, 1);
+  std::vector<mesh::SurfacePoint> out;
+  while (static_cast<int>(out.size()) < n) {
+    const double at = u(rng) * total;
+    const int32_t f = static_cast<int32_t>(
+        std::min<ptrdiff_t>(std::upper_bound(cumulative.begin(), cumulative.end(), at) -
+                                cumulative.begin(),
+                            ix.num_faces() - 1));
+    double a = u(rng), b = u(rng);
+    if (a + b > 1) a = 1 - a, b = 1 - b;
+    out.push_back({f, {1 - a - b, a, b}});
+  }
+  return out;
+}
+
+// The every-distance table's row of one index: area-uniform interior pairs,
+// the default mode with the threshold raised to `below` L1000, beside the
+// default and the pure O(1) answer on the same pairs; how many of the raised
+// pairs kept their O(1) answer.
+void BenchEveryDistance(const std::string& label, std::shared_ptr<const index::Index> ix,
+                        double below, int pairs) {
+  auto engine = query::QueryEngine::Create(ix);
+  if (!engine.ok()) {
+    std::printf("| %s | %s |\n", label.c_str(), engine.status().ToString().c_str());
+    return;
+  }
+  const auto a = AreaUniformPoints(*ix, pairs, 21), b = AreaUniformPoints(*ix, pairs, 22);
+  const size_t n = a.size();
+  std::vector<double> out(n);
+  auto rate = [&](const query::DistanceOptions& options, query::NearPairStats* stats) {
+    query::QueryScratch scratch;
+    const double start = ThreadCpuSeconds();
+    if (!(*engine)->DistanceBatch(a, b, out, options, &scratch).ok()) return 0.0;
+    const double seconds = ThreadCpuSeconds() - start;
+    if (stats != nullptr) *stats = scratch.near_pair_stats();
+    return n / seconds;
+  };
+  const double pure = rate({.near_pairs = query::NearPairs::kUnfold}, nullptr);
+  const double plain = rate({}, nullptr);
+  query::NearPairStats stats;
+  const double every = rate({.refine_below_l1000 = below}, &stats);
+  std::printf("%s\n", MarkdownRow({label, absl::StrFormat("%zu", n),
+                                   absl::StrFormat("%.3fM", pure / 1e6),
+                                   absl::StrFormat("%.3fM", plain / 1e6),
+                                   absl::StrFormat("%.1fK", every / 1e3),
+                                   absl::StrFormat("%.1f%%", 100.0 * stats.pairs / n),
+                                   absl::StrFormat("%.2f%%", 100.0 * stats.exact_solves / n),
+                                   absl::StrFormat("%.2f%%", 100.0 * stats.raised_kept / n)})
+                          .c_str());
+}
+
 int RunQueryBench(const QueryBenchOptions& options) {
+  if (options.every_distance > 0) {
+    std::printf("Every distance: area-uniform interior pairs, batch pairs/s, one thread; "
+                "threshold %g L1000\n%s",
+                options.every_distance,
+                MarkdownHeader({"index", "pairs", "pure O(1)/s", "default/s", "every-distance/s",
+                                "refined (walked or exact)", "exact", "O(1) kept"})
+                    .c_str());
+    for (const std::string& path : options.indexes) {
+      auto ix = index::Index::Open(path);
+      if (!ix.ok()) {
+        std::fprintf(stderr, "%s\n", ix.status().ToString().c_str());
+        return 1;
+      }
+      BenchEveryDistance(path, *ix, options.every_distance, options.pairs);
+    }
+    return 0;
+  }
   std::printf("(batch: far pairs %s)\n", query::kernel::HasAvx2Lanes()
                                              ? "four at a time with AVX2"
                                              : "one at a time: no AVX2 in this build or CPU");

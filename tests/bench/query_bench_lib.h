@@ -30,6 +30,9 @@ struct QueryBenchOptions {
   std::map<std::string, bool> table_only = {};
   int accuracy_pairs = 1000;         // per row of the table against the exact engine
   bool near_profile = false;         // only the near pairs' rates and profile
+  // > 0: only the every-distance table, the threshold raised to this many
+  // L1000 (DistanceOptions::refine_below_l1000).
+  double every_distance = 0;
 };
 
 // The command line of query_bench, writing into `options` when parsed.

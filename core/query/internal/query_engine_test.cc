@@ -338,9 +338,12 @@ TEST(QueryEngineTest, NearPairsTheWalksCannotSettleAreExact) {
 }
 
 // A request that raises the threshold past every pair (the every-distance
-// mode at its extreme) refines them all: each answer is the walks' local
-// geodesic or exact, so no worse than the O(1) answer, and much better on a
-// coarse index. A threshold it cannot parse is refused.
+// mode at its extreme) refines them all: within the index's own threshold
+// each answer is the walks' local geodesic or exact; beyond it a surface
+// path (a walk or the gradient trace) no longer than the O(1) answer plus
+// its bound (this index has none), or the O(1) answer where none is found;
+// much better than the O(1) answer on a coarse index. A threshold it cannot
+// parse is refused. (The bounds of these answers: tests/bench/accuracy.md.)
 TEST(QueryEngineTest, ARequestRaisesTheRefinementThresholdInL1000) {
   const Mesh m = gen::Torus(48, 24, 1.0, 0.45);
   auto engine = MakeEngine(m, 60);
@@ -359,8 +362,13 @@ TEST(QueryEngineTest, ARequestRaisesTheRefinementThresholdInL1000) {
     const auto walked = engine->WalkedDistance(p, q);
     const double exactly = *engine->Distance(p, q, {.near_pairs = NearPairs::kExact,
                                                     .refine_below_l1000 = 1e6});
-    EXPECT_TRUE((walked.ok() && refined == *walked) || refined == exactly)
-        << refined << " walked " << (walked.ok() ? *walked : -1) << " exact " << exactly;
+    const bool own_band = *engine->Distance(p, q) != o1;  // refined by default too
+    if (own_band) {
+      EXPECT_TRUE((walked.ok() && refined == *walked) || refined == exactly)
+          << refined << " walked " << (walked.ok() ? *walked : -1) << " exact " << exactly;
+    } else {
+      EXPECT_TRUE(refined >= exact * (1 - 1e-9) || refined == o1) << refined << " " << exact;
+    }
     EXPECT_NEAR(exactly, exact, 1e-9 * exact);
     double out = 0;
     ASSERT_TRUE(engine->DistanceBatch({&p, 1}, {&q, 1}, {&out, 1}, every).ok());
@@ -368,8 +376,8 @@ TEST(QueryEngineTest, ARequestRaisesTheRefinementThresholdInL1000) {
     o1_worst = std::max(o1_worst, std::abs(o1 - exact) / exact);
     every_worst = std::max(every_worst, std::abs(refined - exact) / exact);
   }
-  EXPECT_GT(o1_worst, 0.03);       // 60 samples: the O(1) answer errs by several %
-  EXPECT_LT(every_worst, 0.0201);  // walks within 2% of the chord's certificate, or exact
+  EXPECT_GT(o1_worst, 0.03);  // 60 samples: the O(1) answer errs by several %
+  EXPECT_LT(every_worst, o1_worst / 3);
   for (const double bad : {-1.0, std::nan(""), std::numeric_limits<double>::infinity()}) {
     const absl::StatusOr<double> d = engine->Distance(points[0], points[1], {.refine_below_l1000 = bad});
     EXPECT_EQ(d.status().code(), absl::StatusCode::kInvalidArgument) << bad;

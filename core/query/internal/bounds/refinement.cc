@@ -86,6 +86,16 @@ double Refiner::Refine(const SurfacePoint& p_in, const SurfacePoint& q_in, const
   // tests/bench/accuracy.md, "Walks the chord certifies"): it is checked by
   // an exact propagation, which its length prunes from the start.
   auto certified = [&](double length) { return length <= (1 + kCertifiedExcess) * chord; };
+  // A pair refined only because the request raised the threshold past the
+  // index's own (DistanceOptions::refine_below_l1000) is beyond the band
+  // where the chord certifies walks: on a curved surface most of its walks
+  // are more than 2% longer than the chord. There a walk the corridor
+  // vouches for, no longer than the O(1) answer plus its bound, is taken as
+  // it is (a wrong corridor's walk is mostly longer than that), and a pair
+  // whose walks all fail keeps its O(1) answer: the mode's promise is p99
+  // in every band, not the near pairs' largest error
+  // (tests/bench/accuracy.md, "The every-distance mode").
+  const bool raised_only = !near && !MayBeNear(unfolded, refine_below_, p, q);
   // A near pair: the chord's walks find a local geodesic for most; the rest
   // (both walks failed, bent at several saddles, or ran longer than is
   // plausible) are answered exactly, which the gradient trace that used to
@@ -96,7 +106,17 @@ double Refiner::Refine(const SurfacePoint& p_in, const SurfacePoint& q_in, const
     ++stats.pairs;
     if (walk_) {
       const NearWalk walk = WalkNearPair(view_, from, to, plausible(), &solvers);
-      if (walk.path && certified(walk.path->length)) return take(*walk.path);
+      if (walk.path && (certified(walk.path->length) || raised_only)) return take(*walk.path);
+      if (raised_only) {
+        // The gradient trace finds the corridor where the chord's does not
+        // (the chord leaves the surface over a curved band); a trace
+        // longer than is plausible keeps the O(1) answer.
+        const std::optional<NearPath> t =
+            NearPathLength(view_, paths_, from, to, false, plausible());
+        if (t && t->length <= plausible()) return take(*t);
+        ++stats.raised_kept;
+        return false;
+      }
       // The doubted walk's length prunes the propagation from its first
       // window, and its corridor, where the shortest path mostly runs, is
       // the first region (a chain of faces found by a search round the
@@ -146,7 +166,15 @@ double Refiner::Refine(const SurfacePoint& p_in, const SurfacePoint& q_in, const
     // A path's own certificate, where it is the tighter: d - chord covers
     // its error whatever the calibration saw (no less than rounding).
     if (kind == AnswerKind::kTrace || kind == AnswerKind::kWrappedTrace) {
-      *bound = std::min(*bound, std::max(d - chord, bound_of(AnswerKind::kExact, d)));
+      // Beyond the index's own threshold the traces' calibration did not
+      // see these paths: the geodesic is at least the chord and at least
+      // the O(1) answer less its bound, so d less the larger covers it
+      // wherever the O(1) bound does.
+      const double below = raised_only
+                               ? std::max(chord, unfolded - bound_of(AnswerKind::kUnfold, unfolded))
+                               : chord;
+      const double certificate = std::max(d - below, bound_of(AnswerKind::kExact, d));
+      *bound = raised_only ? certificate : std::min(*bound, certificate);
     }
   }
   return d;
