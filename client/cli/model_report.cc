@@ -164,6 +164,20 @@ absl::StatusOr<std::string> ModelReportText(const ModelInfo& m) {
                           FormatMiB(section),
                           share < 0.05 ? "<0.1%" : absl::StrFormat("%.1f%%", share));
   }
+  // Since format 6.0; an older server's report has no such list.
+  if (size.fields().contains("derived_at_load")) {
+    std::vector<std::string> derived;
+    const Value& list = f.Get(size, "derived_at_load");
+    if (list.kind_case() != Value::kListValue) f.ok = false;
+    for (const Value& v : list.list_value().values()) {
+      if (v.kind_case() != Value::kStringValue) f.ok = false;
+      derived.push_back(v.string_value());
+    }
+    if (!derived.empty()) {
+      absl::StrAppendFormat(&out, "                  %s: not stored, derived at load\n",
+                            absl::StrJoin(derived, ", "));
+    }
+  }
   absl::StrAppendFormat(
       &out, "  error bounds  %s\n",
       f.Bool(r, "error_bounds") ? "yes (calibrated)" : "no (geodex-build calibrate adds them)");

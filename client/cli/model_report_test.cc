@@ -10,6 +10,7 @@ namespace geodex::client::cli {
 namespace {
 
 using ::testing::HasSubstr;
+using ::testing::Not;
 
 // A report as core/index/index_report.h writes it (abridged).
 // clang-format off
@@ -99,6 +100,22 @@ TEST(ModelReportTest, LaysOutTheServersReport) {
                                "walked or exact\n"));
   EXPECT_THAT(*text, HasSubstr("                  8-16           5.03%     1.39%       2.00%  "
                                "walked or exact below 9.49, O(1) above  over\n"));
+}
+
+// A 6.0 index's report lists the sections the server derived at load; an
+// older one (above) has no such list and prints no such line.
+TEST(ModelReportTest, SaysWhatTheServerDerivedAtLoad) {
+  ModelInfo m = Model();
+  const std::string sections = R"("bytes": 376}]})";
+  const size_t at = m.report_json.find(sections);
+  ASSERT_NE(at, std::string::npos);
+  m.report_json.replace(at, sections.size(),
+                        R"("bytes": 376}], "derived_at_load": ["twins", "face BVH"]})");
+  const absl::StatusOr<std::string> text = ModelReportText(m);
+  ASSERT_TRUE(text.ok()) << text.status();
+  EXPECT_THAT(*text, HasSubstr("                  calibration               0.000 MiB  <0.1%\n"
+                               "                  twins, face BVH: not stored, derived at load\n"));
+  EXPECT_THAT(*ModelReportText(Model()), Not(HasSubstr("derived at load")));
 }
 
 TEST(ModelReportTest, RefusesAMalformedReport) {

@@ -110,6 +110,9 @@ Presence PresenceIn(uint32_t major, size_t spec, const Counts& counts) {
       return derived_format ? Presence::kAbsent : Presence::kRequired;
     case SectionId::kCompactVertexRecords:
       return derived_format ? Presence::kRequired : Presence::kAbsent;
+    case SectionId::kSplitFaceCodes:
+    case SectionId::kSplitPieceCodes:
+      return derived_format ? Presence::kOptional : Presence::kAbsent;
     case SectionId::kTwins:
       return derived_format ? Presence::kOptional : Presence::kRequired;
     case SectionId::kFaceBvh:
@@ -419,8 +422,18 @@ absl::Status Index::Validate() {
   const std::span<const SplitPieceRecord> split_pieces =
       SectionView<SplitPieceRecord>(p, entry(SectionId::kSplitPieces));
   spread_bounds_ = SectionView<SpreadBoundRecord>(p, entry(SectionId::kSpreadBounds));
-  const bool dense_split = !split_faces.empty() || !coarse_faces.empty();
-  const bool sparse_split = !split_coarse.empty() || !split_pieces.empty();
+  const std::span<const SplitFaceCode> split_face_codes =
+      SectionView<SplitFaceCode>(p, entry(SectionId::kSplitFaceCodes));
+  const std::span<const SplitPieceCode> split_piece_codes =
+      SectionView<SplitPieceCode>(p, entry(SectionId::kSplitPieceCodes));
+  const bool dense_split =
+      !split_faces.empty() || !coarse_faces.empty() || !split_face_codes.empty();
+  const bool sparse_split =
+      !split_coarse.empty() || !split_pieces.empty() || !split_piece_codes.empty();
+  if ((!split_faces.empty() && !split_face_codes.empty()) ||
+      (!split_pieces.empty() && !split_piece_codes.empty())) {
+    return absl::DataLossError("an index with both the records and the codes of its split");
+  }
   if (dense_split && sparse_split) {
     return absl::DataLossError("an index with both dense and sparse split sections");
   }
@@ -431,9 +444,16 @@ absl::Status Index::Validate() {
                                                h.format_major, h.format_minor,
                                                sparse_split ? "sparse" : "dense"));
   }
-  if (sparse_split) {
+  if (!split_piece_codes.empty()) {
+    GEODEX_ASSIGN_OR_RETURN(split_, SplitView::Sparse(faces_, split_coarse, split_piece_codes,
+                                                      absl::StatusCode::kDataLoss));
+  } else if (sparse_split) {
     GEODEX_ASSIGN_OR_RETURN(
         split_, SplitView::Sparse(faces_, split_coarse, split_pieces, absl::StatusCode::kDataLoss));
+  } else if (!split_face_codes.empty()) {
+    GEODEX_ASSIGN_OR_RETURN(split_,
+                            SplitView::Dense(coarse_faces, split_face_codes, faces_.size() / 3,
+                                             absl::StatusCode::kDataLoss));
   } else {
     GEODEX_ASSIGN_OR_RETURN(split_, SplitView::Dense(coarse_faces, split_faces, faces_.size() / 3,
                                                      absl::StatusCode::kDataLoss));

@@ -479,6 +479,86 @@ TEST(IndexTest, Version6LeavesOutWhatTheReaderDerives) {
   EXPECT_THAT(status.message(), HasSubstr("the section vertex records"));
 }
 
+// A split whose weights are all 128ths (a midpoint split's, to seven
+// halvings) is written in 6.0 with codes: 16 bytes a face dense, 20 a piece
+// sparse, for 40 and 44; other weights keep the float records. Either reads
+// back to the same pieces and is written again to the same bytes.
+TEST(IndexTest, SplitWeightsIn128thsAreWrittenAsCodes) {
+  // 20 coarse faces, each cut into four pieces at weight w along an edge.
+  auto make = [](float w) {
+    IndexData d = MakeSphereIndex();
+    d.sample_matrix = MatrixLayout::kCoded;
+    d.coarse_faces.assign(d.faces.begin(), d.faces.begin() + 3 * 20);
+    for (int32_t f = 0; f < static_cast<int32_t>(d.faces.size() / 3); ++f) {
+      SplitFaceRecord r{};
+      r.coarse_face = f % 20;
+      for (int i = 0; i < 3; ++i) r.weight[i][i] = 1;
+      r.weight[0][0] = 1 - w;
+      r.weight[0][1] = w;
+      d.split_faces.push_back(r);
+    }
+    d.params.split_vertices = 1;
+    return d;
+  };
+  auto has = [](const Image& image, SectionId id) {
+    return std::any_of(image.entries.begin(), image.entries.end(),
+                       [id](const SectionEntry& e) { return e.id == static_cast<uint32_t>(id); });
+  };
+  struct Expected {
+    IndexData data;
+    SectionId section;
+  };
+  const Expected cases[] = {{make(0.5f), SectionId::kSplitFaceCodes},
+                            {make(1.0f / 3), SectionId::kSplitFaces},
+                            {MakeSparseSplitSphereIndex(), SectionId::kSplitPieceCodes}};
+  for (const Expected& c : cases) {
+    const std::string bytes = Serialize(c.data);
+    const Image image = Image::Parse(bytes);
+    EXPECT_TRUE(has(image, c.section)) << static_cast<int>(c.section);
+    int split_sections = 0;
+    for (SectionId id : {SectionId::kSplitFaces, SectionId::kSplitFaceCodes,
+                         SectionId::kSplitPieces, SectionId::kSplitPieceCodes}) {
+      split_sections += has(image, id);
+    }
+    EXPECT_EQ(split_sections, 1);
+    absl::StatusOr<std::shared_ptr<const Index>> index = Index::FromBytes(bytes);
+    ASSERT_TRUE(index.ok()) << index.status();
+    for (int32_t f = 0; f < (*index)->num_faces(); ++f) {
+      const SplitFaceRecord r = (*index)->split().Piece(f);
+      EXPECT_EQ(std::memcmp(&r, &c.data.split_faces[f], sizeof(r)), 0) << f;
+    }
+    EXPECT_EQ(Serialize(ToIndexData(**index)), bytes);
+    EXPECT_EQ(PredictIndexBytes(c.data), bytes.size());
+  }
+  // 16 bytes a face for 40.
+  EXPECT_EQ(Image::Parse(Serialize(make(0.5f))).Payload(SectionId::kSplitFaceCodes).size(),
+            80 * sizeof(SplitFaceCode));
+  const std::vector<Case> corrupt = {
+      {"a code over 128",
+       [&](Image& i) {
+         SplitFaceCode code = i.Get<SplitFaceCode>(SectionId::kSplitFaceCodes, 3);
+         code.weight[1][1] = 129;
+         i.Set(SectionId::kSplitFaceCodes, 3, code);
+       },
+       "split piece 3"},
+      {"reserved bytes",
+       [&](Image& i) {
+         SplitFaceCode code = i.Get<SplitFaceCode>(SectionId::kSplitFaceCodes, 5);
+         code.reserved[2] = 1;
+         i.Set(SectionId::kSplitFaceCodes, 5, code);
+       },
+       "split piece 5"},
+      {"weights not summing to 1",
+       [&](Image& i) {
+         SplitFaceCode code = i.Get<SplitFaceCode>(SectionId::kSplitFaceCodes, 7);
+         code.weight[2][2] = 64;
+         i.Set(SectionId::kSplitFaceCodes, 7, code);
+       },
+       "piece 7"},
+  };
+  ExpectDataLoss(Serialize(make(0.5f)), corrupt);
+}
+
 TEST(IndexTest, RefinementCorruptionWithValidChecksumsIsDataLoss) {
   const std::string bytes = Serialize(MakeRefinedSphereIndex());
   const int32_t nv = 43;

@@ -69,7 +69,10 @@
 //        VertexRecordWithCorners), and the twins and the face BVH left
 //        out when the reader's own derivation (DeriveTwins, BuildFaceBvh)
 //        gives them back as they are; the reader then derives them at load.
-//        The split sparse or dense, whichever is smaller. What the builder
+//        The split sparse or dense, whichever is smaller, its weights in
+//        128ths (SplitFaceCode, SplitPieceCode: 16 and 20 bytes for 40 and
+//        44) when every weight is such a fraction, as a midpoint split's
+//        are to seven halvings. What the builder
 //        writes by default (the coded matrix); a 5.x reader would find no
 //        vertex records, hence the major version. The default builds of
 //        the shared meshes take 17-38% fewer bytes; the answers are the
@@ -134,6 +137,8 @@ enum class SectionId : uint32_t {
   // coarse face whole.
   kSplitPieces = 21,
   kCompactVertexRecords = 22,  // VertexRecord[num_vertices] (6.x, instead of kVertexRecords)
+  kSplitFaceCodes = 23,        // SplitFaceCode[num_faces] (6.x, may replace kSplitFaces)
+  kSplitPieceCodes = 24,       // SplitPieceCode[k] (6.x, may replace kSplitPieces)
 };
 
 // Build parameters recorded in the header.
@@ -245,6 +250,23 @@ struct SplitPieceRecord {
   SplitFaceRecord piece;
 };
 static_assert(sizeof(SplitPieceRecord) == 44);
+
+// A SplitFaceRecord with its weights in 128ths (6.0): weight[i][j] / 128,
+// each at most 128; reserved bytes 0.
+inline constexpr int kSplitWeightDenominator = 128;
+struct SplitFaceCode {
+  int32_t coarse_face;
+  uint8_t weight[3][3];
+  uint8_t reserved[3];
+};
+static_assert(sizeof(SplitFaceCode) == 16);
+
+// A SplitPieceRecord with its weights in 128ths (6.0).
+struct SplitPieceCode {
+  int32_t face;
+  SplitFaceCode piece;
+};
+static_assert(sizeof(SplitPieceCode) == 20);
 
 // Axis-aligned bounding-box hierarchy over the mesh faces. A leaf has
 // count > 0 and covers bvh_faces[first, first+count); an inner node has

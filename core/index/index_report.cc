@@ -56,7 +56,7 @@ const std::vector<SectionGroup>& Groups() {
       {"split",
        "split",
        {SectionId::kCoarseFaces, SectionId::kSplitFaces, SectionId::kSplitCoarseFaces,
-        SectionId::kSplitPieces}},
+        SectionId::kSplitPieces, SectionId::kSplitFaceCodes, SectionId::kSplitPieceCodes}},
       {"calibration", "calibration", {SectionId::kAccuracy, SectionId::kSpreadBounds}},
       {"report", "build report", {SectionId::kReport}},
   };

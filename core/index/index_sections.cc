@@ -61,6 +61,8 @@ std::optional<uint64_t> ExpectedCount(SectionId id, const Counts& c) {
     case SectionId::kSplitFaces:
     case SectionId::kSplitCoarseFaces:
     case SectionId::kSplitPieces:
+    case SectionId::kSplitFaceCodes:
+    case SectionId::kSplitPieceCodes:
     case SectionId::kSpreadBounds:
     case SectionId::kDistanceCode:
       return std::nullopt;

@@ -61,6 +61,8 @@ constexpr SectionSpec kSpecs[] = {
     {SectionId::kSplitCoarseFaces, sizeof(SplitCoarseRecord), "split coarse faces", false},
     {SectionId::kSplitPieces, sizeof(SplitPieceRecord), "split pieces", false},
     {SectionId::kCompactVertexRecords, sizeof(VertexRecord), "vertex records (6.0)", false},
+    {SectionId::kSplitFaceCodes, sizeof(SplitFaceCode), "split face codes", false},
+    {SectionId::kSplitPieceCodes, sizeof(SplitPieceCode), "split piece codes", false},
 };
 constexpr size_t kNumSpecs = std::size(kSpecs);
 

@@ -40,11 +40,16 @@ struct Piece {
 // How the split is written: sparse (5.0) for a split index with the coded
 // matrix whose split the sparse records give back as it is, when that takes
 // fewer bytes, else dense. A split of a coarse mesh makes pieces of nearly
-// every face, and a piece record is 4 bytes more than a dense one.
+// every face, and a piece record is 4 bytes more than a dense one. In 6.0
+// either with the weights in 128ths (`coded`) when every weight is such a
+// fraction: the smallest of the layouts that give the split back.
 struct SplitLayout {
   bool sparse = false;
+  bool coded = false;
   std::vector<SplitCoarseRecord> coarse;
   std::vector<SplitPieceRecord> pieces;
+  std::vector<SplitFaceCode> dense_codes;
+  std::vector<SplitPieceCode> piece_codes;
 };
 
 absl::StatusOr<SplitLayout> SplitLayoutOf(const IndexData& d) {
@@ -59,12 +64,42 @@ absl::StatusOr<SplitLayout> SplitLayoutOf(const IndexData& d) {
   // face's id) has no sparse form: it stays dense.
   const absl::StatusOr<SplitView> sparse =
       SplitView::Sparse(d.faces, out.coarse, out.pieces, absl::StatusCode::kInvalidArgument);
-  const uint64_t dense_bytes = d.coarse_faces.size() * sizeof(int32_t) +
-                               d.split_faces.size() * sizeof(SplitFaceRecord);
-  const uint64_t sparse_bytes = out.coarse.size() * sizeof(SplitCoarseRecord) +
-                                out.pieces.size() * sizeof(SplitPieceRecord);
-  out.sparse = sparse.ok() && sparse->num_coarse_faces() == dense.num_coarse_faces() &&
-               sparse_bytes < dense_bytes;
+  const bool sparse_ok = sparse.ok() && sparse->num_coarse_faces() == dense.num_coarse_faces();
+  bool coded_ok = !d.coded_as_version_5;
+  std::vector<SplitFaceCode> codes(coded_ok ? d.split_faces.size() : 0);
+  for (size_t f = 0; f < codes.size() && coded_ok; ++f) {
+    coded_ok = SplitView::Encode(d.split_faces[f], &codes[f]);
+  }
+  const uint64_t coarse_bytes = d.coarse_faces.size() * sizeof(int32_t);
+  const uint64_t sparse_coarse_bytes = out.coarse.size() * sizeof(SplitCoarseRecord);
+  // (bytes, sparse, coded), in the order a tie keeps.
+  struct Candidate {
+    uint64_t bytes;
+    bool sparse, coded, ok;
+  };
+  const Candidate candidates[] = {
+      {coarse_bytes + d.split_faces.size() * sizeof(SplitFaceRecord), false, false, true},
+      {sparse_coarse_bytes + out.pieces.size() * sizeof(SplitPieceRecord), true, false, sparse_ok},
+      {coarse_bytes + d.split_faces.size() * sizeof(SplitFaceCode), false, true, coded_ok},
+      {sparse_coarse_bytes + out.pieces.size() * sizeof(SplitPieceCode), true, true,
+       sparse_ok && coded_ok},
+  };
+  const Candidate* best = &candidates[0];
+  for (const Candidate& c : candidates) {
+    if (c.ok && c.bytes < best->bytes) best = &c;
+  }
+  out.sparse = best->sparse;
+  out.coded = best->coded;
+  if (out.coded && out.sparse) {
+    for (const SplitPieceRecord& p : out.pieces) {
+      SplitPieceCode code{p.face, {}};
+      SplitView::Encode(p.piece, &code.piece);
+      out.piece_codes.push_back(code);
+    }
+    out.pieces.clear();
+  } else if (out.coded) {
+    out.dense_codes = std::move(codes);
+  }
   if (!out.sparse) out.coarse.clear(), out.pieces.clear();
   return out;
 }
@@ -120,7 +155,8 @@ void LayOut(const IndexData& d, const Piece (&matrix)[4], const SplitLayout& spl
       {d.input_faces.data(), d.input_faces.size() * sizeof(InputFaceRecord)},
       {d.vertex_copies.data(), d.vertex_copies.size() * sizeof(int32_t)},
       {d.coarse_faces.data(), dense ? d.coarse_faces.size() * sizeof(int32_t) : 0},
-      {d.split_faces.data(), dense ? d.split_faces.size() * sizeof(SplitFaceRecord) : 0},
+      {d.split_faces.data(),
+       dense && !split.coded ? d.split_faces.size() * sizeof(SplitFaceRecord) : 0},
       {d.spread_bounds.data(), d.spread_bounds.size() * sizeof(SpreadBoundRecord)},
       matrix[1],
       matrix[2],
@@ -128,6 +164,8 @@ void LayOut(const IndexData& d, const Piece (&matrix)[4], const SplitLayout& spl
       {split.coarse.data(), split.coarse.size() * sizeof(SplitCoarseRecord)},
       {split.pieces.data(), split.pieces.size() * sizeof(SplitPieceRecord)},
       {d.vertices.data(), compact ? d.vertices.size() * sizeof(VertexRecord) : 0},
+      {split.dense_codes.data(), split.dense_codes.size() * sizeof(SplitFaceCode)},
+      {split.piece_codes.data(), split.piece_codes.size() * sizeof(SplitPieceCode)},
   };
   std::copy(std::begin(all), std::end(all), std::begin(pieces));
 }
@@ -154,7 +192,9 @@ bool Written(size_t i, const Piece (&pieces)[kNumSpecs], MatrixLayout layout, bo
   return pieces[i].size > 0 || (id != SectionId::kInputFaces && id != SectionId::kVertexCopies &&
                                 id != SectionId::kCoarseFaces && id != SectionId::kSplitFaces &&
                                 id != SectionId::kSplitCoarseFaces &&
-                                id != SectionId::kSplitPieces && id != SectionId::kSpreadBounds);
+                                id != SectionId::kSplitPieces && id != SectionId::kSpreadBounds &&
+                                id != SectionId::kSplitFaceCodes &&
+                                id != SectionId::kSplitPieceCodes);
 }
 
 // The file's size: header, table and every written section aligned.

@@ -1,9 +1,11 @@
 #include "core/index/split_view.h"
 
 #include <algorithm>
+#include <cmath>
 #include <string>
 
 #include "absl/strings/str_format.h"
+#include "core/common/status_macros.h"
 
 namespace geodex::index {
 namespace {
@@ -23,7 +25,81 @@ bool IsWhole(const SplitFaceRecord& r, int32_t f) {
   return true;
 }
 
+SplitFaceRecord Decode(const SplitFaceCode& c) {
+  SplitFaceRecord r;
+  r.coarse_face = c.coarse_face;
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) r.weight[i][j] = c.weight[i][j] / float{kSplitWeightDenominator};
+  }
+  return r;
+}
+
+// The codes' own checks: each at most 128, reserved bytes 0.
+absl::Status CheckCode(const SplitFaceCode& c, size_t k, const char* what, absl::StatusCode code) {
+  bool ok = c.reserved[0] == 0 && c.reserved[1] == 0 && c.reserved[2] == 0;
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) ok = ok && c.weight[i][j] <= kSplitWeightDenominator;
+  }
+  if (ok) return absl::OkStatus();
+  return absl::Status(code, absl::StrFormat("%s %d: a weight code over %d or reserved bytes not 0",
+                                            what, k, kSplitWeightDenominator));
+}
+
 }  // namespace
+
+bool SplitView::Encode(const SplitFaceRecord& r, SplitFaceCode* out) {
+  *out = SplitFaceCode{};
+  out->coarse_face = r.coarse_face;
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) {
+      const float scaled = r.weight[i][j] * float{kSplitWeightDenominator};
+      if (!(scaled >= 0 && scaled <= kSplitWeightDenominator) || scaled != std::floor(scaled)) {
+        return false;
+      }
+      out->weight[i][j] = static_cast<uint8_t>(scaled);
+      if (Decode(*out).weight[i][j] != r.weight[i][j]) return false;
+    }
+  }
+  return true;
+}
+
+absl::StatusOr<SplitView> SplitView::Dense(std::span<const int32_t> coarse_faces,
+                                           std::span<const SplitFaceCode> pieces,
+                                           int64_t num_faces, absl::StatusCode code) {
+  SplitView v;
+  if (coarse_faces.empty() && pieces.empty()) return v;
+  if (coarse_faces.empty() || coarse_faces.size() % 3 != 0 ||
+      static_cast<int64_t>(pieces.size()) != num_faces) {
+    return absl::Status(
+        code, absl::StrFormat("split: %d piece codes for %d faces, %d coarse face ids",
+                              pieces.size(), num_faces, coarse_faces.size()));
+  }
+  for (size_t k = 0; k < pieces.size(); ++k) {
+    GEODEX_RETURN_IF_ERROR(CheckCode(pieces[k], k, "split piece", code));
+  }
+  v.num_coarse_faces_ = static_cast<int32_t>(coarse_faces.size() / 3);
+  v.num_faces_ = num_faces;
+  v.dense_coarse_ = coarse_faces;
+  v.dense_codes_ = pieces;
+  return v;
+}
+
+absl::StatusOr<SplitView> SplitView::Sparse(std::span<const int32_t> faces,
+                                            std::span<const SplitCoarseRecord> coarse,
+                                            std::span<const SplitPieceCode> pieces,
+                                            absl::StatusCode code) {
+  // The checks of the records on the pieces decoded (a few per split face),
+  // then the view over the codes.
+  std::vector<SplitPieceRecord> decoded(pieces.size());
+  for (size_t k = 0; k < pieces.size(); ++k) {
+    GEODEX_RETURN_IF_ERROR(CheckCode(pieces[k].piece, k, "split piece record", code));
+    decoded[k] = {pieces[k].face, Decode(pieces[k].piece)};
+  }
+  GEODEX_ASSIGN_OR_RETURN(SplitView v, Sparse(faces, coarse, decoded, code));
+  v.pieces_ = {};
+  v.piece_codes_ = pieces;
+  return v;
+}
 
 absl::StatusOr<SplitView> SplitView::Dense(std::span<const int32_t> coarse_faces,
                                            std::span<const SplitFaceRecord> pieces,
@@ -105,7 +181,14 @@ std::array<int32_t, 3> SplitView::CoarseFace(int32_t c) const {
 }
 
 SplitFaceRecord SplitView::Piece(int32_t f) const {
-  if (!sparse_) return dense_pieces_[f];
+  if (!sparse_) return dense_codes_.empty() ? dense_pieces_[f] : Decode(dense_codes_[f]);
+  if (!piece_codes_.empty()) {
+    const auto it =
+        std::lower_bound(piece_codes_.begin(), piece_codes_.end(), f,
+                         [](const SplitPieceCode& r, int32_t id) { return r.face < id; });
+    if (it != piece_codes_.end() && it->face == f) return Decode(it->piece);
+    return Whole(f);
+  }
   const auto it =
       std::lower_bound(pieces_.begin(), pieces_.end(), f,
                        [](const SplitPieceRecord& r, int32_t id) { return r.face < id; });

@@ -1,10 +1,11 @@
 #pragma once
 
-// The long-edge split of an index (index_format.h, 2.0 and 5.0) read the
-// same way from either layout: dense (2.x-4.x files, and the builder's
+// The long-edge split of an index (index_format.h, 2.0, 5.0 and 6.0) read
+// the same way from either layout: dense (2.x-4.x files, and the builder's
 // RepairRecord), a coarse face and a piece record for every face; or sparse
 // (5.x), records only for the coarse faces that were split and the faces
-// that are not a coarse face whole. A view of arrays that live elsewhere
+// that are not a coarse face whole; either with the weights in 128ths (6.x:
+// SplitFaceCode, SplitPieceCode). A view of arrays that live elsewhere
 // (a mapped file, an IndexData): they must outlive it.
 //
 // Thread safety: immutable; every method is const.
@@ -39,6 +40,18 @@ class SplitView {
                                           std::span<const SplitCoarseRecord> coarse,
                                           std::span<const SplitPieceRecord> pieces,
                                           absl::StatusCode code);
+  // The same with the weights in 128ths; errors (`code`) also for a code
+  // over 128 or reserved bytes that are not 0.
+  static absl::StatusOr<SplitView> Dense(std::span<const int32_t> coarse_faces,
+                                         std::span<const SplitFaceCode> pieces,
+                                         int64_t num_faces, absl::StatusCode code);
+  static absl::StatusOr<SplitView> Sparse(std::span<const int32_t> faces,
+                                          std::span<const SplitCoarseRecord> coarse,
+                                          std::span<const SplitPieceCode> pieces,
+                                          absl::StatusCode code);
+
+  // `r` with its weights in 128ths; false when a weight is no such fraction.
+  static bool Encode(const SplitFaceRecord& r, SplitFaceCode* out);
 
   bool split() const { return num_coarse_faces_ > 0; }
   int32_t num_coarse_faces() const { return num_coarse_faces_; }
@@ -58,13 +71,15 @@ class SplitView {
   int32_t num_coarse_faces_ = 0;
   int64_t num_faces_ = 0;
   bool sparse_ = false;
-  // Dense.
+  // Dense: the pieces as records or codes (one of the two).
   std::span<const int32_t> dense_coarse_;
   std::span<const SplitFaceRecord> dense_pieces_;
-  // Sparse.
+  std::span<const SplitFaceCode> dense_codes_;
+  // Sparse: the same.
   std::span<const int32_t> faces_;
   std::span<const SplitCoarseRecord> coarse_;
   std::span<const SplitPieceRecord> pieces_;
+  std::span<const SplitPieceCode> piece_codes_;
 };
 
 }  // namespace geodex::index
