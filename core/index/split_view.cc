@@ -66,20 +66,10 @@ bool SplitView::Encode(const SplitFaceRecord& r, SplitFaceCode* out) {
 absl::StatusOr<SplitView> SplitView::Dense(std::span<const int32_t> coarse_faces,
                                            std::span<const SplitFaceCode> pieces,
                                            int64_t num_faces, absl::StatusCode code) {
-  SplitView v;
-  if (coarse_faces.empty() && pieces.empty()) return v;
-  if (coarse_faces.empty() || coarse_faces.size() % 3 != 0 ||
-      static_cast<int64_t>(pieces.size()) != num_faces) {
-    return absl::Status(
-        code, absl::StrFormat("split: %d piece codes for %d faces, %d coarse face ids",
-                              pieces.size(), num_faces, coarse_faces.size()));
-  }
+  GEODEX_ASSIGN_OR_RETURN(SplitView v, DenseOf(coarse_faces, pieces.size(), num_faces, code));
   for (size_t k = 0; k < pieces.size(); ++k) {
     GEODEX_RETURN_IF_ERROR(CheckCode(pieces[k], k, "split piece", code));
   }
-  v.num_coarse_faces_ = static_cast<int32_t>(coarse_faces.size() / 3);
-  v.num_faces_ = num_faces;
-  v.dense_coarse_ = coarse_faces;
   v.dense_codes_ = pieces;
   return v;
 }
@@ -101,20 +91,27 @@ absl::StatusOr<SplitView> SplitView::Sparse(std::span<const int32_t> faces,
   return v;
 }
 
-absl::StatusOr<SplitView> SplitView::Dense(std::span<const int32_t> coarse_faces,
-                                           std::span<const SplitFaceRecord> pieces,
-                                           int64_t num_faces, absl::StatusCode code) {
+absl::StatusOr<SplitView> SplitView::DenseOf(std::span<const int32_t> coarse_faces,
+                                             size_t num_pieces, int64_t num_faces,
+                                             absl::StatusCode code) {
   SplitView v;
-  if (coarse_faces.empty() && pieces.empty()) return v;
+  if (coarse_faces.empty() && num_pieces == 0) return v;
   if (coarse_faces.empty() || coarse_faces.size() % 3 != 0 ||
-      static_cast<int64_t>(pieces.size()) != num_faces) {
+      static_cast<int64_t>(num_pieces) != num_faces) {
     return absl::Status(
         code, absl::StrFormat("split: %d piece records for %d faces, %d coarse face ids",
-                              pieces.size(), num_faces, coarse_faces.size()));
+                              num_pieces, num_faces, coarse_faces.size()));
   }
   v.num_coarse_faces_ = static_cast<int32_t>(coarse_faces.size() / 3);
   v.num_faces_ = num_faces;
   v.dense_coarse_ = coarse_faces;
+  return v;
+}
+
+absl::StatusOr<SplitView> SplitView::Dense(std::span<const int32_t> coarse_faces,
+                                           std::span<const SplitFaceRecord> pieces,
+                                           int64_t num_faces, absl::StatusCode code) {
+  GEODEX_ASSIGN_OR_RETURN(SplitView v, DenseOf(coarse_faces, pieces.size(), num_faces, code));
   v.dense_pieces_ = pieces;
   return v;
 }

@@ -68,6 +68,12 @@ class SplitView {
                        std::vector<SplitPieceRecord>* pieces);
 
  private:
+  // A dense view of `coarse_faces` whose pieces are still to be set, after
+  // the checks of the sizes both kinds of pieces share.
+  static absl::StatusOr<SplitView> DenseOf(std::span<const int32_t> coarse_faces,
+                                           size_t num_pieces, int64_t num_faces,
+                                           absl::StatusCode code);
+
   int32_t num_coarse_faces_ = 0;
   int64_t num_faces_ = 0;
   bool sparse_ = false;
