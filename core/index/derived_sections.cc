@@ -1,47 +1,38 @@
 #include "core/index/derived_sections.h"
 
-#include <algorithm>
-#include <numeric>
 #include <utility>
 
 #include "absl/strings/str_format.h"
+#include "core/common/edge_groups.h"
+#include "core/common/status_macros.h"
 
 namespace geodex::index::internal {
 
 absl::StatusOr<std::vector<int32_t>> DeriveTwins(std::span<const int32_t> faces,
                                                  absl::StatusCode code) {
   const int32_t nh = static_cast<int32_t>(faces.size());
-  auto origin = [&](int32_t h) { return faces[h]; };
-  auto dest = [&](int32_t h) { return faces[h % 3 == 2 ? h - 2 : h + 1]; };
-  auto key = [&](int32_t h) {
-    const int64_t a = origin(h), b = dest(h);
-    return std::pair<int64_t, int64_t>(std::min(a, b), std::max(a, b));
+  auto ends = [&](int32_t h) {
+    return std::pair<int32_t, int32_t>(faces[h], faces[h % 3 == 2 ? h - 2 : h + 1]);
   };
-  std::vector<int32_t> order(nh);
-  std::iota(order.begin(), order.end(), 0);
-  std::sort(order.begin(), order.end(), [&](int32_t x, int32_t y) {
-    const auto kx = key(x), ky = key(y);
-    return kx != ky ? kx < ky : x < y;
-  });
   std::vector<int32_t> twins(nh, -1);
-  for (int32_t i = 0; i < nh;) {
-    int32_t j = i + 1;
-    while (j < nh && key(order[j]) == key(order[i])) ++j;
-    const auto [a, b] = key(order[i]);
-    if (j - i > 2) {
-      return absl::Status(code, absl::StrFormat("twins: edge (%d, %d) is shared by %d faces", a, b, j - i));
-    }
-    if (j - i == 2) {
-      const int32_t h0 = order[i], h1 = order[i + 1];
-      if (origin(h0) == origin(h1)) {
-        return absl::Status(code, absl::StrFormat("twins: faces %d and %d run edge (%d, %d) the same way",
-                                                  h0 / 3, h1 / 3, a, b));
-      }
-      twins[h0] = h1;
-      twins[h1] = h0;
-    }
-    i = j;
-  }
+  GEODEX_RETURN_IF_ERROR(
+      ForEachEdge(nh, ends, [&](std::span<const int32_t> group, int64_t a, int64_t b) {
+        if (group.size() > 2) {
+          return absl::Status(code, absl::StrFormat("twins: edge (%d, %d) is shared by %d faces", a,
+                                                    b, group.size()));
+        }
+        if (group.size() == 2) {
+          const int32_t h0 = group[0], h1 = group[1];
+          if (faces[h0] == faces[h1]) {
+            return absl::Status(
+                code, absl::StrFormat("twins: faces %d and %d run edge (%d, %d) the same way",
+                                      h0 / 3, h1 / 3, a, b));
+          }
+          twins[h0] = h1;
+          twins[h1] = h0;
+        }
+        return absl::OkStatus();
+      }));
   return twins;
 }
 

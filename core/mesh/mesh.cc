@@ -3,9 +3,11 @@
 #include <algorithm>
 #include <cmath>
 #include <numeric>
+#include <span>
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
+#include "core/common/edge_groups.h"
 #include "core/common/status_macros.h"
 
 namespace geodex::mesh {
@@ -106,44 +108,34 @@ absl::Status Mesh::BuildAdjacency() {
   for (int32_t h = 0; h < nh; ++h) length_[h] = (position(Dest(h)) - position(Origin(h))).norm();
 
   // Pair half-edges by their undirected edge.
-  std::vector<int32_t> order(nh);
-  std::iota(order.begin(), order.end(), 0);
-  auto key = [&](int32_t h) {
-    const int64_t a = Origin(h), b = Dest(h);
-    return std::pair<int64_t, int64_t>(std::min(a, b), std::max(a, b));
-  };
-  std::sort(order.begin(), order.end(), [&](int32_t x, int32_t y) {
-    const auto kx = key(x), ky = key(y);
-    return kx != ky ? kx < ky : x < y;
-  });
   twin_.assign(nh, kNone);
   num_boundary_edges_ = 0;
-  for (int32_t i = 0; i < nh;) {
-    int32_t j = i + 1;
-    while (j < nh && key(order[j]) == key(order[i])) ++j;
-    const int32_t count = j - i;
-    const auto [a, b] = key(order[i]);
-    if (count > 2) {
-      std::string list;
-      for (int32_t k = i; k < j; ++k) absl::StrAppend(&list, k > i ? ", " : "", FaceOf(order[k]));
-      return absl::InvalidArgumentError(absl::StrFormat(
-          "%s: non-manifold edge (%d, %d) is shared by %d faces (%s)", name_, a, b, count, list));
-    }
-    if (count == 2) {
-      const int32_t h0 = order[i], h1 = order[i + 1];
-      if (Origin(h0) == Origin(h1)) {
-        return absl::InvalidArgumentError(absl::StrFormat(
-            "%s: faces %d and %d traverse edge (%d, %d) in the same direction (inconsistent "
-            "orientation or a non-orientable surface)",
-            name_, FaceOf(h0), FaceOf(h1), a, b));
-      }
-      twin_[h0] = h1;
-      twin_[h1] = h0;
-    } else {
-      ++num_boundary_edges_;
-    }
-    i = j;
-  }
+  auto ends = [&](int32_t h) { return std::pair<int32_t, int32_t>(Origin(h), Dest(h)); };
+  GEODEX_RETURN_IF_ERROR(
+      ForEachEdge(nh, ends, [&](std::span<const int32_t> group, int64_t a, int64_t b) {
+        if (group.size() > 2) {
+          std::string list;
+          for (size_t k = 0; k < group.size(); ++k)
+            absl::StrAppend(&list, k > 0 ? ", " : "", FaceOf(group[k]));
+          return absl::InvalidArgumentError(
+              absl::StrFormat("%s: non-manifold edge (%d, %d) is shared by %d faces (%s)", name_, a,
+                              b, group.size(), list));
+        }
+        if (group.size() == 2) {
+          const int32_t h0 = group[0], h1 = group[1];
+          if (Origin(h0) == Origin(h1)) {
+            return absl::InvalidArgumentError(absl::StrFormat(
+                "%s: faces %d and %d traverse edge (%d, %d) in the same direction (inconsistent "
+                "orientation or a non-orientable surface)",
+                name_, FaceOf(h0), FaceOf(h1), a, b));
+          }
+          twin_[h0] = h1;
+          twin_[h1] = h0;
+        } else {
+          ++num_boundary_edges_;
+        }
+        return absl::OkStatus();
+      }));
 
   // Outgoing half-edges per vertex, then order each fan counter-clockwise.
   outgoing_offset_.assign(nv + 1, 0);

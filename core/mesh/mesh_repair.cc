@@ -9,6 +9,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
+#include "core/common/edge_groups.h"
 #include "core/common/status_macros.h"
 
 namespace geodex::mesh {
@@ -291,28 +292,18 @@ void DropDuplicates(const RawMesh& raw, Soup* soup, std::vector<int32_t>* group_
 std::vector<int32_t> PairManifoldEdges(const Soup& soup,
                                        std::vector<std::vector<int32_t>>* nonmanifold) {
   const int32_t nh = 3 * static_cast<int32_t>(soup.kept.size());
-  auto key = [&](int32_t h) {
-    const int64_t a = soup.Origin(h), b = soup.Dest(h);
-    return std::pair<int64_t, int64_t>(std::min(a, b), std::max(a, b));
-  };
-  std::vector<int32_t> order(nh);
-  std::iota(order.begin(), order.end(), 0);
-  std::sort(order.begin(), order.end(), [&](int32_t x, int32_t y) {
-    const auto kx = key(x), ky = key(y);
-    return kx != ky ? kx < ky : x < y;
-  });
+  auto ends = [&](int32_t h) { return std::pair<int32_t, int32_t>(soup.Origin(h), soup.Dest(h)); };
   std::vector<int32_t> mate(nh, kNone);
-  for (int32_t i = 0; i < nh;) {
-    int32_t j = i + 1;
-    while (j < nh && key(order[j]) == key(order[i])) ++j;
-    if (j - i == 2) {
-      mate[order[i]] = order[i + 1];
-      mate[order[i + 1]] = order[i];
-    } else if (j - i > 2) {
-      nonmanifold->emplace_back(order.begin() + i, order.begin() + j);
+  // The visit never fails.
+  ForEachEdge(nh, ends, [&](std::span<const int32_t> group, int64_t, int64_t) {
+    if (group.size() == 2) {
+      mate[group[0]] = group[1];
+      mate[group[1]] = group[0];
+    } else if (group.size() > 2) {
+      nonmanifold->emplace_back(group.begin(), group.end());
     }
-    i = j;
-  }
+    return absl::OkStatus();
+  }).IgnoreError();
   return mate;
 }
 
