@@ -63,6 +63,7 @@ struct DistanceSession::State {
   std::unique_ptr<DistanceStream> stream;
   v1::ModelRef model;
   v1::NearPairs near_pairs = v1::NEAR_PAIRS_UNSPECIFIED;
+  double refine_below = 0;
 
   absl::Mutex write_mu;
   uint64_t next_id ABSL_GUARDED_BY(write_mu) = 0;
@@ -96,6 +97,7 @@ absl::StatusOr<uint64_t> DistanceSession::Send(absl::Span<const PointPair> pairs
   // Only the first batch names the model; the server keeps it for the stream.
   if (id == 0) *batch.mutable_model() = state_->model;
   batch.set_near_pairs(state_->near_pairs);
+  batch.set_refine_below(state_->refine_below);
   PairsToProto(pairs, 0, pairs.size(), batch.mutable_a(), batch.mutable_b());
   if (!state_->stream->Write(batch)) {
     state_->broken = true;
@@ -304,6 +306,7 @@ DistanceSession Client::OpenDistanceSession(const ModelRef& model, SessionOption
   state->stream = connection_->StreamDistances(stream_options);
   state->model = ToProto(model);
   state->near_pairs = ToProto(options.near_pairs);
+  state->refine_below = options.refine_below;
   return DistanceSession(std::move(state));
 }
 

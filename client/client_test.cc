@@ -420,6 +420,30 @@ TEST(DistanceSession, SendsReadsInOrderWithPerBatchStatus) {
   EXPECT_TRUE(session.Finish().ok());
 }
 
+TEST(DistanceSession, EveryBatchCarriesTheSessionsOptions) {
+  auto mock = std::make_shared<MockGeodexConnection>();
+  auto stream = std::make_unique<MockDistanceStream>();
+  std::vector<v1::DistanceBatch> written;
+  EXPECT_CALL(*stream, Write).Times(2).WillRepeatedly([&](const v1::DistanceBatch& b) {
+    written.push_back(b);
+    return true;
+  });
+  EXPECT_CALL(*stream, Cancel).Times(::testing::AnyNumber());
+  EXPECT_CALL(*mock, StreamDistances).WillOnce(Return(::testing::ByMove(std::move(stream))));
+  Client client(mock);
+  DistanceSession session = client.OpenDistanceSession(
+      "torus", {.near_pairs = NearPairs::kExact, .refine_below = 8});
+  ASSERT_TRUE(session.Send(NumberedPairs(2)).ok());
+  ASSERT_TRUE(session.Send(NumberedPairs(1)).ok());
+  ASSERT_EQ(written.size(), 2u);
+  for (const v1::DistanceBatch& b : written) {
+    EXPECT_EQ(b.near_pairs(), v1::NEAR_PAIRS_EXACT);
+    EXPECT_EQ(b.refine_below(), 8);
+  }
+  EXPECT_EQ(written[0].model().name(), "torus");
+  EXPECT_TRUE(written[1].model().name().empty());  // the stream keeps the first batch's
+}
+
 TEST(DistanceSession, BrokenStreamFailsSendAndFinishSaysWhy) {
   auto mock = std::make_shared<MockGeodexConnection>();
   auto stream = std::make_unique<MockDistanceStream>();

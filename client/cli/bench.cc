@@ -78,15 +78,41 @@ std::vector<PointPair> RandomPairs(int64_t num_faces, size_t count, uint64_t see
   return pairs;
 }
 
+namespace {
+
+double FaceArea(const Mesh& mesh, const std::array<uint32_t, 3>& f) {
+  const Position u = Minus(mesh.positions[f[1]], mesh.positions[f[0]]);
+  const Position v = Minus(mesh.positions[f[2]], mesh.positions[f[0]]);
+  return 0.5 *
+         Norm({u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]});
+}
+
+}  // namespace
+
+std::vector<PointPair> AreaUniformPairs(const Mesh& mesh, size_t count, uint64_t seed) {
+  std::vector<double> cumulative;
+  cumulative.reserve(mesh.faces.size());
+  double total = 0;
+  for (const auto& f : mesh.faces) cumulative.push_back(total += FaceArea(mesh, f));
+  std::vector<PointPair> pairs;
+  if (!(total > 0)) return pairs;
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> at(0.0, total);
+  auto point = [&] {
+    const size_t f = std::upper_bound(cumulative.begin(), cumulative.end(), at(rng)) -
+                     cumulative.begin();
+    return SurfacePoint{static_cast<int32_t>(std::min(f, cumulative.size() - 1)),
+                        UniformWeights(rng)};
+  };
+  pairs.resize(count);
+  for (PointPair& p : pairs) p = {point(), point()};
+  return pairs;
+}
+
 double ScaleLength(const Mesh& mesh, int64_t num_samples) {
   if (num_samples <= 0) return 0;
   double area = 0;
-  for (const auto& f : mesh.faces) {
-    const Position u = Minus(mesh.positions[f[1]], mesh.positions[f[0]]);
-    const Position v = Minus(mesh.positions[f[2]], mesh.positions[f[0]]);
-    area += 0.5 *
-            Norm({u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]});
-  }
+  for (const auto& f : mesh.faces) area += FaceArea(mesh, f);
   return area > 0 ? std::sqrt(2 * area / (std::sqrt(3.0) * num_samples)) : 0;
 }
 
@@ -170,8 +196,9 @@ void UnaryWorker(const Client& client, const BenchOptions& options,
     if (offset + options.batch > pool.size()) offset = 0;
     absl::Span<const PointPair> batch(pool.data() + offset, options.batch);
     offset += options.batch;
-    const absl::StatusOr<std::vector<double>> d =
-        client.Distance(options.model, batch, options.near_pairs);
+    const absl::StatusOr<Distances> d = client.Distance(
+        options.model, batch,
+        DistanceQuery{.near_pairs = options.near_pairs, .refine_below = options.refine_below});
     const absl::Time done = absl::Now();
     if (start < measure_from) continue;
     if (!d.ok()) {
@@ -188,6 +215,7 @@ void StreamWorker(const Client& client, const BenchOptions& options,
                   absl::Time end, WorkerStats* stats) {
   SessionOptions session_options;
   session_options.near_pairs = options.near_pairs;
+  session_options.refine_below = options.refine_below;
   DistanceSession session = client.OpenDistanceSession(options.model, session_options);
   absl::Mutex mu;
   std::vector<absl::Time> sent;  // send time by batch id
@@ -256,7 +284,16 @@ absl::StatusOr<BenchReport> RunBench(const Client& client, const BenchOptions& o
   }
   BenchReport report;
   std::vector<PointPair> pool;
-  if (options.pairs == BenchOptions::Pairs::kNear) {
+  if (options.pairs == BenchOptions::Pairs::kArea) {
+    absl::StatusOr<Mesh> mesh = client.GetMesh(ModelRef(options.model.name, info->version));
+    if (!mesh.ok()) return mesh.status();
+    pool = AreaUniformPairs(*mesh, std::max<size_t>(65536, 4 * static_cast<size_t>(options.batch)),
+                            options.seed);
+    if (pool.empty()) {
+      return absl::FailedPreconditionError(
+          absl::StrFormat("model %s: its mesh has no area", info->name));
+    }
+  } else if (options.pairs == BenchOptions::Pairs::kNear) {
     // The mesh of the version described, for L and the draw.
     absl::StatusOr<Mesh> mesh = client.GetMesh(ModelRef(options.model.name, info->version));
     if (!mesh.ok()) return mesh.status();
@@ -326,11 +363,16 @@ std::string FormatBenchReport(const BenchOptions& options, const BenchReport& re
       options.pairs == BenchOptions::Pairs::kNear
           ? absl::StrFormat("near pairs %gL-%gL apart (L = %.4g)", options.near_from,
                             options.near_to, report.scale_length)
-          : std::string("uniform pairs");
+          : options.pairs == BenchOptions::Pairs::kArea ? std::string("area-uniform pairs")
+                                                        : std::string("uniform pairs");
   std::string out = absl::StrFormat(
-      "model %s, %s, mode %s, concurrency %d, batch %d pairs%s, %.1f s measured (after %.1f s "
+      "model %s, %s%s, mode %s, concurrency %d, batch %d pairs%s, %.1f s measured (after %.1f s "
       "warm-up)\n",
-      options.model.name, pairs, options.mode, options.concurrency, options.batch,
+      options.model.name, pairs,
+      options.refine_below > 0
+          ? absl::StrFormat(", refined below %g L1000", options.refine_below)
+          : "",
+      options.mode, options.concurrency, options.batch,
       options.mode == "stream" ? absl::StrFormat(", window %d", options.window) : "", seconds,
       absl::ToDoubleSeconds(options.warmup));
   absl::StrAppendFormat(&out, "calls       %d ok", report.calls);

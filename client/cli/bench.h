@@ -29,10 +29,12 @@ struct BenchOptions {
   std::string mode = "unary";
   int window = 4;
   NearPairs near_pairs = NearPairs::kModelDefault;
+  // DistanceQuery::refine_below of every call (8: the every-distance mode).
+  double refine_below = 0;
   uint64_t seed = 1;
-  // Which pairs: kUniform as RandomPairs, kNear as DrawNearPairs between
-  // near_from and near_to scale lengths.
-  enum class Pairs { kUniform, kNear };
+  // Which pairs: kUniform as RandomPairs, kArea as AreaUniformPairs, kNear
+  // as DrawNearPairs between near_from and near_to scale lengths.
+  enum class Pairs { kUniform, kArea, kNear };
   Pairs pairs = Pairs::kUniform;
   double near_from = 1, near_to = 3;
 };
@@ -49,6 +51,13 @@ struct BenchReport {
 // `count` uniform pairs: a random face of `num_faces` each, weights uniform
 // on the triangle.
 std::vector<PointPair> RandomPairs(int64_t num_faces, size_t count, uint64_t seed);
+
+// `count` area-uniform pairs of `mesh`: each point's face drawn with
+// probability proportional to its area, weights uniform on the triangle.
+// The pairs the in-process benchmarks and the accuracy harness draw, so
+// that the rates through the service compare with theirs. Empty for a mesh
+// without area. Deterministic for a seed.
+std::vector<PointPair> AreaUniformPairs(const Mesh& mesh, size_t count, uint64_t seed);
 
 // L = sqrt(2 A / (sqrt(3) m)) of `mesh` (area A) tiled by `num_samples` (m)
 // samples: the edge of an equilateral geodesic triangle, as the server's

@@ -110,5 +110,23 @@ TEST(BenchPairs, UniformPairsAreValidAndCoverTheFaces) {
   for (int h : hits) EXPECT_GT(h, 50);
 }
 
+TEST(BenchPairs, AreaUniformPairsDrawFacesByArea) {
+  // Two triangles, of areas 0.5 and 1.5: three times as many points in the
+  // second.
+  Mesh mesh;
+  mesh.positions = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {4, 0, 0}, {4, 1, 0}};
+  mesh.faces = {{0, 1, 2}, {1, 3, 4}};
+  const std::vector<PointPair> pairs = AreaUniformPairs(mesh, 20000, 5);
+  ASSERT_EQ(pairs.size(), 20000u);
+  int first = 0;
+  for (const PointPair& pair : pairs) {
+    ExpectValid(pair.a, 2);
+    ExpectValid(pair.b, 2);
+    first += (pair.a.face == 0) + (pair.b.face == 0);
+  }
+  EXPECT_NEAR(first / 40000.0, 0.25, 0.01);
+  EXPECT_TRUE(AreaUniformPairs(Mesh{}, 10, 1).empty());
+}
+
 }  // namespace
 }  // namespace geodex::client::cli

@@ -466,6 +466,16 @@ expect "no subcommand: exit 2" 2 "" "$GEODEX"
 "$GEODEX" bench --help > help.txt 2>&1 && grep -q -- "--concurrency" help.txt &&
   grep -q -- "--server" help.txt && pass "bench --help lists its and the connection flags" ||
   fail "bench --help" help.txt
+if [ $FAKE -eq 0 ]; then
+  # The every-distance mode through both call paths: every batch answered.
+  for mode in unary stream; do
+    "$GEODEX" bench "${S[@]}" --model "$MODEL" --pairs uniform --mode "$mode" --refine-below 8 \
+      --duration 0.5 --warmup 0 --concurrency 1 --batch 64 > bench.txt 2>&1 &&
+      grep -q "refined below 8 L1000" bench.txt && grep -Eq "^calls +[1-9][0-9]* ok$" bench.txt &&
+      pass "bench --refine-below 8 --mode $mode: every call answered" ||
+      fail "bench --refine-below 8 --mode $mode" bench.txt
+  done
+fi
 
 if [ $FAKE -eq 0 ]; then
   stop_server && pass "server stops cleanly on SIGTERM" || fail "server exit status" server.log

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
@@ -34,11 +35,11 @@ absl::Status Bench(BenchFlags flags) {
   flags.options.duration = absl::Seconds(flags.duration_s);
   flags.options.warmup = absl::Seconds(flags.warmup_s);
   std::string out;
-  for (const BenchOptions::Pairs kind :
-       {BenchOptions::Pairs::kUniform, BenchOptions::Pairs::kNear}) {
-    if (flags.pairs != "both" && (flags.pairs == "near") != (kind == BenchOptions::Pairs::kNear)) {
-      continue;
-    }
+  std::vector<BenchOptions::Pairs> kinds;
+  if (flags.pairs == "both" || flags.pairs == "uniform") kinds.push_back(BenchOptions::Pairs::kUniform);
+  if (flags.pairs == "area") kinds.push_back(BenchOptions::Pairs::kArea);
+  if (flags.pairs == "both" || flags.pairs == "near") kinds.push_back(BenchOptions::Pairs::kNear);
+  for (const BenchOptions::Pairs kind : kinds) {
     BenchOptions options = flags.options;
     options.pairs = kind;
     absl::StatusOr<BenchReport> report = RunBench(*client, options);
@@ -83,12 +84,18 @@ void AddBenchCommand(CLI::App* app, absl::Status* status) {
   bench
       ->add_option("--pairs", flags->pairs,
                    "both: uniform pairs, then near pairs (each for --duration); uniform: pairs of "
-                   "random faces, most far apart; near: pairs 1L-3L apart in a straight line on "
-                   "one sheet of the surface (L = sqrt(2 A / (sqrt(3) m)) from the mesh's area A "
-                   "and the model's m samples; reads the mesh once)")
-      ->check(CLI::IsMember({"both", "uniform", "near"}))
+                   "random faces, most far apart; area: area-uniform pairs, as the in-process "
+                   "benchmarks draw them (reads the mesh once); near: pairs 1L-3L apart in a "
+                   "straight line on one sheet of the surface (L = sqrt(2 A / (sqrt(3) m)) from "
+                   "the mesh's area A and the model's m samples; reads the mesh once)")
+      ->check(CLI::IsMember({"both", "uniform", "area", "near"}))
       ->capture_default_str();
   AddNearPairsFlags(bench, &flags->options.near_pairs);
+  bench
+      ->add_option("--refine-below", flags->options.refine_below,
+                   "Refine every pair that may be closer than this many L1000 (e.g. 8: the "
+                   "every-distance mode; 0: the model's threshold), as geodex distance does")
+      ->check(CLI::NonNegativeNumber);
   bench->add_option("--seed", flags->options.seed, "Random pairs seed")->capture_default_str();
   bench->callback([flags, status] { *status = Bench(*flags); });
 }

@@ -74,6 +74,10 @@ struct ClientOptions {
 // Options of one DistanceSession.
 struct SessionOptions {
   NearPairs near_pairs = NearPairs::kModelDefault;
+  // Every batch refines the pairs that may be closer than this many L1000
+  // (DistanceQuery::refine_below; about 8 is the every-distance mode). 0:
+  // the model's threshold.
+  double refine_below = 0;
   // The whole stream must end by then; infinite: no deadline.
   absl::Duration deadline = absl::InfiniteDuration();
 };
