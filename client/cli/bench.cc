@@ -28,6 +28,13 @@ Position Minus(const Position& a, const Position& b) {
 }
 double Norm(const Position& a) { return std::sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]); }
 
+double FaceArea(const Mesh& mesh, const std::array<uint32_t, 3>& f) {
+  const Position u = Minus(mesh.positions[f[1]], mesh.positions[f[0]]);
+  const Position v = Minus(mesh.positions[f[2]], mesh.positions[f[0]]);
+  return 0.5 *
+         Norm({u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]});
+}
+
 Position PointOf(const Mesh& mesh, const SurfacePoint& p) {
   Position x = {0, 0, 0};
   for (int k = 0; k < 3; ++k) {
@@ -77,17 +84,6 @@ std::vector<PointPair> RandomPairs(int64_t num_faces, size_t count, uint64_t see
   for (PointPair& p : pairs) p = {point(), point()};
   return pairs;
 }
-
-namespace {
-
-double FaceArea(const Mesh& mesh, const std::array<uint32_t, 3>& f) {
-  const Position u = Minus(mesh.positions[f[1]], mesh.positions[f[0]]);
-  const Position v = Minus(mesh.positions[f[2]], mesh.positions[f[0]]);
-  return 0.5 *
-         Norm({u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]});
-}
-
-}  // namespace
 
 std::vector<PointPair> AreaUniformPairs(const Mesh& mesh, size_t count, uint64_t seed) {
   std::vector<double> cumulative;
@@ -284,9 +280,14 @@ absl::StatusOr<BenchReport> RunBench(const Client& client, const BenchOptions& o
   }
   BenchReport report;
   std::vector<PointPair> pool;
-  if (options.pairs == BenchOptions::Pairs::kArea) {
-    absl::StatusOr<Mesh> mesh = client.GetMesh(ModelRef(options.model.name, info->version));
+  // Area-uniform and near pairs are drawn on the mesh of the version
+  // described.
+  absl::StatusOr<Mesh> mesh = Mesh{};
+  if (options.pairs != BenchOptions::Pairs::kUniform) {
+    mesh = client.GetMesh(ModelRef(options.model.name, info->version));
     if (!mesh.ok()) return mesh.status();
+  }
+  if (options.pairs == BenchOptions::Pairs::kArea) {
     pool = AreaUniformPairs(*mesh, std::max<size_t>(65536, 4 * static_cast<size_t>(options.batch)),
                             options.seed);
     if (pool.empty()) {
@@ -294,9 +295,6 @@ absl::StatusOr<BenchReport> RunBench(const Client& client, const BenchOptions& o
           absl::StrFormat("model %s: its mesh has no area", info->name));
     }
   } else if (options.pairs == BenchOptions::Pairs::kNear) {
-    // The mesh of the version described, for L and the draw.
-    absl::StatusOr<Mesh> mesh = client.GetMesh(ModelRef(options.model.name, info->version));
-    if (!mesh.ok()) return mesh.status();
     report.scale_length = ScaleLength(*mesh, info->num_samples);
     // Drawing walks the faces round each point: fewer pairs than the uniform
     // pool, used in turn.

@@ -35,11 +35,12 @@ absl::Status Bench(BenchFlags flags) {
   flags.options.duration = absl::Seconds(flags.duration_s);
   flags.options.warmup = absl::Seconds(flags.warmup_s);
   std::string out;
-  std::vector<BenchOptions::Pairs> kinds;
-  if (flags.pairs == "both" || flags.pairs == "uniform") kinds.push_back(BenchOptions::Pairs::kUniform);
-  if (flags.pairs == "area") kinds.push_back(BenchOptions::Pairs::kArea);
-  if (flags.pairs == "both" || flags.pairs == "near") kinds.push_back(BenchOptions::Pairs::kNear);
-  for (const BenchOptions::Pairs kind : kinds) {
+  using Pairs = BenchOptions::Pairs;
+  std::vector<Pairs> kinds;
+  if (flags.pairs == "both" || flags.pairs == "uniform") kinds.push_back(Pairs::kUniform);
+  if (flags.pairs == "area") kinds.push_back(Pairs::kArea);
+  if (flags.pairs == "both" || flags.pairs == "near") kinds.push_back(Pairs::kNear);
+  for (const Pairs kind : kinds) {
     BenchOptions options = flags.options;
     options.pairs = kind;
     absl::StatusOr<BenchReport> report = RunBench(*client, options);
