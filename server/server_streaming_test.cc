@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "core/mesh/generators.h"
+#include "core/query/input_queries.h"
 #include "core/query/query_types.h"
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
@@ -472,7 +473,7 @@ ExpMapReply ReadExpMap(v1::Geodex::Stub& stub, const v1::ExpMapRequest& request)
   return reply;
 }
 
-TEST(ServerTest, ExpMapIsTheEnginesToTheBit) {
+TEST(ServerTest, ExpMapIsTheFacadesToTheBit) {
   TestServer ts;
   auto stub = v1::Geodex::NewStub(ts.TcpChannel());
   v1::ExpMapRequest request;
@@ -486,11 +487,16 @@ TEST(ServerTest, ExpMapIsTheEnginesToTheBit) {
   const v1::ExpMapChunk& chunk = reply.chunks[0];
   EXPECT_EQ(chunk.version(), 1);
 
-  auto engine = ReferenceEngine(testing::SphereIndexBytes());
+  // The facade's map over the same index bytes, as the server answers it.
+  auto queries = query::InputQueries::Create(ReferenceEngine(testing::SphereIndexBytes()));
+  ASSERT_TRUE(queries.ok()) << queries.status();
+  const mesh::SurfacePoint centre{17, {0.2, 0.3, 0.5}};
+  query::EnginePoints read;
+  ASSERT_TRUE((*queries)->Read(std::span(&centre, 1), query::Named("center"), &read).ok());
   query::ExpMapOptions options;
   options.radius = 1.5;
   options.reference_direction = mesh::Vec3(0.3, -1.0, 0.2);
-  auto map = engine->ExpMap({17, {0.2, 0.3, 0.5}}, options);
+  auto map = (*queries)->ExpMap(read, 0, options);
   ASSERT_TRUE(map.ok()) << map.status();
   ASSERT_GT(map->size(), 50u);
   ASSERT_EQ(chunk.num_vertices(), static_cast<int64_t>(map->size()));

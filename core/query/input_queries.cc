@@ -8,6 +8,7 @@
 
 #include "absl/strings/str_format.h"
 #include "core/common/status_macros.h"
+#include "core/query/internal/expmap/exp_map.h"
 #include "core/query/internal/input_ids.h"
 #include "core/query/internal/query_engine.h"
 
@@ -183,8 +184,11 @@ absl::StatusOr<std::vector<ExpMapVertex>> InputQueries::ExpMap(const EnginePoint
     options.reference_direction = mesh::Vec3(p[3 * t[1]], p[3 * t[1] + 1], p[3 * t[1] + 2]) -
                                   mesh::Vec3(p[3 * t[0]], p[3 * t[0] + 1], p[3 * t[0] + 2]);
   }
-  GEODEX_ASSIGN_OR_RETURN(std::vector<ExpMapVertex> map,
-                          engine_->ExpMap(internal, options, scratch));
+  GEODEX_ASSIGN_OR_RETURN(
+      std::vector<ExpMapVertex> map,
+      engine_->WithDistances(options.distance, scratch, [&](const SurfaceDistances& surface) {
+        return query::ExpMap(surface, internal, options);
+      }));
   if (ids_->identity()) return map;
   // Midpoints of the long-edge split are no input vertices.
   std::erase_if(

@@ -18,6 +18,7 @@
 #include "core/mesh/broken_meshes_testing.h"
 #include "core/mesh/generators.h"
 #include "core/mesh/mesh_repair.h"
+#include "core/query/internal/expmap/exp_map.h"
 #include "core/query/internal/input_ids.h"
 #include "core/query/internal/query_engine.h"
 #include "gmock/gmock.h"
@@ -438,7 +439,9 @@ TEST(InputQueriesTest, PointsAreCheckedWhereTheyEnter) {
   ExpMapOptions options;
   options.radius = 0.8;
   absl::StatusOr<std::vector<ExpMapVertex>> facade = (*queries)->ExpMap(read, 0, options);
-  absl::StatusOr<std::vector<ExpMapVertex>> engine = b.engine->ExpMap(centre, options);
+  absl::StatusOr<std::vector<ExpMapVertex>> engine = b.engine->WithDistances(
+      options.distance, nullptr,
+      [&](const SurfaceDistances& surface) { return ExpMap(surface, centre, options); });
   ASSERT_TRUE(facade.ok() && engine.ok());
   ASSERT_EQ(facade->size(), engine->size());
   for (size_t i = 0; i < facade->size(); ++i) {

@@ -7,6 +7,7 @@
 
 #include "absl/strings/str_format.h"
 #include "core/index/index.h"
+#include "core/query/internal/expmap/exp_map.h"
 #include "core/query/internal/query_engine.h"
 
 namespace geodex::soak {
@@ -327,7 +328,10 @@ const std::vector<Soak::StreamedCall>& Soak::StreamedCalls() {
         if (answered.engine == nullptr) return;
         query::ExpMapOptions options;
         options.radius = radius;
-        auto map = answered.engine->ExpMap(centre[0], options);
+        auto map = answered.engine->WithDistances(
+            options.distance, nullptr, [&](const query::SurfaceDistances& surface) {
+              return query::ExpMap(surface, centre[0], options);
+            });
         bool same = map.ok() && map->size() == vertices.size();
         for (size_t i = 0; same && i < vertices.size(); ++i) {
           same = (*map)[i].vertex == vertices[i] && (*map)[i].theta == theta[i];

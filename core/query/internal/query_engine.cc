@@ -8,7 +8,6 @@
 #include "core/common/status_macros.h"
 #include "core/query/internal/paths/chord_walk.h"
 #include "core/query/internal/fields/distance_field.h"
-#include "core/query/internal/expmap/exp_map.h"
 #include "core/query/internal/paths/path_straightening.h"
 
 namespace geodex::query {
@@ -209,22 +208,6 @@ absl::StatusOr<RadiusField> QueryEngine::FieldWithin(std::span<const SurfacePoin
   canonical.reserve(sources.size());
   for (const SurfacePoint& source : sources) canonical.push_back(view_.Canonical(source));
   return exact_.DistancesWithin(canonical, options.radius, options.max_vertices, scratch);
-}
-
-absl::StatusOr<std::vector<ExpMapVertex>> QueryEngine::ExpMap(const SurfacePoint& centre,
-                                                              const ExpMapOptions& options,
-                                                              QueryScratch* scratch) const {
-  QueryScratch local;
-  QueryScratch& s = scratch != nullptr ? *scratch : local;
-  auto distance = [&](const SurfacePoint& from, const SurfacePoint& p) {
-    return Distance(from, p, options.distance, &s);
-  };
-  auto exact_within = [&](const SurfacePoint& from, double radius) {
-    FieldWithinOptions within;
-    within.radius = radius;
-    return FieldWithin(std::span<const SurfacePoint>(&from, 1), within, s);
-  };
-  return query::ExpMap({view_, scale_length_, distance, exact_within}, centre, options);
 }
 
 absl::StatusOr<LocatedPoint> QueryEngine::Locate(const mesh::Vec3& x) const {

@@ -22,8 +22,11 @@
 //   exact/local_exact.h              exact propagations near a point
 //   fields/distance_field.h    §6.2  fields from several sources
 //   locate/point_locator.h           the closest surface point to a position
-//   expmap/exp_map.h           §6.4  the exponential map (from the distances
-//                                    this engine gives it)
+//
+// Queries made of the engine's own answers (the exponential map of §6.4 is
+// one) are parts over SurfaceDistances (surface_distances.h), which
+// WithDistances hands them; the facade calls them, and the engine has no
+// method of theirs (core/README.md, "Adding a query").
 //
 // Points are valid (mesh::ValidateSurfacePoint against the index's faces)
 // and in internal ids: the facade checks them once, when they enter.
@@ -37,6 +40,7 @@
 #include <cstdint>
 #include <memory>
 #include <span>
+#include <utility>
 #include <vector>
 
 #include "absl/status/statusor.h"
@@ -51,6 +55,8 @@
 #include "core/query/internal/locate/point_locator.h"
 #include "core/query/internal/query_knobs.h"
 #include "core/query/internal/bounds/refinement.h"
+#include "core/query/internal/surface_distances.h"
+#include "core/query/query_scratch.h"
 #include "core/query/query_types.h"
 
 namespace geodex::query {
@@ -147,11 +153,24 @@ class QueryEngine {
                                           const FieldWithinOptions& options,
                                           QueryScratch& scratch) const;
 
-  // The exponential map round `centre` (exp_map.h, §6.4). Errors: those of
-  // query::ExpMap.
-  absl::StatusOr<std::vector<ExpMapVertex>> ExpMap(const SurfacePoint& centre,
-                                                   const ExpMapOptions& options,
-                                                   QueryScratch* scratch = nullptr) const;
+  // Calls `query` with this engine's SurfaceDistances: Distance refined as
+  // `options` says and FieldWithin, both keeping `scratch` (a local one when
+  // null) between calls. Returns what `query` returns. How a query made of
+  // the engine's answers is run (surface_distances.h).
+  template <typename Query>
+  auto WithDistances(const DistanceOptions& options, QueryScratch* scratch, Query&& query) const {
+    QueryScratch local;
+    QueryScratch& s = scratch != nullptr ? *scratch : local;
+    auto distance = [&](const SurfacePoint& from, const SurfacePoint& p) {
+      return Distance(from, p, options, &s);
+    };
+    auto exact_within = [&](const SurfacePoint& from, double radius) {
+      FieldWithinOptions within;
+      within.radius = radius;
+      return FieldWithin(std::span<const SurfacePoint>(&from, 1), within, s);
+    };
+    return std::forward<Query>(query)(SurfaceDistances{view_, scale_length_, distance, exact_within});
+  }
 
   // Closest surface point to a 3D position.
   absl::StatusOr<LocatedPoint> Locate(const mesh::Vec3& x) const;

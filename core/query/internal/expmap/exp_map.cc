@@ -63,7 +63,7 @@ struct Node {
 // whose distance is known but whose angle is not.
 class ExpMapper {
  public:
-  ExpMapper(const ExpMapSurface& surface, const mesh::SurfacePoint& centre,
+  ExpMapper(const SurfaceDistances& surface, const mesh::SurfacePoint& centre,
             const ExpMapOptions& options)
       : surface_(surface), view_(surface.view), centre_(centre), options_(options) {}
 
@@ -101,12 +101,12 @@ class ExpMapper {
   }
   double Edge(int32_t a, int32_t b) const { return (view_.Position(a) - view_.Position(b)).norm(); }
 
-  const ExpMapSurface& surface_;
+  const SurfaceDistances& surface_;
   const MeshView view_;
   mesh::SurfacePoint centre_;
   const ExpMapOptions& options_;
   // Exact distances of the vertices within exact_radius_ of the centre
-  // (ExpMapSurface::exact_within), when the distance options refine.
+  // (SurfaceDistances::exact_within), when the distance options refine.
   absl::flat_hash_map<int32_t, double> exact_;
   double exact_radius_ = -1;
   Vec3 origin_, normal_, e1_, e2_;
@@ -408,7 +408,7 @@ absl::StatusOr<std::vector<ExpMapVertex>> ExpMapper::Run() {
 
 }  // namespace
 
-absl::StatusOr<std::vector<ExpMapVertex>> ExpMap(const ExpMapSurface& surface,
+absl::StatusOr<std::vector<ExpMapVertex>> ExpMap(const SurfaceDistances& surface,
                                                  const mesh::SurfacePoint& centre,
                                                  const ExpMapOptions& options) {
   return ExpMapper(surface, centre, options).Run();

@@ -19,48 +19,30 @@
 // Only the vertices within the radius and one ring round them are visited:
 // the cost grows with the vertices inside the radius, not with the mesh.
 //
-// The map takes its distances from the caller (QueryEngine::ExpMap passes
-// its own Distance and FieldWithin), so that it depends on the parts
-// it reads and not on the engine that composes them.
+// The map takes its distances from the caller (the facade runs it through
+// QueryEngine::WithDistances, which passes the engine's Distance and
+// FieldWithin), so that it depends on the parts it reads and not on the
+// engine that composes them. Distances below kRefineScale * L are taken
+// from one exact propagation (SurfaceDistances::exact_within).
 //
 // Thread safety: a pure function of its inputs; the distance functions are
 // called on the calling thread only.
 
-#include <cstdint>
-#include <optional>
 #include <vector>
 
-#include "absl/functional/function_ref.h"
 #include "absl/status/statusor.h"
 #include "core/mesh/mesh.h"
-#include "core/query/internal/mesh_view.h"
+#include "core/query/internal/surface_distances.h"
 #include "core/query/query_types.h"
 
 namespace geodex::query {
-
-// What the map reads of the surface and of the distances from its centre.
-struct ExpMapSurface {
-  MeshView view;
-  // L of the index (QueryEngine::scale_length): distances below
-  // kRefineScale * L are taken from one exact propagation.
-  double scale_length;
-  // The distance from `centre` to `p`, refined as options.distance says.
-  absl::FunctionRef<absl::StatusOr<double>(const mesh::SurfacePoint& centre,
-                                           const mesh::SurfacePoint& p)>
-      distance;
-  // The exact distances from `centre` to the vertices within `radius`
-  // (QueryEngine::FieldWithin): an owned copy, so that the distance function
-  // may reuse the solver that made it.
-  absl::FunctionRef<absl::StatusOr<RadiusField>(const mesh::SurfacePoint& centre, double radius)>
-      exact_within;
-};
 
 // The map of every vertex within options.radius of `centre`, ascending by
 // vertex id. `centre` is valid, in the surface's ids. Errors: InvalidArgument
 // for a radius that is not finite and > 0, and for a reference direction that
 // is not finite or is perpendicular to the centre's face; those of the
 // surface's distance functions.
-absl::StatusOr<std::vector<ExpMapVertex>> ExpMap(const ExpMapSurface& surface,
+absl::StatusOr<std::vector<ExpMapVertex>> ExpMap(const SurfaceDistances& surface,
                                                  const mesh::SurfacePoint& centre,
                                                  const ExpMapOptions& options);
 

@@ -32,12 +32,21 @@ std::shared_ptr<const QueryEngine> MakeEngine(const Mesh& m, int32_t samples) {
   return geodex::testing::TestEngineOrThrow(m, samples);
 }
 
+// The map over the engine's distances, as the facade runs it.
+absl::StatusOr<std::vector<ExpMapVertex>> EngineMap(const QueryEngine& engine,
+                                                    const SurfacePoint& centre,
+                                                    const ExpMapOptions& options) {
+  return engine.WithDistances(options.distance, nullptr, [&](const SurfaceDistances& surface) {
+    return ExpMap(surface, centre, options);
+  });
+}
+
 std::vector<ExpMapVertex> MapOrDie(const QueryEngine& engine, const SurfacePoint& centre,
                                    double radius, std::optional<Vec3> direction = std::nullopt) {
   ExpMapOptions options;
   options.radius = radius;
   options.reference_direction = direction;
-  absl::StatusOr<std::vector<ExpMapVertex>> map = engine.ExpMap(centre, options);
+  absl::StatusOr<std::vector<ExpMapVertex>> map = EngineMap(engine, centre, options);
   if (!map.ok()) throw std::runtime_error(std::string(map.status().message()));
   return *std::move(map);
 }
@@ -325,20 +334,20 @@ TEST(ExpMapTest, RejectsBadArguments) {
   const auto engine = MakeEngine(mesh, 8);
   ExpMapOptions options;
   options.radius = 0;
-  EXPECT_THAT(engine->ExpMap({0, {1, 0, 0}}, options).status().message(), HasSubstr("radius"));
+  EXPECT_THAT(EngineMap(*engine, {0, {1, 0, 0}}, options).status().message(), HasSubstr("radius"));
   options.radius = std::numeric_limits<double>::quiet_NaN();
-  EXPECT_FALSE(engine->ExpMap({0, {1, 0, 0}}, options).ok());
+  EXPECT_FALSE(EngineMap(*engine, {0, {1, 0, 0}}, options).ok());
   options.radius = 0.5;
   options.reference_direction = Vec3(0, 0, 1);  // the grid's normal
-  EXPECT_THAT(engine->ExpMap({0, {1, 0, 0}}, options).status().message(),
+  EXPECT_THAT(EngineMap(*engine, {0, {1, 0, 0}}, options).status().message(),
               HasSubstr("perpendicular"));
   options.reference_direction = Vec3(std::nan(""), 0, 0);
-  EXPECT_THAT(engine->ExpMap({0, {1, 0, 0}}, options).status().message(), HasSubstr("finite"));
+  EXPECT_THAT(EngineMap(*engine, {0, {1, 0, 0}}, options).status().message(), HasSubstr("finite"));
   // Along the reference direction theta is 0; the grid faces +z, so +v
   // points along +z x +y = -x.
   options.reference_direction = Vec3(0, 1, 0);
   const SurfacePoint centre{5, {0.2, 0.3, 0.5}};
-  const absl::StatusOr<std::vector<ExpMapVertex>> map = engine->ExpMap(centre, options);
+  const absl::StatusOr<std::vector<ExpMapVertex>> map = EngineMap(*engine, centre, options);
   ASSERT_TRUE(map.ok()) << map.status();
   ASSERT_FALSE(map->empty());
   const Vec3 c = mesh::PositionOf(mesh, centre);
