@@ -4,14 +4,17 @@
 // twins and the face BVH stored), and the time to validate and load each
 // image (Index::FromBytes, the copy of the image excluded; 6.0 derives the
 // twins and the BVH there), the median of several loads; whether the two
-// give the same spans.
+// give the same spans. With --write-dir, each file is also written there as
+// today's writer writes it (for the sections `geodex-query --info` lists).
 //
-//   index_load INDEX.gdx... [--repeats 5]
+//   index_load INDEX.gdx... [--repeats 5] [--write-dir DIR]
 
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstring>
+#include <filesystem>
+#include <fstream>
 #include <string>
 #include <vector>
 
@@ -46,7 +49,7 @@ bool Same(std::span<const T> a, std::span<const T> b) {
   return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size_bytes()) == 0;
 }
 
-int Run(const std::vector<std::string>& paths, int repeats) {
+int Run(const std::vector<std::string>& paths, int repeats, const std::string& write_dir) {
   std::printf("| index | format | MiB | load ms | older format | MiB | load ms | same spans |\n"
               "|---|---|---|---|---|---|---|---|\n");
   for (const std::string& path : paths) {
@@ -63,6 +66,16 @@ int Run(const std::vector<std::string>& paths, int repeats) {
     if (!now.ok() || !older.ok()) {
       std::fprintf(stderr, "%s: cannot write it again\n", path.c_str());
       return 1;
+    }
+    if (!write_dir.empty()) {
+      // The file as today's writer writes it, for geodex info's sections.
+      const std::string to = write_dir + "/" + std::filesystem::path(path).filename().string();
+      std::ofstream out(to, std::ios::binary);
+      out.write(now->data(), static_cast<std::streamsize>(now->size()));
+      if (!out.good()) {
+        std::fprintf(stderr, "%s: cannot write\n", to.c_str());
+        return 1;
+      }
     }
     std::shared_ptr<const index::Index> a, b;
     const double ta = LoadSeconds(*now, repeats, &a), tb = LoadSeconds(*older, repeats, &b);
@@ -88,7 +101,10 @@ int main(int argc, char** argv) {
   std::vector<std::string> paths;
   int repeats = 5;
   app.add_option("indexes", paths, "Index files")->required();
+  std::string write_dir;
   app.add_option("--repeats", repeats, "Loads of each image")->check(CLI::PositiveNumber);
+  app.add_option("--write-dir", write_dir, "Also write each index again, in today's format, here")
+      ->check(CLI::ExistingDirectory);
   CLI11_PARSE(app, argc, argv);
-  return geodex::Run(paths, repeats);
+  return geodex::Run(paths, repeats, write_dir);
 }
