@@ -11,6 +11,7 @@
 #include "absl/status/status.h"
 #include "absl/strings/str_format.h"
 #include "absl/synchronization/mutex.h"
+#include "client/cli/text_io.h"
 
 namespace geodex::client::cli {
 namespace {
@@ -314,6 +315,12 @@ absl::StatusOr<BenchReport> RunBench(const Client& client, const BenchOptions& o
     pool =
         RandomPairs(info->num_faces,
                     std::max<size_t>(65536, 4 * static_cast<size_t>(options.batch)), options.seed);
+  }
+
+  if (!options.save_pairs.empty()) {
+    if (absl::Status saved = WriteFileOrStdout(options.save_pairs, FormatPairs(pool)); !saved.ok()) {
+      return saved;
+    }
   }
 
   std::vector<WorkerStats> stats(options.concurrency);

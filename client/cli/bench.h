@@ -37,6 +37,12 @@ struct BenchOptions {
   enum class Pairs { kUniform, kArea, kNear };
   Pairs pairs = Pairs::kUniform;
   double near_from = 1, near_to = 3;
+  // When not empty, the pairs drawn are written to this file first (as
+  // FormatPairs writes them, which geodex-query --pairs reads), so that the
+  // same pairs can be timed in process (tests/bench/pairs_rate.cc) beside
+  // the rate through the service: the pool the calls take their batches
+  // from, in order.
+  std::string save_pairs;
 };
 
 struct BenchReport {

@@ -200,6 +200,21 @@ std::string FormatDistance(double d) {
   return std::string(buffer, ptr);
 }
 
+std::string FormatPairs(const std::vector<PointPair>& pairs) {
+  std::string out;
+  auto point = [&out](const SurfacePoint& p) {
+    absl::StrAppend(&out, p.face);
+    for (double w : p.w) absl::StrAppend(&out, " ", FormatDistance(w));
+  };
+  for (const PointPair& pair : pairs) {
+    point(pair.a);
+    out += ' ';
+    point(pair.b);
+    out += '\n';
+  }
+  return out;
+}
+
 absl::Status WriteFileOrStdout(const std::string& path, const std::string& contents) {
   if (path == "-") {
     if (std::fwrite(contents.data(), 1, contents.size(), stdout) != contents.size() ||

@@ -72,4 +72,9 @@ absl::Status CheckPoint(const SurfacePoint& p, int64_t num_faces, int64_t line);
 // Shortest round-trip decimal; "inf" when unreachable (as geodex-query).
 std::string FormatDistance(double d);
 
+// One line "fa a0 a1 a2 fb b0 b1 b2" per pair, weights in shortest
+// round-trip decimals: what ParsePairs (and geodex-query --pairs) read back
+// to the same bits.
+std::string FormatPairs(const std::vector<PointPair>& pairs);
+
 }  // namespace geodex::client::cli

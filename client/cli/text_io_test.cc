@@ -56,6 +56,19 @@ TEST(CheckPoint, ServerRules) {
   EXPECT_EQ(CheckPoint({0, {0.5, 0.5, 0.5}}, 10, 2).code(), absl::StatusCode::kInvalidArgument);
 }
 
+TEST(FormatPairs, ParsePairsReadsThemBackToTheBit) {
+  const std::vector<PointPair> pairs = {
+      {{3, {0.1, 0.2, 0.7}}, {0, {1.0 / 3, 1.0 / 3, 1.0 / 3}}},
+      {{12, {1, 0, 0}}, {7, {0.123456789012345678, 0.5, 0.376543210987654322}}},
+  };
+  const std::string text = FormatPairs(pairs);
+  EXPECT_EQ(text.substr(0, text.find('\n')), "3 0.1 0.2 0.7 0 0.3333333333333333 0.3333333333333333 0.3333333333333333");
+  absl::StatusOr<ParsedPairs> read = ParsePairs(text);
+  ASSERT_TRUE(read.ok()) << read.status();
+  EXPECT_EQ(read->pairs, pairs);
+  EXPECT_EQ(read->lines, (std::vector<int64_t>{1, 2}));
+}
+
 TEST(FormatDistance, ShortestRoundTripAndInf) {
   EXPECT_EQ(FormatDistance(1.5), "1.5");
   EXPECT_EQ(FormatDistance(0.1), "0.1");

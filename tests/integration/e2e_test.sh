@@ -475,6 +475,14 @@ if [ $FAKE -eq 0 ]; then
       pass "bench --refine-below 8 --mode $mode: every call answered" ||
       fail "bench --refine-below 8 --mode $mode" bench.txt
   done
+  # The pairs a bench draws, saved: the service and geodex-query answer them alike.
+  "$GEODEX" bench "${S[@]}" --model "$MODEL" --pairs near --save-pairs near_pairs.txt \
+    --duration 0.3 --warmup 0 --concurrency 1 --batch 64 > bench.txt 2> err.txt &&
+    "$GEODEX" distance "${S[@]}" --model "$MODEL" --pairs near_pairs.txt > d_near.txt 2>> err.txt &&
+    "$QUERY_BIN" models/cube/1/index.gdx --pairs near_pairs.txt > d_near_offline.txt 2>> err.txt &&
+    [ "$(wc -l < d_near.txt)" -ge 64 ] && same_numbers d_near_offline.txt d_near.txt &&
+    pass "bench --save-pairs: $(wc -l < near_pairs.txt) near pairs, answered alike by the service and geodex-query" ||
+    fail "bench --save-pairs" err.txt near_pairs.txt d_near.txt d_near_offline.txt
 fi
 
 if [ $FAKE -eq 0 ]; then

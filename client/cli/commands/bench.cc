@@ -98,6 +98,10 @@ void AddBenchCommand(CLI::App* app, absl::Status* status) {
                    "every-distance mode; 0: the model's threshold), as geodex distance does")
       ->check(CLI::NonNegativeNumber);
   bench->add_option("--seed", flags->options.seed, "Random pairs seed")->capture_default_str();
+  bench->add_option("--save-pairs", flags->options.save_pairs,
+                    "Write the pairs drawn to this file first (lines 'fa a0 a1 a2 fb b0 b1 b2', "
+                    "as geodex-query --pairs reads them; with --pairs both, the near ones), to time the same "
+                    "pairs in process");
   bench->callback([flags, status] { *status = Bench(*flags); });
 }
 
