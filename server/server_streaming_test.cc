@@ -12,12 +12,12 @@
 #include <vector>
 
 #include "core/mesh/generators.h"
+#include "core/query/exp_map.h"
 #include "core/query/input_queries.h"
 #include "core/query/query_types.h"
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
 #include "server/server_test_util.h"
-#include "server/streams/exp_map_stream.h"
 
 namespace geodex::server {
 namespace {
@@ -480,6 +480,7 @@ TEST(ServerTest, ExpMapIsTheFacadesToTheBit) {
   *request.mutable_model() = Ref("sphere");
   *request.mutable_center() = ToProto(std::vector<mesh::SurfacePoint>{{17, {0.2, 0.3, 0.5}}});
   request.set_radius(1.5);
+  request.set_near_pairs(v1::NEAR_PAIRS_UNFOLD);
   for (double x : {0.3, -1.0, 0.2}) request.mutable_reference_direction()->add_xyz(x);
   const ExpMapReply reply = ReadExpMap(*stub, request);
   ASSERT_TRUE(reply.status.ok()) << reply.status.error_message();
@@ -496,7 +497,8 @@ TEST(ServerTest, ExpMapIsTheFacadesToTheBit) {
   query::ExpMapOptions options;
   options.radius = 1.5;
   options.reference_direction = mesh::Vec3(0.3, -1.0, 0.2);
-  auto map = (*queries)->ExpMap(read, 0, options);
+  options.distance.near_pairs = query::NearPairs::kUnfold;
+  auto map = query::ExpMap(**queries, read, 0, options);
   ASSERT_TRUE(map.ok()) << map.status();
   ASSERT_GT(map->size(), 50u);
   ASSERT_EQ(chunk.num_vertices(), static_cast<int64_t>(map->size()));
@@ -534,49 +536,17 @@ TEST(ServerTest, ExpMapRejectsBadRequests) {
   two_numbers.mutable_reference_direction()->add_xyz(0);
   reply = ReadExpMap(*stub, two_numbers);
   EXPECT_EQ(reply.status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
-  EXPECT_THAT(reply.status.error_message(), HasSubstr("reference_direction"));
+  EXPECT_THAT(reply.status.error_message(),
+              HasSubstr("reference_direction: give one direction (3 numbers), got 2 numbers"));
+  v1::ExpMapRequest negative_tolerance = request({good}, 1);
+  negative_tolerance.set_tolerance(-1);
+  EXPECT_EQ(ReadExpMap(*stub, negative_tolerance).status.error_code(),
+            grpc::StatusCode::INVALID_ARGUMENT);
   v1::ExpMapRequest unknown = request({good}, 1);
   *unknown.mutable_model() = Ref("no-such-model");
   EXPECT_EQ(ReadExpMap(*stub, unknown).status.error_code(), grpc::StatusCode::NOT_FOUND);
   // The server keeps serving.
   EXPECT_TRUE(ReadExpMap(*stub, request({good}, 0.5)).status.ok());
-}
-
-// The request's options as exp_map_stream.h reads them, without a server.
-TEST(ExpMapOptionsForTest, RadiusDirectionAndDistanceOptions) {
-  v1::ExpMapRequest request;
-  request.set_radius(0.75);
-  request.set_near_pairs(v1::NEAR_PAIRS_UNFOLD);
-  for (double x : {0.3, -1.0, 0.2}) request.mutable_reference_direction()->add_xyz(x);
-  ModelConfig config;
-  config.set_tolerance(0.01);
-  auto options = ExpMapOptionsFor(config, request);
-  ASSERT_TRUE(options.ok()) << options.status();
-  EXPECT_EQ(options->radius, 0.75);
-  ASSERT_TRUE(options->reference_direction.has_value());
-  EXPECT_EQ(options->reference_direction->x(), 0.3);
-  EXPECT_EQ(options->reference_direction->y(), -1.0);
-  EXPECT_EQ(options->reference_direction->z(), 0.2);
-  EXPECT_EQ(options->distance.near_pairs, query::NearPairs::kUnfold);
-  EXPECT_EQ(options->distance.tolerance, 0.01);
-
-  request.clear_reference_direction();
-  options = ExpMapOptionsFor(ModelConfig(), request);
-  ASSERT_TRUE(options.ok()) << options.status();
-  EXPECT_FALSE(options->reference_direction.has_value());
-}
-
-TEST(ExpMapOptionsForTest, RefusesADirectionOfOtherThanThreeNumbers) {
-  v1::ExpMapRequest request;
-  for (double x : {1.0, 0.0}) request.mutable_reference_direction()->add_xyz(x);
-  auto options = ExpMapOptionsFor(ModelConfig(), request);
-  EXPECT_EQ(options.status().code(), absl::StatusCode::kInvalidArgument);
-  EXPECT_THAT(std::string(options.status().message()),
-              HasSubstr("reference_direction: give one direction (3 numbers), got 2 numbers"));
-  request.clear_reference_direction();
-  request.set_tolerance(-1);
-  EXPECT_EQ(ExpMapOptionsFor(ModelConfig(), request).status().code(),
-            absl::StatusCode::kInvalidArgument);
 }
 
 TEST(ServerTest, GetMeshInSmallChunksTilesVerticesAndFaces) {

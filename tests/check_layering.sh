@@ -8,8 +8,9 @@
 #   server/       not the client library;
 #   the parts of core/query (core/query/internal/) only from core/ and from
 #                 tests and benchmarks: the server, the offline tools and the
-#                 Python bindings use the public headers (input_queries.h,
-#                 query_types.h, query_scratch.h).
+#                 Python bindings use the public headers (those at the
+#                 top of core/query/: input_queries.h, query_types.h,
+#                 query_scratch.h and one for each query of its own).
 # The Python package keeps the same direction: client/python/geodex imports
 # core only through the optional in-process module geodex._core, in
 # _inprocess.py alone and inside a try (the client works without it), and

@@ -17,8 +17,11 @@
 // error from the server or the network (NOT_FOUND for an unknown model,
 // UNAVAILABLE, ...) and local I/O errors on output.
 
+#include <algorithm>
 #include <cstdio>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "CLI/CLI.hpp"
 #include "absl/status/status.h"
@@ -26,6 +29,33 @@
 #include "client/cli/commands/command_util.h"
 
 namespace geodex::client::cli {
+
+namespace {
+
+// Filled at static initialisation, before Main reads it: a function-local
+// static, so that its construction comes before the first registration
+// whatever the order of the files.
+std::vector<std::pair<int, AddCommand>>& Verbs() {
+  static auto* verbs = new std::vector<std::pair<int, AddCommand>>();
+  return *verbs;
+}
+
+}  // namespace
+
+bool RegisterVerb(int rank, AddCommand add) {
+  Verbs().emplace_back(rank, add);
+  return true;
+}
+
+std::vector<AddCommand> RegisteredVerbs() {
+  std::vector<std::pair<int, AddCommand>> verbs = Verbs();
+  std::stable_sort(verbs.begin(), verbs.end(),
+                   [](const auto& a, const auto& b) { return a.first < b.first; });
+  std::vector<AddCommand> out;
+  for (const auto& [rank, add] : verbs) out.push_back(add);
+  return out;
+}
+
 namespace {
 
 int Main(int argc, char** argv) {
@@ -37,9 +67,7 @@ int Main(int argc, char** argv) {
 
   // The chosen verb runs while parsing and leaves its outcome here.
   absl::Status status;
-#define GEODEX_CLI_VERB_ADDER(Verb) Add##Verb##Command,
-  for (AddCommand add : {GEODEX_CLI_VERBS(GEODEX_CLI_VERB_ADDER)}) add(&app, &status);
-#undef GEODEX_CLI_VERB_ADDER
+  for (AddCommand add : RegisteredVerbs()) add(&app, &status);
 
   try {
     app.parse(argc, argv);

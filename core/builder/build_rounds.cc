@@ -33,8 +33,11 @@ constexpr int64_t kReportAllowance = 16 << 10;
 constexpr double kLeastGrowth = 1.05;
 
 // The m at which the far band of the shared meshes' default builds came
-// closest to the default target (tests/bench, "Building to the default
-// target"): most builds then end in one or two rounds.
+// closest to the default target (tests/bench/building.md): every one of
+// them then ends in one or two rounds. The same m for every mesh: the
+// target is in L1000, so a mesh's area is in it already, and no statistic
+// of the mesh predicted which builds need a second round
+// (building.md, "The first round's m").
 constexpr double kFirstRoundAtDefaultTarget = 1200;
 
 std::string TargetPath(const std::string& workdir) { return workdir + "/target.bin"; }

@@ -27,6 +27,7 @@
 #include "core/index/index_report.h"
 #include "core/python/bindings.h"
 #include "core/python/python_status.h"
+#include "core/query/exp_map.h"
 #include "core/query/input_queries.h"
 #include "core/query/query_types.h"
 #include "pybind11/numpy.h"
@@ -329,7 +330,7 @@ class Index {
       ThrowIfError(queries_->Read(std::span<const query::SurfacePoint>(&centre, 1),
                                   query::Named("center"), &checked));
       query::QueryScratch scratch;
-      map = ValueOrThrow(queries_->ExpMap(checked, 0, options, &scratch));
+      map = ValueOrThrow(query::ExpMap(*queries_, checked, 0, options, &scratch));
     }
     const int64_t k = static_cast<int64_t>(map.size());
     py::array_t<int32_t> vertices(k);

@@ -2,13 +2,11 @@
 
 #include <algorithm>
 #include <array>
-#include <numbers>
 #include <unordered_map>
 #include <utility>
 
 #include "absl/strings/str_format.h"
 #include "core/common/status_macros.h"
-#include "core/query/internal/expmap/exp_map.h"
 #include "core/query/internal/input_ids.h"
 #include "core/query/internal/query_engine.h"
 
@@ -51,6 +49,8 @@ int32_t InputQueries::InputVertex(int32_t internal_vertex) const {
 }
 
 const index::Index& InputQueries::index() const { return engine_->index(); }
+const QueryEngine& InputQueries::engine() const { return *engine_; }
+const InputIds& InputQueries::ids() const { return *ids_; }
 const QueryOptions& InputQueries::options() const { return engine_->options(); }
 bool InputQueries::has_error_bounds() const { return engine_->has_error_bounds(); }
 double InputQueries::scale_length() const { return engine_->scale_length(); }
@@ -167,48 +167,6 @@ absl::StatusOr<RadiusField> InputQueries::FieldWithin(const EnginePoints& source
     out.nearest.push_back(e.nearest);
   }
   return out;
-}
-
-absl::StatusOr<std::vector<ExpMapVertex>> InputQueries::ExpMap(const EnginePoints& centres,
-                                                               size_t i, ExpMapOptions options,
-                                                               QueryScratch* scratch) const {
-  const SurfacePoint& internal = centres.points_.at(i);
-  const int32_t input_face = centres.input_faces_.at(i);
-  // A re-oriented face's normal is the input face's reversed, and its first
-  // edge another edge: give the input's first edge, and mirror θ. A piece of
-  // a split face has other edges too.
-  const bool mirrored = ids_->Reoriented(input_face);
-  if ((mirrored || ids_->split()) && !options.reference_direction.has_value()) {
-    const mesh::Triangle t = ids_->InputFace(input_face);
-    const std::span<const double> p = index().positions();
-    options.reference_direction = mesh::Vec3(p[3 * t[1]], p[3 * t[1] + 1], p[3 * t[1] + 2]) -
-                                  mesh::Vec3(p[3 * t[0]], p[3 * t[0] + 1], p[3 * t[0] + 2]);
-  }
-  GEODEX_ASSIGN_OR_RETURN(
-      std::vector<ExpMapVertex> map,
-      engine_->WithDistances(options.distance, scratch, [&](const SurfaceDistances& surface) {
-        return query::ExpMap(surface, internal, options);
-      }));
-  if (ids_->identity()) return map;
-  // Midpoints of the long-edge split are no input vertices.
-  std::erase_if(
-      map, [this](const ExpMapVertex& e) { return ids_->InputVertex(e.vertex) == mesh::kNone; });
-  for (ExpMapVertex& e : map) {
-    e.vertex = ids_->InputVertex(e.vertex);
-    if (mirrored) {
-      e.theta = e.theta == 0 || e.theta == std::numbers::pi ? e.theta : -e.theta;
-      e.v = -e.v;
-    }
-  }
-  // One entry per input vertex: the copy of smallest r.
-  std::stable_sort(map.begin(), map.end(), [](const ExpMapVertex& a, const ExpMapVertex& b) {
-    return a.vertex != b.vertex ? a.vertex < b.vertex : a.r < b.r;
-  });
-  map.erase(std::unique(
-                map.begin(), map.end(),
-                [](const ExpMapVertex& a, const ExpMapVertex& b) { return a.vertex == b.vertex; }),
-            map.end());
-  return map;
 }
 
 absl::StatusOr<LocatedPoint> InputQueries::Locate(const mesh::Vec3& x) const {

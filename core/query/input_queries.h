@@ -14,8 +14,11 @@
 //
 // Points enter once: Read validates a span of points in input ids and keeps
 // them, translated, in an EnginePoints, which the queries take. Answers that
-// name faces or vertices (paths, located points, fields, exponential maps,
-// the triangulation) come back in input ids.
+// name faces or vertices (paths, located points, fields, the triangulation)
+// come back in input ids. A query that is a part of its own (a header of
+// its own beside this one: core/README.md, "Adding a query") takes an
+// InputQueries and its EnginePoints and answers in input ids too, through
+// engine() and ids(), with no method here.
 //
 //   GEODEX_ASSIGN_OR_RETURN(auto queries, query::InputQueries::Open(path));
 //   query::EnginePoints a, b;
@@ -58,6 +61,10 @@ class EnginePoints {
     points_.assign(n, from.points_.at(i));
     input_faces_.assign(n, from.input_faces_.at(i));
   }
+  // Point i in the engine's ids, and its face as the caller gave it: for a
+  // query that is a part of its own over InputQueries.
+  const SurfacePoint& engine_point(size_t i) const { return points_.at(i); }
+  int32_t input_face(size_t i) const { return input_faces_.at(i); }
 
  private:
   friend class InputQueries;
@@ -98,6 +105,12 @@ class InputQueries {
   // L = sqrt(2 A / (sqrt(3) m)): the edge of an equilateral geodesic
   // triangle when the index's m samples tile the surface's area A.
   double scale_length() const;
+
+  // What a query that is a part of its own is lent: the engine
+  // whose distances it takes (internal/query_engine.h), and the map between
+  // the file's ids and the engine's (internal/input_ids.h).
+  const QueryEngine& engine() const;
+  const InputIds& ids() const;
 
   // The input mesh's counts: what face and vertex ids are checked against.
   int32_t num_vertices() const;
@@ -162,17 +175,6 @@ class InputQueries {
   absl::StatusOr<RadiusField> FieldWithin(const EnginePoints& sources,
                                           const FieldWithinOptions& options,
                                           QueryScratch* scratch = nullptr) const;
-
-  // The exponential map round centres[i] (§6.4, internal/exp_map.h):
-  // vertices are input vertices, ascending (a split vertex: its copy of
-  // smallest r); θ counter-clockwise about the normal of the centre's input
-  // face, θ = 0 by default along that face's first input edge. Errors:
-  // InvalidArgument for a radius that is not finite and > 0, and for a
-  // reference direction that is not finite or is perpendicular to the
-  // centre's face.
-  absl::StatusOr<std::vector<ExpMapVertex>> ExpMap(const EnginePoints& centres, size_t i,
-                                                   ExpMapOptions options,
-                                                   QueryScratch* scratch = nullptr) const;
 
   // The closest surface point to `x`, in an input face.
   absl::StatusOr<LocatedPoint> Locate(const mesh::Vec3& x) const;

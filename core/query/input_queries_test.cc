@@ -11,16 +11,14 @@
 #include <string>
 
 #include "absl/strings/str_format.h"
-#include "core/builder/builder.h"
-#include "core/builder/mesh_arrays.h"
 #include "core/geodesic/exact_geodesic.h"
 #include "core/index/index.h"
 #include "core/mesh/broken_meshes_testing.h"
 #include "core/mesh/generators.h"
 #include "core/mesh/mesh_repair.h"
-#include "core/query/internal/expmap/exp_map.h"
 #include "core/query/internal/input_ids.h"
 #include "core/query/internal/query_engine.h"
+#include "core/validation/test_index.h"
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
 
@@ -33,46 +31,12 @@ using mesh::SurfacePoint;
 using mesh::testing::AddTriangle;
 using mesh::testing::RawOf;
 
-struct Built {
-  RepairedMesh repaired;
-  std::shared_ptr<const QueryEngine> engine;
-};
+using Built = geodex::testing::RepairedTestEngine;
 
 // Repairs, builds (as geodex-build does, with the long-edge split when
 // `refine`) and loads an index of `raw`.
 Built Build(const RawMesh& raw, int32_t samples, bool refine = false) {
-  absl::StatusOr<RepairedMesh> repaired = mesh::RepairMesh(raw);
-  if (!repaired.ok()) throw std::runtime_error(repaired.status().ToString());
-  absl::StatusOr<builder::PreparedMesh> prepared =
-      builder::PrepareMesh(repaired->mesh, builder::RecordRepair(*repaired), samples, refine);
-  if (!prepared.ok()) throw std::runtime_error(prepared.status().ToString());
-  builder::BuildOptions options;
-  options.num_samples = samples;
-  options.threads = 2;
-  builder::BuildSummary summary;
-  absl::StatusOr<index::IndexData> data = builder::BuildPreparedIndex(*prepared, options, &summary);
-  if (!data.ok()) throw std::runtime_error(data.status().ToString());
-  absl::StatusOr<std::string> bytes = index::SerializeIndex(*data);
-  if (!bytes.ok()) throw std::runtime_error(bytes.status().ToString());
-  auto index = index::Index::FromBytes(*std::move(bytes));
-  if (!index.ok()) throw std::runtime_error(index.status().ToString());
-  auto engine = QueryEngine::Create(*index);
-  if (!engine.ok()) throw std::runtime_error(engine.status().ToString());
-  return {*std::move(repaired), *std::move(engine)};
-}
-
-// The exponential map of `e` round an input point (InputQueries::ExpMap).
-absl::StatusOr<std::vector<ExpMapVertex>> ExpMapOfInput(const QueryEngine& e,
-                                                        const SurfacePoint& centre,
-                                                        const ExpMapOptions& options) {
-  // The engine outlives the call: a non-owning pointer.
-  auto queries =
-      InputQueries::Create(std::shared_ptr<const QueryEngine>(&e, [](const QueryEngine*) {}));
-  if (!queries.ok()) return queries.status();
-  EnginePoints read;
-  const absl::Status status = (*queries)->Read(std::span(&centre, 1), Named("centre"), &read);
-  if (!status.ok()) return status;
-  return (*queries)->ExpMap(read, 0, options);
+  return geodex::testing::RepairedTestEngineOrThrow(raw, samples, refine);
 }
 
 double InputDistance(const QueryEngine& engine, const SurfacePoint& a, const SurfacePoint& b,
@@ -154,21 +118,6 @@ TEST(InputIdsTest, ReorientedFacesKeepTheirInputWeights) {
   EXPECT_NEAR(path->front().point.w[1], 0.2, 1e-12);
   EXPECT_NEAR(path->front().point.w[2], 0.7, 1e-12);
   EXPECT_EQ(path->back().point.face, 150);
-  // The exponential map's θ runs round the input face's normal: mirrored
-  // against the internal face's.
-  ExpMapOptions map_options;
-  map_options.radius = 0.5;
-  absl::StatusOr<std::vector<ExpMapVertex>> mirrored =
-      ExpMapOfInput(e, {5, {0.1, 0.2, 0.7}}, map_options);
-  absl::StatusOr<std::vector<ExpMapVertex>> plain =
-      ExpMapOfInput(*reference.engine, {5, {0.1, 0.7, 0.2}}, map_options);
-  ASSERT_TRUE(mirrored.ok() && plain.ok());
-  ASSERT_EQ(mirrored->size(), plain->size());
-  ASSERT_FALSE(plain->empty());
-  for (size_t i = 0; i < plain->size(); ++i) {
-    EXPECT_EQ((*mirrored)[i].vertex, (*plain)[i].vertex);
-    EXPECT_NEAR((*mirrored)[i].r, (*plain)[i].r, 1e-9);
-  }
 }
 
 TEST(InputIdsTest, SplitVertexFieldTakesTheSmallestCopy) {
@@ -353,12 +302,6 @@ TEST(InputIdsTest, SplitIndexAnswersInTheInputIds) {
   for (int32_t v = 0; v < 42; ++v) {
     EXPECT_NEAR(input.distance[v], exact.VertexDistance(v), 0.03 * exact.VertexDistance(v) + 0.02);
   }
-  ExpMapOptions map_options;
-  map_options.radius = 1.0;
-  absl::StatusOr<std::vector<ExpMapVertex>> map = ExpMapOfInput(e, points[3], map_options);
-  ASSERT_TRUE(map.ok()) << map.status();
-  ASSERT_FALSE(map->empty());
-  for (const ExpMapVertex& v : *map) EXPECT_LT(v.vertex, 42);
   // A path comes back in input faces, from the first point to the second.
   absl::StatusOr<SurfacePoint> to = ids.ToInternal(points[200]);
   ASSERT_TRUE(to.ok());
@@ -432,26 +375,6 @@ TEST(InputQueriesTest, PointsAreCheckedWhereTheyEnter) {
   EXPECT_EQ((*queries)->Read(face_ids, weights, Named("c"), &read).code(),
             absl::StatusCode::kInvalidArgument);
 
-  // The exponential map's centre is read like any point; its answers are
-  // the engine's round the same point (this mesh needed no repair).
-  const SurfacePoint centre{5, {0.2, 0.3, 0.5}};
-  ASSERT_TRUE((*queries)->Read(std::span(&centre, 1), Named("centre"), &read).ok());
-  ExpMapOptions options;
-  options.radius = 0.8;
-  absl::StatusOr<std::vector<ExpMapVertex>> facade = (*queries)->ExpMap(read, 0, options);
-  absl::StatusOr<std::vector<ExpMapVertex>> engine = b.engine->WithDistances(
-      options.distance, nullptr,
-      [&](const SurfaceDistances& surface) { return ExpMap(surface, centre, options); });
-  ASSERT_TRUE(facade.ok() && engine.ok());
-  ASSERT_EQ(facade->size(), engine->size());
-  for (size_t i = 0; i < facade->size(); ++i) {
-    EXPECT_EQ((*facade)[i].vertex, (*engine)[i].vertex);
-    EXPECT_EQ((*facade)[i].r, (*engine)[i].r);
-    EXPECT_EQ((*facade)[i].theta, (*engine)[i].theta);
-  }
-  options.radius = 0;
-  EXPECT_EQ((*queries)->ExpMap(read, 0, options).status().code(),
-            absl::StatusCode::kInvalidArgument);
   EnginePoints none;
   EXPECT_EQ((*queries)->Field(none).status().code(), absl::StatusCode::kInvalidArgument);
 }

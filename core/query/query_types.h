@@ -2,10 +2,11 @@
 
 // The value types of geodex's queries: how a distance is asked for
 // (DistanceOptions, NearPairs), how the queries of an index are set up
-// (QueryOptions), the options of an exponential map and of a field within a
-// radius, and what comes back (PathPoint, DistanceField, RadiusField,
-// ExpMapVertex, LocatedPoint). Plain data: the
-// public face of core/query with input_queries.h and query_scratch.h.
+// (QueryOptions), the options of a field within a radius, and what comes
+// back (PathPoint, DistanceField, RadiusField, LocatedPoint). Plain data: the
+// public face of core/query with input_queries.h and query_scratch.h. A
+// query that is a part of its own keeps its types in its own header beside
+// them.
 
 #include <array>
 #include <cstdint>
@@ -111,27 +112,6 @@ struct RadiusField {
 struct LocatedPoint {
   SurfacePoint point;   // face + barycentric weights (>= 0, sum 1)
   double distance = 0;  // Euclidean distance from the query to the surface
-};
-
-struct ExpMapOptions {
-  // Vertices whose distance from the centre exceeds this are left out.
-  double radius = 0;
-  // θ = 0 along this direction, projected into the plane of the centre's
-  // face; without it, along that face's first edge (corner 0 to corner 1).
-  std::optional<mesh::Vec3> reference_direction;
-  // How r is computed.
-  DistanceOptions distance;
-};
-
-// One vertex of an exponential map: polar (r, theta), theta in (-pi, pi],
-// counter-clockwise about the centre face's normal, and
-// (u, v) = r (cos, sin) theta.
-struct ExpMapVertex {
-  int32_t vertex = -1;
-  double r = 0;
-  double theta = 0;
-  double u = 0;
-  double v = 0;
 };
 
 }  // namespace geodex::query

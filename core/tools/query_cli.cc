@@ -7,6 +7,7 @@
 #include "core/common/status_macros.h"
 #include "core/index/index_report.h"
 #include "core/mesh/pairs_io.h"
+#include "core/query/exp_map.h"
 
 namespace geodex::tools {
 namespace {
@@ -260,7 +261,7 @@ absl::StatusOr<std::string> ExpMapText(const query::InputQueries& queries,
   query::EnginePoints read;
   GEODEX_RETURN_IF_ERROR(queries.Read(std::span(&*centre, 1), query::PointName(), &read));
   query::QueryScratch scratch;
-  GEODEX_ASSIGN_OR_RETURN(const auto map, queries.ExpMap(read, 0, map_options, &scratch));
+  GEODEX_ASSIGN_OR_RETURN(const auto map, query::ExpMap(queries, read, 0, map_options, &scratch));
   std::string out;
   for (const query::ExpMapVertex& e : map) {
     out += absl::StrFormat("%d %.17g %.17g\n", e.vertex, e.u, e.v);

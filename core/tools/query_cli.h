@@ -14,7 +14,7 @@
 // FILE holds lines "fa a0 a1 a2 fb b0 b1 b2" (core/mesh/pairs_io.h); SOURCES
 // lines "f w0 w1 w2"; POINTS lines "x y z". "-" reads standard input.
 // --expmap prints "vertex u v" for every vertex within R of the centre (the
-// exponential map, core/query/internal/expmap/exp_map.h), ascending by vertex id. Face and
+// exponential map, core/query/exp_map.h), ascending by vertex id. Face and
 // vertex ids, in and out, are those of the mesh file the index was built
 // from, also when the builder repaired it (core/query/internal/input_ids.h). Output
 // goes to standard output in input order; on a bad line nothing is printed and

@@ -3,6 +3,7 @@
 #include <stdexcept>
 
 #include "core/builder/builder.h"
+#include "core/builder/mesh_arrays.h"
 #include "core/common/status_macros.h"
 #include "core/validation/calibration.h"
 
@@ -34,6 +35,28 @@ std::shared_ptr<const query::QueryEngine> TestEngineOrThrow(const mesh::Mesh& me
                                                             index::MatrixLayout matrix) {
   absl::StatusOr<std::shared_ptr<const query::QueryEngine>> engine =
       BuildTestEngine(mesh, samples, calibrate, options, matrix);
+  if (!engine.ok()) throw std::runtime_error(engine.status().ToString());
+  return *std::move(engine);
+}
+
+RepairedTestEngine RepairedTestEngineOrThrow(const mesh::RawMesh& raw, int32_t samples,
+                                             bool split) {
+  auto engine = [&]() -> absl::StatusOr<RepairedTestEngine> {
+    GEODEX_ASSIGN_OR_RETURN(mesh::RepairedMesh repaired, mesh::RepairMesh(raw));
+    GEODEX_ASSIGN_OR_RETURN(
+        builder::PreparedMesh prepared,
+        builder::PrepareMesh(repaired.mesh, builder::RecordRepair(repaired), samples, split));
+    builder::BuildOptions options;
+    options.num_samples = samples;
+    options.threads = 2;
+    builder::BuildSummary summary;
+    GEODEX_ASSIGN_OR_RETURN(index::IndexData data,
+                            builder::BuildPreparedIndex(prepared, options, &summary));
+    GEODEX_ASSIGN_OR_RETURN(std::string bytes, index::SerializeIndex(data));
+    GEODEX_ASSIGN_OR_RETURN(auto index, index::Index::FromBytes(std::move(bytes)));
+    GEODEX_ASSIGN_OR_RETURN(auto queries, query::QueryEngine::Create(std::move(index)));
+    return RepairedTestEngine{std::move(repaired), std::move(queries)};
+  }();
   if (!engine.ok()) throw std::runtime_error(engine.status().ToString());
   return *std::move(engine);
 }

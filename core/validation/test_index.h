@@ -11,6 +11,7 @@
 #include "absl/status/statusor.h"
 #include "core/index/sample_matrix.h"
 #include "core/mesh/mesh.h"
+#include "core/mesh/mesh_repair.h"
 #include "core/query/internal/query_engine.h"
 
 namespace geodex::testing {
@@ -34,5 +35,16 @@ absl::StatusOr<std::shared_ptr<const query::QueryEngine>> BuildTestEngine(
 std::shared_ptr<const query::QueryEngine> TestEngineOrThrow(
     const mesh::Mesh& mesh, int32_t samples, bool calibrate = false,
     query::QueryOptions options = {}, index::MatrixLayout matrix = index::MatrixLayout::kCoded);
+
+// A mesh file's triangles repaired, split (the long-edge split, when
+// `split`) and built as geodex-build does, and a query engine over the
+// index: for tests of answers in the input's ids. Throws std::runtime_error
+// with the status on failure.
+struct RepairedTestEngine {
+  mesh::RepairedMesh repaired;
+  std::shared_ptr<const query::QueryEngine> engine;
+};
+RepairedTestEngine RepairedTestEngineOrThrow(const mesh::RawMesh& raw, int32_t samples,
+                                             bool split = false);
 
 }  // namespace geodex::testing

@@ -11,8 +11,9 @@
 // pool queue answers RESOURCE_EXHAUSTED.
 //
 // Streams. Each streaming call has a reactor of its own in server/streams/
-// (<call>_stream.h, e.g. distance_stream.h for StreamDistances; the
-// server-streaming ones are listed in streamed_calls.h), which sees
+// (<call>_stream.cc; the server-streaming ones are listed, and their start
+// functions declared, in streamed_calls.h; StreamDistances' in
+// distance_stream.h), which sees
 // the service only through ServiceResources (service_resources.h). They
 // write one message at a time and make the next when the write has
 // completed (backpressure).

@@ -1,4 +1,8 @@
-#include "server/streams/field_stream.h"
+// DistanceField: the distance of every vertex of the input mesh from its
+// nearest source, or, with a radius, the exact distances of the vertices
+// within it (sparse chunks: vertices with their distances). One job on the
+// worker pool computes the whole field; its chunks of at most 1 MiB are then
+// written one at a time.
 
 #include <algorithm>
 
@@ -7,6 +11,7 @@
 #include "server/convert/convert.h"
 #include "server/service/service_resources.h"
 #include "server/streams/chunked_write_stream.h"
+#include "server/streams/streamed_calls.h"
 
 namespace geodex::server {
 namespace {

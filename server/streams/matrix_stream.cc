@@ -1,4 +1,8 @@
-#include "server/streams/matrix_stream.h"
+// Matrix: the distances from every source to every target, streamed as
+// blocks of whole rows (at most 1 MiB of values each, fewer rows when the
+// request's block_rows asks). It computes one block on the worker pool,
+// writes it, and computes the next only when the write has completed; a
+// cancelled call stops between rows.
 
 #include <algorithm>
 #include <span>
@@ -10,6 +14,7 @@
 #include "server/convert/convert.h"
 #include "server/service/service_resources.h"
 #include "server/streams/chunked_write_stream.h"
+#include "server/streams/streamed_calls.h"
 
 namespace geodex::server {
 namespace {

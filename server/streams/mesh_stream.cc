@@ -1,4 +1,9 @@
-#include "server/streams/mesh_stream.h"
+// GetMesh: the input mesh (the mesh file's vertices and faces) in chunks of
+// at most ServiceLimits::mesh_chunk_elements vertices and as many faces. It
+// copies one chunk of the mapped index on the worker pool, writes it, and
+// copies the next only when the write has completed; the resolved model
+// (and so the mapped index) stays alive until the stream ends, even if the
+// version is swapped out meanwhile.
 
 #include <algorithm>
 
@@ -6,6 +11,7 @@
 #include "server/convert/convert.h"
 #include "server/service/service_resources.h"
 #include "server/streams/chunked_write_stream.h"
+#include "server/streams/streamed_calls.h"
 
 namespace geodex::server {
 namespace {

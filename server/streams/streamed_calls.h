@@ -10,20 +10,33 @@
 //     Name     the rpc, as proto/geodex/v1/geodex.proto spells it
 //     Request  its request message in geodex.v1
 //     Chunk    the message it streams, in geodex.v1
-//     Start    the function that admits and starts the call's reactor:
-//              grpc::ServerWriteReactor<v1::Chunk>* Start(
-//                  const ServiceResources*, grpc::CallbackServerContext*,
-//                  const v1::Request*)
+//     Start    the function that admits and starts the call's reactor, or
+//              returns one already finished with its admission's error;
+//              declared below from this list, defined in the reactor's file.
+//              `resources` and `request` must outlive the call.
 //
-// StreamDistances, the one bidirectional stream, is declared by hand.
+// StreamDistances, the one bidirectional stream, is declared by hand
+// (distance_stream.h).
 
-#include "server/streams/exp_map_stream.h"
-#include "server/streams/field_stream.h"
-#include "server/streams/matrix_stream.h"
-#include "server/streams/mesh_stream.h"
+#include "geodex/v1/geodex.pb.h"
+#include "grpcpp/server_context.h"
+#include "grpcpp/support/server_callback.h"
 
 #define GEODEX_SERVER_STREAMED_CALLS(X)                                        \
   X(Matrix, MatrixRequest, MatrixBlock, StartMatrixStream)                     \
   X(DistanceField, DistanceFieldRequest, DistanceFieldChunk, StartFieldStream) \
   X(ExpMap, ExpMapRequest, ExpMapChunk, StartExpMapStream)                     \
   X(GetMesh, GetMeshRequest, MeshChunk, StartMeshStream)
+
+namespace geodex::server {
+
+struct ServiceResources;
+
+#define GEODEX_SERVER_DECLARE_START(Name, Request, Chunk, Start)                     \
+  grpc::ServerWriteReactor<v1::Chunk>* Start(const ServiceResources* resources,     \
+                                             grpc::CallbackServerContext* context, \
+                                             const v1::Request* request);
+GEODEX_SERVER_STREAMED_CALLS(GEODEX_SERVER_DECLARE_START)
+#undef GEODEX_SERVER_DECLARE_START
+
+}  // namespace geodex::server

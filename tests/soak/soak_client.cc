@@ -7,7 +7,8 @@
 
 #include "absl/strings/str_format.h"
 #include "core/index/index.h"
-#include "core/query/internal/expmap/exp_map.h"
+#include "core/query/exp_map.h"
+#include "core/query/input_queries.h"
 #include "core/query/internal/query_engine.h"
 
 namespace geodex::soak {
@@ -328,10 +329,14 @@ const std::vector<Soak::StreamedCall>& Soak::StreamedCalls() {
         if (answered.engine == nullptr) return;
         query::ExpMapOptions options;
         options.radius = radius;
-        auto map = answered.engine->WithDistances(
-            options.distance, nullptr, [&](const query::SurfaceDistances& surface) {
-              return query::ExpMap(surface, centre[0], options);
-            });
+        // The engine outlives the call: a non-owning pointer.
+        auto queries = query::InputQueries::Create(std::shared_ptr<const query::QueryEngine>(
+            answered.engine, [](const query::QueryEngine*) {}));
+        query::EnginePoints read;
+        absl::StatusOr<std::vector<query::ExpMapVertex>> map =
+            queries.ok() && (*queries)->Read(centre, query::Named("center"), &read).ok()
+                ? query::ExpMap(**queries, read, 0, options)
+                : absl::InternalError("the offline engine refused the centre");
         bool same = map.ok() && map->size() == vertices.size();
         for (size_t i = 0; same && i < vertices.size(); ++i) {
           same = (*map)[i].vertex == vertices[i] && (*map)[i].theta == theta[i];

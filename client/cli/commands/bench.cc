@@ -105,4 +105,6 @@ void AddBenchCommand(CLI::App* app, absl::Status* status) {
   bench->callback([flags, status] { *status = Bench(*flags); });
 }
 
+[[maybe_unused]] const bool kRegistered = RegisterVerb(90, AddBenchCommand);
+
 }  // namespace geodex::client::cli

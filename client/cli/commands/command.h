@@ -4,7 +4,7 @@
 // (models.cc, info.cc, distance.cc, ...), each headed by what the verb does;
 // `geodex --help-all` prints the usage of all of them.
 //
-// Add<Verb>Command adds the verb's subcommand to `app` with its flags, in
+// A verb's AddCommand adds its subcommand to `app` with its flags, in
 // the order `--help` lists them: the connection flags every verb has first,
 // then the model's (every verb but models and web), then its own. When the
 // user chooses that subcommand, parsing runs the verb and stores its Status
@@ -12,6 +12,8 @@
 // code 2, any other error to 1. The flags' values are owned by the
 // subcommand's callback, so they live as long as `app`; `status` must
 // outlive the parse.
+
+#include <vector>
 
 #include "CLI/CLI.hpp"
 #include "absl/status/status.h"
@@ -21,24 +23,15 @@ namespace geodex::client::cli {
 // The signature every Add<Verb>Command has.
 using AddCommand = void (*)(CLI::App* app, absl::Status* status);
 
-// The verbs, written once, in the order `--help` lists them: X(Verb) stands
-// for Add<Verb>Command, defined in the verb's file. geodex_main.cc adds them
-// all from this list, so a new verb is its file, one line here and one in
-// client/CMakeLists.txt.
-#define GEODEX_CLI_VERBS(X) \
-  X(Models)                 \
-  X(Info)                   \
-  X(Distance)               \
-  X(Path)                   \
-  X(Field)                  \
-  X(ExpMap)                 \
-  X(Locate)                 \
-  X(Matrix)                 \
-  X(Bench)                  \
-  X(Web)
-
-#define GEODEX_CLI_DECLARE_VERB(Verb) void Add##Verb##Command(CLI::App* app, absl::Status* status);
-GEODEX_CLI_VERBS(GEODEX_CLI_DECLARE_VERB)
-#undef GEODEX_CLI_DECLARE_VERB
+// Each verb registers itself from its file, at static initialisation:
+//   [[maybe_unused]] const bool kRegistered = RegisterVerb(30, AddDistanceCommand);
+// `rank` is its place in `--help`, ascending: the verbs' files rank them in
+// steps of 10, from models (10) to web (100).
+// geodex_main.cc adds every registered verb, so a new verb is its file and
+// nothing else. Returns true (a value to initialise the registering constant).
+bool RegisterVerb(int rank, AddCommand add);
+// The registered verbs' AddCommand, by rank. Call after static
+// initialisation (from main).
+std::vector<AddCommand> RegisteredVerbs();
 
 }  // namespace geodex::client::cli

@@ -78,4 +78,6 @@ void AddDistanceCommand(CLI::App* app, absl::Status* status) {
   distance->callback([flags, status] { *status = Distance(*flags); });
 }
 
+[[maybe_unused]] const bool kRegistered = RegisterVerb(30, AddDistanceCommand);
+
 }  // namespace geodex::client::cli

@@ -164,4 +164,6 @@ void AddExpMapCommand(CLI::App* app, absl::Status* status) {
   expmap->callback([flags, status] { *status = ExpMapCommand(*flags); });
 }
 
+[[maybe_unused]] const bool kRegistered = RegisterVerb(60, AddExpMapCommand);
+
 }  // namespace geodex::client::cli

@@ -137,4 +137,6 @@ void AddFieldCommand(CLI::App* app, absl::Status* status) {
   field->callback([flags, status] { *status = Field(*flags); });
 }
 
+[[maybe_unused]] const bool kRegistered = RegisterVerb(50, AddFieldCommand);
+
 }  // namespace geodex::client::cli

@@ -48,4 +48,6 @@ void AddInfoCommand(CLI::App* app, absl::Status* status) {
   info->callback([flags, status] { *status = Info(*flags); });
 }
 
+[[maybe_unused]] const bool kRegistered = RegisterVerb(20, AddInfoCommand);
+
 }  // namespace geodex::client::cli

@@ -52,4 +52,6 @@ void AddLocateCommand(CLI::App* app, absl::Status* status) {
   locate->callback([flags, status] { *status = Locate(*flags); });
 }
 
+[[maybe_unused]] const bool kRegistered = RegisterVerb(70, AddLocateCommand);
+
 }  // namespace geodex::client::cli

@@ -60,4 +60,6 @@ void AddMatrixCommand(CLI::App* app, absl::Status* status) {
   matrix->callback([flags, status] { *status = Matrix(*flags); });
 }
 
+[[maybe_unused]] const bool kRegistered = RegisterVerb(80, AddMatrixCommand);
+
 }  // namespace geodex::client::cli

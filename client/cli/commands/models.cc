@@ -44,4 +44,6 @@ void AddModelsCommand(CLI::App* app, absl::Status* status) {
   models->callback([flags, status] { *status = Models(*flags); });
 }
 
+[[maybe_unused]] const bool kRegistered = RegisterVerb(10, AddModelsCommand);
+
 }  // namespace geodex::client::cli

@@ -71,4 +71,6 @@ void AddPathCommand(CLI::App* app, absl::Status* status) {
   path->callback([flags, status] { *status = Path(*flags); });
 }
 
+[[maybe_unused]] const bool kRegistered = RegisterVerb(40, AddPathCommand);
+
 }  // namespace geodex::client::cli

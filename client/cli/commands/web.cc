@@ -70,4 +70,6 @@ void AddWebCommand(CLI::App* app, absl::Status* status) {
   web->callback([flags, status] { *status = Web(*flags); });
 }
 
+[[maybe_unused]] const bool kRegistered = RegisterVerb(100, AddWebCommand);
+
 }  // namespace geodex::client::cli

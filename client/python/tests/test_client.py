@@ -189,6 +189,18 @@ def test_expmap_equals_geodex_query(client, torus_index, tmp_path):
     assert np.array_equal(turned_ids, vertices)
 
 
+def test_expmap_refuses_a_bad_centre_or_radius(client, num_faces):
+    past = (np.array([num_faces], np.int32), np.array([[1.0, 0.0, 0.0]]))
+    with pytest.raises(geodex.OutOfRange, match=r"center\[0\]"):
+        client.expmap(MODEL, past, 1.0)
+    with pytest.raises(geodex.InvalidArgument, match="radius"):
+        client.expmap(MODEL, (3, (1.0, 0.0, 0.0)), -1.0)
+    two = random_points(num_faces, 2, 21)
+    with pytest.raises(geodex.InvalidArgument, match="one point"):
+        client.expmap(MODEL, two, 1.0)
+    assert len(client.expmap(MODEL, (3, (1.0, 0.0, 0.0)), 0.5)[0]) > 0
+
+
 def test_locate_equals_geodex_query(client, torus_index, tmp_path, torus_mesh):
     rng = np.random.default_rng(16)
     xyz = rng.uniform(-3, 3, (200, 3))

@@ -1,7 +1,9 @@
 """Every kind of bad input gets the exception of its status code, with a
 message that names the array and the element; the server keeps serving
 after each one. Bad arrays are refused before anything is sent; what only
-the server can judge comes back as the server's error."""
+the server can judge comes back as the server's error. What only one method
+takes (the exponential map's centre and radius) is refused in that method's
+test in test_client.py."""
 
 from pathlib import Path
 
@@ -114,17 +116,11 @@ def test_bad_points_of_the_other_methods(client, num_faces):
         client.field(MODEL, past)
     with pytest.raises(geodex.OutOfRange, match=r"b\[0\]"):
         client.path(MODEL, (g.faces[:1], g.weights[:1]), past)
-    with pytest.raises(geodex.OutOfRange, match=r"center\[0\]"):
-        client.expmap(MODEL, past, 1.0)
-    with pytest.raises(geodex.InvalidArgument, match="radius"):
-        client.expmap(MODEL, (3, (1.0, 0.0, 0.0)), -1.0)
     for radius, shown in [(-1.0, "-1"), (np.nan, "nan"), (np.inf, "inf")]:
         with pytest.raises(geodex.InvalidArgument, match=f"radius must be finite and > 0, got {shown}"):
             client.field(MODEL, g, radius=radius)
     with pytest.raises(geodex.OutOfRange, match=r"sources\[0\]"):
         client.field(MODEL, past, radius=1.0)
-    with pytest.raises(geodex.InvalidArgument, match="one point"):
-        client.expmap(MODEL, (g.faces[:2], g.weights[:2]), 1.0)
     with pytest.raises(geodex.InvalidArgument, match=r"xyz\[1\]"):
         client.locate(MODEL, [[0, 0, 0], [np.nan, 0, 0]])
     with pytest.raises(geodex.InvalidArgument, match=r"a\[1\] is \[1.0, 2.0, nan\]"):

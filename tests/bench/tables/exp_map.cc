@@ -1,4 +1,4 @@
-// query_bench's exponential map table (core/query/internal/expmap/exp_map.h),
+// query_bench's exponential map table (core/query/exp_map.h),
 // registered with the bench's tables (QueryBenchTable, query_bench_lib.h):
 // the time of one map round an interior point for radii of 3 L, 10 L and the
 // whole mesh, in the default mode and with r from the pure O(1) distance.
@@ -9,8 +9,8 @@
 #include <string>
 
 #include "absl/strings/str_format.h"
-#include "core/query/internal/expmap/exp_map.h"
-#include "core/query/internal/query_engine.h"
+#include "core/query/exp_map.h"
+#include "core/query/input_queries.h"
 #include "tests/bench/bench_table.h"
 #include "tests/bench/bench_timing.h"
 #include "tests/bench/query_bench_lib.h"
@@ -26,9 +26,16 @@ std::string ExpMapHeader() {
 // Five interior centres, each mapped once per radius and mode after a
 // warm-up map (the lazy exact mesh); times per map.
 void BenchExpMap(const std::string& label, std::shared_ptr<const index::Index> ix) {
-  auto engine = *query::QueryEngine::Create(ix);
-  const auto centres = InteriorPoints(*ix, 5, 7);
-  const double l = engine->scale_length();
+  auto queries = *query::InputQueries::Create(ix);
+  // Interior points of the input's faces, which the facade reads.
+  const auto points = InteriorPoints(queries->num_faces(), 5, 7);
+  query::EnginePoints centres;
+  if (const absl::Status read = queries->Read(points, query::Named("centre"), &centres);
+      !read.ok()) {
+    std::printf("%s: %s\n", label.c_str(), read.ToString().c_str());
+    return;
+  }
+  const double l = queries->scale_length();
   for (const double radius : {3 * l, 10 * l, std::numeric_limits<double>::max()}) {
     double ms[2];
     size_t mapped = 0;
@@ -37,19 +44,11 @@ void BenchExpMap(const std::string& label, std::shared_ptr<const index::Index> i
       options.radius = radius;
       if (mode == 1) options.distance.near_pairs = query::NearPairs::kUnfold;
       query::QueryScratch scratch;
-      // As the facade runs it: over the engine's distances.
-      auto map = [&](const mesh::SurfacePoint& c) {
-        return engine->WithDistances(options.distance, &scratch,
-                                     [&](const query::SurfaceDistances& surface) {
-                                       return query::ExpMap(surface, c, options);
-                                     });
-      };
-      (void)map(centres[0]);  // the lazy exact mesh
+      auto map = [&](size_t i) { return query::ExpMap(*queries, centres, i, options, &scratch); };
+      (void)map(0);  // the lazy exact mesh
       mapped = 0;
       const double t0 = ThreadCpuSeconds();
-      for (const mesh::SurfacePoint& c : centres) {
-        mapped += map(c)->size();
-      }
+      for (size_t i = 0; i < centres.size(); ++i) mapped += map(i)->size();
       ms[mode] = 1e3 * (ThreadCpuSeconds() - t0) / centres.size();
     }
     const double per_map = static_cast<double>(mapped) / centres.size();

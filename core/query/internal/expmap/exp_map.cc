@@ -1,4 +1,21 @@
-#include "core/query/internal/expmap/exp_map.h"
+// The exponential map's work (the public call: core/query/exp_map.h).
+//
+// A vertex w is unfolded into the centre's tangent plane across each face
+// (w, a, b) whose other corners already have coordinates, and the straight
+// ray from the centre to the unfolded w tells where the geodesic crosses
+// a-b; when it misses the edge, the geodesic bends round a (or b) and w
+// takes that vertex's angle. Of the faces, the one giving the shortest path
+// is used, as a propagation of distances would. On a developable surface the
+// unfolding is exact.
+//
+// The map takes its distances from the engine through
+// QueryEngine::WithDistances (its Distance and FieldWithin), so that it
+// depends on the parts it reads and not on the engine that composes them.
+// Distances below kRefineScale * L are taken from one exact propagation
+// (SurfaceDistances::exact_within). It runs in the engine's ids; ExpMap at
+// the end gives the answer in the input's.
+
+#include "core/query/exp_map.h"
 
 #include <algorithm>
 #include <cmath>
@@ -15,7 +32,11 @@
 #include "core/common/status_macros.h"
 #include "core/geometry/planar_unfolding.h"
 #include "core/geometry/vec2.h"
+#include "core/query/input_queries.h"
+#include "core/query/internal/input_ids.h"
 #include "core/query/internal/mesh_view.h"
+#include "core/query/internal/query_engine.h"
+#include "core/query/internal/surface_distances.h"
 
 namespace geodex::query {
 namespace {
@@ -408,10 +429,48 @@ absl::StatusOr<std::vector<ExpMapVertex>> ExpMapper::Run() {
 
 }  // namespace
 
-absl::StatusOr<std::vector<ExpMapVertex>> ExpMap(const SurfaceDistances& surface,
-                                                 const mesh::SurfacePoint& centre,
-                                                 const ExpMapOptions& options) {
-  return ExpMapper(surface, centre, options).Run();
+absl::StatusOr<std::vector<ExpMapVertex>> ExpMap(const InputQueries& queries,
+                                                 const EnginePoints& centres, size_t i,
+                                                 ExpMapOptions options, QueryScratch* scratch) {
+  const SurfacePoint& internal = centres.engine_point(i);
+  const int32_t input_face = centres.input_face(i);
+  const InputIds& ids = queries.ids();
+  // A re-oriented face's normal is the input face's reversed, and its first
+  // edge another edge: give the input's first edge, and mirror θ. A piece of
+  // a split face has other edges too.
+  const bool mirrored = ids.Reoriented(input_face);
+  if ((mirrored || ids.split()) && !options.reference_direction.has_value()) {
+    const mesh::Triangle t = ids.InputFace(input_face);
+    const std::span<const double> p = queries.index().positions();
+    options.reference_direction = mesh::Vec3(p[3 * t[1]], p[3 * t[1] + 1], p[3 * t[1] + 2]) -
+                                  mesh::Vec3(p[3 * t[0]], p[3 * t[0] + 1], p[3 * t[0] + 2]);
+  }
+  GEODEX_ASSIGN_OR_RETURN(
+      std::vector<ExpMapVertex> map,
+      queries.engine().WithDistances(
+          options.distance, scratch, [&](const SurfaceDistances& surface) {
+            return ExpMapper(surface, internal, options).Run();
+          }));
+  if (ids.identity()) return map;
+  // Midpoints of the long-edge split are no input vertices.
+  std::erase_if(map,
+                [&](const ExpMapVertex& e) { return ids.InputVertex(e.vertex) == mesh::kNone; });
+  for (ExpMapVertex& e : map) {
+    e.vertex = ids.InputVertex(e.vertex);
+    if (mirrored) {
+      e.theta = e.theta == 0 || e.theta == std::numbers::pi ? e.theta : -e.theta;
+      e.v = -e.v;
+    }
+  }
+  // One entry per input vertex: the copy of smallest r.
+  std::stable_sort(map.begin(), map.end(), [](const ExpMapVertex& a, const ExpMapVertex& b) {
+    return a.vertex != b.vertex ? a.vertex < b.vertex : a.r < b.r;
+  });
+  map.erase(std::unique(
+                map.begin(), map.end(),
+                [](const ExpMapVertex& a, const ExpMapVertex& b) { return a.vertex == b.vertex; }),
+            map.end());
+  return map;
 }
 
 }  // namespace geodex::query

@@ -1,4 +1,4 @@
-#include "core/query/internal/expmap/exp_map.h"
+#include "core/query/exp_map.h"
 
 #include <algorithm>
 #include <cmath>
@@ -7,7 +7,10 @@
 #include <set>
 
 #include "absl/container/flat_hash_map.h"
+#include "core/mesh/broken_meshes_testing.h"
 #include "core/mesh/generators.h"
+#include "core/query/input_queries.h"
+#include "core/common/status_macros.h"
 #include "core/query/internal/query_engine.h"
 #include "core/validation/test_index.h"
 #include "gmock/gmock.h"
@@ -32,13 +35,18 @@ std::shared_ptr<const QueryEngine> MakeEngine(const Mesh& m, int32_t samples) {
   return geodex::testing::TestEngineOrThrow(m, samples);
 }
 
-// The map over the engine's distances, as the facade runs it.
+// The map round `centre`, given in the input's ids, over `engine`: the
+// generated meshes need no repair, so the input's ids are the engine's.
 absl::StatusOr<std::vector<ExpMapVertex>> EngineMap(const QueryEngine& engine,
                                                     const SurfacePoint& centre,
                                                     const ExpMapOptions& options) {
-  return engine.WithDistances(options.distance, nullptr, [&](const SurfaceDistances& surface) {
-    return ExpMap(surface, centre, options);
-  });
+  // The engine outlives the call: a non-owning pointer.
+  GEODEX_ASSIGN_OR_RETURN(
+      auto queries,
+      InputQueries::Create(std::shared_ptr<const QueryEngine>(&engine, [](const QueryEngine*) {})));
+  EnginePoints read;
+  GEODEX_RETURN_IF_ERROR(queries->Read(std::span(&centre, 1), Named("centre"), &read));
+  return ExpMap(*queries, read, 0, options);
 }
 
 std::vector<ExpMapVertex> MapOrDie(const QueryEngine& engine, const SurfacePoint& centre,
@@ -355,6 +363,63 @@ TEST(ExpMapTest, RejectsBadArguments) {
     const Vec3 d = mesh.position(e.vertex) - c;
     EXPECT_NEAR(e.u, d.y(), 1e-9);
     EXPECT_NEAR(e.v, -d.x(), 1e-9);
+  }
+}
+
+// θ runs round the normal of the centre's input face: where the repair
+// re-oriented that face, mirrored against the internal face's.
+TEST(ExpMapTest, AReorientedFaceMirrorsTheta) {
+  const Mesh sphere = gen::Sphere(2, 1.0);
+  mesh::RawMesh raw = mesh::testing::RawOf(sphere, "sphere");
+  for (int32_t f : {0, 5, 17, 200}) std::swap(raw.triangles[f][1], raw.triangles[f][2]);
+  const auto reoriented = geodex::testing::RepairedTestEngineOrThrow(raw, 40);
+  const auto plain =
+      geodex::testing::RepairedTestEngineOrThrow(mesh::testing::RawOf(sphere, "sphere"), 40);
+  ExpMapOptions options;
+  options.radius = 0.5;
+  // Input face 5 is (a, c, b) of the sphere's (a, b, c): weights (x, y, z) on
+  // it are (x, z, y) on the sphere's face 5.
+  absl::StatusOr<std::vector<ExpMapVertex>> mirrored =
+      EngineMap(*reoriented.engine, {5, {0.1, 0.2, 0.7}}, options);
+  absl::StatusOr<std::vector<ExpMapVertex>> reference =
+      EngineMap(*plain.engine, {5, {0.1, 0.7, 0.2}}, options);
+  ASSERT_TRUE(mirrored.ok()) << mirrored.status();
+  ASSERT_TRUE(reference.ok()) << reference.status();
+  ASSERT_EQ(mirrored->size(), reference->size());
+  ASSERT_FALSE(reference->empty());
+  int turned = 0;
+  for (size_t i = 0; i < reference->size(); ++i) {
+    const ExpMapVertex& m = (*mirrored)[i];
+    const ExpMapVertex& r = (*reference)[i];
+    EXPECT_EQ(m.vertex, r.vertex);
+    EXPECT_NEAR(m.r, r.r, 1e-9);
+    // The sphere's face 5 runs a -> b first, the input's a -> c: θ = 0 lies
+    // along another edge, and turns the other way.
+    EXPECT_NEAR(m.u * m.u + m.v * m.v, r.r * r.r, 1e-9);
+    turned += std::abs(m.theta - r.theta) > 1e-6;
+  }
+  EXPECT_GT(turned, 0);
+}
+
+// With the long-edge split, the map names input vertices only: a midpoint
+// is none, and a vertex appears once.
+TEST(ExpMapTest, ASplitIndexNamesInputVerticesOnly) {
+  const Mesh coarse = gen::Sphere(1, 1.0);
+  ASSERT_EQ(coarse.num_vertices(), 42);
+  const auto split = geodex::testing::RepairedTestEngineOrThrow(
+      mesh::testing::RawOf(coarse, "sphere"), 120, /*split=*/true);
+  ASSERT_GT(split.engine->index().split_vertices(), 0);
+  ExpMapOptions options;
+  options.radius = 1.0;
+  absl::StatusOr<std::vector<ExpMapVertex>> map =
+      EngineMap(*split.engine, {3, {0.2, 0.3, 0.5}}, options);
+  ASSERT_TRUE(map.ok()) << map.status();
+  ASSERT_FALSE(map->empty());
+  for (size_t i = 0; i < map->size(); ++i) {
+    EXPECT_LT((*map)[i].vertex, 42);
+    if (i > 0) {
+      EXPECT_LT((*map)[i - 1].vertex, (*map)[i].vertex);
+    }
   }
 }
 
