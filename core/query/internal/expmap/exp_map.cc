@@ -8,12 +8,13 @@
 // is used, as a propagation of distances would. On a developable surface the
 // unfolding is exact.
 //
-// The map takes its distances from the engine through
-// QueryEngine::WithDistances (its Distance and FieldWithin), so that it
-// depends on the parts it reads and not on the engine that composes them.
-// Distances below kRefineScale * L are taken from one exact propagation
-// (SurfaceDistances::exact_within). It runs in the engine's ids; ExpMap at
-// the end gives the answer in the input's.
+// The map (ExpMapper) reads only the distances it is given, a
+// SurfaceDistances: distances below kRefineScale * L from one exact
+// propagation (exact_within), the others from the engine's Distance. It
+// runs in the engine's ids. ExpMap, at the end, is the public call: it
+// composes the map over the facade, which lends it the engine's distances
+// (QueryEngine::WithDistances) and the input ids, and gives the answer in
+// the input's.
 
 #include "core/query/exp_map.h"
 
