@@ -54,8 +54,8 @@ RepairedTestEngine RepairedTestEngineOrThrow(const mesh::RawMesh& raw, int32_t s
                             builder::BuildPreparedIndex(prepared, options, &summary));
     GEODEX_ASSIGN_OR_RETURN(std::string bytes, index::SerializeIndex(data));
     GEODEX_ASSIGN_OR_RETURN(auto index, index::Index::FromBytes(std::move(bytes)));
-    GEODEX_ASSIGN_OR_RETURN(auto queries, query::QueryEngine::Create(std::move(index)));
-    return RepairedTestEngine{std::move(repaired), std::move(queries)};
+    GEODEX_ASSIGN_OR_RETURN(auto query_engine, query::QueryEngine::Create(std::move(index)));
+    return RepairedTestEngine{std::move(repaired), std::move(query_engine)};
   }();
   if (!engine.ok()) throw std::runtime_error(engine.status().ToString());
   return *std::move(engine);
