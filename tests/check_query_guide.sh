@@ -32,7 +32,7 @@ fi
 guide=core/README.md
 # A ratchet on how many files a new query touches: lower it when a change
 # leaves fewer, never raise it to make room for one.
-max_files=28
+max_files=25
 
 tree_list() {
   # This script names the map too, to search for it.

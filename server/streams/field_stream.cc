@@ -92,7 +92,7 @@ class FieldStream final : public ChunkedWriteStream<v1::DistanceFieldChunk> {
 
 }  // namespace
 
-grpc::ServerWriteReactor<v1::DistanceFieldChunk>* StartFieldStream(
+grpc::ServerWriteReactor<v1::DistanceFieldChunk>* StartDistanceFieldStream(
     const ServiceResources* resources, grpc::CallbackServerContext* context,
     const v1::DistanceFieldRequest* request) {
   return (new FieldStream(resources, context, request))->Start();

@@ -79,9 +79,9 @@ class MeshStream final : public ChunkedWriteStream<v1::MeshChunk> {
 
 }  // namespace
 
-grpc::ServerWriteReactor<v1::MeshChunk>* StartMeshStream(const ServiceResources* resources,
-                                                         grpc::CallbackServerContext* context,
-                                                         const v1::GetMeshRequest* request) {
+grpc::ServerWriteReactor<v1::MeshChunk>* StartGetMeshStream(const ServiceResources* resources,
+                                                            grpc::CallbackServerContext* context,
+                                                            const v1::GetMeshRequest* request) {
   return (new MeshStream(resources, context, request))->Start();
 }
 

@@ -1,6 +1,6 @@
-"""The back half of :class:`geodex.Client`'s queries: requests over gRPC,
-answers decoded (the front half, shared with the in-process index, is
-geodex/_front.py).
+"""The queries of :class:`geodex.Client`: each public method beside its
+back half, the request over gRPC and the answer decoded (the front half,
+shared with the in-process index, is geodex/_front.py).
 
 Requests carrying arrays are serialised by _wire (bytes in), and the
 numeric answers decoded by it too (bytes out): protobuf's Python objects
@@ -9,7 +9,7 @@ would copy every number through a Python float.
 
 from __future__ import annotations
 
-from typing import Iterator, List, Optional, Tuple, cast
+from typing import Any, Iterator, List, Optional, Sequence, Tuple, Union, cast
 
 import grpc
 import numpy as np
@@ -47,7 +47,9 @@ class At:
 
 
 class RemoteQueries(QueryFront[At]):
-    """The seven queries over a channel (``_run_*`` of QueryFront)."""
+    """The seven queries over a channel: the public methods of
+    :class:`geodex.Client`, and their back halves (``_run_*`` of
+    QueryFront)."""
 
     _timeout: Optional[float]
     _metadata: Optional[Tuple[Tuple[str, str], ...]]
@@ -63,6 +65,67 @@ class RemoteQueries(QueryFront[At]):
         self._expmap_call = raw("unary_stream", "ExpMap")
         self._locate_call = raw("unary_unary", "Locate")
         self._mesh_call = raw("unary_stream", "GetMesh")
+
+    def distance(
+        self,
+        model: str,
+        a: Any,
+        b: Any,
+        bounds: bool = False,
+        tolerance: float = 0.0,
+        *,
+        near_pairs: Optional[str] = None,
+        xyz: bool = False,
+        version: int = 0,
+        refine_below: float = 0.0,
+    ) -> Union[np.ndarray, Tuple[np.ndarray, np.ndarray]]:
+        """Geodesic distances of pairs: ``d[i] = d(a[i], b[i])``.
+
+        Parameters
+        ----------
+        model : str
+            The model's name.
+        a, b : points
+            N points each: ``(faces (N,), weights (N, 3))``, or (N, 3)
+            positions with ``xyz=True``.
+        bounds : bool
+            Also return each distance's absolute error bound (needs a model
+            built with its accuracy calibration: FailedPrecondition
+            otherwise).
+        tolerance : float
+            Relative error tolerance (e.g. 0.005): pairs whose bound exceeds
+            tolerance x distance are refined further. 0: the model's.
+        near_pairs : {None, "path", "unfold", "exact"}
+            How near pairs are answered (geodex.v1.NearPairs); None: the
+            model's configuration.
+        xyz : bool
+            ``a`` and ``b`` are positions, located first.
+        version : int
+            The model version (0: the newest).
+        refine_below : float
+            Also refine every pair that may be closer than this many L1000
+            (the spacing of 1,000 samples on the surface; 8: the
+            every-distance mode). 0: the model's threshold.
+
+        Returns
+        -------
+        numpy.ndarray or (numpy.ndarray, numpy.ndarray)
+            (N,) float64 distances (``inf`` between components); with
+            ``bounds``, also (N,) float64 bounds.
+
+        Raises
+        ------
+        InvalidArgument
+            Bad arrays or options (before anything is sent), or points the
+            server refuses (weights that do not sum to 1).
+        OutOfRange
+            A face id past the model's face count.
+        NotFound
+            An unknown model or version.
+        """
+        return self._distance(
+            At(model, version), a, b, bounds, tolerance, near_pairs, xyz, refine_below
+        )
 
     def _run_distance(
         self, at: At, a: SurfacePoints, b: SurfacePoints, near_pairs: int, tolerance: float,
@@ -160,6 +223,33 @@ class RemoteQueries(QueryFront[At]):
             raise DataLoss(f"the distance stream ended after {k} of {num_batches} batches")
         return out, out_bounds
 
+    def matrix(
+        self,
+        model: str,
+        sources: Any,
+        targets: Any,
+        bounds: bool = False,
+        tolerance: float = 0.0,
+        *,
+        near_pairs: Optional[str] = None,
+        xyz: bool = False,
+        version: int = 0,
+        refine_below: float = 0.0,
+    ) -> Union[np.ndarray, Tuple[np.ndarray, np.ndarray]]:
+        """All sources x targets distances: ``m[s, t] = d(sources[s],
+        targets[t])``.
+
+        Parameters are those of :meth:`distance`. Returns an (S, T) float64
+        array, and with ``bounds`` the (S, T) bounds too. Sources are sent
+        in groups of at most 2**24 cells (the server streams each group's
+        rows back in blocks); beyond the server's max_matrix_cells a group
+        fails ResourceExhausted.
+        """
+        at = At(model, version)
+        return self._matrix(
+            at, sources, targets, bounds, tolerance, near_pairs, xyz, refine_below
+        )
+
     def _run_matrix(
         self, at: At, sources: SurfacePoints, targets: SurfacePoints, near_pairs: int,
         tolerance: float, bounds: bool, refine_below: float,
@@ -213,6 +303,37 @@ class RemoteQueries(QueryFront[At]):
                 break
         return out, out_bounds
 
+    def path(
+        self,
+        model: str,
+        a: Any,
+        b: Any,
+        *,
+        exact_corridor: int = 0,
+        xyz: bool = False,
+        version: int = 0,
+        batch_size: int = 256,
+    ) -> List[Path]:
+        """Geodesic paths from a[i] to b[i].
+
+        Parameters
+        ----------
+        exact_corridor : int
+            When > 0 (at most 64), each path is also solved exactly within
+            this many edge steps of the traced one, and the shorter kept.
+            0: the model's default.
+        batch_size : int
+            Pairs per Path call (the server allows 10000 by default).
+
+        Returns
+        -------
+        list of Path
+            One per pair: (K, 3) positions with the (K,) faces and (K, 3)
+            weights of the points, and the length; K = 0 and length ``inf``
+            between components.
+        """
+        return self._path(At(model, version), a, b, exact_corridor, xyz, batch_size)
+
     def _run_path(
         self, at: At, a: SurfacePoints, b: SurfacePoints, exact_corridor: int, batch_size: int
     ) -> List[Path]:
@@ -241,6 +362,48 @@ class RemoteQueries(QueryFront[At]):
             paths.extend(_path_of(p) for p in polylines)
             at.pin(_wire.scalar(fields, 2))
         return paths
+
+    def field(
+        self,
+        model: str,
+        sources: Any,
+        *,
+        radius: float = 0.0,
+        nearest: bool = False,
+        xyz: bool = False,
+        version: int = 0,
+    ) -> Union[np.ndarray, Tuple[np.ndarray, ...]]:
+        """The distance from the nearest of ``sources`` to every vertex, or
+        to the vertices within ``radius``.
+
+        Parameters
+        ----------
+        radius : float
+            0 (the default): every vertex, O(1) per vertex per source.
+            > 0 and finite: only the vertices within this geodesic distance
+            of the sources, with exact distances (one exact propagation on
+            the server, whose cost follows the vertices it reaches: for many
+            targets round a few sources).
+
+        Returns
+        -------
+        numpy.ndarray or tuple of numpy.ndarray
+            Without a radius: (n,) float64 per vertex of the mesh file
+            (``inf`` for vertices no face uses or on other components); with
+            ``nearest``, also (n,) int32 the index of each vertex's nearest
+            source (-1 if none). With a radius: (k,) int32 the vertices
+            within it, ascending, and (k,) float64 their distances; with
+            ``nearest``, also (k,) int32 their nearest sources.
+
+        Raises
+        ------
+        InvalidArgument
+            For a radius that is negative, NaN or infinite.
+        ResourceExhausted
+            When the field within the radius reaches more vertices than the
+            server allows (max_field_vertices).
+        """
+        return self._field(At(model, version), sources, radius, nearest, xyz)
 
     def _field_request(self, at: At, sources: SurfacePoints, radius: float, nearest: bool) -> bytes:
         return (
@@ -335,6 +498,42 @@ class RemoteQueries(QueryFront[At]):
         )
         return ids, out, near
 
+    def expmap(
+        self,
+        model: str,
+        centre: Any,
+        radius: float,
+        *,
+        direction: Optional[Sequence[float]] = None,
+        polar: bool = False,
+        near_pairs: Optional[str] = None,
+        tolerance: float = 0.0,
+        xyz: bool = False,
+        version: int = 0,
+    ) -> Tuple[np.ndarray, np.ndarray]:
+        """The exponential map (geodesic polar coordinates) round one point.
+
+        Parameters
+        ----------
+        centre : point
+            One point: ``(face, (w0, w1, w2))``, or a position with xyz=True.
+        radius : float
+            Vertices farther than this from the centre are left out.
+        direction : (3,) float, optional
+            theta = 0 along it, projected into the centre's face; default
+            along that face's first edge.
+        polar : bool
+            Return (r, theta) instead of (u, v).
+
+        Returns
+        -------
+        (numpy.ndarray, numpy.ndarray)
+            (k,) int32 vertex ids, ascending, and (k, 2) float64 coordinates:
+            (u, v) = r (cos theta, sin theta), or (r, theta) with ``polar``.
+        """
+        at = At(model, version)
+        return self._expmap(at, centre, radius, direction, polar, near_pairs, tolerance, xyz)
+
     def _run_expmap(
         self, at: At, centre: SurfacePoints, radius: float, direction: Optional[np.ndarray],
         polar: bool, near_pairs: int, tolerance: float,
@@ -368,7 +567,16 @@ class RemoteQueries(QueryFront[At]):
             raise DataLoss("the exponential map's arrays differ in length")
         return ids, coords
 
-    # --- location and the mesh ---------------------------------------------
+    def locate(self, model: str, xyz: Any, *, version: int = 0, batch_size: int = 65536) -> Located:
+        """The closest surface point of each (N, 3) position.
+
+        Returns
+        -------
+        Located
+            faces (N,) int32, weights (N, 3) float64 (usable as points) and
+            distances (N,) float64 from each position to its point.
+        """
+        return self._locate(At(model, version), xyz, max(1, int(batch_size)))
 
     def _run_locate(self, at: At, xyz: np.ndarray, batch_size: int) -> Located:
         n = xyz.shape[0]
@@ -393,6 +601,18 @@ class RemoteQueries(QueryFront[At]):
             distances[lo:hi] = self._sized(_wire.packed_doubles(fields, 2), hi - lo, "distances")
             at.pin(_wire.scalar(fields, 3))
         return Located(faces, weights, distances)
+
+    def mesh(self, model: str, *, version: int = 0) -> Tuple[np.ndarray, np.ndarray]:
+        """The model's triangle mesh, in the mesh file's ids.
+
+        Returns
+        -------
+        (numpy.ndarray, numpy.ndarray)
+            (V, 3) float64 vertex positions and (F, 3) int32 vertex ids of
+            each face (polygons fan-triangulated; unreferenced vertices
+            kept).
+        """
+        return self._mesh(At(model, version))
 
     def _run_mesh(self, at: At) -> Tuple[np.ndarray, np.ndarray]:
         request = pb.GetMeshRequest(model=at.ref()).SerializeToString()

@@ -24,6 +24,7 @@
 #include "absl/status/statusor.h"
 #include "absl/time/time.h"
 #include "geodex/v1/geodex.pb.h"
+#include "geodex/v1/geodex_rpcs.h"
 
 namespace geodex::client {
 
@@ -53,26 +54,23 @@ struct StreamOptions {
   std::optional<absl::Duration> deadline;
 };
 
-// The calls of geodex.v1.Geodex other than StreamDistances, written once:
+// The calls of geodex.v1.Geodex other than StreamDistances:
 // X(Name, Request, Result), where GeodexConnection::Name(request) returns
 // absl::StatusOr<Result>. Result is the response of a unary call, or for a
 // server-streaming call the std::vector of all its messages in the order
-// received. The connection interface and its UNIMPLEMENTED defaults, the gRPC
-// connection, the retrying connection and MockGeodexConnection are all
-// expanded from this list, so a new call is one line here (plus its typed
+// received. The list is the proto's (geodex/v1/geodex_rpcs.h, generated from
+// the service): the connection interface and its UNIMPLEMENTED defaults, the
+// gRPC connection, the retrying connection and MockGeodexConnection are all
+// expanded from it, so a new call is its rpc in geodex.proto (plus its typed
 // method on Client). StreamDistances, the one bidirectional stream, is
 // declared by hand below.
-#define GEODEX_CLIENT_RPCS(X)                                                     \
-  X(ListModels, v1::ListModelsRequest, v1::ListModelsResponse)                    \
-  X(GetModel, v1::GetModelRequest, v1::ModelInfo)                                 \
-  X(Distance, v1::DistanceRequest, v1::DistanceResponse)                          \
-  X(Matrix, v1::MatrixRequest, std::vector<v1::MatrixBlock>)                      \
-  X(Path, v1::PathRequest, v1::PathResponse)                                      \
-  X(DistanceField, v1::DistanceFieldRequest, std::vector<v1::DistanceFieldChunk>) \
-  X(Locate, v1::LocateRequest, v1::LocateResponse)                                \
-  X(GetMesh, v1::GetMeshRequest, std::vector<v1::MeshChunk>)                      \
-  X(ExpMap, v1::ExpMapRequest, std::vector<v1::ExpMapChunk>)                      \
-  X(GetTriangulation, v1::GetTriangulationRequest, v1::TriangulationResponse)
+#define GEODEX_CLIENT_RPCS(X) GEODEX_V1_RPCS(GEODEX_CLIENT_RPC_OF_KIND, X)
+#define GEODEX_CLIENT_RPC_OF_KIND(Name, Request, Response, Kind, X) \
+  GEODEX_CLIENT_RPC_##Kind(X, Name, Request, Response)
+#define GEODEX_CLIENT_RPC_Unary(X, Name, Request, Response) X(Name, v1::Request, v1::Response)
+#define GEODEX_CLIENT_RPC_ServerStreaming(X, Name, Request, Chunk) \
+  X(Name, v1::Request, std::vector<v1::Chunk>)
+#define GEODEX_CLIENT_RPC_BidiStreaming(X, Name, Request, Response)
 
 class GeodexConnection {
  public:
