@@ -33,8 +33,8 @@ if(NOT _service_count EQUAL 1 OR NOT _services MATCHES "service +Geodex *\\{")
   message(FATAL_ERROR "rpc_list.cmake: ${PROTO} must declare one service, Geodex; found: ${_services}")
 endif()
 string(REGEX REPLACE ".*service +Geodex *\\{" "" _body "${_text}")
-# The service ends at the first "}" that closes no rpc's option block; rpc
-# options are not used, so the first "}" not after "{".
+# The service ends at its first "}". A "{" before it opens an rpc's option
+# block, which this script does not read: refused.
 string(REGEX REPLACE "\\}.*" "" _body "${_body}")
 if(_body MATCHES "\\{")
   message(FATAL_ERROR "rpc_list.cmake: rpc option blocks are not read; declare each rpc with ';'")
