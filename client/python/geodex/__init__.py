@@ -16,7 +16,7 @@ the barycentric weights of that face's three vertices: points are
 (:class:`InvalidArgument`, :class:`NotFound`, ...).
 """
 
-from typing import TYPE_CHECKING, NoReturn
+import typing as _typing
 
 from .errors import (
     Aborted,
@@ -48,7 +48,7 @@ except ImportError as _error:
     # The client's dependencies (grpcio, protobuf) are the extra "client";
     # without them the rest of the package works, and connect (or Client)
     # names what is missing. Type checkers see the client as installed.
-    if TYPE_CHECKING or not (_error.name or "").startswith(("grpc", "google")):
+    if _typing.TYPE_CHECKING or not (_error.name or "").startswith(("grpc", "google")):
         raise  # a broken installation, not a missing extra
     _MISSING = (
         f"geodex.connect needs {'grpcio' if _error.name.startswith('grpc') else 'protobuf'} "
@@ -56,7 +56,7 @@ except ImportError as _error:
         "install grpcio and protobuf"
     )
 
-    def connect(*args: object, **kwargs: object) -> NoReturn:
+    def connect(*args: object, **kwargs: object) -> _typing.NoReturn:
         """Raises ImportError: the client's dependencies are not installed."""
         raise ImportError(_MISSING, name="grpc")
 
@@ -84,3 +84,8 @@ __all__ = [
     # the exception classes, one per status code
     *(name for name in _errors.__all__ if name != "error_for_code"),
 ]
+
+
+def __dir__() -> _typing.List[str]:
+    # The public names, not the helpers and submodules the package imports.
+    return sorted([*__all__, "__version__", "errors"])

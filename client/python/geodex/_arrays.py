@@ -106,13 +106,42 @@ def _first(mask: np.ndarray) -> int:
     return int(np.argmax(mask))
 
 
+def as_ids(ids: np.ndarray, name: str) -> np.ndarray:
+    """Ids as an integer array: integers as they are, floats that are whole
+    numbers (a table read with ``np.loadtxt``) as int64.
+
+    Raises
+    ------
+    InvalidArgument
+        Neither integers nor floats (booleans, strings, objects), or a float
+        that is no whole number, naming the first such element (``name[i]``,
+        or ``name[i, j]`` for a 2-D array).
+    """
+    if np.issubdtype(ids.dtype, np.integer) and ids.dtype != np.bool_:
+        return ids
+    if not np.issubdtype(ids.dtype, np.floating):
+        raise InvalidArgument(f"{name} must be an integer array, not {ids.dtype}")
+    fractional = (ids != np.floor(ids)) | ~np.isfinite(ids)
+    if fractional.any():
+        at = np.unravel_index(_first(fractional.ravel()), ids.shape)
+        where = ", ".join(str(int(i)) for i in at)
+        raise InvalidArgument(
+            f"{name}[{where}] is {ids[at]!r}: ids must be whole numbers "
+            f"(a {ids.dtype} array is accepted when every element is one)"
+        )
+    # Clipped so that a whole float past int64 (1e30) does not wrap into a
+    # valid id: it stays past every id, and the range checks name it.
+    return np.clip(ids, -(2.0**62), 2.0**62).astype(np.int64)
+
+
 def as_points(points: PointsLike, name: str) -> SurfacePoints:
     """Validates surface points and returns them as C-contiguous arrays.
 
     Parameters
     ----------
     points : tuple or object
-        ``(faces, weights)``: faces an integer array of shape (N,) and weights
+        ``(faces, weights)``: faces an integer array of shape (N,) (or a
+        float array of whole numbers) and weights
         a float array of shape (N, 3); or anything with ``.faces`` and
         ``.weights`` (a :class:`SurfacePoints`, a :class:`Located`). A single
         point may be given as ``(face, (w0, w1, w2))``.
@@ -151,8 +180,8 @@ def as_points(points: PointsLike, name: str) -> SurfacePoints:
     if faces.ndim != 1:
         raise InvalidArgument(f"{name}.faces has shape {faces.shape}, want (N,)")
     n = faces.shape[0]
-    if n > 0 and not (np.issubdtype(faces.dtype, np.integer) and faces.dtype != np.bool_):
-        raise InvalidArgument(f"{name}.faces must be an integer array, not {faces.dtype}")
+    if n > 0:
+        faces = as_ids(faces, f"{name}.faces")
     if weights.shape != (n, 3):
         raise InvalidArgument(f"{name}.weights has shape {weights.shape}, want ({n}, 3)")
     if n > 0:
@@ -223,7 +252,8 @@ def as_mesh(mesh: Any, faces: Any = None) -> Tuple[np.ndarray, np.ndarray]:
         anything with ``.vertices`` (or ``.points``) and ``.faces``: a trimesh
         Trimesh, a pyvista PolyData of triangles (flat face array), ...
     faces : array, optional
-        (F, 3) integer vertex ids, 0-based.
+        (F, 3) integer vertex ids, 0-based (floats that are whole numbers are
+        accepted, as ``np.loadtxt`` reads them).
 
     Raises
     ------
@@ -249,10 +279,8 @@ def as_mesh(mesh: Any, faces: Any = None) -> Tuple[np.ndarray, np.ndarray]:
         faces = _triangles_from_flat(faces, "faces")
     if faces.ndim != 2 or faces.shape[1] != 3:
         raise InvalidArgument(f"faces has shape {faces.shape}, want (F, 3)")
-    if faces.shape[0] > 0 and not (
-        np.issubdtype(faces.dtype, np.integer) and faces.dtype != np.bool_
-    ):
-        raise InvalidArgument(f"faces must be an integer array, not {faces.dtype}")
+    if faces.shape[0] > 0:
+        faces = as_ids(faces, "faces")
     bad = ((faces < 0) | (faces >= vertices.shape[0])).any(axis=1)
     if bad.any():
         i = _first(bad)

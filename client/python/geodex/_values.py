@@ -35,7 +35,7 @@ class Tls:
     server_name: Optional[str] = None
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, repr=False)
 class Model:
     """A model as the server describes it (GetModel, ListModels).
 
@@ -44,6 +44,10 @@ class Model:
     ``build_report`` holds the builder's validation and accuracy figures
     ("key" -> "value"); ``report`` the same report as a structured dict
     (``Client.info``), empty when the server sends none.
+
+    Printed, a model is one line (``repr``): its name, version, state,
+    counts, size and the error target's verdict; the whole report is
+    ``model.report`` (or ``client.info(model.name)``).
     """
 
     name: str
@@ -65,6 +69,28 @@ class Model:
     mapped_bytes: int = 0
     mesh_hash: int = 0
     report: Dict[str, Any] = field(default_factory=dict)
+
+    @property
+    def verdict(self) -> str:
+        """The build report's verdict on the error target ("0.500% met in 1
+        round ..."); empty without a report."""
+        target = self.report.get("target") if self.report else None
+        return str(target.get("verdict", "")) if isinstance(target, dict) else ""
+
+    def __repr__(self) -> str:
+        head = f"geodex.Model({self.name!r}, version {self.version}, {self.state}"
+        if self.state != "SERVING":
+            return head + (f": {self.reason})" if self.reason else ")")
+        size = f", {self.mapped_bytes / 1048576:.2f} MiB" if self.mapped_bytes else ""
+        verdict = self.verdict
+        if len(verdict) > 60:
+            verdict = verdict[:57].rstrip() + "..."
+        return (
+            f"{head}: {self.num_vertices} vertices, {self.num_faces} faces, "
+            f"m = {self.num_samples}{size}"
+            + (f"; error target {verdict}" if verdict else "")
+            + ")"
+        )
 
 
 class Triangulation(NamedTuple):

@@ -121,7 +121,14 @@ def connect(
         if settings.server_name:
             options.append(("grpc.ssl_target_name_override", settings.server_name))
         channel = grpc.secure_channel(address, credentials, options=options)
-    return Client(channel, token=token, timeout=timeout, batch_size=int(batch_size))
+    return Client(
+        channel,
+        token=token,
+        timeout=timeout,
+        batch_size=int(batch_size),
+        address=address,
+        tls=not (tls is None or tls is False),
+    )
 
 
 class Client(RemoteQueries):
@@ -136,6 +143,9 @@ class Client(RemoteQueries):
     The seven queries are RemoteQueries' (geodex/_remote.py), each written
     beside the request it sends; this class opens the channel and answers
     for the models and their triangulations.
+
+    ``address`` is the address :func:`connect` was given (None for a
+    Client made on a channel of the caller's); the repr shows it.
     """
 
     def __init__(
@@ -144,13 +154,28 @@ class Client(RemoteQueries):
         token: Optional[str] = None,
         timeout: Optional[float] = 60.0,
         batch_size: int = 32768,
+        *,
+        address: Optional[str] = None,
+        tls: bool = False,
     ) -> None:
+        self.address = address
+        self._tls = tls
+        self._token = token is not None
         self._channel = channel
         self._metadata = (("authorization", f"Bearer {token}"),) if token else None
         self._timeout = timeout
         self._batch_size = batch_size
         self._stub = pb_grpc.GeodexStub(channel)
         self._open_methods(channel)  # the queries' calls (geodex/_remote.py)
+
+    def __repr__(self) -> str:
+        # The token is a secret: only whether one is sent.
+        where = repr(self.address) if self.address is not None else "a given channel"
+        return (
+            f"geodex.Client({where}, {'TLS' if self._tls else 'plaintext'}"
+            f"{', token' if self._token else ''}, timeout={self._timeout}, "
+            f"batch_size={self._batch_size})"
+        )
 
     # --- lifetime ----------------------------------------------------------
 
@@ -167,7 +192,11 @@ class Client(RemoteQueries):
     # --- models ------------------------------------------------------------
 
     def models(self) -> List[Model]:
-        """Every model of the server's repository, with its state."""
+        """Every model of the server's repository, with its state.
+
+        Each prints as one line (name, version, state, counts, size and
+        the error target's verdict); its whole build report is
+        ``model.report``, or ``info(name)``."""
         try:
             response = self._stub.ListModels(
                 pb.ListModelsRequest(), timeout=self._timeout, metadata=self._metadata

@@ -3,6 +3,10 @@
 Every failure the package reports is a :class:`geodex.Error` whose subclass
 names the status code (``geodex.NotFound``, ``geodex.InvalidArgument``, ...)
 and whose message is the one the server, or the in-process engine, gave.
+The classes of a caller's mistakes are also the built-in exceptions Python
+code expects for them: ``InvalidArgument`` and ``OutOfRange`` are also
+``ValueError``, ``NotFound`` is also a ``LookupError``; an ``except
+geodex.Error`` still catches every one.
 The codes are gRPC's (google.rpc.Code), which are also Abseil's: the client
 and the in-process index raise the same class for the same mistake.
 
@@ -73,8 +77,9 @@ class Unknown(Error):
     code, code_name = 2, "UNKNOWN"
 
 
-class InvalidArgument(Error):
-    """Malformed input: a bad array, point, option or mesh (INVALID_ARGUMENT)."""
+class InvalidArgument(Error, ValueError):
+    """Malformed input: a bad array, point, option or mesh (INVALID_ARGUMENT);
+    a ``ValueError``."""
 
     code, code_name = 3, "INVALID_ARGUMENT"
 
@@ -85,8 +90,9 @@ class DeadlineExceeded(Error):
     code, code_name = 4, "DEADLINE_EXCEEDED"
 
 
-class NotFound(Error):
-    """An unknown model or version, or a missing file (NOT_FOUND)."""
+class NotFound(Error, LookupError):
+    """An unknown model or version, or a missing file (NOT_FOUND); a
+    ``LookupError``."""
 
     code, code_name = 5, "NOT_FOUND"
 
@@ -122,8 +128,8 @@ class Aborted(Error):
     code, code_name = 10, "ABORTED"
 
 
-class OutOfRange(Error):
-    """A face or vertex id past the end (OUT_OF_RANGE)."""
+class OutOfRange(Error, ValueError):
+    """A face or vertex id past the end (OUT_OF_RANGE); a ``ValueError``."""
 
     code, code_name = 11, "OUT_OF_RANGE"
 

@@ -45,7 +45,12 @@ def test_empty_points():
          "a.weights has shape (2, 3), want (3, 3)"),
         ([[0, 1]], [[1, 0, 0]] * 2, geodex.InvalidArgument, "a.faces has shape (1, 2)"),
         ([0, 1], [[1, 0]] * 2, geodex.InvalidArgument, "want (2, 3)"),
-        ([0.0, 1.5], [[1, 0, 0]] * 2, geodex.InvalidArgument, "integer array, not float64"),
+        ([0.0, 1.5], [[1, 0, 0]] * 2, geodex.InvalidArgument,
+         "a.faces[1] is 1.5: ids must be whole numbers"),
+        ([0.0, np.nan], [[1, 0, 0]] * 2, geodex.InvalidArgument, "a.faces[1] is nan"),
+        ([True, False], [[1, 0, 0]] * 2, geodex.InvalidArgument, "integer array, not bool"),
+        ([0.0, -3.0], [[1, 0, 0]] * 2, geodex.InvalidArgument, "a.faces[1] is -3"),
+        ([0.0, 1e30], [[1, 0, 0]] * 2, geodex.OutOfRange, "a.faces[1]"),
         ([0, 1, 2], [[1, 0, 0], [0, 1, 0], [np.nan, 0, 1]], geodex.InvalidArgument, "a.weights[2]"),
         ([0, 1], [[np.inf, 0, 0], [0, 1, 0]], geodex.InvalidArgument, "a.weights[0]"),
         ([0, 2**31], [[1, 0, 0]] * 2, geodex.OutOfRange, "a.faces[1]"),
@@ -57,6 +62,18 @@ def test_bad_points_name_the_array_and_the_element(faces, weights, error, words)
         as_points((np.asarray(faces), weights), "a")
     assert words in str(e.value)
     assert isinstance(e.value, geodex.Error)
+
+
+def test_whole_float_ids_are_ids():
+    # What np.loadtxt reads from a table of ids: float64 of whole numbers.
+    p = as_points((np.array([3.0, 0.0, 17.0]), np.full((3, 3), 1 / 3)), "a")
+    assert p.faces.dtype == np.int32 and p.faces.tolist() == [3, 0, 17]
+    v = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [1, 1, 0]], dtype=float)
+    faces = np.loadtxt(["0 1 2", "1 3 2"])
+    assert faces.dtype == np.float64
+    assert as_mesh(v, faces)[1].tolist() == [[0, 1, 2], [1, 3, 2]]
+    with pytest.raises(geodex.InvalidArgument, match=r"faces\[1, 2\] is 2.5: ids must be whole"):
+        as_mesh(v, [[0.0, 1.0, 2.0], [1.0, 3.0, 2.5]])
 
 
 def test_points_of_another_kind_are_refused():
@@ -87,6 +104,20 @@ def test_meshes_from_arrays_and_objects():
         as_mesh(SimpleNamespace(points=v, faces=np.array([4, 0, 1, 3, 2])))
     with pytest.raises(geodex.InvalidArgument, match=".vertices"):
         as_mesh(object())
+
+
+def test_error_classes_are_the_builtin_exceptions_of_their_mistakes():
+    # A caller's bad argument is a ValueError, an unknown name a
+    # LookupError, as Python code expects; each stays a geodex.Error.
+    for code, builtin in ((3, ValueError), (11, ValueError), (5, LookupError)):
+        e = geodex.errors.error_for_code(code, "m")
+        assert isinstance(e, builtin) and isinstance(e, geodex.Error), type(e)
+    with pytest.raises(ValueError, match=r"a.faces\[0\] is -1"):
+        as_points(([-1], [[1, 0, 0]]), "a")
+    for code in (5, 9, 13, 14, 15):  # not a caller's argument
+        assert not isinstance(geodex.errors.error_for_code(code, "m"), ValueError)
+    assert not isinstance(geodex.errors.error_for_code(3, "m"), LookupError)
+    assert str(geodex.errors.error_for_code(3, "m")) == "INVALID_ARGUMENT: m"
 
 
 def test_error_classes_carry_code_and_message():

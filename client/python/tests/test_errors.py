@@ -58,8 +58,10 @@ def bad_pairs(num_faces: int):
          geodex.InvalidArgument, "b[33]"),
         ("weights of the wrong shape", (g.faces, g.weights[:, :2]), g,
          geodex.InvalidArgument, "a.weights has shape (40, 2), want (40, 3)"),
-        ("float face ids", (g.faces.astype(float), g.weights), g,
-         geodex.InvalidArgument, "a.faces must be an integer array"),
+        ("a face id that is no whole number",
+         with_(geodex.SurfacePoints(g.faces.astype(float), g.weights),
+               faces=lambda f: at33(f, 2.5)), g,
+         geodex.InvalidArgument, "a.faces[33] is 2.5"),
         ("pairs that do not pair up", g, (g.faces[:39], g.weights[:39]),
          geodex.InvalidArgument, "a has 40 points but b has 39"),
     ]
