@@ -111,6 +111,93 @@ std::string PlainReport(const ModelInfo& m) {
   return out;
 }
 
+// The samples line, as core/index/index_report.cc says it: a target
+// build's m is the target's choice.
+std::string SamplesText(Fields& f, const Struct& samples, const Struct& target) {
+  const std::string repair = absl::StrFormat("%d added by the repair of the triangulation",
+                                             f.Int(samples, "added_by_repair"));
+  std::vector<int64_t> rounds;
+  const Value& list = f.Get(target, "rounds");
+  for (const Value& v : list.list_value().values()) {
+    rounds.push_back(std::llround(v.number_value()));
+  }
+  if (f.Bool(target, "asked") && !rounds.empty()) {
+    return absl::StrFormat("m = %d (chosen by the target; rounds m = %s), %s",
+                           f.Int(samples, "final"), absl::StrJoin(rounds, ", "), repair);
+  }
+  return absl::StrFormat("m = %d: %d requested, %s", f.Int(samples, "final"),
+                         f.Int(samples, "requested"), repair);
+}
+
+// The judged checks (reports since they were stored; none before).
+std::string ChecksText(Fields& f, const Struct& target) {
+  if (!target.fields().contains("checks")) return "";
+  const std::vector<const Struct*> checks = f.List(target, "checks");
+  if (checks.empty()) return "";
+  std::string out = "                judged by the target: measured (95% upper limit / limit)\n";
+  for (const Struct* c : checks) {
+    const double upper = f.Num(*c, "upper95"), limit = f.Num(*c, "limit");
+    absl::StrAppendFormat(
+        &out, "                  %-24s %9s %s\n", f.Str(*c, "label"),
+        f.Int(*c, "pairs") > 0 ? FormatPercent(f.Num(*c, "measured")) : std::string("no pairs"),
+        f.Int(*c, "pairs") > 0
+            ? absl::StrFormat("(%s / %s)%s", FormatPercent(upper), FormatPercent(limit),
+                              upper > limit ? "  over" : "")
+            : std::string("(not judged)"));
+  }
+  return out;
+}
+
+// The accuracy section: p99 by L1000 band, which bands the target judges,
+// the judged checks, and the one mention of the index's own L, where it
+// sets the walked / O(1) split; a report without bands by the bins of L.
+std::string AccuracyText(Fields& f, const Struct& a, const Struct& target) {
+  std::string out = absl::StrFormat(
+      "  accuracy      relative error of the default answer over %d held-out pairs from %d "
+      "sources; p99 by distance\n",
+      f.Int(a, "pairs"), f.Int(a, "sources"));
+  const double scale = f.Num(a, "scale_length");
+  // The fixed L1000 bands: in reports since format 4.0, empty or absent before.
+  const std::vector<const Struct*> bands =
+      a.fields().contains("bands") ? f.List(a, "bands") : std::vector<const Struct*>();
+  if (bands.empty()) {
+    absl::StrAppendFormat(&out,
+                          "                  %-10s %9s %9s   (L = %.4g, the index's sample "
+                          "spacing; this index has no L1000 bands)\n",
+                          "distance", "RMS", "p99", scale);
+    for (const Struct* b : f.List(a, "bins")) {
+      absl::StrAppendFormat(&out, "                  %-10s %9s %9s\n", f.Str(*b, "label"),
+                            FormatPercent(f.Num(*b, "rms")), FormatPercent(f.Num(*b, "p99")));
+    }
+    return out + absl::StrFormat("                area-uniform pairs: RMS %s (limit %s)\n",
+                                 FormatPercent(f.Num(a, "uniform_rms")),
+                                 FormatPercent(f.Num(target, "error")));
+  }
+  absl::StrAppendFormat(&out, "                  %-10s %9s %9s  %-8s  %s\n", "L1000", "vertex",
+                        "interior", "target", "answered");
+  for (const Struct* b : bands) {
+    absl::StrAppendFormat(&out, "                  %-10s %9s %9s  %-8s  %s\n", f.Str(*b, "label"),
+                          FormatPercent(f.Num(*b, "p99_vertex")),
+                          FormatPercent(f.Num(*b, "p99_interior")),
+                          std::isnan(f.Num(*b, "p99_limit")) ? "-" : "judged", f.Str(*b, "answer"));
+  }
+  const std::string checks = ChecksText(f, target);
+  out += !checks.empty()
+             ? checks
+             : absl::StrFormat("                area-uniform pairs: RMS %s (limit %s)\n",
+                               FormatPercent(f.Num(a, "uniform_rms")),
+                               FormatPercent(f.Num(target, "error")));
+  const double unit = f.Num(a, "band_unit"), below = f.Num(a, "refined_below");
+  absl::StrAppendFormat(
+      &out,
+      "                L1000 = %.4g, the spacing of 1000 samples on this surface; the target\n"
+      "                judges the p99 from 8 L1000 (vertex and interior pairs apart) and the\n"
+      "                uniform RMS. Answers are walked or exact below %.3g L1000 (%.3g L,\n"
+      "                where L = %.4g is this index's own sample spacing), O(1) above.\n",
+      unit, below, scale > 0 ? below * unit / scale : NAN, scale);
+  return out;
+}
+
 }  // namespace
 
 std::string FormatPercent(double fraction) {
@@ -147,13 +234,10 @@ absl::StatusOr<std::string> ModelReportText(const ModelInfo& m) {
   const int64_t midpoints = f.Int(mesh, "split_midpoints");
   absl::StrAppendFormat(&out, "  split         %s\n",
                         midpoints == 0
-                            ? std::string("none (no edge longer than L/2)")
+                            ? std::string("none (no edge longer than half the sample spacing)")
                             : absl::StrFormat("%d midpoints (long edges split flat)", midpoints));
-  absl::StrAppendFormat(&out,
-                        "  samples       m = %d: %d requested, %d added by the repair of the "
-                        "triangulation\n",
-                        f.Int(samples, "final"), f.Int(samples, "requested"),
-                        f.Int(samples, "added_by_repair"));
+  absl::StrAppendFormat(&out, "  samples       %s\n",
+                        Wrap(SamplesText(f, samples, target), 16, 100));
   absl::StrAppendFormat(&out, "  triangles     %d geodesic triangles\n", f.Int(r, "triangles"));
   const double bytes = f.Num(size, "bytes");
   absl::StrAppendFormat(&out, "  size          %s\n", FormatMiB(bytes));
@@ -184,45 +268,7 @@ absl::StatusOr<std::string> ModelReportText(const ModelInfo& m) {
   absl::StrAppendFormat(&out, "  error target  %s\n", Wrap(f.Str(target, "verdict"), 16, 100));
   const Value& accuracy_value = f.Get(r, "accuracy");
   if (accuracy_value.kind_case() == Value::kStructValue) {
-    const Struct& a = accuracy_value.struct_value();
-    absl::StrAppendFormat(&out,
-                          "  accuracy      relative error of the default answer over %d held-out "
-                          "pairs from %d sources; L = %.4g\n",
-                          f.Int(a, "pairs"), f.Int(a, "sources"), f.Num(a, "scale_length"));
-    absl::StrAppendFormat(&out, "                  %-10s %9s %9s %11s\n", "distance", "RMS", "p99",
-                          "p99 limit");
-    for (const Struct* b : f.List(a, "bins")) {
-      const double p99 = f.Num(*b, "p99"), limit = f.Num(*b, "p99_limit");
-      absl::StrAppendFormat(&out, "                  %-10s %9s %9s %11s%s\n", f.Str(*b, "label"),
-                            FormatPercent(f.Num(*b, "rms")), FormatPercent(p99),
-                            FormatPercent(limit), p99 > limit ? "  over" : "");
-    }
-    absl::StrAppendFormat(&out,
-                          "                  area-uniform pairs: RMS %s (limit %s), p99 beyond "
-                          "10L %s\n",
-                          FormatPercent(f.Num(a, "uniform_rms")),
-                          FormatPercent(f.Num(target, "error")),
-                          FormatPercent(f.Num(a, "uniform_far_p99")));
-    // The fixed L1000 bands: in reports since format 4.0, empty or absent
-    // before.
-    const std::vector<const Struct*> bands =
-        a.fields().contains("bands") ? f.List(a, "bands") : std::vector<const Struct*>();
-    if (!bands.empty()) {
-      absl::StrAppendFormat(&out,
-                            "  by distance   p99 in units of L1000 = %.4g (the spacing of 1000 "
-                            "samples); refined below %.3g L1000\n",
-                            f.Num(a, "band_unit"), f.Num(a, "refined_below"));
-      absl::StrAppendFormat(&out, "                  %-10s %9s %9s %11s  %s\n", "L1000", "vertex",
-                            "interior", "p99 limit", "answered");
-      for (const Struct* b : bands) {
-        const double vertex = f.Num(*b, "p99_vertex"), interior = f.Num(*b, "p99_interior");
-        const double limit = f.Num(*b, "p99_limit");
-        absl::StrAppendFormat(&out, "                  %-10s %9s %9s %11s  %s%s\n",
-                              f.Str(*b, "label"), FormatPercent(vertex), FormatPercent(interior),
-                              std::isnan(limit) ? std::string("-") : FormatPercent(limit),
-                              f.Str(*b, "answer"), vertex > limit || interior > limit ? "  over" : "");
-      }
-    }
+    out += AccuracyText(f, accuracy_value.struct_value(), target);
   }
   if (!f.ok) {
     return absl::InvalidArgumentError(

@@ -41,6 +41,11 @@ constexpr char kReport[] = R"json({
     "closest_check": "vertex 3L-10L p99",
     "closest_upper95": 0.064817,
     "closest_limit": 0.02,
+    "checks": [
+      {"key": "uniform_rms", "label": "uniform RMS", "measured": 0.0125, "upper95": 0.0131, "limit": 0.005, "pairs": 8000},
+      {"key": "vertex_far_p99", "label": "vertex >=8 L1000 p99", "measured": 0.0503, "upper95": 0.064817, "limit": 0.02, "pairs": 900},
+      {"key": "interior_far_p99", "label": "interior >=8 L1000 p99", "measured": 0.0139, "upper95": 0.0151, "limit": 0.02, "pairs": 870}
+    ],
     "verdict": "0.500% NOT met: m stopped at the cap of 300 samples after 1 round (m = 300)"
   },
   "accuracy": {
@@ -87,19 +92,27 @@ TEST(ModelReportTest, LaysOutTheServersReport) {
   EXPECT_THAT(*text, HasSubstr("                  distance matrix            0.34 MiB  31.3%\n"));
   EXPECT_THAT(*text, HasSubstr("                  calibration               0.000 MiB  <0.1%\n"));
   EXPECT_THAT(*text, HasSubstr("  error target  0.500% NOT met: m stopped at the cap"));
-  EXPECT_THAT(*text, HasSubstr("L = 0.1486\n"));
-  EXPECT_THAT(*text, HasSubstr("                  d < L        0.0176%   <0.001%       1.00%\n"));
+  EXPECT_THAT(*text, HasSubstr("  samples       m = 300 (chosen by the target; rounds m = 300), 0 "
+                               "added by the repair of the\n                triangulation\n"));
+  // The fixed L1000 bands, as core/index/index_report.cc lays them out: no
+  // limit on a row, the judged checks below, the index's own L only where
+  // it sets the walked / O(1) split.
+  EXPECT_THAT(
+      *text,
+      HasSubstr("                  1-2          <0.001%       n/a  -         walked or exact\n"));
+  EXPECT_THAT(*text, HasSubstr("                  8-16           5.03%     1.39%  judged    walked "
+                               "or exact below 9.49, O(1) above\n"));
+  EXPECT_THAT(
+      *text,
+      HasSubstr("                  vertex >=8 L1000 p99         5.03% (6.48% / 2.00%)  over\n"));
   EXPECT_THAT(*text,
-              HasSubstr("                  >= 10L         1.42%     4.69%       2.00%  over\n"));
+              HasSubstr("                  interior >=8 L1000 p99       1.39% (1.51% / 2.00%)\n"));
+  EXPECT_THAT(*text, HasSubstr("L1000 = 0.2525, the spacing of 1000 samples on this surface"));
   EXPECT_THAT(*text,
-              HasSubstr("area-uniform pairs: RMS 1.25% (limit 0.500%), p99 beyond 10L 4.73%"));
-  // The fixed L1000 bands, as core/index/index_report.cc lays them out.
-  EXPECT_THAT(*text, HasSubstr("  by distance   p99 in units of L1000 = 0.2525 (the spacing of "
-                               "1000 samples); refined below 9.49 L1000\n"));
-  EXPECT_THAT(*text, HasSubstr("                  1-2          <0.001%       n/a           -  "
-                               "walked or exact\n"));
-  EXPECT_THAT(*text, HasSubstr("                  8-16           5.03%     1.39%       2.00%  "
-                               "walked or exact below 9.49, O(1) above  over\n"));
+              HasSubstr("below 9.49 L1000 (16.1 L,\n                where L = 0.1486 is this "
+                        "index's own sample spacing), O(1) above.\n"));
+  EXPECT_THAT(*text, Not(HasSubstr("10L")));  // the bins by L: not shown beside the bands
+  EXPECT_THAT(*text, Not(HasSubstr("p99 limit")));
 }
 
 // A 6.0 index's report lists the sections the server derived at load; an

@@ -1,5 +1,6 @@
 #include "core/builder/build_pipeline.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -23,6 +24,8 @@
 namespace geodex::builder {
 namespace {
 
+using Clock = std::chrono::steady_clock;
+
 std::string EdgeLine(int32_t edges, int32_t crossings, double total, double longest) {
   if (edges == 0) return "not traced";
   return absl::StrFormat(
@@ -31,10 +34,28 @@ std::string EdgeLine(int32_t edges, int32_t crossings, double total, double long
       edges, crossings, total, longest);
 }
 
+// "12.3s in all: sampling 0.5s, ..., the rest (reading, repair, split,
+// writing) 0.4s": the parts of `wall_seconds` (a build in one process), so
+// that they add up to it; without it (the merge of a distributed build,
+// whose sampling ran in another process) the parts only.
+std::string TimeText(const BuildSummary& s, std::optional<double> wall_seconds) {
+  const double parts[] = {s.sampling_seconds, s.triangulation_seconds, s.rows_seconds,
+                          s.validation_seconds, s.merge_seconds};
+  std::string text =
+      absl::StrFormat("sampling %s, triangulation %s, rows %s, validation %s, merge %s",
+                      FormatSeconds(parts[0]), FormatSeconds(parts[1]), FormatSeconds(parts[2]),
+                      FormatSeconds(parts[3]), FormatSeconds(parts[4]));
+  if (!wall_seconds.has_value()) return text;
+  double rest = *wall_seconds;
+  for (const double part : parts) rest -= part;
+  return absl::StrFormat("%s in all: %s, the rest (reading, repair, split, writing) %s",
+                         FormatSeconds(*wall_seconds), text, FormatSeconds(std::max(0.0, rest)));
+}
+
 // The closing lines of a build: the index's report (core/index/index_report.h),
 // then what only the build knows: its triangulation's figures and its times.
 std::string ClosingText(const BuildSummary& s, const index::IndexReport& report,
-                        const std::string& out, double calibration_seconds) {
+                        const std::string& out, std::optional<double> wall_seconds) {
   std::string text =
       absl::StrFormat("geodex-build: wrote %s\n%s", out, index::IndexReportText(report, out));
   absl::StrAppendFormat(
@@ -45,12 +66,7 @@ std::string ClosingText(const BuildSummary& s, const index::IndexReport& report,
                             : absl::StrFormat("%d edges traced exactly, %d crossings repaired",
                                               s.geodesic_edges, s.edge_crossings_found),
       100 * s.share_outside, s.bbox_diagonal > 0 ? s.longest_edge / s.bbox_diagonal : 0.0);
-  absl::StrAppendFormat(
-      &text, "  time          sampling %s, triangulation %s, rows %s, merge %s%s\n",
-      FormatSeconds(s.sampling_seconds), FormatSeconds(s.triangulation_seconds),
-      FormatSeconds(s.rows_seconds), FormatSeconds(s.merge_seconds),
-      calibration_seconds > 0 ? absl::StrCat(", calibration ", FormatSeconds(calibration_seconds))
-                              : "");
+  absl::StrAppendFormat(&text, "  time          %s\n", TimeText(s, wall_seconds));
   return text;
 }
 
@@ -93,11 +109,13 @@ absl::Status AddCalibration(const mesh::Mesh& mesh, index::IndexData& data, int 
 }
 
 // Writes `data` to `out`, checks that it reads back, and adds the closing
-// lines (and the chart). No index over `budget` bytes (0: no budget) is
-// written: the rounds predict their bytes, and this is the last word.
+// lines (and the chart), timed from `start` when the whole build ran in this
+// process. No index over `budget` bytes (0: no budget) is written: the
+// rounds predict their bytes, and this is the last word.
 absl::Status WriteAndReport(const index::IndexData& data, BuildSummary& summary,
                             const std::string& out, const PipelineOptions& options,
-                            double calibration_seconds, int64_t budget, BuildReport* report) {
+                            std::optional<Clock::time_point> start, int64_t budget,
+                            BuildReport* report) {
   const uint64_t bytes = index::PredictIndexBytes(data);
   if (budget > 0 && bytes > static_cast<uint64_t>(budget)) {
     return absl::ResourceExhaustedError(
@@ -111,7 +129,11 @@ absl::Status WriteAndReport(const index::IndexData& data, BuildSummary& summary,
   report->index_bytes = summary.index_bytes;
   report->num_samples = loaded->num_samples();
   const index::IndexReport index_report = index::MakeIndexReport(*loaded);
-  report->text += ClosingText(summary, index_report, out, calibration_seconds);
+  std::optional<double> wall_seconds;
+  if (start.has_value()) {
+    wall_seconds = std::chrono::duration<double>(Clock::now() - *start).count();
+  }
+  report->text += ClosingText(summary, index_report, out, wall_seconds);
   return WriteReportChart(index_report, options, report);
 }
 
@@ -130,18 +152,19 @@ RoundsOptions RoundsOf(const PipelineOptions& options) {
 
 absl::StatusOr<BuildReport> BuildToTargetError(const mesh::RepairedMesh& repaired,
                                                const std::string& out,
-                                               const PipelineOptions& options) {
+                                               const PipelineOptions& options,
+                                               Clock::time_point start) {
   GEODEX_ASSIGN_OR_RETURN(TargetBuild result, BuildToTarget(repaired.mesh, RecordRepair(repaired),
                                                             RoundsOf(options), options.log));
   if (!result.last.reached) {
-    Log(options, absl::StrFormat("geodex-build: the target error was not reached (%s); "
+    Log(options, absl::StrFormat("the target error was not reached (%s); "
                                  "writing the index of round %d (m = %d)",
                                  result.last.stop, result.last.keep + 1,
                                  result.rounds[result.last.keep].samples));
   }
   BuildReport report;
   GEODEX_RETURN_IF_ERROR(WriteEdges(result.mesh, result.plan, options.edges_obj, &report));
-  GEODEX_RETURN_IF_ERROR(WriteAndReport(result.data, result.summary, out, options, 0,
+  GEODEX_RETURN_IF_ERROR(WriteAndReport(result.data, result.summary, out, options, start,
                                         RoundsOf(options).max_index_bytes, &report));
   return report;
 }
@@ -251,11 +274,12 @@ absl::StatusOr<BuildReport> MergeTargetRound(const std::string& workdir, TargetS
     }
     result.data.report += TargetReport(state.rounds, next, state.target, result.data.accuracy[0]);
     if (!next.reached) {
-      Log(options, absl::StrFormat("geodex-build: the target error was not reached (%s); "
+      Log(options, absl::StrFormat("the target error was not reached (%s); "
                                    "writing the index of round %d (m = %d)",
                                    next.stop, next.keep + 1, state.rounds[next.keep].samples));
     }
-    GEODEX_RETURN_IF_ERROR(WriteAndReport(result.data, result.summary, out, options, 0,
+    result.summary.validation_seconds = result.validation_seconds;
+    GEODEX_RETURN_IF_ERROR(WriteAndReport(result.data, result.summary, out, options, std::nullopt,
                                           state.max_index_bytes, &report));
     return report;
   }
@@ -291,6 +315,14 @@ absl::StatusOr<BuildReport> MergeTargetRound(const std::string& workdir, TargetS
 
 }  // namespace
 
+PipelineOptions WithSampleDefaults(PipelineOptions options, bool samples_asked) {
+  if (!samples_asked) {
+    options.build.num_samples = kDefaultFirstRoundSamples;
+    if (options.target_error == 0) options.target_error = validation::kDefaultTargetError;
+  }
+  return options;
+}
+
 absl::StatusOr<mesh::RepairedMesh> LoadBuildInput(const std::string& path,
                                                   const mesh::RepairOptions& options) {
   const std::string prefix = "builtin:";
@@ -306,9 +338,10 @@ absl::StatusOr<mesh::RepairedMesh> LoadBuildInput(const std::string& path,
 
 absl::StatusOr<BuildReport> BuildIndexFile(const std::string& mesh_path, const std::string& out,
                                            const PipelineOptions& options) {
+  const Clock::time_point start = Clock::now();
   GEODEX_ASSIGN_OR_RETURN(const mesh::RepairedMesh repaired,
                           LoadBuildInput(mesh_path, options.repair));
-  if (options.target_error > 0) return BuildToTargetError(repaired, out, options);
+  if (options.target_error > 0) return BuildToTargetError(repaired, out, options, start);
   GEODEX_ASSIGN_OR_RETURN(const PreparedMesh prepared,
                           PrepareMesh(repaired.mesh, RecordRepair(repaired),
                                       options.build.num_samples, options.build.refine_long_edges));
@@ -324,12 +357,12 @@ absl::StatusOr<BuildReport> BuildIndexFile(const std::string& mesh_path, const s
   GEODEX_ASSIGN_OR_RETURN(auto data, BuildIndexFromPlan(mesh, plan, options.build, &summary,
                                                         surface ? &*surface : nullptr));
   AddRepair(prepared.record, &data);
-  double calibration_seconds = 0;
   if (options.calibrate) {
-    GEODEX_RETURN_IF_ERROR(AddCalibration(mesh, data, options.build.threads, &calibration_seconds));
+    GEODEX_RETURN_IF_ERROR(
+        AddCalibration(mesh, data, options.build.threads, &summary.validation_seconds));
   }
-  GEODEX_RETURN_IF_ERROR(WriteAndReport(data, summary, out, options, calibration_seconds,
-                                        options.max_index_bytes, &report));
+  GEODEX_RETURN_IF_ERROR(
+      WriteAndReport(data, summary, out, options, start, options.max_index_bytes, &report));
   return report;
 }
 
@@ -412,12 +445,12 @@ absl::StatusOr<BuildReport> MergeBuild(const std::string& workdir, const std::st
   GEODEX_ASSIGN_OR_RETURN(auto data, Merge(mesh, plan, std::move(rows), &summary));
   AddRepair(repair, &data);
   BuildReport report;
-  double calibration_seconds = 0;
   if (options.calibrate) {
-    GEODEX_RETURN_IF_ERROR(AddCalibration(mesh, data, options.build.threads, &calibration_seconds));
+    GEODEX_RETURN_IF_ERROR(
+        AddCalibration(mesh, data, options.build.threads, &summary.validation_seconds));
   }
-  GEODEX_RETURN_IF_ERROR(WriteAndReport(data, summary, out, options, calibration_seconds,
-                                        options.max_index_bytes, &report));
+  GEODEX_RETURN_IF_ERROR(
+      WriteAndReport(data, summary, out, options, std::nullopt, options.max_index_bytes, &report));
   return report;
 }
 

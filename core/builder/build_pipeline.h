@@ -76,6 +76,14 @@ struct BuildReport {
   bool another_round = false;
 };
 
+// `options` of a build whose caller asked for a sample count
+// (`samples_asked`: build.num_samples is the caller's) or did not: then the
+// build is to the error target, validation::kDefaultTargetError unless
+// target_error says otherwise, from a predicted first round. geodex-build
+// (no --samples) and Python's geodex.build (no samples=) both call it, so
+// the same request builds the same index.
+PipelineOptions WithSampleDefaults(PipelineOptions options, bool samples_asked);
+
 // The mesh at `path` (a mesh file core/mesh/mesh_io.h reads, or builtin:NAME
 // for a generated demo mesh: torus, sphere, cube, double-torus), read and
 // repaired as `options` says.

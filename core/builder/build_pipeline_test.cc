@@ -1,7 +1,14 @@
 #include "core/builder/build_pipeline.h"
 
+#include <chrono>
+#include <cstdio>
 #include <filesystem>
+#include <string>
+#include <vector>
 
+#include "absl/strings/match.h"
+#include "absl/strings/str_cat.h"
+#include "absl/strings/str_split.h"
 #include "core/common/file_util.h"
 #include "core/index/index.h"
 #include "core/mesh/generators.h"
@@ -11,6 +18,10 @@
 
 namespace geodex::builder {
 namespace {
+
+using ::testing::ContainsRegex;
+using ::testing::HasSubstr;
+using ::testing::Not;
 
 std::string TempDir(const std::string& name) {
   const std::string dir =
@@ -152,6 +163,78 @@ TEST(BuildPipelineTest, EdgesObjIsWritten) {
   EXPECT_THAT(report->text, testing::HasSubstr("geodesic edges to " + options.edges_obj));
   EXPECT_THAT(FileBytes(options.edges_obj), testing::HasSubstr("\nl "));
   std::filesystem::remove_all(dir);
+}
+
+// The numbers of "label 1.5s" / "label 2m05s" (FormatSeconds), in seconds.
+double ParseSeconds(absl::string_view text) {
+  int minutes = 0;
+  double seconds = 0;
+  const std::string s(text);
+  if (std::sscanf(s.c_str(), "%dm%lfs", &minutes, &seconds) == 2) return 60 * minutes + seconds;
+  return std::sscanf(s.c_str(), "%lfs", &seconds) == 1 ? seconds : -1;
+}
+
+// The report of a default build (no sample count: to the default target)
+// gives one verdict: the target line and the tables agree, lengths are in
+// L1000 but where the walked / O(1) split is explained in the index's own
+// L, m is said to be the target's choice, and the time line adds up to the
+// build's wall time.
+TEST(BuildPipelineTest, DefaultBuildsReportIsOneVerdictInOneUnit) {
+  const std::string dir = TempDir("default_report");
+  const std::string sphere = dir + "/sphere.obj";
+  ASSERT_TRUE(mesh::WriteObj(mesh::gen::Sphere(3, 1.0), sphere).ok());
+  PipelineOptions options = WithSampleDefaults(Fixed(1000), /*samples_asked=*/false);
+  EXPECT_EQ(options.target_error, 0.005);
+  const auto start = std::chrono::steady_clock::now();
+  absl::StatusOr<BuildReport> built = BuildIndexFile(sphere, dir + "/x.gdx", options);
+  const double wall =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  ASSERT_TRUE(built.ok()) << built.status();
+  const std::string& text = built->text;
+  EXPECT_THAT(text, HasSubstr("error target  0.500% met in 1 round"));
+  EXPECT_THAT(text, HasSubstr("(chosen by the target; rounds m = "));
+  EXPECT_THAT(text, Not(HasSubstr("requested")));
+  // Met: no check, row or column says otherwise, and the bins by the
+  // index's own L, which the target does not judge, carry no limit.
+  EXPECT_THAT(text, Not(HasSubstr("  over")));
+  EXPECT_THAT(text, Not(HasSubstr("over the limit")));
+  EXPECT_THAT(text, Not(HasSubstr("limit  ")));
+  EXPECT_THAT(text, Not(HasSubstr("3L-10L")));
+  EXPECT_THAT(text, Not(HasSubstr("--")));
+  EXPECT_THAT(text, HasSubstr("judged by the target: measured (95% upper limit / limit)"));
+  for (const char* check : {"uniform RMS", "vertex >=8 L1000 p99", "interior >=8 L1000 p99"}) {
+    EXPECT_THAT(text, HasSubstr(absl::StrCat("\n                  ", check))) << check;
+  }
+  // L appears once, where it explains the split, and says what it is.
+  EXPECT_THAT(text, ContainsRegex("where L = [0-9.]+ is this index's own sample spacing"));
+  size_t own_l = 0;
+  for (size_t at = text.find(" L = "); at != std::string::npos; at = text.find(" L = ", at + 1)) {
+    ++own_l;
+  }
+  EXPECT_EQ(own_l, 1u) << text;
+
+  // "time          12.3s in all: sampling ..., the rest (...) 0.4s".
+  const size_t line = text.find("\n  time          ");
+  ASSERT_NE(line, std::string::npos) << text;
+  const std::string time_line = text.substr(line + 17, text.find('\n', line + 1) - line - 17);
+  const std::vector<std::string> words =
+      absl::StrSplit(time_line, absl::ByAnyChar(" ,:"), absl::SkipEmpty());
+  ASSERT_GE(words.size(), 3u) << time_line;
+  const double total = ParseSeconds(words[0]);
+  double parts = 0;
+  int counted = 0;
+  for (size_t i = 3; i < words.size(); ++i) {
+    const double seconds = ParseSeconds(words[i]);
+    if (seconds >= 0 && absl::EndsWith(words[i], "s")) {
+      parts += seconds;
+      ++counted;
+    }
+  }
+  EXPECT_THAT(time_line, HasSubstr("validation "));
+  EXPECT_EQ(counted, 6) << time_line;  // five phases and the rest
+  EXPECT_NEAR(parts, total, 0.05 * counted + 0.05) << time_line;
+  EXPECT_LE(total, wall + 0.05) << time_line;
+  EXPECT_GE(total, wall - 0.3) << time_line;
 }
 
 }  // namespace

@@ -11,13 +11,21 @@ ProgressPrinter::ProgressPrinter(std::FILE* out) : out_(out), tty_(isatty(fileno
 void ProgressPrinter::operator()(const Progress& p) {
   std::lock_guard<std::mutex> lock(mutex_);
   const auto now = std::chrono::steady_clock::now();
-  auto [it, inserted] = phase_start_.try_emplace(p.phase, now);
-  const double elapsed = std::chrono::duration<double>(now - it->second).count();
+  if (!build_start_.has_value()) build_start_ = now;
+  if (p.phase != phase_ || p.done == 0) {
+    phase_ = p.phase;
+    phase_start_ = now;
+  }
+  const auto seconds = [&](std::chrono::steady_clock::time_point from) {
+    return std::chrono::duration<double>(now - from).count();
+  };
+  const double in_phase = seconds(phase_start_);
   const double fraction = p.total > 0 ? static_cast<double>(p.done) / p.total : 1.0;
   std::string eta = "";
-  if (fraction > 0 && fraction < 1) eta = " ETA " + FormatSeconds(elapsed / fraction - elapsed);
-  const std::string line = absl::StrFormat("[%s] %d/%d (%.1f%%) elapsed %s%s", p.phase, p.done,
-                                           p.total, 100 * fraction, FormatSeconds(elapsed), eta);
+  if (fraction > 0 && fraction < 1) eta = " ETA " + FormatSeconds(in_phase / fraction - in_phase);
+  const std::string line =
+      absl::StrFormat("[%s] %d/%d (%.1f%%) elapsed %s%s", p.phase, p.done, p.total, 100 * fraction,
+                      FormatSeconds(seconds(*build_start_)), eta);
   if (tty_) {
     std::fprintf(out_, "\r\033[K%s%s", line.c_str(), p.done >= p.total ? "\n" : "");
   } else if (p.done >= p.total || std::chrono::duration<double>(now - last_log_).count() >= 10) {

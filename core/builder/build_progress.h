@@ -2,15 +2,19 @@
 
 // How geodex-build shows the builder's progress (BuildOptions::progress) on
 // stderr: a live line with an ETA on a terminal, otherwise a log line every
-// 10 seconds and at the end of each phase.
+// 10 seconds and at the end of each phase. "elapsed" is the time since the
+// build's first progress call, the same clock on every line (it never runs
+// backwards from one phase to the next); the ETA is the current phase's,
+// timed from when that phase last began (a target-error build runs its
+// phases once a round).
 //
 // Thread safety: operator() may be called from any thread (calls are
 // serialised).
 
 #include <chrono>
 #include <cstdio>
-#include <map>
 #include <mutex>
+#include <optional>
 #include <string>
 
 #include "core/builder/builder.h"
@@ -27,7 +31,9 @@ class ProgressPrinter {
   std::FILE* out_;
   bool tty_;
   std::mutex mutex_;
-  std::map<std::string, std::chrono::steady_clock::time_point> phase_start_;
+  std::optional<std::chrono::steady_clock::time_point> build_start_;
+  std::string phase_;  // the phase of the last call
+  std::chrono::steady_clock::time_point phase_start_{};
   std::chrono::steady_clock::time_point last_log_{};
 };
 

@@ -341,6 +341,7 @@ absl::StatusOr<TargetBuild> BuildToTarget(const mesh::Mesh& coarse, const Repair
     build.summary.triangulation_seconds = totals.triangulation_seconds;
     build.summary.rows_seconds = totals.rows_seconds;
     build.summary.merge_seconds = totals.merge_seconds;
+    build.summary.validation_seconds = totals.validation_seconds;
     build.data.report +=
         TargetReport(build.rounds, build.last, options.target, build.data.accuracy[0]);
     return build;
@@ -362,6 +363,7 @@ absl::StatusOr<TargetBuild> BuildToTarget(const mesh::Mesh& coarse, const Repair
     totals.triangulation_seconds += round.plan.triangulation_seconds;
     totals.rows_seconds += rows_seconds;
     totals.merge_seconds += result.summary.merge_seconds;
+    totals.validation_seconds += result.validation_seconds;
     if (log) {
       log(RoundLine(k, result.figures, options.target) +
           absl::StrFormat(" (rows %.1fs, validation %.1fs)", rows_seconds,

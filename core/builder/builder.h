@@ -78,6 +78,9 @@ struct BuildSummary {
   double triangulation_seconds = 0;
   double rows_seconds = 0;
   double merge_seconds = 0;
+  // The held-out validation (the calibration; every round's in a
+  // target-error build).
+  double validation_seconds = 0;
   int32_t requested_samples = 0;
   int32_t num_samples = 0;
   std::string repair;

@@ -235,6 +235,60 @@ void ReadTarget(IndexReport& r) {
   for (int b = 0; b < 4; ++b) r.bins[b].p99_limit = kBins[b].limit_factor * r.target_error;
 }
 
+// The judged checks (check_<key> = measured upper95 pairs), in
+// core/validation/target_error.h's order and names.
+void ReadChecks(IndexReport& r) {
+  struct CheckSpec {
+    const char* key;
+    const char* label;
+    double limit_factor;
+  };
+  static constexpr CheckSpec kChecks[3] = {{"uniform_rms", "uniform RMS", 1},
+                                           {"vertex_far_p99", "vertex >=8 L1000 p99", 4},
+                                           {"interior_far_p99", "interior >=8 L1000 p99", 4}};
+  for (const CheckSpec& spec : kChecks) {
+    const std::string* line = Find(r, absl::StrCat("check_", spec.key));
+    if (line == nullptr) return;
+    const std::vector<absl::string_view> words = absl::StrSplit(*line, ' ', absl::SkipEmpty());
+    ReportCheck c;
+    c.key = spec.key;
+    c.label = spec.label;
+    c.limit = spec.limit_factor * r.target_error;
+    if (words.size() != 3 || !absl::SimpleAtod(words[0], &c.measured) ||
+        !absl::SimpleAtod(words[1], &c.upper95) || !absl::SimpleAtoi(words[2], &c.pairs)) {
+      r.checks.clear();
+      return;
+    }
+    r.checks.push_back(c);
+  }
+}
+
+// The fixed-m verdict's "over the limit" list: the judged checks over their
+// limits, or for an index built before the checks were stored, the uniform
+// RMS and the judged bands' measured p99s.
+std::vector<std::string> OverTheLimit(const IndexReport& r) {
+  std::vector<std::string> over;
+  if (!r.checks.empty()) {
+    for (const ReportCheck& c : r.checks) {
+      if (c.pairs > 0 && c.upper95 > c.limit) {
+        over.push_back(absl::StrFormat("the %s (95%% upper limit %s against %s)", c.label,
+                                       FormatPercent(c.upper95), FormatPercent(c.limit)));
+      }
+    }
+    return over;
+  }
+  if (r.uniform_rms > r.target_error) over.push_back("the uniform RMS");
+  static const char* const kKind[2] = {"vertex", "interior"};
+  for (const ReportBand& band : r.bands) {
+    for (int k = 0; k < 2; ++k) {
+      if (band.p99[k] > band.p99_limit) {
+        over.push_back(absl::StrCat(kKind[k], " p99 at ", band.label, " L1000"));
+      }
+    }
+  }
+  return over;
+}
+
 std::string Verdict(const IndexReport& r) {
   if (r.target_asked) {
     const std::string rounds = absl::StrFormat("%d round%s (m = %s)", r.target_rounds.size(),
@@ -254,28 +308,15 @@ std::string Verdict(const IndexReport& r) {
                            r.target_stop.empty() ? "the builder's limit" : r.target_stop, rounds,
                            closest);
   }
+  // Said without the tool's words: the same index comes from geodex-build
+  // --samples and from Python's geodex.build(samples=).
   const std::string none =
-      absl::StrFormat("none asked (built with --samples %d)", r.requested_samples);
+      absl::StrFormat("none asked (a fixed m, %d requested)", r.requested_samples);
   if (!r.has_accuracy) return none + "; no calibration to compare with";
-  std::vector<std::string> over;
-  if (r.uniform_rms > r.target_error) over.push_back("the uniform RMS");
-  if (!r.bands.empty()) {
-    static const char* const kKind[2] = {"vertex", "interior"};
-    for (const ReportBand& band : r.bands) {
-      for (int k = 0; k < 2; ++k) {
-        if (band.p99[k] > band.p99_limit) {
-          over.push_back(absl::StrCat(kKind[k], " p99 at ", band.label, " L1000"));
-        }
-      }
-    }
-  } else {
-    for (const ReportBin& bin : r.bins) {
-      if (bin.p99 > bin.p99_limit) over.push_back(absl::StrCat("p99 at ", bin.label));
-    }
-  }
+  const std::vector<std::string> over = OverTheLimit(r);
   return absl::StrFormat("%s; measured against the default target %s: %s", none,
                          FormatPercent(r.target_error),
-                         over.empty() ? "every figure within its limit"
+                         over.empty() ? "every judged figure within its limit"
                                       : absl::StrCat(absl::StrJoin(over, ", "), " over the limit"));
 }
 
@@ -332,6 +373,97 @@ void ReadSections(const Index& index, IndexReport& r) {
   std::stable_sort(
       r.sections.begin(), r.sections.end(),
       [](const ReportSection& a, const ReportSection& b) { return a.bytes > b.bytes; });
+}
+
+std::string ChecksJson(const std::vector<ReportCheck>& checks) {
+  std::string out;
+  for (size_t i = 0; i < checks.size(); ++i) {
+    const ReportCheck& c = checks[i];
+    absl::StrAppend(&out, i ? ",\n" : "\n", "      {\"key\": ", JsonString(c.key),
+                    ", \"label\": ", JsonString(c.label),
+                    ", \"measured\": ", JsonNumber(c.measured),
+                    ", \"upper95\": ", JsonNumber(c.upper95), ", \"limit\": ", JsonNumber(c.limit),
+                    ", \"pairs\": ", c.pairs, "}");
+  }
+  return checks.empty() ? out : out + "\n    ";
+}
+
+// The samples line: m and where it came from. A target build's m is the
+// target's choice (a --samples or samples= given with a target is only its
+// first round's m).
+std::string SamplesText(const IndexReport& r) {
+  const std::string repair =
+      absl::StrFormat("%d added by the repair of the triangulation", r.samples_added_by_repair);
+  if (r.target_asked && !r.target_rounds.empty()) {
+    return absl::StrFormat("m = %d (chosen by the target; rounds m = %s), %s", r.samples,
+                           absl::StrJoin(r.target_rounds, ", "), repair);
+  }
+  return absl::StrFormat("m = %d: %d requested, %s", r.samples, r.requested_samples, repair);
+}
+
+// The judged checks, one line each: measured, then the 95% upper limit the
+// target judges and its limit.
+std::string ChecksText(const IndexReport& r) {
+  std::string out = "                judged by the target: measured (95% upper limit / limit)\n";
+  for (const ReportCheck& c : r.checks) {
+    absl::StrAppendFormat(
+        &out, "                  %-24s %9s %s\n", c.label,
+        c.pairs > 0 ? FormatPercent(c.measured) : std::string("no pairs"),
+        c.pairs > 0 ? absl::StrFormat("(%s / %s)%s", FormatPercent(c.upper95),
+                                      FormatPercent(c.limit), c.upper95 > c.limit ? "  over" : "")
+                    : std::string("(not judged)"));
+  }
+  return out;
+}
+
+// The p99 by L1000 band, which bands the target judges, and where the
+// default mode's answers change from walked to O(1): the one place the
+// index's own L appears, since that split is set in it.
+std::string BandsTableText(const IndexReport& r) {
+  std::string out = absl::StrFormat("                  %-10s %9s %9s  %-8s  %s\n", "L1000",
+                                    "vertex", "interior", "target", "answered");
+  for (const ReportBand& b : r.bands) {
+    absl::StrAppendFormat(&out, "                  %-10s %9s %9s  %-8s  %s\n", b.label,
+                          FormatPercent(b.p99[0]), FormatPercent(b.p99[1]),
+                          std::isnan(b.p99_limit) ? "-" : "judged", b.answer);
+  }
+  if (!r.checks.empty()) {
+    out += ChecksText(r);
+  } else {
+    absl::StrAppendFormat(&out, "                area-uniform pairs: RMS %s (limit %s)\n",
+                          FormatPercent(r.uniform_rms), FormatPercent(r.target_error));
+  }
+  const double refine_l =
+      r.scale_length > 0 ? r.refined_below * r.band_unit / r.scale_length : kNaN;
+  absl::StrAppendFormat(
+      &out,
+      "                L1000 = %.4g, the spacing of 1000 samples on this surface; the target\n"
+      "                judges the p99 from 8 L1000 (vertex and interior pairs apart) and the\n"
+      "                uniform RMS. Answers are walked or exact below %.3g L1000 (%.3g L,\n"
+      "                where L = %.4g is this index's own sample spacing), O(1) above.\n",
+      r.band_unit, r.refined_below, refine_l, r.scale_length);
+  return out;
+}
+
+// The accuracy section of a calibrated index: p99 by L1000 band and the
+// judged checks; an index without bands (format < 4) by its own L.
+std::string AccuracyText(const IndexReport& r) {
+  std::string out = absl::StrFormat(
+      "  accuracy      relative error of the default answer over %d held-out pairs from %d "
+      "sources; p99 by distance\n",
+      r.accuracy_pairs, r.accuracy_sources);
+  if (!r.bands.empty()) return out + BandsTableText(r);
+  absl::StrAppendFormat(&out,
+                        "                  %-10s %9s %9s   (L = %.4g, the index's sample "
+                        "spacing; this index has no L1000 bands)\n",
+                        "distance", "RMS", "p99", r.scale_length);
+  for (const ReportBin& b : r.bins) {
+    absl::StrAppendFormat(&out, "                  %-10s %9s %9s\n", b.label, FormatPercent(b.rms),
+                          FormatPercent(b.p99));
+  }
+  absl::StrAppendFormat(&out, "                area-uniform pairs: RMS %s (limit %s)\n",
+                        FormatPercent(r.uniform_rms), FormatPercent(r.target_error));
+  return out;
 }
 
 }  // namespace
@@ -411,6 +543,7 @@ IndexReport MakeIndexReport(const Index& index) {
     }
   }
   ReadTarget(r);
+  ReadChecks(r);
   ReadBands(r);
   r.target_verdict = Verdict(r);
   return r;
@@ -444,12 +577,9 @@ std::string IndexReportText(const IndexReport& r, std::string_view title) {
   absl::StrAppendFormat(
       &out, "  split         %s\n",
       r.split_midpoints == 0
-          ? std::string("none (no edge longer than L/2)")
+          ? std::string("none (no edge longer than half the sample spacing)")
           : absl::StrFormat("%d midpoints (long edges split flat)", r.split_midpoints));
-  absl::StrAppendFormat(&out,
-                        "  samples       m = %d: %d requested, %d added by the repair of the "
-                        "triangulation\n",
-                        r.samples, r.requested_samples, r.samples_added_by_repair);
+  absl::StrAppendFormat(&out, "  samples       %s\n", Wrap(SamplesText(r), 16, 100));
   if (r.euler_samples > 0) {
     std::vector<std::string> places;
     for (const PlacedSample& p : r.euler_sample_places) places.push_back(DescribePlace(p));
@@ -473,36 +603,7 @@ std::string IndexReportText(const IndexReport& r, std::string_view title) {
       &out, "  error bounds  %s\n",
       r.error_bounds ? "yes (calibrated)" : "no (geodex-build calibrate adds them)");
   absl::StrAppendFormat(&out, "  error target  %s\n", Wrap(r.target_verdict, 16, 100));
-  if (!r.has_accuracy) return out;
-  absl::StrAppendFormat(&out,
-                        "  accuracy      relative error of the default answer over %d held-out "
-                        "pairs from %d sources; L = %.4g\n",
-                        r.accuracy_pairs, r.accuracy_sources, r.scale_length);
-  absl::StrAppendFormat(&out, "                  %-10s %9s %9s %11s\n", "distance", "RMS", "p99",
-                        "p99 limit");
-  for (const ReportBin& b : r.bins) {
-    absl::StrAppendFormat(&out, "                  %-10s %9s %9s %11s%s\n", b.label,
-                          FormatPercent(b.rms), FormatPercent(b.p99), FormatPercent(b.p99_limit),
-                          b.p99 > b.p99_limit ? "  over" : "");
-  }
-  absl::StrAppendFormat(
-      &out, "                  area-uniform pairs: RMS %s (limit %s), p99 beyond 10L %s\n",
-      FormatPercent(r.uniform_rms), FormatPercent(r.target_error),
-      FormatPercent(r.uniform_far_p99));
-  if (r.bands.empty()) return out;
-  absl::StrAppendFormat(&out,
-                        "  by distance   p99 in units of L1000 = %.4g (the spacing of 1000 "
-                        "samples); refined below %.3g L1000\n",
-                        r.band_unit, r.refined_below);
-  absl::StrAppendFormat(&out, "                  %-10s %9s %9s %11s  %s\n", "L1000", "vertex",
-                        "interior", "p99 limit", "answered");
-  for (const ReportBand& b : r.bands) {
-    const bool over = b.p99[0] > b.p99_limit || b.p99[1] > b.p99_limit;
-    absl::StrAppendFormat(&out, "                  %-10s %9s %9s %11s  %s%s\n", b.label,
-                          FormatPercent(b.p99[0]), FormatPercent(b.p99[1]),
-                          std::isnan(b.p99_limit) ? std::string("-") : FormatPercent(b.p99_limit),
-                          b.answer, over ? "  over" : "");
-  }
+  if (r.has_accuracy) out += AccuracyText(r);
   return out;
 }
 
@@ -555,6 +656,7 @@ std::string IndexReportJson(const IndexReport& r) {
       "],\n    \"closest_check\": ", JsonString(r.closest_check), ",\n    \"closest_upper95\": ",
       r.closest_check.empty() ? "null" : JsonNumber(r.closest_upper95),
       ",\n    \"closest_limit\": ", r.closest_check.empty() ? "null" : JsonNumber(r.closest_limit),
+      ",\n    \"checks\": [", ChecksJson(r.checks), "]",
       ",\n    \"verdict\": ", JsonString(r.target_verdict), "\n  },\n");
   if (r.has_accuracy) {
     absl::StrAppend(&out, "  \"accuracy\": {\n    \"sources\": ", r.accuracy_sources,

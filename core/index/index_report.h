@@ -47,9 +47,10 @@ struct ReportBin {
   double to_l = 0;    // +infinity for the last bin
   double rms = 0;     // relative error of the default answer: RMS
   double p99 = 0;     // and 99th percentile
-  // The limit this bin's p99 is read against: 2E below 3L (answers walked
-  // or exact), 4E from 3L (the target's E or, for a build with a fixed m,
-  // the default's). The target itself judges the bands (ReportBand).
+  // The limit a target of earlier formats read this bin's p99 against: 2E
+  // below 3L (answers walked or exact), 4E from 3L. Today's target judges
+  // the bands from 8 L1000 (ReportBand) and not the bins: kept for the
+  // charts and the JSON, not shown in the text.
   double p99_limit = 0;
 };
 
@@ -69,6 +70,18 @@ struct ReportBand {
   // How the default mode answers this band: "walked or exact", "O(1)", or
   // both with the distance in between.
   std::string answer;
+};
+
+// One check the error target judges (core/validation/target_error.h), as
+// the build measured it on held-out pairs: the verdict and the report's
+// "judged" lines both read these, so they cannot disagree.
+struct ReportCheck {
+  std::string key;    // "uniform_rms", "vertex_far_p99", "interior_far_p99"
+  std::string label;  // "uniform RMS", "vertex >=8 L1000 p99", "interior >=8 L1000 p99"
+  double measured = 0;
+  double upper95 = 0;  // its 95% upper confidence limit, what is judged
+  double limit = 0;    // E or 4E of the report's target_error
+  int64_t pairs = 0;   // 0: no pairs (not judged)
 };
 
 // Bytes of one group of sections (the distance matrix, the mesh, ...).
@@ -133,6 +146,9 @@ struct IndexReport {
   std::string closest_check;
   double closest_upper95 = 0;
   double closest_limit = 0;
+  // The judged checks, stored by builds since the report's check_* lines
+  // (empty before: the verdict then reads the bands).
+  std::vector<ReportCheck> checks;
   // One sentence: met, or not and why (every build with a calibration).
   std::string target_verdict;
   // The calibration (has_accuracy), over held-out exact propagations.

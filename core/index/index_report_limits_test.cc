@@ -41,5 +41,42 @@ TEST(IndexReportLimitsTest, AreTheErrorTargets) {
   EXPECT_EQ(r.bands[4].answer, "O(1)");  // [4, 8) L1000
 }
 
+// The judged checks the build stores (BandsText) are the ones the report
+// reads, with the target's names and limits: the verdict and the "judged"
+// lines are the build's own measurement.
+TEST(IndexReportLimitsTest, ChecksAreTheTargetsChecks) {
+  validation::TargetFigures f;
+  f.unit = 0.01;
+  for (int c = 0; c < validation::kNumTargetChecks; ++c) {
+    f.measured[c] = 0.001 * (c + 1);
+    f.upper[c] = 0.0015 * (c + 1);
+    f.pairs[c] = 100 * (c + 1);
+  }
+  f.upper[2] = 0.05;  // the interior far check over 4E
+  IndexData d = testing_util::MakeSphereIndex();
+  AccuracyRecord calibration{};
+  calibration.scale_length = 0.02f;
+  calibration.num_sources = 8;
+  calibration.num_pairs = 600;
+  d.accuracy = {calibration};
+  d.report = "target_error = 0.004\n" + validation::BandsText(f, 0.02);
+  auto index = Index::FromBytes(testing_util::Serialize(d));
+  ASSERT_TRUE(index.ok()) << index.status();
+  const IndexReport r = MakeIndexReport(**index);
+  ASSERT_EQ(r.checks.size(), size_t{validation::kNumTargetChecks});
+  for (int c = 0; c < validation::kNumTargetChecks; ++c) {
+    EXPECT_EQ(r.checks[c].label, validation::TargetCheckName(c));
+    EXPECT_DOUBLE_EQ(r.checks[c].limit, validation::TargetLimit(c, 0.004));
+    EXPECT_DOUBLE_EQ(r.checks[c].measured, f.measured[c]);
+    EXPECT_DOUBLE_EQ(r.checks[c].upper95, f.upper[c]);
+    EXPECT_EQ(r.checks[c].pairs, f.pairs[c]);
+  }
+  const std::string text = IndexReportText(r, "x.gdx");
+  EXPECT_NE(text.find("interior >=8 L1000 p99      0.300% (5.00% / 1.60%)  over"),
+            std::string::npos)
+      << text;
+  EXPECT_NE(IndexReportJson(r).find("\"key\": \"interior_far_p99\""), std::string::npos);
+}
+
 }  // namespace
 }  // namespace geodex::index

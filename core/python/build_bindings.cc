@@ -5,6 +5,7 @@
 #include <memory>
 #include <mutex>
 #include <string>
+#include <utility>
 
 #include "core/builder/build_pipeline.h"
 #include "core/python/bindings.h"
@@ -68,21 +69,24 @@ class Callbacks {
 };
 
 // Builds the index of `mesh_path` (a mesh file, or builtin:NAME) into `out`;
-// returns geodex-build's report. samples 0: the builder's default; target
-// error 0: none; max_samples 0: the default cap.
+// returns geodex-build's report. samples 0: none asked, so to the error
+// target as geodex-build without --samples (target_error 0: the default
+// target); otherwise exactly `samples`, or with target_error > 0 the first
+// round's. max_samples 0: the default cap.
 std::string Build(const std::string& mesh_path, const std::string& out, int32_t samples,
                   double target_error, int32_t max_samples, uint64_t seed, int threads, bool strict,
                   bool refine, bool calibrate, py::object progress, py::object log) {
   auto callbacks = std::make_shared<Callbacks>(std::move(progress), std::move(log));
   builder::PipelineOptions options;
   if (samples > 0) options.build.num_samples = samples;
+  options.target_error = target_error;
+  options = builder::WithSampleDefaults(std::move(options), samples > 0);
   options.build.seed = seed;
   options.build.threads = threads;
   options.build.refine_long_edges = refine;
   options.build.progress = [callbacks](const builder::Progress& p) { callbacks->Progress(p); };
   options.repair.strict = strict;
   options.calibrate = calibrate;
-  options.target_error = target_error;
   options.max_samples = max_samples;
   options.log = [callbacks](const std::string& line) { callbacks->Log(line); };
   absl::StatusOr<builder::BuildReport> report;

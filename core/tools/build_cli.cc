@@ -1,6 +1,6 @@
 #include "core/tools/build_cli.h"
 
-#include "core/builder/build_rounds.h"
+#include <utility>
 
 namespace geodex::tools {
 
@@ -110,11 +110,7 @@ builder::PipelineOptions BuildCommandLine::Options() const {
   }
   o.calibrate = !args_.no_calibration;
   const CLI::App* sampled = *plan_ ? plan_ : &app_;
-  if (sampled->count("--samples") == 0) {
-    o.build.num_samples = builder::kDefaultFirstRoundSamples;
-    if (o.target_error == 0) o.target_error = validation::kDefaultTargetError;
-  }
-  return o;
+  return builder::WithSampleDefaults(std::move(o), sampled->count("--samples") > 0);
 }
 
 std::string BuildCommandLine::MissingPathsMessage() const {

@@ -105,9 +105,10 @@ void QueryCommandLine::AddQueryOptions() {
 void QueryCommandLine::AddAnswerOptions() {
   QueryToolArgs& a = args_;
   app_.add_option("--near-pairs", a.near_pairs,
-                  "Near pairs (the same or adjacent geodesic triangles, or closer than 3 scale "
-                  "lengths): path (the traced path's length, default), unfold (pure O(1)) or "
-                  "exact (local exact propagation)")
+                  "Near pairs (the same or adjacent geodesic triangles, or closer than the "
+                  "index's refinement distance, which --info gives in L1000: 'walked or exact "
+                  "below N L1000'): path (the traced path's length, default), unfold (pure "
+                  "O(1)) or exact (local exact propagation)")
       ->check(CLI::IsMember({"path", "unfold", "exact"}));
   app_.add_flag("--exact-near-pairs", a.exact_near, "Same as --near-pairs exact");
   app_.add_flag("--error-bounds", a.error_bounds,

@@ -101,6 +101,14 @@ std::string BandsText(const TargetFigures& f, double scale_length) {
                              f.band_p99[k][b], kKind[k], kKey[b], f.band_pairs[k][b]);
     }
   }
+  // The judged checks, so that the report's verdict and its figures are
+  // one measurement (core/index/index_report.h reads them).
+  static const char* const kCheckKey[kNumTargetChecks] = {"uniform_rms", "vertex_far_p99",
+                                                          "interior_far_p99"};
+  for (int c = 0; c < kNumTargetChecks; ++c) {
+    out += absl::StrFormat("check_%s = %.6g %.6g %d\n", kCheckKey[c], f.measured[c], f.upper[c],
+                           f.pairs[c]);
+  }
   return out;
 }
 

@@ -102,7 +102,9 @@ std::string BandsLine(const TargetFigures& figures);
 // band_refined_below (kRefineScale L of an index of scale length
 // `scale_length`, in L1000: the answers below it are walked or exact, the
 // others O(1)), then band_p99_<vertex|interior>_<bin> and
-// band_pairs_<kind>_<bin>, bins 0_0.5, 0.5_1, ..., 8_16, 16_inf.
+// band_pairs_<kind>_<bin>, bins 0_0.5, 0.5_1, ..., 8_16, 16_inf, then each
+// judged check as check_<uniform_rms|vertex_far_p99|interior_far_p99> =
+// "measured upper95 pairs" (the report's verdict reads these).
 std::string BandsText(const TargetFigures& figures, double scale_length);
 
 struct PredictionOptions {

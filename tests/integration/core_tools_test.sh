@@ -77,25 +77,34 @@ check "geodex-query --error-bounds prints distance and bound" \
 check "geodex-query --tolerance 0.005 is within 0.5% of exact" within 0.005 "$work/exact.txt" "$work/bounded.txt" 3
 "$tools/geodex-query" "$work/one.gdx" --info >"$work/info.txt" 2>&1
 exits 0 "geodex-query --info"
-check "geodex-query --info shows the accuracy table" grep -q "^                  3L-10L  *[0-9.<]*%  *[0-9.<]*%" "$work/info.txt"
+check "geodex-query --info shows the accuracy table" grep -q "^                  8-16  *[0-9.<]*%  *[0-9.<]*%  judged" "$work/info.txt"
 "$tools/geodex-query" "$work/one.gdx" --info --format json >"$work/info.json" 2>&1
 exits 0 "geodex-query --info --format json"
-# The text and the JSON show the same figures: each bin's p99, formatted as
-# the text formats it, is in the text's row of that bin.
+# The text and the JSON show the same figures: each L1000 band's p99s,
+# formatted as the text formats them, are in the text's row of that band,
+# and each judged check's measured figure, 95% upper limit and limit in its
+# line; the bins by the index's own L have no row of their own.
 check "geodex-query --info text and JSON agree" python3 -c '
 import json, sys
 r = json.load(open(sys.argv[1])); text = open(sys.argv[2]).read()
 def pct(x):
+    if x is None: return "n/a"
     v = 100 * x
     if v == 0: return "0%"
     if v < 0.001: return "<0.001%"
     d = 0 if v >= 100 else 1 if v >= 10 else 2 if v >= 1 else 3 if v >= 0.1 else 4 if v >= 0.01 else 5
     return "%.*f%%" % (d, v)
-for b in r["accuracy"]["bins"]:
+for b in r["accuracy"]["bands"]:
     row = [l for l in text.splitlines() if l.startswith(" " * 18 + b["label"] + " ")]
     assert len(row) == 1, b["label"]
     cells = row[0][18 + len(b["label"]):].split()
-    assert cells[:3] == [pct(b["rms"]), pct(b["p99"]), pct(b["p99_limit"])], (b, cells)
+    judged = "-" if b["p99_limit"] is None else "judged"
+    assert cells[:3] == [pct(b["p99_vertex"]), pct(b["p99_interior"]), judged], (b, cells)
+for c in r["target"]["checks"]:
+    line = "%s (%s / %s)" % (pct(c["measured"]), pct(c["upper95"]), pct(c["limit"]))
+    if c["pairs"] == 0: line = "no pairs (not judged)"
+    assert any(l.startswith(" " * 18 + c["label"]) and line in l for l in text.splitlines()), c
+assert not any(l.startswith(" " * 18 + "3L-10L") for l in text.splitlines())
 assert "m = %d:" % r["samples"]["final"] in text
 ' "$work/info.json" "$work/info.txt"
 "$tools/geodex-build" builtin:sphere -o "$work/charted.gdx" --samples 100 --threads 2 \

@@ -78,4 +78,5 @@ def build(
     log: Optional[Callable[[str], None]],
 ) -> str:
     """Builds the index of mesh_path (a mesh file or builtin:NAME) into out;
-    returns the build report."""
+    returns the build report. samples 0: none asked, so to the error target
+    (target_error, 0: the default) as geodex-build without --samples."""

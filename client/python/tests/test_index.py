@@ -208,3 +208,43 @@ def test_a_repaired_shared_mesh_answers_in_the_files_ids(tmp_path):
     d = cow.distance(a, b)
     same = (d == reference) | (np.isinf(d) & np.isinf(reference))
     assert np.all(same | (np.abs(d - reference) <= 1e-12 * np.abs(reference)))
+
+
+def _write_hill(path: Path, n: int = 16) -> Path:
+    """A bumpy 1 x 1 height field of 2 (n - 1)^2 triangles, as an OBJ file."""
+    x, y = np.meshgrid(np.linspace(0, 1, n), np.linspace(0, 1, n))
+    z = 0.15 * np.sin(3 * x) * np.cos(2 * y)
+    corners = np.arange(n * n).reshape(n, n)[:-1, :-1].ravel()
+    faces = np.concatenate([
+        np.c_[corners, corners + 1, corners + n + 1],
+        np.c_[corners, corners + n + 1, corners + n],
+    ])
+    path.write_text("".join(f"v {a!r} {b!r} {c!r}\n" for a, b, c in zip(x.flat, y.flat, z.flat))
+                    + "".join(f"f {i + 1} {j + 1} {k + 1}\n" for i, j, k in faces))
+    return path
+
+
+def test_build_without_samples_is_geodex_builds_default_target_build(tmp_path):
+    """No samples=: to the default error target from a predicted first
+    round, as geodex-build without --samples: the same file, byte for byte."""
+    require_in_process()
+    hill = _write_hill(tmp_path / "hill.obj")
+    cli = build_index(str(hill), tmp_path / "cli.gdx", "--threads", "1")
+    built = geodex.build(hill, tmp_path / "python.gdx", threads=1)
+    target = built.info()["target"]
+    assert target["asked"] and target["error"] == 0.005 and target["met"], target
+    assert target["rounds"] and target["rounds"][0] != 1000  # predicted, not the old fixed m
+    assert (tmp_path / "python.gdx").read_bytes() == cli.read_bytes()
+
+
+def test_build_messages_speak_pythons_keywords_and_a_missed_target_warns(tmp_path):
+    require_in_process()
+    hill = _write_hill(tmp_path / "hill.obj", n=8)
+    fixed = geodex.build(hill, tmp_path / "fixed.gdx", samples=20, threads=1)
+    verdict = fixed.info()["target"]["verdict"]
+    assert verdict.startswith("none asked (a fixed m, 20 requested)"), verdict
+    assert "--" not in verdict
+    with pytest.warns(UserWarning, match=r"error target 0\.0100% NOT met: m stopped at the cap"):
+        short = geodex.build(hill, tmp_path / "short.gdx", target_error=0.0001, max_samples=30,
+                             threads=1)
+    assert short.info()["target"]["met"] is False
