@@ -447,7 +447,8 @@ def build(
         short of its target warns (``UserWarning``) with the report's
         verdict.
     max_samples : int, optional
-        With a target: the cap on m (default 8000).
+        With a target: the cap on m (default 8000; with ``refine=False``,
+        at most half the mesh's vertices).
     seed : int
         The sampling seed: the same mesh and options give the same bytes.
     threads : int
