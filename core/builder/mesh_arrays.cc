@@ -7,6 +7,7 @@
 
 #include "absl/strings/str_format.h"
 #include "core/common/status_macros.h"
+#include "core/geometry/sample_spacing.h"
 
 namespace geodex::builder {
 
@@ -106,8 +107,7 @@ absl::StatusOr<std::optional<CoarseSurface>> CoarseSurfaceOf(const mesh::Mesh& s
 }
 
 absl::StatusOr<mesh::LongEdgeSplit> SplitForSamples(const mesh::Mesh& mesh, int32_t num_samples) {
-  const double scale_length =
-      std::sqrt(2 * mesh.TotalArea() / (std::sqrt(3.0) * std::max(num_samples, 1)));
+  const double scale_length = geometry::SampleSpacing(mesh.TotalArea(), num_samples);
   const int64_t cap = 4 * int64_t{mesh.num_vertices()} + 16 * int64_t{std::max(num_samples, 0)};
   double max_edge = kMaxEdgeOverScaleLength * scale_length;
   // A surface of zero area has no scale: leave it as it is.

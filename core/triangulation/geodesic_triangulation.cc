@@ -9,6 +9,7 @@
 #include "absl/strings/str_format.h"
 #include "absl/strings/str_join.h"
 #include "core/common/status_macros.h"
+#include "core/geometry/sample_spacing.h"
 
 namespace geodex::triangulation {
 namespace {
@@ -457,7 +458,7 @@ int32_t ClosingEdge(const Mesh& mesh, const sampling::SampleSet& set,
 
 // The sample spacing L = sqrt(2 A / (sqrt(3) m)).
 double SampleSpacing(const Mesh& mesh, int32_t num_samples) {
-  return std::sqrt(2 * mesh.TotalArea() / (std::sqrt(3.0) * std::max(num_samples, 1)));
+  return geometry::SampleSpacing(mesh.TotalArea(), num_samples);
 }
 
 }  // namespace

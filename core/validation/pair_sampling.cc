@@ -11,6 +11,7 @@
 
 #include "core/common/threads.h"
 #include "core/geodesic/vertex_geodesic.h"
+#include "core/geometry/sample_spacing.h"
 
 namespace geodex::validation {
 namespace {
@@ -164,7 +165,7 @@ int ScaleBinOf(double d, double scale_length) {
 }
 
 double ScaleLength(double area, int32_t num_samples) {
-  return std::sqrt(2 * area / (std::sqrt(3.0) * num_samples));
+  return geometry::SampleSpacing(area, num_samples);
 }
 
 const char* FixedBinName(int bin) {
