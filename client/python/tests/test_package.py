@@ -1,4 +1,4 @@
-"""What a Python session sees of the package before any call: its names
+"""What Python code sees of the package before any call: its names
 (``__all__``, ``dir(geodex)``) and how its objects print. No server needed."""
 
 from __future__ import annotations
