@@ -10,6 +10,7 @@
 //   query::QueryScratch scratch;  // per worker thread
 //   GEODEX_RETURN_IF_ERROR(queries->DistanceBatch(a, b, out, options, &scratch));
 
+#include <array>
 #include <cstdint>
 #include <memory>
 
@@ -30,6 +31,11 @@ struct NearPairStats {
   int64_t exact_rounds = 0;        // its propagations
   int64_t exact_region_faces = 0;  // faces of its last regions
   int64_t exact_windows = 0;       // windows it created
+  int64_t traces = 0;              // pairs whose walks failed, sent to the gradient trace
+  int64_t shots = 0;               // geodesics shot at the other point (chord_walk.h)
+  // Pairs whose k-th shot (k = 1..4) was a straight local geodesic to the
+  // other point: [k - 1].
+  std::array<int64_t, 4> straight_at_shot = {};
   // Pairs refined only by a raised threshold whose walks all failed: their
   // O(1) answer kept.
   int64_t raised_kept = 0;

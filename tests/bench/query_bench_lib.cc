@@ -298,7 +298,8 @@ std::unique_ptr<CLI::App> QueryBenchFlags(QueryBenchOptions* options) {
   app->add_option("--accuracy-pairs", options->accuracy_pairs,
                   "Pairs per row of the table against the exact engine");
   app->add_flag("--near-profile", options->near_profile,
-                "Only the near pairs' rates and where their time goes");
+                "Only the near pairs' rates and where their time goes (with --every-distance: "
+                "where the every-distance mode's time goes, on its area-uniform pairs)");
   app->add_option("--every-distance", options->every_distance,
                   "Only the every-distance table: area-uniform pairs, default mode with the "
                   "refinement threshold raised to X L1000, against default and pure O(1)")
@@ -481,44 +482,65 @@ std::string FieldRow(const std::string& label, const FieldFigures& f) {
                       absl::StrFormat("%.3gM", f.us > 0 ? f.per_field / f.us : 0)});
 }
 
-void BenchNearProfile(const std::string& label, std::shared_ptr<const index::Index> ix, int n) {
-  if (!Calibrated(label, *ix)) return;
-  auto engine = *query::QueryEngine::Create(ix);
-  const ScaleBins bins = DrawScalePairs(*ix, *engine, n);
-  const Points &x = bins.a[1], &y = bins.b[1];
+namespace {
+
+// How the refinement answered one pair, read from the scratch's counts
+// before and after its call.
+enum NearClass {
+  kShot1,
+  kShot2,
+  kShot3,
+  kShot4,
+  kStraight,
+  kReleased,
+  kTraced,
+  kExactWalked,
+  kExactUnwalked,
+  kO1,
+  kClasses
+};
+constexpr const char* kNearClassNames[kClasses] = {
+    "straight at shot 1", "straight at shot 2", "straight at shot 3",
+    "straight at shot 4", "straight walk",      "walk with releases",
+    "gradient trace",     "exact, pruned by a walk", "exact, no walk",
+    "O(1), not refined"};
+
+NearClass ClassOf(const query::NearPairStats& before, const query::NearPairStats& after) {
+  if (after.pairs == before.pairs) return kO1;
+  if (after.exact_solves > before.exact_solves) {
+    return after.exact_with_walk > before.exact_with_walk ? kExactWalked : kExactUnwalked;
+  }
+  if (after.traces > before.traces) return kTraced;
+  for (int k = 0; k < 4; ++k) {
+    if (after.straight_at_shot[k] > before.straight_at_shot[k]) return NearClass(kShot1 + k);
+  }
+  return after.releases > before.releases ? kReleased : kStraight;
+}
+
+// The pairs (x[i], y[i]) one Distance call each under `options`, each
+// timed (the least of three calls: the machine is shared, a call preempted
+// once is not its cost) and sorted by how the refinement answered it: a
+// row a class, then a total row named `total_how`.
+void PrintProfileRows(const std::string& label, const query::QueryEngine& engine,
+                      const Points& x, const Points& y, const query::DistanceOptions& options,
+                      const std::string& total_how) {
   query::QueryScratch scratch;
   // The engine's exact mesh and the scratch's solvers, made before the clocks
   // run.
-  (void)engine->Distance(x[0], y[0], {.near_pairs = query::NearPairs::kExact}, &scratch);
+  (void)engine.Distance(x[0], y[0], {.near_pairs = query::NearPairs::kExact}, &scratch);
   const size_t all = x.size();
-  const double near_rate = BatchRate(*engine, bins.a[0], bins.b[0], {}, false, bins.a[0].size());
-  const double default_rate = BatchRate(*engine, x, y, {}, false, all);
-  const double pure_rate =
-      BatchRate(*engine, x, y, {.near_pairs = query::NearPairs::kUnfold}, false, all);
-  // Each pair's class from its first call; its time, the least of three
-  // calls (the machine is shared: a call preempted once is not its cost).
-  enum Class { kStraight, kReleased, kExactWalked, kExactUnwalked, kOther, kClasses };
-  constexpr const char* kNames[kClasses] = {"straight walk", "walk with releases",
-                                            "exact, pruned by a walk", "exact, no walk",
-                                            "not walked"};
-  std::vector<Class> cls(all);
+  std::vector<NearClass> cls(all);
   std::vector<double> seconds(all, 1e300);
   NearProfileRow rows[kClasses];
   for (int pass = 0; pass < 3; ++pass) {
     for (size_t i = 0; i < all; ++i) {
       const query::NearPairStats before = scratch.near_pair_stats();
       const Clock::time_point start = Clock::now();
-      const absl::StatusOr<double> d = engine->Distance(x[i], y[i], {}, &scratch);
+      const absl::StatusOr<double> d = engine.Distance(x[i], y[i], options, &scratch);
       seconds[i] = std::min(seconds[i], SecondsSince(start));
       if (!d.ok() || pass > 0) continue;
       const query::NearPairStats& after = scratch.near_pair_stats();
-      cls[i] = after.pairs == before.pairs               ? kOther
-               : after.exact_solves > before.exact_solves ? (after.exact_with_walk >
-                                                                     before.exact_with_walk
-                                                                 ? kExactWalked
-                                                                 : kExactUnwalked)
-               : after.releases > before.releases        ? kReleased
-                                                          : kStraight;
+      cls[i] = ClassOf(before, after);
       NearProfileRow& row = rows[cls[i]];
       row.faces_crossed += static_cast<double>(after.faces_crossed - before.faces_crossed);
       row.faces_unfolded += static_cast<double>(after.faces_unfolded - before.faces_unfolded);
@@ -529,14 +551,12 @@ void BenchNearProfile(const std::string& label, std::shared_ptr<const index::Ind
     }
   }
   NearProfileRow total;
-  total.how = absl::StrFormat("all (d<L %.3fM/s, L-3L %.3fM/s, pure O(1) %.3fM/s)",
-                              near_rate / 1e6, default_rate / 1e6, pure_rate / 1e6);
+  total.how = total_how;
   for (size_t i = 0; i < all; ++i) {
     ++rows[cls[i]].count;
     rows[cls[i]].us += 1e6 * seconds[i];
   }
-  for (int c = 0; c < kClasses; ++c) {
-    NearProfileRow& row = rows[c];
+  for (NearProfileRow& row : rows) {
     total.count += row.count;
     total.us += row.us;
     total.faces_crossed += row.faces_crossed;
@@ -545,24 +565,41 @@ void BenchNearProfile(const std::string& label, std::shared_ptr<const index::Ind
     total.exact_rounds += row.exact_rounds;
     total.exact_region_faces += row.exact_region_faces;
   }
-  for (NearProfileRow* row : {&rows[0], &rows[1], &rows[2], &rows[3], &rows[4], &total}) {
-    if (row->count == 0) continue;
-    if (row != &total) row->how = kNames[row - rows];
-    const double count = static_cast<double>(row->count);
-    row->share = count / static_cast<double>(all);
-    row->us /= count;
-    row->faces_crossed /= count;
-    row->faces_unfolded /= count;
-    row->releases /= count;
-    row->exact_rounds /= count;
-    row->exact_region_faces /= count;
-    std::printf("%s\n", NearProfileRowText(label, *row).c_str());
+  for (int c = 0; c <= kClasses; ++c) {
+    NearProfileRow& row = c < kClasses ? rows[c] : total;
+    if (row.count == 0) continue;
+    if (c < kClasses) row.how = kNearClassNames[c];
+    const double count = static_cast<double>(row.count);
+    row.share = count / static_cast<double>(all);
+    row.us /= count;
+    row.faces_crossed /= count;
+    row.faces_unfolded /= count;
+    row.releases /= count;
+    row.exact_rounds /= count;
+    row.exact_region_faces /= count;
+    std::printf("%s\n", NearProfileRowText(label, row).c_str());
   }
 }
 
-std::string NearProfileHeader() {
-  return "\nNear pairs at L-3L of the O(1) answer, one Distance call each (least of 3), by how "
-         "the default mode answered them\n" +
+}  // namespace
+
+void BenchNearProfile(const std::string& label, std::shared_ptr<const index::Index> ix, int n) {
+  if (!Calibrated(label, *ix)) return;
+  auto engine = *query::QueryEngine::Create(ix);
+  const ScaleBins bins = DrawScalePairs(*ix, *engine, n);
+  const Points &x = bins.a[1], &y = bins.b[1];
+  const size_t all = x.size();
+  const double near_rate = BatchRate(*engine, bins.a[0], bins.b[0], {}, false, bins.a[0].size());
+  const double default_rate = BatchRate(*engine, x, y, {}, false, all);
+  const double pure_rate =
+      BatchRate(*engine, x, y, {.near_pairs = query::NearPairs::kUnfold}, false, all);
+  PrintProfileRows(label, *engine, x, y, {},
+                   absl::StrFormat("all (d<L %.3fM/s, L-3L %.3fM/s, pure O(1) %.3fM/s)",
+                                   near_rate / 1e6, default_rate / 1e6, pure_rate / 1e6));
+}
+
+std::string NearProfileHeader(const std::string& pairs) {
+  return "\n" + pairs + ", one Distance call each (least of 3), by how they were answered\n" +
          MarkdownHeader({"index", "how", "pairs", "share", "us a pair", "faces crossed",
                          "faces unfolded", "releases", "exact rounds", "exact region faces",
                          "us a face crossed"});
@@ -676,6 +713,14 @@ void BenchEveryDistance(const std::string& label, std::shared_ptr<const index::I
                           .c_str());
 }
 
+void BenchEveryDistanceProfile(const std::string& label, std::shared_ptr<const index::Index> ix,
+                               double below, int n) {
+  auto engine = *query::QueryEngine::Create(ix);
+  const auto a = AreaUniformPoints(*ix, n, 21), b = AreaUniformPoints(*ix, n, 22);
+  PrintProfileRows(label, *engine, a, b, {.refine_below_l1000 = below},
+                   absl::StrFormat("all area-uniform pairs, threshold %g L1000", below));
+}
+
 int RunQueryBench(const QueryBenchOptions& options) {
   if (options.every_distance > 0) {
     std::printf("Every distance: area-uniform interior pairs, batch pairs/s, one thread; "
@@ -691,6 +736,10 @@ int RunQueryBench(const QueryBenchOptions& options) {
         return 1;
       }
       BenchEveryDistance(path, *ix, options.every_distance, options.pairs);
+      if (options.near_profile) {
+        std::printf("%s", NearProfileHeader("The every-distance mode's area-uniform pairs").c_str());
+        BenchEveryDistanceProfile(path, *ix, options.every_distance, options.pairs);
+      }
     }
     return 0;
   }
@@ -715,7 +764,9 @@ int RunQueryBench(const QueryBenchOptions& options) {
     }
     loaded.push_back(*ix);
     if (options.near_profile) {
-      if (loaded.size() == 1) std::printf("%s", NearProfileHeader().c_str());
+      if (loaded.size() == 1) {
+        std::printf("%s", NearProfileHeader("Near pairs at L-3L of the O(1) answer").c_str());
+      }
       BenchNearProfile(path, *ix, std::min(options.pairs, 200'000));
       continue;
     }

@@ -43,6 +43,10 @@ std::unique_ptr<CLI::App> QueryBenchFlags(QueryBenchOptions* options);
 std::vector<mesh::SurfacePoint> InteriorPoints(const index::Index& ix, int n, uint64_t seed);
 std::vector<mesh::SurfacePoint> InteriorPoints(int32_t num_faces, int n, uint64_t seed);
 
+// `n` interior points drawn uniformly by area (fixed `seed`): a face with
+// probability proportional to its area, uniform barycentric weights.
+std::vector<mesh::SurfacePoint> AreaUniformPoints(const index::Index& ix, int n, uint64_t seed);
+
 // `n` points at a random corner of a random face (fixed `seed`).
 std::vector<mesh::SurfacePoint> VertexPoints(const index::Index& ix, int n, uint64_t seed);
 
@@ -168,8 +172,16 @@ struct NearProfileRow {
 // Needs the accuracy calibration (a note row without).
 void BenchNearProfile(const std::string& label, std::shared_ptr<const index::Index> ix, int n);
 
-// The near-pair profile's header, and one row of it (no newline).
-std::string NearProfileHeader();
+// Area-uniform interior pairs of `ix` (n, as BenchEveryDistance draws them)
+// one Distance call each with the threshold raised to `below` L1000, sorted
+// as BenchNearProfile sorts them: where the every-distance mode's time goes.
+void BenchEveryDistanceProfile(const std::string& label, std::shared_ptr<const index::Index> ix,
+                               double below, int n);
+
+// The near-pair profile's header for the pairs it describes (a title such
+// as "Near pairs at L-3L of the O(1) answer"), and one row of it (no
+// newline).
+std::string NearProfileHeader(const std::string& pairs);
 std::string NearProfileRowText(const std::string& label, const NearProfileRow& row);
 
 // Runs the whole benchmark as the command line asks and returns the exit

@@ -6,16 +6,17 @@
 
 #include "absl/strings/str_format.h"
 #include "core/common/status_macros.h"
-#include "core/query/internal/paths/chord_walk.h"
+#include "core/geometry/sample_spacing.h"
 #include "core/query/internal/fields/distance_field.h"
+#include "core/query/internal/paths/chord_walk.h"
 #include "core/query/internal/paths/path_straightening.h"
 
 namespace geodex::query {
 namespace {
 
-// L = sqrt(2 A / (sqrt(3) m)) of the mesh `view` tiled by m samples.
+// L of the mesh `view` tiled by m samples.
 double ScaleLength(const MeshView& view, int32_t num_samples) {
-  return std::sqrt(2 * view.Area() / (std::sqrt(3.0) * num_samples));
+  return geometry::SampleSpacing(view.Area(), num_samples);
 }
 
 }  // namespace
@@ -155,7 +156,11 @@ absl::StatusOr<double> QueryEngine::WalkedDistance(const SurfacePoint& p, const 
   const SurfacePoint a = view_.InLowestFaceIfVertex(view_.Canonical(p)),
                      b = view_.InLowestFaceIfVertex(view_.Canonical(q));
   const bool swap = std::tie(b.face, b.w) < std::tie(a.face, a.w);
-  const NearWalk walk = WalkNearPair(view_, swap ? b : a, swap ? a : b);
+  // Aimed as the refinement aims its walks (refinement.cc), so that the
+  // two agree to the bit.
+  const SurfacePoint& from = swap ? b : a;
+  const SurfacePoint& to = swap ? a : b;
+  const NearWalk walk = WalkNearPair(view_, from, to, {.heading = paths_.Heading(from, to)});
   if (!walk.path)
     return absl::NotFoundError("the walks found no local geodesic between the points");
   if (wraps != nullptr) *wraps = walk.path->wraps;

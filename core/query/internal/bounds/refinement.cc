@@ -105,12 +105,22 @@ double Refiner::Refine(const SurfacePoint& p_in, const SurfacePoint& q_in, const
   auto near_path = [&] {
     ++stats.pairs;
     if (walk_) {
-      const NearWalk walk = WalkNearPair(view_, from, to, plausible(), &solvers);
+      // Every walk taken is checked (against the chord, or the O(1)
+      // answer's bound): local geodesics bending round several saddles may
+      // be taken too.
+      // The shots are aimed as the O(1) field of `to` sees the geodesic
+      // leave `from`.
+      const NearWalk walk = WalkNearPair(view_, from, to,
+                                         {.plausible = plausible(),
+                                          .max_saddles = kMaxSaddles,
+                                          .heading = paths_.Heading(from, to)},
+                                         &solvers);
       if (walk.path && (certified(walk.path->length) || raised_only)) return take(*walk.path);
       if (raised_only) {
         // The gradient trace finds the corridor where the chord's does not
         // (the chord leaves the surface over a curved band); a trace
         // longer than is plausible keeps the O(1) answer.
+        ++stats.traces;
         const std::optional<NearPath> t =
             NearPathLength(view_, paths_, from, to, false, plausible());
         if (t && t->length <= plausible()) return take(*t);
@@ -133,6 +143,7 @@ double Refiner::Refine(const SurfacePoint& p_in, const SurfacePoint& q_in, const
       if (solved) return true;
       if (walk.path) return take(*walk.path);  // a mesh without exact propagation
     }
+    ++stats.traces;
     const std::optional<NearPath> t = NearPathLength(view_, paths_, from, to, walk_, plausible());
     return t && take(*t);
   };
@@ -170,9 +181,8 @@ double Refiner::Refine(const SurfacePoint& p_in, const SurfacePoint& q_in, const
       // see these paths: the geodesic is at least the chord and at least
       // the O(1) answer less its bound, so d less the larger covers it
       // wherever the O(1) bound does.
-      const double below = raised_only
-                               ? std::max(chord, unfolded - bound_of(AnswerKind::kUnfold, unfolded))
-                               : chord;
+      const double below =
+          raised_only ? std::max(chord, unfolded - bound_of(AnswerKind::kUnfold, unfolded)) : chord;
       const double certificate = std::max(d - below, bound_of(AnswerKind::kExact, d));
       *bound = raised_only ? certificate : std::min(*bound, certificate);
     }

@@ -31,6 +31,12 @@ namespace geodex::query {
 // surface (tests/bench/accuracy.md, "Walks the chord certifies").
 inline constexpr double kCertifiedExcess = 0.02;
 
+// The saddles a walk's local geodesic may bend round and still be taken
+// (chord_walk.h, NearWalkOptions): the refinement checks every walk it
+// takes, against the chord or against the O(1) answer and its bound, as it
+// checks a trace.
+inline constexpr int kMaxSaddles = 1;
+
 // A pair whose O(1) answer lands above refine_below is still refined when
 // its chord is below and the answer below kChordNet x refine_below: the
 // calibrated margin in refine_below covers 99.5% of the O(1) answer's

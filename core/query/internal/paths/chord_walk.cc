@@ -52,6 +52,31 @@ Vec3 UnfoldHeading(const MeshView& view, int32_t f, const std::array<int32_t, 2>
   return along * e + (d - along * e).norm() * into.normalized();
 }
 
+// The 3D vector that the plane vector u of face `flat` (as laid out) stands
+// for: the layout is an isometry of the face, so u's coordinates in the
+// basis of two laid-out edges carry over to the same edges in space.
+Vec3 InSpace(const MeshView& view, const FlatFace& flat, const Vec2& u) {
+  const Vec2 e1 = flat.corners[1] - flat.corners[0], e2 = flat.corners[2] - flat.corners[0];
+  const double det = Cross(e1, e2);
+  const Vec3 p0 = view.Position(flat.vertices[0]);
+  return (Cross(u, e2) / det) * (view.Position(flat.vertices[1]) - p0) +
+         (Cross(e1, u) / det) * (view.Position(flat.vertices[2]) - p0);
+}
+
+// The plane vector of face `flat` (as laid out) that stands for the part of
+// the 3D vector v in the face's plane: InSpace's inverse on that plane.
+Vec2 InPlane(const MeshView& view, const FlatFace& flat, const Vec3& v) {
+  const Vec3 p0 = view.Position(flat.vertices[0]);
+  const Vec3 a = view.Position(flat.vertices[1]) - p0, b = view.Position(flat.vertices[2]) - p0;
+  const double aa = a.dot(a), ab = a.dot(b), bb = b.dot(b), det = aa * bb - ab * ab;
+  const double alpha = (bb * v.dot(a) - ab * v.dot(b)) / det;
+  const double beta = (aa * v.dot(b) - ab * v.dot(a)) / det;
+  return alpha * (flat.corners[1] - flat.corners[0]) + beta * (flat.corners[2] - flat.corners[0]);
+}
+
+bool WalkCorridor(const MeshView& view, const PathPoint& from, const PathPoint& to, int max_steps,
+                  std::vector<int32_t>* faces);
+
 // A corridor of faces (consecutive ones share an edge) unfolded into one
 // plane (strip_funnel.h), with the points it runs between, in a walk
 // scratch's arrays. The shortest path through it is found by the funnel
@@ -75,13 +100,13 @@ class Corridor {
       : faces_(scratch.faces), flat_(scratch.flat), portals_(scratch.portals) {}
 
   std::vector<int32_t>& faces() { return faces_; }
+  const std::vector<int32_t>& faces() const { return faces_; }
 
   // Lays out faces() from `from` (a point faces()[0] holds) to `to` (one the
   // last face holds), keeping the layouts of the faces before `first` (laid
-  // out by the last call, and unchanged since). The layouts are those of
-  // UnfoldStrip, to the bit: each face is placed across the edge it shares
-  // with the one before, as laid out. False when consecutive faces share no
-  // edge.
+  // out by the last call, and unchanged since). Each face is placed by
+  // StepAcross, as UnfoldStrip places it, so the layouts agree to the bit.
+  // False when consecutive faces share no edge.
   bool Unfold(const MeshView& view, const SurfacePoint& from, const SurfacePoint& to,
               size_t first = 0) {
     const size_t n = faces_.size();
@@ -93,20 +118,7 @@ class Corridor {
       first = 1;
     }
     for (size_t t = first; t < n; ++t) {
-      const int32_t f = faces_[t - 1];
-      int edge = -1;
-      for (int i = 0; i < 3; ++i) {
-        const int32_t h = view.twins[3 * f + i];
-        if (h >= 0 && h / 3 == faces_[t]) edge = i;
-      }
-      if (edge < 0) return false;
-      // The half-edge runs from corner `edge` to the next, with f on its
-      // left: going out of f, its end is on the left.
-      const int left = (edge + 1) % 3;
-      const int32_t a = view.Vertex(f, left), b = view.Vertex(f, edge);
-      const FlatFace& prev = flat_[t - 1];
-      portals_[t - 1] = {{prev.corners[left], prev.corners[edge]}, {a, b}};
-      flat_[t] = UnfoldAcross(view, prev, faces_[t], a, b);
+      if (!StepAcross(view, flat_[t - 1], faces_[t], &portals_[t - 1], &flat_[t])) return false;
     }
     end_ = LocateInFlat(view, flat_[n - 1], to, 0);
     return true;
@@ -115,6 +127,70 @@ class Corridor {
   // |end - start| when that segment passes through every portal.
   std::optional<double> StraightLength() const {
     return query::StraightLength(start_, portals_, end_);
+  }
+
+  // Where the points fall in the layout of the last Unfold or Shoot.
+  const Vec2& start() const { return start_; }
+  const Vec2& end() const { return end_; }
+  const FlatFace& first_face() const { return flat_.front(); }
+
+  // The corridor of a straight geodesic shot from `from`, a point strictly
+  // inside its face, along `aim` (a vector of that face as LayOutFace lays
+  // it out), laid out as Unfold would: face to face, each step one cross
+  // product deciding the edge the ray leaves by, until the ray enters
+  // `to`'s face or passes `to` (abeam of it in space, in the face it
+  // crosses), where the chord's walk joins it to `to`. `join` is the join's
+  // working memory. False when the ray meets the boundary or a vertex
+  // exactly, runs past `max_length`, or the join fails.
+  bool Shoot(const MeshView& view, const PathPoint& from, const PathPoint& to, const Vec2& aim,
+             double max_length, std::vector<int32_t>* join) {
+    const int32_t f0 = from.point.face;
+    faces_.assign(1, f0);
+    flat_.assign(1, LayOutFace(view, f0));
+    portals_.clear();
+    start_ = LocateInFlat(view, flat_[0], from.point, 0);
+    const Vec2 u = aim.normalized();
+    auto side = [&](const Vec2& c) { return Cross(u, c - start_); };
+    // Faces are laid out counter-clockwise: the ray leaves by the edge
+    // (corner k, corner k + 1) whose corner k is on its right and k + 1 on
+    // its left.
+    int exit = -1;
+    for (int k = 0; k < 3; ++k) {
+      if (side(flat_[0].corners[k]) <= 0 && side(flat_[0].corners[(k + 1) % 3]) > 0) exit = k;
+    }
+    if (exit < 0) return false;
+    for (int step = 0; step < kMaxShotSteps; ++step) {
+      const FlatFace& flat = flat_.back();
+      if (FaceHolds(view, flat.face, to.point)) {
+        end_ = LocateInFlat(view, flat, to.point, 0);
+        return true;
+      }
+      const int right = exit, left = (exit + 1) % 3;
+      const double sr = side(flat.corners[right]), sl = side(flat.corners[left]);
+      const double lambda = sr / (sr - sl);  // sr <= 0 < sl: where the ray crosses
+      const Vec2 x = flat.corners[right] + lambda * (flat.corners[left] - flat.corners[right]);
+      if (u.dot(x - start_) > max_length) return false;
+      const Vec3 pr = view.Position(flat.vertices[right]);
+      const Vec3 x3 = pr + lambda * (view.Position(flat.vertices[left]) - pr);
+      if ((to.position - x3).dot(InSpace(view, flat, u)) <= 0) {
+        return Join(view, from.point, to, lambda, exit, join);
+      }
+      const int32_t twin = view.twins[3 * flat.face + exit];
+      if (twin < 0) return false;
+      faces_.push_back(twin / 3);
+      flat_.emplace_back();
+      portals_.emplace_back();
+      StepAcross(view, flat_[flat_.size() - 2], twin / 3, &portals_.back(), &flat_.back());
+      // The ray entered across the twin half-edge, which runs from the
+      // entry's left corner to its right one: the third corner's side
+      // chooses the edge it leaves by.
+      const FlatFace& next = flat_.back();
+      const int entry_right = (twin % 3 + 1) % 3, third = (entry_right + 1) % 3;
+      const double st = side(next.corners[third]);
+      if (st == 0) return false;  // through a vertex
+      exit = st > 0 ? entry_right : third;
+    }
+    return false;
   }
 
   // The length of the shortest path through the corridor (the funnel
@@ -159,6 +235,40 @@ class Corridor {
   }
 
  private:
+  static constexpr int kMaxShotSteps = 256;
+
+  // Joins the ray of Shoot, which leaves the last face across its edge
+  // `exit` at `lambda` from the edge's start, to `to` by the chord's walk
+  // from a point just inside that face, and lays the joined faces out. A
+  // join that comes back through the ray's last faces cuts the loop.
+  bool Join(const MeshView& view, const SurfacePoint& from, const PathPoint& to, double lambda,
+            int exit, std::vector<int32_t>* join) {
+    const FlatFace& flat = flat_.back();
+    // Inside by a thousandth of the way to the centroid: the walk starts in
+    // this face, not in its neighbour across the edge.
+    constexpr double kInward = 1e-3;
+    SurfacePoint x{flat.face, {kInward / 3, kInward / 3, kInward / 3}};
+    x.w[exit] += (1 - kInward) * (1 - lambda);
+    x.w[(exit + 1) % 3] += (1 - kInward) * lambda;
+    const PathPoint start{x, view.PositionOf(x)};
+    if (!WalkCorridor(view, start, to, kMaxShotSteps, join)) return false;
+    size_t keep = faces_.size();  // the faces whose layouts stay
+    for (size_t i = 1; i < join->size(); ++i) {
+      const int32_t g = (*join)[i];
+      // A face the corridor already holds near its end: cut back to it.
+      const size_t lookback = std::min<size_t>(faces_.size(), 16);
+      const auto again = std::find(faces_.end() - lookback, faces_.end(), g);
+      if (again == faces_.end()) {
+        faces_.push_back(g);
+        continue;
+      }
+      const size_t at = static_cast<size_t>(again - faces_.begin());
+      faces_.resize(at + 1);
+      keep = std::min(keep, at + 1);
+    }
+    return Unfold(view, from, to.point, keep);
+  }
+
   std::vector<int32_t>& faces_;
   std::vector<FlatFace>& flat_;
   std::vector<Portal>& portals_;
@@ -279,111 +389,299 @@ std::optional<double> AngleSum(const MeshView& view, int32_t face, int32_t v) {
   return std::nullopt;
 }
 
+// The aim of a pair's shots: the angle of the first, then the secant on the
+// miss (the angle between a shot and where its target fell, which falls as
+// the aim turns counter-clockwise), held by regula falsi within the last
+// bracket of a sign change: the map from aim to miss jumps where rays pass
+// on either side of a curved vertex, where the secant alone wanders.
+class AimSearch {
+ public:
+  explicit AimSearch(double theta) : theta_(theta) {}
+
+  // The angle to shoot at next, and the one of the smallest miss so far.
+  double theta() const { return theta_; }
+  double best() const { return best_.theta; }
+  bool last_is_best() const { return last_.theta == best_.theta; }
+
+  // Takes the miss of a shot at theta() and moves theta() on.
+  void Record(double miss) {
+    const Sample now{theta_, miss};
+    if (std::abs(miss) < std::abs(best_.miss)) best_ = now;
+    (miss < 0 ? low_ : high_) = now;
+    double next = theta_ + miss;  // the fixed point, where the secant is not sound
+    if (last_.seen() && miss != last_.miss) {
+      const double secant = theta_ - miss * (theta_ - last_.theta) / (miss - last_.miss);
+      if (std::abs(secant - theta_) < 4 * std::abs(miss) + 1e-3) next = secant;
+    }
+    if (low_.seen() && high_.seen() &&
+        !(std::min(low_.theta, high_.theta) < next && next < std::max(low_.theta, high_.theta))) {
+      next = low_.theta - low_.miss * (high_.theta - low_.theta) / (high_.miss - low_.miss);
+    }
+    last_ = now;
+    theta_ = next;
+  }
+
+ private:
+  struct Sample {
+    double theta = std::numeric_limits<double>::quiet_NaN();
+    double miss = std::numeric_limits<double>::infinity();
+    bool seen() const { return !std::isnan(theta); }
+  };
+  double theta_;
+  Sample last_, low_, high_, best_;
+};
+
+// The walks of one near pair (WalkNearPair): geodesics shot from `from`,
+// then the chord's walks from either end, each corridor unfolded into the
+// plane. A straight segment through a corridor is a local geodesic, as the
+// straightened trace would be, found without evaluating the distance
+// field, so at a fraction of the trace's cost. Else the funnel's path
+// through it, released from the vertices it bends round short of a
+// straight angle on their other side: one that then bends at no vertex, or
+// at one saddle by no more than its angle excess, is a local geodesic too.
+// Paths bending at several saddles were often in a wrong corridor, and so,
+// rarely, is a straight one longer than `plausible` (across a sharp
+// feature); then the caller decides (NearPathLength: the trace; the
+// refinement: an exact propagation round the pair). Every candidate is a
+// surface path, so the shortest is kept (figures: tests/bench/throughput.md).
+class NearWalker {
+ public:
+  NearWalker(const MeshView& view, const SurfacePoint& from, const SurfacePoint& to,
+             const NearWalkOptions& options, QueryScratch& scratch, bool own_scratch)
+      : view_(view),
+        ends_{{from, view.PositionOf(from)}, {to, view.PositionOf(to)}},
+        plausible_(options.plausible),
+        heading_(options.heading),
+        max_saddles_(options.max_saddles),
+        walks_(scratch.walks()),
+        count_(scratch.near_pair_stats()),
+        corridor_(walks_),
+        own_scratch_(own_scratch) {}
+
+  NearWalk Walk() {
+    // Without a plausible length nothing tells a shot that went round the
+    // wrong side of a handle or a bump (the secant may wander there): the
+    // shot is doubted, and the chord's walks answer as they would without
+    // it.
+    const bool checked = std::isfinite(plausible_);
+    if (std::optional<NearPath> shot = Shoot()) {
+      if (checked) return Answer(*shot, corridor_.faces());
+      Doubt(shot->length);
+    }
+    // Else the last shot ran within a small angle of the geodesic: its
+    // corridor holds the geodesic but near the vertices the ray passed
+    // close to, which the funnel bends round and the releases settle. A
+    // shot that did not converge may settle round the wrong side of a
+    // feature, which only a check can tell: unchecked, the chord's walks
+    // answer as they would without shots.
+    const bool shot_corridor = !corridor_.faces().empty();
+    if (checked && shot_corridor) {
+      if (std::optional<NearPath> settled =
+              Settle(ends_[0].point, ends_[1].point, kMaxShotReleases)) {
+        return Answer(*settled, corridor_.faces());
+      }
+    }
+    if (checked && found_) return Answer(*found_, walks_.found_faces);
+    // The chord's walks seldom settle a pair whose shots did not (they
+    // pursue the chord, which the shots left for the geodesic): the caller
+    // takes it from here.
+    if (checked && shot_corridor) {
+      if (doubted_) return {std::nullopt, doubted_, InScratch(walks_.doubted_faces)};
+      return {std::nullopt, std::nullopt, InScratch(corridor_.faces())};
+    }
+    for (int start = 0; start < 2; ++start) {
+      const SurfacePoint& a = ends_[start].point;
+      const SurfacePoint& b = ends_[1 - start].point;
+      if (!WalkCorridor(view_, ends_[start], ends_[1 - start], kMaxWalkSteps, &corridor_.faces()) ||
+          !corridor_.Unfold(view_, a, b)) {
+        continue;
+      }
+      ++count_.walks;
+      count_.faces_crossed += static_cast<int64_t>(corridor_.faces().size());
+      count_.faces_unfolded += static_cast<int64_t>(corridor_.faces().size());
+      if (std::optional<NearPath> settled = Settle(a, b, kMaxReleases)) {
+        if (!found_ || settled->length <= found_->length) {
+          return Answer(*settled, corridor_.faces());
+        }
+      }
+    }
+    // Every candidate is a surface path: the shortest is the closest.
+    if (found_) {
+      if (doubted_ && *doubted_ < found_->length) {
+        return Answer(NearPath{*doubted_, true}, walks_.doubted_faces);
+      }
+      return Answer(*found_, walks_.found_faces);
+    }
+    if (doubted_) return {std::nullopt, doubted_, InScratch(walks_.doubted_faces)};
+    return {};
+  }
+
+  // Keeps `path`, through the corridor as it is, if it is the shortest
+  // local geodesic found so far.
+  void Keep(const NearPath& path) {
+    if (found_ && found_->length <= path.length) return;
+    found_ = path;
+    walks_.found_faces.assign(corridor_.faces().begin(), corridor_.faces().end());
+  }
+
+ private:
+  static constexpr int kMaxWalkSteps = 256;
+  // A release shortens the path; a near path passes few vertices.
+  static constexpr int kMaxReleases = 8;
+  // A shot's corridor runs close to the geodesic: its releases are worth
+  // more of them than a trace costs.
+  static constexpr int kMaxShotReleases = 24;
+  // Shots at the other point: most straight ones converge in two or three
+  // (tests/bench/throughput.md, "The every-distance mode").
+  static constexpr int kMaxShots = 4;
+  // The angle (radians) between a shot and where its target fell, below
+  // which the shot's corridor is settled by the funnel instead of shot
+  // again.
+  static constexpr double kSettleAngle = 0.01;
+
+  // Geodesics shot from an interior `from` (at a vertex the direction of a
+  // ray is not one angle): aimed along the chord, then by the secant on the
+  // angle between the aim and where `to` fell in the last shot's layout
+  // (the layout of a corridor is a chart of the surface round it, so that
+  // angle goes to 0 as the aim does). A walk that pursues `to` along the
+  // chord bends away from the geodesic wherever the chord leaves the
+  // surface, which on curved parts costs releases or a trace. The straight
+  // shot, if one is; else the corridor holds the last shot's (or is empty).
+  std::optional<NearPath> Shoot() {
+    corridor_.faces().clear();
+    const SurfacePoint& from = ends_[0].point;
+    if (!(from.w[0] > 0 && from.w[1] > 0 && from.w[2] > 0)) return std::nullopt;
+    const Vec3 chord = ends_[1].position - ends_[0].position;
+    const Vec2 aim =
+        InPlane(view_, LayOutFace(view_, from.face), heading_.squaredNorm() > 0 ? heading_ : chord);
+    AimSearch search(std::atan2(aim.y(), aim.x()));
+    for (int shot = 0; shot < kMaxShots; ++shot) {
+      const std::optional<Shot> fired = ShootAt(search.theta(), chord.norm());
+      if (!fired) return std::nullopt;
+      if (fired->straight) {
+        if (*fired->straight > plausible_) {
+          Doubt(*fired->straight);
+          return std::nullopt;
+        }
+        ++count_.straight_at_shot[shot];
+        return NearPath{*fired->straight, false};
+      }
+      // Within a small angle another shot mostly moves the ray across a
+      // vertex it passes close to, and back: the funnel does better.
+      if (std::abs(fired->miss) < kSettleAngle) return std::nullopt;
+      search.Record(fired->miss);
+    }
+    // The funnel settles the corridor of the best shot.
+    if (!search.last_is_best()) (void)ShootAt(search.best(), chord.norm());
+    return std::nullopt;
+  }
+
+  // One shot at angle theta (in the layout of from's face): nullopt when
+  // the ray is cut short (the corridor is then cleared: none to settle);
+  // else its length if it is straight, or its miss, the angle between the
+  // shot and where `to` fell in its corridor's layout.
+  struct Shot {
+    std::optional<double> straight;
+    double miss = 0;
+  };
+  std::optional<Shot> ShootAt(double theta, double chord) {
+    const Vec2 u(std::cos(theta), std::sin(theta));
+    if (!corridor_.Shoot(view_, ends_[0], ends_[1], u, 2 * chord, &walks_.join)) {
+      corridor_.faces().clear();
+      return std::nullopt;
+    }
+    ++count_.shots;
+    count_.faces_crossed += static_cast<int64_t>(corridor_.faces().size());
+    if (const std::optional<double> length = corridor_.StraightLength()) return Shot{length, 0};
+    const Vec2 seen = corridor_.end() - corridor_.start();
+    return Shot{std::nullopt, std::atan2(Cross(u, seen), u.dot(seen))};
+  }
+
+  // The funnel's path through the corridor, which runs from a to b and is
+  // laid out, released round vertices it bends round short of a straight
+  // angle: a local geodesic straight in the corridor as found is returned;
+  // one found after releases is kept in found_ (the other walk may find a
+  // shorter one), a doubted one in doubted_.
+  std::optional<NearPath> Settle(const SurfacePoint& a, const SurfacePoint& b, int max_releases) {
+    if (corridor_.faces().empty()) return std::nullopt;
+    if (const std::optional<double> length = corridor_.StraightLength()) {
+      if (*length <= plausible_) return NearPath{*length, false};
+      Doubt(*length);
+      return std::nullopt;
+    }
+    for (int release = 0; release <= max_releases; ++release) {
+      const double length = corridor_.Shortest(&bends_);
+      std::optional<const Corridor::Bend*> shortcut = Shortcut();
+      if (!shortcut) return std::nullopt;  // a boundary vertex
+      if (*shortcut == nullptr) {
+        if (length <= plausible_ && static_cast<int>(bends_.size()) <= max_saddles_) {
+          if (release == 0 && bends_.empty()) return NearPath{length, false};
+          Keep(NearPath{length, !bends_.empty()});
+        } else {
+          Doubt(length);
+        }
+        return std::nullopt;
+      }
+      ++count_.releases;
+      if (!corridor_.Release(view_, **shortcut)) return std::nullopt;
+      const size_t changed = (*shortcut)->first + 1;
+      if (!corridor_.Unfold(view_, a, b, changed)) return std::nullopt;
+      count_.faces_unfolded += static_cast<int64_t>(corridor_.faces().size() - changed);
+    }
+    return std::nullopt;
+  }
+
+  // The first bend of the funnel's path short of a straight angle on its
+  // vertex's other side (null: none); nullopt at a boundary vertex, where
+  // the angle is not known.
+  std::optional<const Corridor::Bend*> Shortcut() const {
+    for (const Corridor::Bend& bend : bends_) {
+      const std::optional<double> angle =
+          AngleSum(view_, corridor_.faces()[bend.first], bend.vertex);
+      if (!angle) return std::nullopt;
+      if (bend.turn > *angle - 2 * M_PI + kBendSlack) return &bend;
+    }
+    return nullptr;
+  }
+
+  // Keeps the shortest doubted length and its corridor.
+  void Doubt(double length) {
+    if (doubted_ && *doubted_ <= length) return;
+    doubted_ = length;
+    walks_.doubted_faces.assign(corridor_.faces().begin(), corridor_.faces().end());
+  }
+
+  // The corridor returned lives in the scratch: none when the scratch is
+  // this call's own.
+  std::span<const int32_t> InScratch(std::span<const int32_t> faces) const {
+    return own_scratch_ ? std::span<const int32_t>() : faces;
+  }
+  NearWalk Answer(const NearPath& path, std::span<const int32_t> faces) const {
+    return {path, std::nullopt, InScratch(faces)};
+  }
+
+  const MeshView& view_;
+  const PathPoint ends_[2];
+  const double plausible_;
+  const Vec3 heading_;
+  const int max_saddles_;
+  QueryScratch::Walks& walks_;
+  NearPairStats& count_;
+  Corridor corridor_;
+  const bool own_scratch_;
+  Corridor::Bends bends_;
+  std::optional<NearPath> found_;
+  std::optional<double> doubted_;
+};
+
 }  // namespace
 
 NearWalk WalkNearPair(const MeshView& view, const SurfacePoint& from, const SurfacePoint& to,
-                      double plausible, QueryScratch* scratch) {
+                      const NearWalkOptions& options, QueryScratch* scratch) {
   QueryScratch own;
-  QueryScratch& s = scratch != nullptr ? *scratch : own;
-  QueryScratch::Walks& walks = s.walks();
-  NearPairStats& count = s.near_pair_stats();
-  // First the corridors of the chord, from either end, unfolded into the
-  // plane. A straight segment through the corridor is a local geodesic, as
-  // the straightened trace would be, found without evaluating the distance
-  // field, so at a fraction of the trace's cost. Else the funnel's path
-  // through it, released from the vertices it bends round short of a
-  // straight angle on their other side: one that then bends at no vertex,
-  // or at one saddle by no more than its angle excess, is a local geodesic
-  // too. Paths bending at several saddles were often in a wrong corridor,
-  // and so, rarely, is a straight one longer than `plausible` (across a
-  // sharp feature); then the caller decides (NearPathLength: the trace; the
-  // refinement: an exact propagation round the pair). Every candidate is a surface
-  // path, so the shortest is kept (figures: tests/bench/throughput.md).
-  constexpr int kMaxWalkSteps = 256;
-  // A release shortens the path; a near path passes few vertices.
-  constexpr int kMaxReleases = 8;
-  const PathPoint ends[2] = {{from, view.PositionOf(from)}, {to, view.PositionOf(to)}};
-  std::optional<double> doubted;
-  Corridor corridor(walks);
-  // The corridor returned lives in the scratch: none when the scratch is
-  // this call's own.
-  const auto in_scratch = [&](std::span<const int32_t> faces) {
-    return scratch != nullptr ? faces : std::span<const int32_t>();
-  };
-  // The corridors of `doubted` and `found`, in walks.doubted_faces and
-  // walks.found_faces.
-  auto doubt = [&](double length) {
-    if (doubted && *doubted <= length) return;
-    doubted = length;
-    walks.doubted_faces.assign(corridor.faces().begin(), corridor.faces().end());
-  };
-  std::optional<NearPath> found;
-  Corridor::Bends bends;
-  for (int start = 0; start < 2; ++start) {
-    const SurfacePoint& a = ends[start].point;
-    const SurfacePoint& b = ends[1 - start].point;
-    if (!WalkCorridor(view, ends[start], ends[1 - start], kMaxWalkSteps, &corridor.faces()) ||
-        !corridor.Unfold(view, a, b)) {
-      continue;
-    }
-    ++count.walks;
-    count.faces_crossed += static_cast<int64_t>(corridor.faces().size());
-    count.faces_unfolded += static_cast<int64_t>(corridor.faces().size());
-    if (const std::optional<double> length = corridor.StraightLength()) {
-      if (*length <= plausible) return {NearPath{*length, false}, std::nullopt, in_scratch(corridor.faces())};
-      doubt(*length);
-      continue;
-    }
-    for (int release = 0; release <= kMaxReleases; ++release) {
-      const double length = corridor.Shortest(&bends);
-      const Corridor::Bend* shortcut = nullptr;
-      bool judged = true;
-      for (const Corridor::Bend& bend : bends) {
-        const std::optional<double> angle =
-            AngleSum(view, corridor.faces()[bend.first], bend.vertex);
-        if (!angle) {
-          judged = false;  // a boundary vertex
-          break;
-        }
-        if (bend.turn > *angle - 2 * M_PI + kBendSlack) {
-          shortcut = &bend;
-          break;
-        }
-      }
-      if (!judged) break;
-      if (shortcut == nullptr) {
-        if (length <= plausible && bends.size() <= 1) {
-          // Straight in the walk's own corridor: as sure as a straight walk.
-          if (release == 0 && bends.empty()) {
-            return {NearPath{length, false}, std::nullopt, in_scratch(corridor.faces())};
-          }
-          // Else a local geodesic in a corridor the walk did not find by
-          // itself: kept, but the other walk may find a shorter one.
-          if (!found || length < found->length) {
-            found = NearPath{length, !bends.empty()};
-            walks.found_faces.assign(corridor.faces().begin(), corridor.faces().end());
-          }
-        } else {
-          doubt(length);
-        }
-        break;
-      }
-      ++count.releases;
-      if (!corridor.Release(view, *shortcut)) break;
-      const size_t changed = shortcut->first + 1;
-      if (!corridor.Unfold(view, a, b, changed)) break;
-      count.faces_unfolded += static_cast<int64_t>(corridor.faces().size() - changed);
-    }
-  }
-  // Every candidate is a surface path: the shortest is the closest.
-  if (found) {
-    if (doubted && *doubted < found->length) {
-      return {NearPath{*doubted, true}, std::nullopt, in_scratch(walks.doubted_faces)};
-    }
-    return {found, std::nullopt, in_scratch(walks.found_faces)};
-  }
-  if (doubted) return {std::nullopt, doubted, in_scratch(walks.doubted_faces)};
-  return {};
+  return NearWalker(view, from, to, options, scratch != nullptr ? *scratch : own,
+                    scratch == nullptr)
+      .Walk();
 }
 
 std::optional<NearPath> NearPathLength(const MeshView& view, const GradientPaths& paths,
@@ -391,7 +689,7 @@ std::optional<NearPath> NearPathLength(const MeshView& view, const GradientPaths
                                        bool walk_chord, double plausible) {
   std::optional<double> doubted;
   if (walk_chord) {
-    const NearWalk walk = WalkNearPair(view, from, to, plausible);
+    const NearWalk walk = WalkNearPair(view, from, to, {.plausible = plausible});
     if (walk.path) return walk.path;
     doubted = walk.doubted;
   }

@@ -18,8 +18,8 @@
 #include <span>
 #include <vector>
 
-#include "core/query/internal/paths/gradient_path.h"
 #include "core/query/internal/mesh_view.h"
+#include "core/query/internal/paths/gradient_path.h"
 #include "core/query/internal/paths/strip_funnel.h"
 #include "core/query/query_scratch.h"
 #include "core/query/query_types.h"
@@ -47,6 +47,7 @@ struct QueryScratch::Walks {
   std::vector<FlatFace> flat;  // flat[t]: faces[t] laid out
   std::vector<Portal> portals;
   std::vector<int32_t> found_faces, doubted_faces;
+  std::vector<int32_t> join;  // the chord's walk that joins a shot to its target
 };
 
 // What the chord's walks found between near points.
@@ -65,14 +66,27 @@ struct NearWalk {
   std::span<const int32_t> corridor;
 };
 
-// The chord's walks from either end between valid canonical points `from`
-// and `to` (from the smaller point, for symmetry). A straight walk longer
-// than `plausible` is doubted (it may run in a wrong corridor). `scratch`
-// (optional: without, the call makes its own) holds the walks' memory and
-// counts them in its NearPairStats.
+struct NearWalkOptions {
+  // A walk longer than this is doubted (it may run in a wrong corridor).
+  double plausible = std::numeric_limits<double>::infinity();
+  // A funnel path bending round more saddles than this (each by no more
+  // than its angle excess: a local geodesic all the same) is doubted. Where
+  // the caller checks every answer against a lower bound or the O(1)
+  // answer's bound, such paths may be taken; a caller without a check keeps
+  // 1 (several bends were often a wrong corridor).
+  int max_saddles = 1;
+  // The direction in which the geodesic is expected to leave `from` (in the
+  // plane of its face: GradientPaths::Heading), where the first shot is
+  // aimed; zero: along the chord.
+  mesh::Vec3 heading = mesh::Vec3::Zero();
+};
+
+// Geodesics shot from `from` at `to`, then the chord's walks from either
+// end, between valid canonical points `from` and `to` (from the smaller
+// point, for symmetry). `scratch` (optional: without, the call makes its
+// own) holds the walks' memory and counts them in its NearPairStats.
 NearWalk WalkNearPair(const MeshView& view, const SurfacePoint& from, const SurfacePoint& to,
-                      double plausible = std::numeric_limits<double>::infinity(),
-                      QueryScratch* scratch = nullptr);
+                      const NearWalkOptions& options = {}, QueryScratch* scratch = nullptr);
 
 // The shortest path found between valid canonical points `from` and `to`
 // (from the smaller point, for symmetry): the walks' (WalkNearPair), else

@@ -42,12 +42,24 @@ struct Tracer {
   std::array<double, 3> Descent(int32_t f, const std::array<double, 3>& b, double* magnitude) {
     const Vec3 v[3] = {mesh.Position(mesh.Vertex(f, 0)), mesh.Position(mesh.Vertex(f, 1)),
                        mesh.Position(mesh.Vertex(f, 2))};
+    const Vec3 n = (v[1] - v[0]).cross(v[2] - v[0]);
+    const double area2 = n.squaredNorm();
+    Vec3 grad_b[3];
+    for (int i = 0; i < 3; ++i) grad_b[i] = n.cross(v[(i + 2) % 3] - v[(i + 1) % 3]) / area2;
+    const Vec3 dir = DescentDirection(f, b);
+    *magnitude = dir.norm();
+    return {grad_b[0].dot(dir), grad_b[1].dot(dir), grad_b[2].dot(dir)};
+  }
+
+  // Descent's direction, in space: towards the source unfolded into the
+  // face's plane.
+  Vec3 DescentDirection(int32_t f, const std::array<double, 3>& b) {
+    const Vec3 v[3] = {mesh.Position(mesh.Vertex(f, 0)), mesh.Position(mesh.Vertex(f, 1)),
+                       mesh.Position(mesh.Vertex(f, 2))};
     const double d[3] = {D(mesh.Vertex(f, 0)), D(mesh.Vertex(f, 1)), D(mesh.Vertex(f, 2))};
     const Vec3 e1 = v[1] - v[0], e2 = v[2] - v[0];
     const Vec3 n = e1.cross(e2);
     const double area2 = n.squaredNorm();
-    Vec3 grad_b[3];
-    for (int i = 0; i < 3; ++i) grad_b[i] = n.cross(v[(i + 2) % 3] - v[(i + 1) % 3]) / area2;
     Vec3 dir;
     const double l = e1.norm();
     const Vec3 ux = e1 / l;
@@ -66,10 +78,10 @@ struct Tracer {
       }
     }
     if (!planar) {
-      dir = -(d[0] * grad_b[0] + d[1] * grad_b[1] + d[2] * grad_b[2]);
+      dir = Vec3::Zero();
+      for (int i = 0; i < 3; ++i) dir -= d[i] * n.cross(v[(i + 2) % 3] - v[(i + 1) % 3]) / area2;
     }
-    *magnitude = dir.norm();
-    return {grad_b[0].dot(dir), grad_b[1].dot(dir), grad_b[2].dot(dir)};
+    return dir;
   }
 
   // Faces around vertex v, starting from face f.
@@ -241,6 +253,11 @@ void FaceStep(Tracer& tr, const MeshView& view, int32_t* f, std::array<double, 3
 }
 
 }  // namespace
+
+Vec3 GradientPaths::Heading(const SurfacePoint& from, const SurfacePoint& to) const {
+  Tracer tr{lifting_, unfolding_, view_, lifting_.Lift(to), {}};
+  return tr.DescentDirection(from.face, from.w);
+}
 
 absl::StatusOr<std::vector<PathPoint>> GradientPaths::Shortest(const SurfacePoint& from,
                                                                const SurfacePoint& to,

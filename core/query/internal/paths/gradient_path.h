@@ -13,9 +13,9 @@
 #include <vector>
 
 #include "absl/status/statusor.h"
+#include "core/query/internal/mesh_view.h"
 #include "core/query/internal/o1/lifted_unfolding.h"
 #include "core/query/internal/o1/lifting.h"
-#include "core/query/internal/mesh_view.h"
 #include "core/query/query_types.h"
 
 namespace geodex::query {
@@ -44,6 +44,14 @@ class GradientPaths {
   // components.
   absl::StatusOr<std::vector<PathPoint>> Shortest(const SurfacePoint& from, const SurfacePoint& to,
                                                   Search search) const;
+
+  // The direction, in the plane of from's face, in which the geodesic from
+  // `from` to `to` (valid canonical points) leaves `from` as the O(1) field
+  // of `to` sees it: towards `to` unfolded into that plane from the field's
+  // values at the face's corners (three O(1) answers), or down the field's
+  // linear gradient where they fit no point. Not normalised; zero where the
+  // field is flat.
+  mesh::Vec3 Heading(const SurfacePoint& from, const SurfacePoint& to) const;
 
   // The raw gradient trace from `from` to `to` (valid points), before
   // straightening. Errors: NotFound between components.

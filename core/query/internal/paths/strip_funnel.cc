@@ -46,19 +46,9 @@ bool UnfoldStrip(const MeshView& view, std::span<const int32_t> faces,
   FlatFace flat = LayOutFace(view, faces[0]);
   out->start = LocateInFlat(view, flat, from, min_weight);
   for (size_t t = 0; t + 1 < faces.size(); ++t) {
-    const int32_t f = faces[t];
-    int edge = -1;
-    for (int i = 0; i < 3; ++i) {
-      const int32_t h = view.twins[3 * f + i];
-      if (h >= 0 && h / 3 == faces[t + 1]) edge = i;
-    }
-    if (edge < 0) return false;
-    // The half-edge runs from corner `edge` to the next, with f on its
-    // left: going out of f, its end is on the left.
-    const int left = (edge + 1) % 3;
-    const int32_t a = view.Vertex(f, left), b = view.Vertex(f, edge);
-    out->portals.push_back({{flat.corners[left], flat.corners[edge]}, {a, b}});
-    flat = UnfoldAcross(view, flat, faces[t + 1], a, b);
+    Portal portal;
+    if (!StepAcross(view, flat, faces[t + 1], &portal, &flat)) return false;
+    out->portals.push_back(portal);
   }
   out->end = LocateInFlat(view, flat, to, min_weight);
   return true;

@@ -104,11 +104,18 @@ struct UnfoldedStrip {
   absl::InlinedVector<Portal, 32> portals;
 };
 
-// The strip loop, written once: lays out faces[0] (LayOutFace) and each next
-// face across the edge it shares with the one before (UnfoldAcross), and
-// places `from` (a point faces[0] holds) and `to` (one the last face holds)
-// with LocateInFlat(min_weight). False when two consecutive faces share no
-// edge.
+// One step of a strip, written once for every strip loop (UnfoldStrip, the
+// chord walk's corridor): face `next`, which shares an edge with prev's
+// face, laid out across that edge (UnfoldAcross) into *out, and the edge as
+// the portal a path crosses going out of prev into *portal. False when the
+// faces share no edge.
+bool StepAcross(const MeshView& view, const FlatFace& prev, int32_t next, Portal* portal,
+                FlatFace* out);
+
+// The strip loop: lays out faces[0] (LayOutFace) and each next face across
+// the edge it shares with the one before (StepAcross), and places `from` (a
+// point faces[0] holds) and `to` (one the last face holds) with
+// LocateInFlat(min_weight). False when two consecutive faces share no edge.
 bool UnfoldStrip(const MeshView& view, std::span<const int32_t> faces,
                  const mesh::SurfacePoint& from, const mesh::SurfacePoint& to, double min_weight,
                  UnfoldedStrip* out);
@@ -169,6 +176,25 @@ inline FlatFace UnfoldAcross(const MeshView& view, const FlatFace& prev, int32_t
   flat.corners[jb] = pb;
   flat.corners[k] = pa + x * ux + y * uy;
   return flat;
+}
+
+inline bool StepAcross(const MeshView& view, const FlatFace& prev, int32_t next, Portal* portal,
+                       FlatFace* out) {
+  const int32_t f = prev.face;
+  int edge = -1;
+  for (int i = 0; i < 3; ++i) {
+    const int32_t h = view.twins[3 * f + i];
+    if (h >= 0 && h / 3 == next) edge = i;
+  }
+  if (edge < 0) return false;
+  // The half-edge runs from corner `edge` to the next, with f on its left:
+  // going out of f, its end is on the left. prev's corners are in f's
+  // corner order (LayOutFace, UnfoldAcross).
+  const int left = (edge + 1) % 3;
+  const int32_t a = view.Vertex(f, left), b = view.Vertex(f, edge);
+  *portal = {{prev.corners[left], prev.corners[edge]}, {a, b}};
+  *out = UnfoldAcross(view, prev, next, a, b);
+  return true;
 }
 
 inline geometry::Vec2 LocateInFlat(const MeshView& view, const FlatFace& flat,
