@@ -36,6 +36,7 @@
 #include "CLI/CLI.hpp"
 #include "absl/strings/str_format.h"
 #include "core/index/index.h"
+#include "core/query/internal/bounds/refinement.h"
 #include "core/query/internal/exact/local_exact.h"
 #include "core/query/internal/o1/lifted_unfolding.h"
 #include "core/query/internal/o1/lifting.h"
@@ -145,7 +146,7 @@ double StoredBound(const index::Index& ix, const query::MeshView& view, const Su
   return best;
 }
 
-void Measure(const index::Index& ix, const query::QueryEngine& engine, Parts& parts,
+void Measure(const index::Index& ix, const query::QueryEngine& engine, Parts& parts, bool near,
              const SurfacePoint& p, const SurfacePoint& q, query::QueryScratch& scratch,
              Tally* tally) {
   const absl::StatusOr<double> exact =
@@ -160,8 +161,14 @@ void Measure(const index::Index& ix, const query::QueryEngine& engine, Parts& pa
   if (auto s = parts.exact.Distances(q, reach, scratch); s.ok()) dq.assign(s->begin(), s->end());
   if (dp.empty() || dq.empty()) return;
   ++tally->pairs;
+  // Walked as the refinement walks: under the O(1) answer plus its bound,
+  // shots held within kShotExcess of the O(1) answer beyond the near band.
   const query::NearWalk walk =
-      query::WalkNearPair(parts.view, p, q, {.heading = parts.paths.Heading(p, q)}, &scratch);
+      query::WalkNearPair(parts.view, p, q,
+                          {.plausible = *o1 + bound,
+                           .plausible_shot = near ? query::kInf : (1 + query::kShotExcess) * *o1,
+                           .heading = parts.paths.Heading(p, q)},
+                          &scratch);
   const double chord = (parts.view.PositionOf(p) - parts.view.PositionOf(q)).norm();
   std::vector<int32_t> k3;
   {
@@ -246,7 +253,7 @@ int Run(const std::string& path, int n) {
     Tally tally;
     query::QueryScratch scratch;
     for (size_t i = 0; i < a.size(); ++i)
-      Measure(**ix, **engine, parts, a[i], b[i], scratch, &tally);
+      Measure(**ix, **engine, parts, near, a[i], b[i], scratch, &tally);
     const std::string set = near ? "L-3L (index's L)" : "1-8 L1000";
     for (int bnd = 0; bnd < kBounds; ++bnd) {
       // Bytes a face beyond today's index: k landmark ids and unfolded

@@ -105,16 +105,15 @@ double Refiner::Refine(const SurfacePoint& p_in, const SurfacePoint& q_in, const
   auto near_path = [&] {
     ++stats.pairs;
     if (walk_) {
-      // Every walk taken is checked (against the chord, or the O(1)
-      // answer's bound): local geodesics bending round several saddles may
-      // be taken too.
       // The shots are aimed as the O(1) field of `to` sees the geodesic
-      // leave `from`.
-      const NearWalk walk = WalkNearPair(view_, from, to,
-                                         {.plausible = plausible(),
-                                          .max_saddles = kMaxSaddles,
-                                          .heading = paths_.Heading(from, to)},
-                                         &solvers);
+      // leave `from`; beyond the index's own threshold, where no chord
+      // certifies them, held within kShotExcess of the O(1) answer.
+      const NearWalk walk =
+          WalkNearPair(view_, from, to,
+                       {.plausible = plausible(),
+                        .plausible_shot = raised_only ? (1 + kShotExcess) * unfolded : kInf,
+                        .heading = paths_.Heading(from, to)},
+                       &solvers);
       if (walk.path && (certified(walk.path->length) || raised_only)) return take(*walk.path);
       if (raised_only) {
         // The gradient trace finds the corridor where the chord's does not

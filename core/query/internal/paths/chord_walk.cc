@@ -451,8 +451,8 @@ class NearWalker {
       : view_(view),
         ends_{{from, view.PositionOf(from)}, {to, view.PositionOf(to)}},
         plausible_(options.plausible),
+        plausible_shot_(std::min(options.plausible, options.plausible_shot)),
         heading_(options.heading),
-        max_saddles_(options.max_saddles),
         walks_(scratch.walks()),
         count_(scratch.near_pair_stats()),
         corridor_(walks_),
@@ -477,7 +477,7 @@ class NearWalker {
     const bool shot_corridor = !corridor_.faces().empty();
     if (checked && shot_corridor) {
       if (std::optional<NearPath> settled =
-              Settle(ends_[0].point, ends_[1].point, kMaxShotReleases)) {
+              Settle(ends_[0].point, ends_[1].point, kMaxShotReleases, plausible_shot_)) {
         return Answer(*settled, corridor_.faces());
       }
     }
@@ -499,7 +499,7 @@ class NearWalker {
       ++count_.walks;
       count_.faces_crossed += static_cast<int64_t>(corridor_.faces().size());
       count_.faces_unfolded += static_cast<int64_t>(corridor_.faces().size());
-      if (std::optional<NearPath> settled = Settle(a, b, kMaxReleases)) {
+      if (std::optional<NearPath> settled = Settle(a, b, kMaxReleases, plausible_)) {
         if (!found_ || settled->length <= found_->length) {
           return Answer(*settled, corridor_.faces());
         }
@@ -559,7 +559,7 @@ class NearWalker {
       const std::optional<Shot> fired = ShootAt(search.theta(), chord.norm());
       if (!fired) return std::nullopt;
       if (fired->straight) {
-        if (*fired->straight > plausible_) {
+        if (*fired->straight > plausible_shot_) {
           Doubt(*fired->straight);
           return std::nullopt;
         }
@@ -602,10 +602,11 @@ class NearWalker {
   // angle: a local geodesic straight in the corridor as found is returned;
   // one found after releases is kept in found_ (the other walk may find a
   // shorter one), a doubted one in doubted_.
-  std::optional<NearPath> Settle(const SurfacePoint& a, const SurfacePoint& b, int max_releases) {
+  std::optional<NearPath> Settle(const SurfacePoint& a, const SurfacePoint& b, int max_releases,
+                                 double plausible) {
     if (corridor_.faces().empty()) return std::nullopt;
     if (const std::optional<double> length = corridor_.StraightLength()) {
-      if (*length <= plausible_) return NearPath{*length, false};
+      if (*length <= plausible) return NearPath{*length, false};
       Doubt(*length);
       return std::nullopt;
     }
@@ -614,7 +615,7 @@ class NearWalker {
       std::optional<const Corridor::Bend*> shortcut = Shortcut();
       if (!shortcut) return std::nullopt;  // a boundary vertex
       if (*shortcut == nullptr) {
-        if (length <= plausible_ && static_cast<int>(bends_.size()) <= max_saddles_) {
+        if (length <= plausible && bends_.size() <= 1) {
           if (release == 0 && bends_.empty()) return NearPath{length, false};
           Keep(NearPath{length, !bends_.empty()});
         } else {
@@ -663,8 +664,8 @@ class NearWalker {
   const MeshView& view_;
   const PathPoint ends_[2];
   const double plausible_;
+  const double plausible_shot_;
   const Vec3 heading_;
-  const int max_saddles_;
   QueryScratch::Walks& walks_;
   NearPairStats& count_;
   Corridor corridor_;

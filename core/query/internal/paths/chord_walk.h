@@ -69,12 +69,10 @@ struct NearWalk {
 struct NearWalkOptions {
   // A walk longer than this is doubted (it may run in a wrong corridor).
   double plausible = std::numeric_limits<double>::infinity();
-  // A funnel path bending round more saddles than this (each by no more
-  // than its angle excess: a local geodesic all the same) is doubted. Where
-  // the caller checks every answer against a lower bound or the O(1)
-  // answer's bound, such paths may be taken; a caller without a check keeps
-  // 1 (several bends were often a wrong corridor).
-  int max_saddles = 1;
+  // The same for a shot and the settling of its corridor (at most
+  // `plausible`): where the secant wanders, a shot may go round the wrong
+  // side of a feature, so the caller may hold shots closer.
+  double plausible_shot = std::numeric_limits<double>::infinity();
   // The direction in which the geodesic is expected to leave `from` (in the
   // plane of its face: GradientPaths::Heading), where the first shot is
   // aimed; zero: along the chord.
