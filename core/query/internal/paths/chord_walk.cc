@@ -516,6 +516,7 @@ class NearWalker {
     return {};
   }
 
+ private:
   // Keeps `path`, through the corridor as it is, if it is the shortest
   // local geodesic found so far.
   void Keep(const NearPath& path) {
@@ -524,15 +525,14 @@ class NearWalker {
     walks_.found_faces.assign(corridor_.faces().begin(), corridor_.faces().end());
   }
 
- private:
   static constexpr int kMaxWalkSteps = 256;
   // A release shortens the path; a near path passes few vertices.
   static constexpr int kMaxReleases = 8;
   // A shot's corridor runs close to the geodesic: its releases are worth
   // more of them than a trace costs.
   static constexpr int kMaxShotReleases = 24;
-  // Shots at the other point: most straight ones converge in two or three
-  // (tests/bench/throughput.md, "The every-distance mode").
+  // Shots at the other point: nine in ten of the straight ones are straight
+  // by the second (tests/bench/throughput.md, "The every-distance mode").
   static constexpr int kMaxShots = 4;
   // The angle (radians) between a shot and where its target fell, below
   // which the shot's corridor is settled by the funnel instead of shot
@@ -540,13 +540,14 @@ class NearWalker {
   static constexpr double kSettleAngle = 0.01;
 
   // Geodesics shot from an interior `from` (at a vertex the direction of a
-  // ray is not one angle): aimed along the chord, then by the secant on the
-  // angle between the aim and where `to` fell in the last shot's layout
-  // (the layout of a corridor is a chart of the surface round it, so that
-  // angle goes to 0 as the aim does). A walk that pursues `to` along the
-  // chord bends away from the geodesic wherever the chord leaves the
-  // surface, which on curved parts costs releases or a trace. The straight
-  // shot, if one is; else the corridor holds the last shot's (or is empty).
+  // ray is not one angle): aimed along the heading (else the chord), then
+  // by the secant on the angle between the aim and where `to` fell in the
+  // last shot's layout (the layout of a corridor is a chart of the surface
+  // round it, so that angle goes to 0 as the aim does). A walk that pursues
+  // `to` along the chord bends away from the geodesic wherever the chord
+  // leaves the surface, which on curved parts costs releases or a trace.
+  // The straight shot, if one is; else the corridor holds the best shot's
+  // (or is empty).
   std::optional<NearPath> Shoot() {
     corridor_.faces().clear();
     const SurfacePoint& from = ends_[0].point;
