@@ -394,17 +394,21 @@ def check_report(driver, stack):
     cli_json = subprocess.run([stack.args.geodex, "info", "--server", stack.grpc, "--model", stack.name,
                                "--format", "json"], capture_output=True, text=True)
     check(json.loads(cli_json.stdout)["report"] == report, "geodex info --format json's report differs")
-    # The table: each bin's row shows the text report's cells.
+    # The table: each bin's row holds the report's values, and shows the text
+    # report's cells where the text has the bin (indexes built before the
+    # bands by L1000; today's text gives the bands instead).
     bins = report["accuracy"]["bins"]
     rows = [line for line in text.splitlines() if line.startswith(" " * 18)]
     for b in bins:
-        row = next(line for line in rows if line[18:].startswith(b["label"] + " "))
-        want = row[18 + len(b["label"]):].split()[:3]
         cells = driver.find_elements(By.CSS_SELECTOR, f"#accuracy-table tr[data-bin='{b['key']}'] td")
-        got = [c.text for c in cells[1:4]]
-        check(got == want, f"the panel's {b['label']} row shows {got}, geodex-query --info {want}")
         check([float(c.get_attribute("data-value")) for c in cells[1:4]] == [b["rms"], b["p99"], b["p99_limit"]],
               f"the panel's {b['label']} row holds other values than the report")
+        row = next((line for line in rows if line[18:].startswith(b["label"] + " ")), None)
+        if row is None:
+            continue
+        want = row[18 + len(b["label"]):].split()[:3]
+        got = [c.text for c in cells[1:4]]
+        check(got == want, f"the panel's {b['label']} row shows {got}, geodex-query --info {want}")
     # The chart: every bin's p99 and RMS, at the value and place the frame gives.
     chart = driver.execute_script(CHART)
     frame = chart["frame"]
