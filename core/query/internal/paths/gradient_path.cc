@@ -19,6 +19,35 @@ namespace {
 
 using mesh::Vec3;
 
+// The direction in which the field whose values at face f's corners are
+// d leaves the point at barycentric position b: towards the source those
+// distances place in the face's plane (trilateration), exact where the
+// field is planar; where they fit no point, down the gradient of their
+// linear interpolant.
+Vec3 TowardsSource(const MeshView& mesh, int32_t f, const std::array<double, 3>& d,
+                   const std::array<double, 3>& b) {
+  const Vec3 v[3] = {mesh.Position(mesh.Vertex(f, 0)), mesh.Position(mesh.Vertex(f, 1)),
+                     mesh.Position(mesh.Vertex(f, 2))};
+  const Vec3 e1 = v[1] - v[0], e2 = v[2] - v[0];
+  const Vec3 n = e1.cross(e2);
+  const double l = e1.norm();
+  const Vec3 ux = e1 / l;
+  const Vec3 uy = n.cross(e1).normalized();
+  const double cx = e2.dot(ux), cy = e2.dot(uy);
+  if (cy > 1e-6 * l) {
+    double sx, sy;
+    geometry::Trilaterate(l, cx, cy, d[0], d[1], d[2], &sx, &sy);
+    const double r0 = std::sqrt(sx * sx + sy * sy);
+    if (std::abs(r0 - d[0]) < 1e-3 * (d[0] + l)) {
+      return v[0] + sx * ux + sy * uy - (b[0] * v[0] + b[1] * v[1] + b[2] * v[2]);
+    }
+  }
+  const double area2 = n.squaredNorm();
+  Vec3 dir = Vec3::Zero();
+  for (int i = 0; i < 3; ++i) dir -= d[i] * n.cross(v[(i + 2) % 3] - v[(i + 1) % 3]) / area2;
+  return dir;
+}
+
 struct Tracer {
   const Lifting& lifting;
   const LiftedUnfolding& unfolding;
@@ -54,34 +83,8 @@ struct Tracer {
   // Descent's direction, in space: towards the source unfolded into the
   // face's plane.
   Vec3 DescentDirection(int32_t f, const std::array<double, 3>& b) {
-    const Vec3 v[3] = {mesh.Position(mesh.Vertex(f, 0)), mesh.Position(mesh.Vertex(f, 1)),
-                       mesh.Position(mesh.Vertex(f, 2))};
-    const double d[3] = {D(mesh.Vertex(f, 0)), D(mesh.Vertex(f, 1)), D(mesh.Vertex(f, 2))};
-    const Vec3 e1 = v[1] - v[0], e2 = v[2] - v[0];
-    const Vec3 n = e1.cross(e2);
-    const double area2 = n.squaredNorm();
-    Vec3 dir;
-    const double l = e1.norm();
-    const Vec3 ux = e1 / l;
-    const Vec3 uy = n.cross(e1).normalized();
-    const double cx = e2.dot(ux), cy = e2.dot(uy);
-    bool planar = false;
-    if (cy > 1e-6 * l) {
-      double sx, sy;
-      geometry::Trilaterate(l, cx, cy, d[0], d[1], d[2], &sx, &sy);
-      const double r0 = std::sqrt(sx * sx + sy * sy);
-      planar = std::abs(r0 - d[0]) < 1e-3 * (d[0] + l);
-      if (planar) {
-        const Vec3 source = v[0] + sx * ux + sy * uy;
-        const Vec3 x = b[0] * v[0] + b[1] * v[1] + b[2] * v[2];
-        dir = source - x;
-      }
-    }
-    if (!planar) {
-      dir = Vec3::Zero();
-      for (int i = 0; i < 3; ++i) dir -= d[i] * n.cross(v[(i + 2) % 3] - v[(i + 1) % 3]) / area2;
-    }
-    return dir;
+    return TowardsSource(mesh, f,
+                         {D(mesh.Vertex(f, 0)), D(mesh.Vertex(f, 1)), D(mesh.Vertex(f, 2))}, b);
   }
 
   // Faces around vertex v, starting from face f.
@@ -255,8 +258,13 @@ void FaceStep(Tracer& tr, const MeshView& view, int32_t* f, std::array<double, 3
 }  // namespace
 
 Vec3 GradientPaths::Heading(const SurfacePoint& from, const SurfacePoint& to) const {
-  Tracer tr{lifting_, unfolding_, view_, lifting_.Lift(to), {}};
-  return tr.DescentDirection(from.face, from.w);
+  // Three answers, no Tracer: its memo would allocate for each pair.
+  const LiftedPoint source = lifting_.Lift(to);
+  std::array<double, 3> d;
+  for (int i = 0; i < 3; ++i) {
+    d[i] = unfolding_.Distance(source, lifting_.VertexLift(view_.Vertex(from.face, i)));
+  }
+  return TowardsSource(view_, from.face, d, from.w);
 }
 
 absl::StatusOr<std::vector<PathPoint>> GradientPaths::Shortest(const SurfacePoint& from,
