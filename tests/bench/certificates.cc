@@ -167,7 +167,8 @@ void Measure(const index::Index& ix, const query::QueryEngine& engine, Parts& pa
       query::WalkNearPair(parts.view, p, q,
                           {.plausible = *o1 + bound,
                            .plausible_shot = near ? query::kInf : (1 + query::kShotExcess) * *o1,
-                           .heading = parts.paths.Heading(p, q)},
+                           .heading = parts.paths.Heading(p, q),
+                           .shoot = !near},
                           &scratch);
   const double chord = (parts.view.PositionOf(p) - parts.view.PositionOf(q)).norm();
   std::vector<int32_t> k3;

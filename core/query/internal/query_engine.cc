@@ -156,11 +156,7 @@ absl::StatusOr<double> QueryEngine::WalkedDistance(const SurfacePoint& p, const 
   const SurfacePoint a = view_.InLowestFaceIfVertex(view_.Canonical(p)),
                      b = view_.InLowestFaceIfVertex(view_.Canonical(q));
   const bool swap = std::tie(b.face, b.w) < std::tie(a.face, a.w);
-  // Aimed as the refinement aims its walks (refinement.cc), so that the
-  // two agree to the bit.
-  const SurfacePoint& from = swap ? b : a;
-  const SurfacePoint& to = swap ? a : b;
-  const NearWalk walk = WalkNearPair(view_, from, to, {.heading = paths_.Heading(from, to)});
+  const NearWalk walk = WalkNearPair(view_, swap ? b : a, swap ? a : b);
   if (!walk.path)
     return absl::NotFoundError("the walks found no local geodesic between the points");
   if (wraps != nullptr) *wraps = walk.path->wraps;

@@ -105,15 +105,19 @@ double Refiner::Refine(const SurfacePoint& p_in, const SurfacePoint& q_in, const
   auto near_path = [&] {
     ++stats.pairs;
     if (walk_) {
-      // The shots are aimed as the O(1) field of `to` sees the geodesic
-      // leave `from`; beyond the index's own threshold, where no chord
-      // certifies them, held within kShotExcess of the O(1) answer.
+      // Beyond the index's own threshold geodesics are shot first, aimed as
+      // the O(1) field of `to` sees the geodesic leave `from` and held within
+      // kShotExcess of the O(1) answer: there the chord's walks mostly fail
+      // (the chord leaves the surface) and a trace costs ten shots. Near
+      // pairs keep the chord's walks, which settle most of them.
       const NearWalk walk =
-          WalkNearPair(view_, from, to,
-                       {.plausible = plausible(),
-                        .plausible_shot = raised_only ? (1 + kShotExcess) * unfolded : kInf,
-                        .heading = paths_.Heading(from, to)},
-                       &solvers);
+          raised_only ? WalkNearPair(view_, from, to,
+                                     {.plausible = plausible(),
+                                      .plausible_shot = (1 + kShotExcess) * unfolded,
+                                      .heading = paths_.Heading(from, to),
+                                      .shoot = true},
+                                     &solvers)
+                      : WalkNearPair(view_, from, to, {.plausible = plausible()}, &solvers);
       if (walk.path && (certified(walk.path->length) || raised_only)) return take(*walk.path);
       if (raised_only) {
         // The gradient trace finds the corridor where the chord's does not

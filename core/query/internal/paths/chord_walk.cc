@@ -453,6 +453,7 @@ class NearWalker {
         plausible_(options.plausible),
         plausible_shot_(std::min(options.plausible, options.plausible_shot)),
         heading_(options.heading),
+        shoot_(options.shoot),
         walks_(scratch.walks()),
         count_(scratch.near_pair_stats()),
         corridor_(walks_),
@@ -551,7 +552,7 @@ class NearWalker {
   std::optional<NearPath> Shoot() {
     corridor_.faces().clear();
     const SurfacePoint& from = ends_[0].point;
-    if (!(from.w[0] > 0 && from.w[1] > 0 && from.w[2] > 0)) return std::nullopt;
+    if (!shoot_ || !(from.w[0] > 0 && from.w[1] > 0 && from.w[2] > 0)) return std::nullopt;
     const Vec3 chord = ends_[1].position - ends_[0].position;
     const Vec2 aim =
         InPlane(view_, LayOutFace(view_, from.face), heading_.squaredNorm() > 0 ? heading_ : chord);
@@ -667,6 +668,7 @@ class NearWalker {
   const double plausible_;
   const double plausible_shot_;
   const Vec3 heading_;
+  const bool shoot_;
   QueryScratch::Walks& walks_;
   NearPairStats& count_;
   Corridor corridor_;

@@ -77,6 +77,11 @@ struct NearWalkOptions {
   // plane of its face: GradientPaths::Heading), where the first shot is
   // aimed; zero: along the chord.
   mesh::Vec3 heading = mesh::Vec3::Zero();
+  // Shoot geodesics before the chord's walks (the refinement does beyond
+  // the index's own threshold, where the chord leaves the surface). Off,
+  // the walks answer alone, as they do for near pairs, whose corridors are
+  // short enough for the chord's pursuit.
+  bool shoot = false;
 };
 
 // Geodesics shot from `from` at `to`, then the chord's walks from either

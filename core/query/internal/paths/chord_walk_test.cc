@@ -162,7 +162,8 @@ TEST(ChordWalkTest, ShotsFindTheStraightGeodesicRoundACylinder) {
     // Shots are taken under a check (the refinement's: the O(1) answer plus
     // its bound), here a generous one.
     const NearPairStats before = scratch.near_pair_stats();
-    const NearWalk walk = WalkNearPair(parts.view, a, b, {.plausible = 1.2 * *exact}, &scratch);
+    const NearWalk walk =
+        WalkNearPair(parts.view, a, b, {.plausible = 1.2 * *exact, .shoot = true}, &scratch);
     ++pairs;
     if (!walk.path) continue;
     EXPECT_GE(walk.path->length, *exact * (1 - 1e-9)) << f << " " << g;  // a surface path
@@ -192,10 +193,11 @@ TEST(ChordWalkTest, ShotsAimedAlongTheChordOrByTheFieldFindTheGeodesic) {
     const std::optional<double> exact = parts.exact.NearDistance(a, b, &by_field);
     ASSERT_TRUE(exact.has_value());
     const double plausible = 1.2 * *exact;  // a generous check, as in the cylinder's test
-    const NearWalk chord = WalkNearPair(parts.view, a, b, {.plausible = plausible}, &by_chord);
-    const NearWalk field =
-        WalkNearPair(parts.view, a, b,
-                     {.plausible = plausible, .heading = parts.paths.Heading(a, b)}, &by_field);
+    const NearWalk chord =
+        WalkNearPair(parts.view, a, b, {.plausible = plausible, .shoot = true}, &by_chord);
+    const NearWalk field = WalkNearPair(
+        parts.view, a, b,
+        {.plausible = plausible, .heading = parts.paths.Heading(a, b), .shoot = true}, &by_field);
     // Both are surface paths, local geodesics near the shortest (a convex
     // polyhedron has several, of nearly the same length).
     for (const NearWalk* walk : {&chord, &field}) {
