@@ -4,8 +4,9 @@
 #include <cstdio>
 #include <vector>
 
+#include "absl/strings/str_format.h"
+#include "tests/bench/bench_table.h"
 #include "tests/bench/bench_timing.h"
-#include "tests/bench/query_bench_lib.h"
 
 namespace geodex::bench {
 
@@ -108,6 +109,31 @@ void PrintProfileRows(const std::string& label, const query::QueryEngine& engine
     row.exact_region_faces /= count;
     std::printf("%s\n", NearProfileRowText(label, row).c_str());
   }
+}
+
+std::string NearProfileHeader(const std::string& pairs) {
+  return "\n" + pairs + ", one Distance call each (least of 3), by how they were answered\n" +
+         MarkdownHeader({"index", "how", "pairs", "share", "us a pair", "faces crossed",
+                         "faces unfolded", "releases", "exact rounds", "exact region faces",
+                         "us a face crossed"});
+}
+
+std::string NearProfileRowText(const std::string& label, const NearProfileRow& row) {
+  return MarkdownRow({
+      label,
+      row.how,
+      absl::StrFormat("%zu", row.count),
+      absl::StrFormat("%.1f%%", 100 * row.share),
+      absl::StrFormat("%.2f", row.us),
+      absl::StrFormat("%.1f", row.faces_crossed),
+      absl::StrFormat("%.1f", row.faces_unfolded),
+      absl::StrFormat("%.2f", row.releases),
+      absl::StrFormat("%.2f", row.exact_rounds),
+      absl::StrFormat("%.0f", row.exact_region_faces),
+      row.faces_crossed > 0 && row.exact_rounds == 0
+          ? absl::StrFormat("%.3f", row.us / row.faces_crossed)
+          : std::string("-"),
+  });
 }
 
 }  // namespace geodex::bench

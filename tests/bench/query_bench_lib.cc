@@ -498,31 +498,6 @@ void BenchNearProfile(const std::string& label, std::shared_ptr<const index::Ind
                                    near_rate / 1e6, default_rate / 1e6, pure_rate / 1e6));
 }
 
-std::string NearProfileHeader(const std::string& pairs) {
-  return "\n" + pairs + ", one Distance call each (least of 3), by how they were answered\n" +
-         MarkdownHeader({"index", "how", "pairs", "share", "us a pair", "faces crossed",
-                         "faces unfolded", "releases", "exact rounds", "exact region faces",
-                         "us a face crossed"});
-}
-
-std::string NearProfileRowText(const std::string& label, const NearProfileRow& row) {
-  return MarkdownRow({
-      label,
-      row.how,
-      absl::StrFormat("%zu", row.count),
-      absl::StrFormat("%.1f%%", 100 * row.share),
-      absl::StrFormat("%.2f", row.us),
-      absl::StrFormat("%.1f", row.faces_crossed),
-      absl::StrFormat("%.1f", row.faces_unfolded),
-      absl::StrFormat("%.2f", row.releases),
-      absl::StrFormat("%.2f", row.exact_rounds),
-      absl::StrFormat("%.0f", row.exact_region_faces),
-      row.faces_crossed > 0 && row.exact_rounds == 0
-          ? absl::StrFormat("%.3f", row.us / row.faces_crossed)
-          : std::string("-"),
-  });
-}
-
 namespace {
 
 std::vector<QueryBenchTable>& Registry() {

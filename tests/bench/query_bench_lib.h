@@ -19,6 +19,7 @@
 #include "absl/status/status.h"
 #include "core/index/index.h"
 #include "core/mesh/mesh.h"
+#include "tests/bench/near_profile.h"
 
 namespace geodex::bench {
 
@@ -151,20 +152,6 @@ absl::Status BenchField(const std::string& label, std::shared_ptr<const index::I
 std::string FieldHeader();
 std::string FieldRow(const std::string& label, const FieldFigures& f);
 
-// One row of the near-pair profile: the pairs at L-3L of the O(1) answer that
-// the default mode answered one way, and what they cost.
-struct NearProfileRow {
-  std::string how;                // "straight walk", "walk with releases", ...
-  size_t count = 0;               // pairs answered this way
-  double share = 0;               // of the bin's pairs
-  double us = 0;                  // microseconds a pair (one Distance call)
-  double faces_crossed = 0;       // faces of the walked corridors a pair
-  double faces_unfolded = 0;      // faces laid out a pair, releases included
-  double releases = 0;            // a pair
-  double exact_rounds = 0;        // exact propagations a pair
-  double exact_region_faces = 0;  // faces of the exact solver's last region a pair
-};
-
 // The near pairs of `ix` (the d<L and L-3L bins of the refinement table, at
 // most n / 4 each): their batch rates in the default and pure O(1) modes,
 // then the L-3L pairs one Distance call at a time, each timed and sorted by
@@ -177,12 +164,6 @@ void BenchNearProfile(const std::string& label, std::shared_ptr<const index::Ind
 // as BenchNearProfile sorts them: where the every-distance mode's time goes.
 void BenchEveryDistanceProfile(const std::string& label, std::shared_ptr<const index::Index> ix,
                                double below, int n);
-
-// The near-pair profile's header for the pairs it describes (a title such
-// as "Near pairs at L-3L of the O(1) answer"), and one row of it (no
-// newline).
-std::string NearProfileHeader(const std::string& pairs);
-std::string NearProfileRowText(const std::string& label, const NearProfileRow& row);
 
 // Runs the whole benchmark as the command line asks and returns the exit
 // code: 1 when an index cannot be opened.

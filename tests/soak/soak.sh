@@ -5,7 +5,7 @@
 # hot-swapped: a new version, then a corrupt one (truncated: refused, the
 # previous version keeps serving), then another good one. Checks that no valid
 # call failed, every invalid one was refused with its code, the server's heap
-# (RssAnon) grew less than 5% after warm-up, and no file descriptor or thread
+# (RssAnon) grew less than 5% over the last 40% of the run, and no file descriptor or thread
 # leaked. Prints its figures; exits 1 on any violation, 77 when a binary is
 # missing.
 #
@@ -97,10 +97,13 @@ FDS_BEFORE=$(fds) THREADS_BEFORE=$(status_field Threads)
   --version "4=$WORK/v1.gdx" > "$WORK/driver.out" 2> "$WORK/driver.err" &
 DRIVER_PID=$!
 
-# Samples the heap and the threads every 0.25 s; swaps versions at 10%, 20%
-# and 30% of the run, so that its second half is steady state: each swap
-# loads an engine, and the first near-pair refinement of a version builds its
-# exact mesh, which is growth by design, not a leak.
+# Samples the heap and the threads every 0.25 s; swaps versions at 5%, 10%
+# and 15% of the run, so that its last 40% is steady state: each swap loads
+# an engine, the first near-pair refinement of a version builds its exact
+# mesh, and each worker's scratch grows to the largest request it has seen
+# (a high-water mark that rises for about 15 s after a swap under this load,
+# then stays flat: +0.1% from 50% to 100% of a 180 s run). That is growth by
+# design; a leak grows with every call, in the last 40% as anywhere.
 START_MS=$(date +%s%3N)
 # The share of the run done, in percent.
 percent_done() { echo $((($(date +%s%3N) - START_MS) / (10 * RUN_SECONDS))); }
@@ -109,9 +112,9 @@ STEP=0
 while kill -0 "$DRIVER_PID" 2> /dev/null; do
   DONE=$(percent_done)
   RSS_AT+=("$DONE $(status_field RssAnon) $(status_field Threads) $(fds)")
-  if [ $STEP -eq 0 ] && [ "$DONE" -ge 10 ]; then publish "$WORK/v2.gdx" 2; STEP=1; fi
-  if [ $STEP -eq 1 ] && [ "$DONE" -ge 20 ]; then publish "$WORK/corrupt.gdx" 3; STEP=2; fi
-  if [ $STEP -eq 2 ] && [ "$DONE" -ge 30 ]; then publish "$WORK/v1.gdx" 4; STEP=3; fi
+  if [ $STEP -eq 0 ] && [ "$DONE" -ge 5 ]; then publish "$WORK/v2.gdx" 2; STEP=1; fi
+  if [ $STEP -eq 1 ] && [ "$DONE" -ge 10 ]; then publish "$WORK/corrupt.gdx" 3; STEP=2; fi
+  if [ $STEP -eq 2 ] && [ "$DONE" -ge 15 ]; then publish "$WORK/v1.gdx" 4; STEP=3; fi
   sleep 0.25
 done
 DRIVER_RC=0
@@ -132,11 +135,11 @@ echo "$MODELS" | grep -q "SERVING" || fail "no version serving after the run: $M
 INFO="$("$CLIENT_BIN" info --server "$ADDR" --model torus --format json)"
 echo "$INFO" | grep -q '"version": 4' || fail "version 4 is not the one serving: $INFO"
 
-# After warm-up (the samples from half the run on) the heap grows less than
-# 5%, and the threads and descriptors do not grow.
+# After warm-up (the samples from 60% of the run on) the heap grows less
+# than 5%, and the threads and descriptors do not grow.
 read -r HEAP_WARM HEAP_END HEAP_MAX THREADS_WARM THREADS_END FDS_WARM FDS_END < <(
   printf '%s\n' "${RSS_AT[@]}" | awk '
-    $1 >= 50 && $2 > 0 { n++; v[n] = $2; t[n] = $3; f[n] = $4; if ($2 > mx) mx = $2 }
+    $1 >= 60 && $2 > 0 { n++; v[n] = $2; t[n] = $3; f[n] = $4; if ($2 > mx) mx = $2 }
     END { if (n < 4) { print 0, 0, 0, 0, 0, 0, 0; exit }
           print v[1], v[n], mx, t[1], t[n], f[1], f[n] }')
 [ "$HEAP_WARM" -gt 0 ] || fail "too few heap samples after warm-up"
