@@ -386,6 +386,51 @@ TEST(QueryEngineTest, ARequestRaisesTheRefinementThresholdInL1000) {
   }
 }
 
+// A refined answer's bound says what refined it: an exact answer carries
+// the rounding bound (kExactRelativeBound) alone; in the index's own band a
+// walk carries the smaller of its calibrated bound and its certificate, no
+// more than the O(1) answer's; every bound covers its answer's error,
+// beyond the index's own threshold too, where the O(1) answer's floor is
+// set aside when the walk is shorter than it.
+TEST(QueryEngineTest, ARefinedAnswersBoundSaysWhatRefinedIt) {
+  const Mesh m = gen::Torus(48, 24, 1.0, 0.45);
+  auto engine = geodex::testing::TestEngineOrThrow(m, 60, /*calibrate=*/true);
+  ASSERT_TRUE(engine->has_error_bounds());
+  const auto points = RandomPoints(m, 300, 23);
+  geodesic::ExactGeodesicSolver solver(m);
+  QueryScratch scratch;
+  int refined = 0, raised = 0;
+  for (size_t i = 0; i + 1 < points.size(); i += 2) {
+    const SurfacePoint& p = points[i];
+    const SurfacePoint& q = points[i + 1];
+    ASSERT_TRUE(solver.Propagate({p}).ok());
+    const double exact = solver.DistanceAt(q);
+    const double slack = 1e-9 * exact;
+    double o1_bound = 0, bound = 0, every_bound = 0, exact_bound = 0;
+    const double o1 =
+        *engine->Distance(p, q, {.near_pairs = NearPairs::kUnfold}, &scratch, &o1_bound);
+    const double d = *engine->Distance(p, q, {}, &scratch, &bound);
+    if (d != o1) {
+      ++refined;
+      EXPECT_LE(bound, o1_bound) << "pair " << i / 2 << ": " << d << " against O(1) " << o1;
+      EXPECT_LE(std::abs(d - exact), bound + slack) << "pair " << i / 2;
+    }
+    const double every =
+        *engine->Distance(p, q, {.refine_below_l1000 = 1e6}, &scratch, &every_bound);
+    if (every != o1 && d == o1) {
+      ++raised;
+      EXPECT_LE(std::abs(every - exact), every_bound + slack)
+          << "pair " << i / 2 << ": " << every << " exact " << exact << " O(1) " << o1;
+    }
+    const double exactly = *engine->Distance(
+        p, q, {.near_pairs = NearPairs::kExact, .refine_below_l1000 = 1e6}, &scratch, &exact_bound);
+    EXPECT_NEAR(exactly, exact, slack);
+    EXPECT_EQ(exact_bound, kExactRelativeBound * exactly);
+  }
+  EXPECT_GT(refined, 5);
+  EXPECT_GT(raised, 25);
+}
+
 // An O(1) answer that overestimates puts a pair closer than 3L above 3L; a
 // calibrated index also refines the pairs its bound says may be closer, and
 // every index the pairs whose chord is below its threshold while the answer

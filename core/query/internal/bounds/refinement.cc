@@ -183,9 +183,11 @@ double Refiner::Refine(const SurfacePoint& p_in, const SurfacePoint& q_in, const
       // Beyond the index's own threshold the traces' calibration did not
       // see these paths: the geodesic is at least the chord and at least
       // the O(1) answer less its bound, so d less the larger covers it
-      // wherever the O(1) bound does.
-      const double below =
-          raised_only ? std::max(chord, unfolded - bound_of(AnswerKind::kUnfold, unfolded)) : chord;
+      // wherever the O(1) bound does. A path shorter than that floor shows
+      // the O(1) bound wrong for this pair (it covers about 99% of them):
+      // then only the chord is left to stand on.
+      const double o1_floor = unfolded - bound_of(AnswerKind::kUnfold, unfolded);
+      const double below = raised_only && d >= o1_floor ? std::max(chord, o1_floor) : chord;
       const double certificate = std::max(d - below, bound_of(AnswerKind::kExact, d));
       *bound = raised_only ? certificate : std::min(*bound, certificate);
     }
