@@ -323,17 +323,40 @@ PipelineOptions WithSampleDefaults(PipelineOptions options, bool samples_asked) 
   return options;
 }
 
+namespace {
+
+// The demo meshes by name, in the order help texts list them.
+struct BuiltinMesh {
+  const char* name;
+  mesh::Mesh (*make)();
+};
+constexpr BuiltinMesh kBuiltinMeshes[] = {
+    {"torus", [] { return mesh::gen::Torus(96, 48, 2.0, 0.7); }},
+    {"sphere", [] { return mesh::gen::Sphere(5, 1.0); }},
+    {"cube", [] { return mesh::gen::Cube(24, 2.0); }},
+    {"double-torus", [] { return mesh::gen::DoubleTorus(24, 4.0); }},
+};
+
+}  // namespace
+
+std::string BuiltinMeshNames() {
+  std::string names;
+  for (const BuiltinMesh& m : kBuiltinMeshes) {
+    absl::StrAppend(&names, names.empty() ? "" : ", ", m.name);
+  }
+  return names;
+}
+
 absl::StatusOr<mesh::RepairedMesh> LoadBuildInput(const std::string& path,
                                                   const mesh::RepairOptions& options) {
   const std::string prefix = "builtin:";
   if (path.rfind(prefix, 0) != 0) return mesh::LoadAndRepairMesh(path, options);
   const std::string name = path.substr(prefix.size());
-  if (name == "torus") return mesh::WithoutRepairs(mesh::gen::Torus(96, 48, 2.0, 0.7));
-  if (name == "sphere") return mesh::WithoutRepairs(mesh::gen::Sphere(5, 1.0));
-  if (name == "cube") return mesh::WithoutRepairs(mesh::gen::Cube(24, 2.0));
-  if (name == "double-torus") return mesh::WithoutRepairs(mesh::gen::DoubleTorus(24, 4.0));
+  for (const BuiltinMesh& m : kBuiltinMeshes) {
+    if (name == m.name) return mesh::WithoutRepairs(m.make());
+  }
   return absl::InvalidArgumentError(
-      absl::StrFormat("unknown built-in mesh '%s' (torus, sphere, cube, double-torus)", name));
+      absl::StrFormat("unknown built-in mesh '%s' (%s)", name, BuiltinMeshNames()));
 }
 
 absl::StatusOr<BuildReport> BuildIndexFile(const std::string& mesh_path, const std::string& out,

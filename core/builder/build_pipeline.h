@@ -84,9 +84,13 @@ struct BuildReport {
 // the same request builds the same index.
 PipelineOptions WithSampleDefaults(PipelineOptions options, bool samples_asked);
 
+// The generated demo meshes builtin:NAME names, for help texts and errors:
+// "torus, sphere, cube, double-torus".
+std::string BuiltinMeshNames();
+
 // The mesh at `path` (a mesh file core/mesh/mesh_io.h reads, or builtin:NAME
-// for a generated demo mesh: torus, sphere, cube, double-torus), read and
-// repaired as `options` says.
+// for a generated demo mesh, BuiltinMeshNames()), read and repaired as
+// `options` says.
 absl::StatusOr<mesh::RepairedMesh> LoadBuildInput(const std::string& path,
                                                   const mesh::RepairOptions& options);
 

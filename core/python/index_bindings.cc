@@ -252,15 +252,14 @@ class Index {
       double* x = positions.mutable_data();
       double* w = weights.mutable_data();
       int32_t* f = faces.mutable_data();
-      double length = reachable[i] ? 0.0 : std::numeric_limits<double>::infinity();
+      const double length =
+          reachable[i] ? query::PathLength(path) : std::numeric_limits<double>::infinity();
       for (int64_t j = 0; j < k; ++j) {
         for (int c = 0; c < 3; ++c) {
           x[3 * j + c] = path[j].position[c];
           w[3 * j + c] = path[j].point.w[c];
         }
         f[j] = path[j].point.face;
-        // The sum of the 3D segments, as the server's PathToProto.
-        if (j > 0) length += (path[j].position - path[j - 1].position).norm();
       }
       out.append(py::make_tuple(positions, faces, weights, length));
     }

@@ -12,6 +12,7 @@
 #include <cstdint>
 #include <limits>
 #include <optional>
+#include <span>
 #include <vector>
 
 #include "core/mesh/mesh.h"
@@ -83,6 +84,13 @@ struct PathPoint {
   SurfacePoint point;
   mesh::Vec3 position;
 };
+
+// The sum of a path's 3D segments: the length every interface reports.
+inline double PathLength(std::span<const PathPoint> path) {
+  double sum = 0;
+  for (size_t i = 1; i < path.size(); ++i) sum += (path[i].position - path[i - 1].position).norm();
+  return sum;
+}
 
 struct DistanceField {
   std::vector<double> distance;  // per vertex; +inf when unreachable or unreferenced

@@ -16,7 +16,9 @@ BuildCommandLine::BuildCommandLine()
   calibrate_ = app_.add_subcommand(
       "calibrate", "Adds the accuracy calibration (error bounds) to an index built without it");
   app_.add_option("mesh", args_.mesh_path,
-                  "Mesh file (.obj/.ply/.off/.stl/.gltf/.glb) or builtin:NAME");
+                  "Mesh file (.obj/.ply/.off/.stl/.gltf/.glb) or builtin:NAME, a generated "
+                  "demo mesh: " +
+                      builder::BuiltinMeshNames());
   app_.add_option("-o,--output", args_.out, "Output index file (.gdx)");
   AddSamplingOptions(&app_);
   AddSubcommandOptions();

@@ -112,6 +112,20 @@ TEST(BuildCommandLineTest, MissingPathsMessageCarriesTheHelp) {
   }
 }
 
+// Every built-in mesh is listed in --help, and the one a name does not
+// match is refused with the list; each listed one builds.
+TEST(BuildCommandLineTest, HelpListsTheBuiltInMeshes) {
+  const std::string help = Parsed("m.obj -o x.gdx")->app().help();
+  for (const char* name : {"torus", "sphere", "cube", "double-torus"}) {
+    EXPECT_THAT(help, HasSubstr(name));
+    EXPECT_THAT(builder::BuiltinMeshNames(), HasSubstr(name));
+    EXPECT_TRUE(builder::LoadBuildInput(std::string("builtin:") + name, {}).ok()) << name;
+  }
+  const auto unknown = builder::LoadBuildInput("builtin:teapot", {});
+  EXPECT_EQ(unknown.status().code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(unknown.status().message(), HasSubstr(builder::BuiltinMeshNames()));
+}
+
 TEST(BuildToolTest, ExitCodes) {
   EXPECT_EQ(BuildExitCode(builder::BuildReport{}), 0);
   builder::BuildReport another;

@@ -12,7 +12,7 @@
 // Without --samples the build is to an error target (E = 0.005 unless
 // --target-error says otherwise; core/validation/target_error.h), in rounds
 // from M0 = 500 samples; --samples alone builds exactly M. MESH is a
-// .obj/.ply/.off file, or builtin:NAME (torus, sphere, cube, double-torus).
+// .obj/.ply/.off file, or builtin:NAME (a generated demo mesh; --help lists them).
 // Exit codes: 0 success, 2 bad input or usage, 1 any other failure, 3 merge
 // planned another round of a target-error build (run rows and merge again).
 

@@ -39,9 +39,10 @@ absl::Status AtLine(const absl::Status& status, int64_t line) {
   return absl::Status(status.code(), absl::StrFormat("line %d: %s", line, status.message()));
 }
 
-// One path of PathsText as a JSON array of points, without a line end.
+// One path of PathsText as a JSON object (its length and its points, as
+// the geodex command line writes them), without a line end.
 std::string PathJson(const std::vector<query::PathPoint>& path) {
-  std::string out = "  [";
+  std::string out = absl::StrFormat("  {\"length\": %.17g, \"points\": [", query::PathLength(path));
   for (size_t k = 0; k < path.size(); ++k) {
     const query::PathPoint& p = path[k];
     out += absl::StrFormat(
@@ -49,7 +50,7 @@ std::string PathJson(const std::vector<query::PathPoint>& path) {
         k ? ", " : "", p.point.face, p.point.w[0], p.point.w[1], p.point.w[2], p.position.x(),
         p.position.y(), p.position.z());
   }
-  return out + "]";
+  return out + "]}";
 }
 
 // The --expmap centre "F W0 W1 W2", or nothing when it is not one line of
@@ -129,8 +130,10 @@ void QueryCommandLine::AddAnswerOptions() {
       ->check(CLI::Range(0, 64));
   app_.add_flag("--linear-baseline", a.baseline, "The paper's linear interpolation (§6.3)");
   app_.add_flag("--nearest", a.nearest, "With --field: also print the nearest source");
-  app_.add_option("--format", a.format,
-                  "Path output: xyz (blank line between paths) or json; --info: text or json")
+  app_.add_option(
+          "--format", a.format,
+          "Path output: xyz ('# path I length L', then a line 'x y z' a point, a blank line "
+          "between paths) or json ({length, points}); --info: text or json")
       ->check(CLI::IsMember({"xyz", "json", "text"}));
 }
 
@@ -190,6 +193,7 @@ absl::StatusOr<std::string> PathsText(const query::InputQueries& queries,
       out += PathJson(*path) + (i + 1 < pairs.size() ? ",\n" : "\n");
       continue;
     }
+    out += absl::StrFormat("# path %d length %.17g\n", i, query::PathLength(*path));
     for (const query::PathPoint& p : *path) {
       out += absl::StrFormat("%.17g %.17g %.17g\n", p.position.x(), p.position.y(), p.position.z());
     }

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -227,17 +228,36 @@ TEST_F(QueryToolIndexTest, PathsAsXyzAndJson) {
   args.paths = WriteTestFile("path_pairs.txt", "0 1 0 0 60 0.3 0.3 0.4\n5 0 1 0 7 0 0 1\n");
   absl::StatusOr<std::string> out = AnswerQueryTool(args);
   ASSERT_TRUE(out.ok()) << out.status();
-  // Two paths, each followed by a blank line.
+  // Two paths, each its length, its points and a blank line; the length is
+  // the sum of the segments between the points printed.
+  EXPECT_THAT(*out, StartsWith("# path 0 length "));
+  EXPECT_THAT(*out, HasSubstr("\n\n# path 1 length "));
   EXPECT_THAT(*out, EndsWith("\n\n"));
   const size_t line_ends = std::count(out->begin(), out->end(), '\n');
   EXPECT_EQ(line_ends, Lines(*out).size() + 2);
+  std::istringstream text(*out);
+  std::string line;
+  std::getline(text, line);
+  const double stated = std::stod(line.substr(std::string("# path 0 length ").size()));
+  double summed = 0;
+  std::optional<mesh::Vec3> last;
+  while (std::getline(text, line) && !line.empty()) {
+    std::istringstream xyz(line);
+    mesh::Vec3 p;
+    xyz >> p.x() >> p.y() >> p.z();
+    if (last) summed += (p - *last).norm();
+    last = p;
+  }
+  EXPECT_GT(stated, 0);
+  EXPECT_NEAR(stated, summed, 1e-12 * stated);
 
   args.format = "json";
   out = AnswerQueryTool(args);
   ASSERT_TRUE(out.ok()) << out.status();
-  EXPECT_THAT(*out, StartsWith("[\n  [{\"face\": 0, \"w\": [1, 0, 0], \"xyz\": ["));
-  EXPECT_THAT(*out, HasSubstr("}],\n  [{\"face\": 5, "));
-  EXPECT_THAT(*out, EndsWith("}]\n]\n"));
+  EXPECT_THAT(*out, StartsWith("[\n  {\"length\": "));
+  EXPECT_THAT(*out, HasSubstr(", \"points\": [{\"face\": 0, \"w\": [1, 0, 0], \"xyz\": ["));
+  EXPECT_THAT(*out, HasSubstr("}]},\n  {\"length\": "));
+  EXPECT_THAT(*out, EndsWith("}]}\n]\n"));
 }
 
 TEST_F(QueryToolIndexTest, FieldHasALinePerVertex) {

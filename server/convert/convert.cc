@@ -83,13 +83,11 @@ void PathToProto(std::span<const query::PathPoint> path, v1::Polyline* polyline)
   points->mutable_faces()->Reserve(static_cast<int>(path.size()));
   points->mutable_weights()->Reserve(static_cast<int>(3 * path.size()));
   xyz->Reserve(static_cast<int>(3 * path.size()));
-  double length = 0;
-  for (size_t i = 0; i < path.size(); ++i) {
-    AppendPoint(path[i].point, points);
-    for (int c = 0; c < 3; ++c) xyz->Add(path[i].position[c]);
-    if (i > 0) length += (path[i].position - path[i - 1].position).norm();
+  for (const query::PathPoint& p : path) {
+    AppendPoint(p.point, points);
+    for (int c = 0; c < 3; ++c) xyz->Add(p.position[c]);
   }
-  polyline->set_length(length);
+  polyline->set_length(query::PathLength(path));
 }
 
 void UnreachablePathToProto(v1::Polyline* polyline) {

@@ -217,7 +217,11 @@ def test_http(stack):
 
     path = http.json("POST", f"v1/models/{stack.name}:path", {"a": surface_points(a[:1]), "b": surface_points(b[:1])})
     xyz = [num(x) for x in path["paths"][0]["positions"]["xyz"]]
-    want = stack.query("--paths", stack.write("pair1.txt", [point_line(a[0]) + " " + point_line(b[0])]))
+    lines = stack.query("--paths", stack.write("pair1.txt", [point_line(a[0]) + " " + point_line(b[0])]))
+    check(lines[0][:4] == ["#", "path", "0", "length"], f"geodex-query --paths: {lines[0]}")
+    check(close(num(path["paths"][0]["length"]), float(lines[0][4])),
+          f"path length {path['paths'][0]['length']} != geodex-query's {lines[0][4]}")
+    want = lines[1:]
     check(len(xyz) == 3 * len(want), f"path: {len(xyz) // 3} points, geodex-query {len(want)}")
     for i, line in enumerate(want):
         for k in range(3):

@@ -113,7 +113,9 @@ def test_paths_equal_geodex_query(client, torus_index, tmp_path, num_faces, toru
     paths = client.path(MODEL, a, b, batch_size=6)
     assert len(paths) == 20
     vertices, faces = torus_mesh
-    for path, ref in zip(paths, reference):
+    for path, ref_path in zip(paths, reference):
+        assert path.length == ref_path["length"]
+        ref = ref_path["points"]
         assert path.faces.tolist() == [p["face"] for p in ref]
         assert np.array_equal(path.weights, np.array([p["w"] for p in ref]).reshape(-1, 3))
         assert np.array_equal(path.positions, np.array([p["xyz"] for p in ref]).reshape(-1, 3))

@@ -251,13 +251,6 @@ TEST(QueryEngineTest, ExactNearPairsMatchTheExactEngine) {
   EXPECT_GT(near, 0);
 }
 
-double PathLength(const std::vector<PathPoint>& path) {
-  double length = 0;
-  for (size_t k = 1; k < path.size(); ++k)
-    length += (path[k].position - path[k - 1].position).norm();
-  return length;
-}
-
 TEST(QueryEngineTest, NearPairsAreThePathLengthByDefault) {
   const Mesh m = gen::Grid(30, 30, 1.0, 1.0, 0.2, 4);
   auto engine = MakeEngine(m, 40);

@@ -271,10 +271,4 @@ bool WrapsRoundAVertex(const std::vector<PathPoint>& path) {
   return false;
 }
 
-double PathLength(const std::vector<PathPoint>& path) {
-  double sum = 0;
-  for (size_t i = 1; i < path.size(); ++i) sum += (path[i].position - path[i - 1].position).norm();
-  return sum;
-}
-
 }  // namespace geodex::query

@@ -27,9 +27,6 @@ namespace geodex::query {
 // funnel of StraightenPath wrapped round the vertex.
 bool WrapsRoundAVertex(const std::vector<PathPoint>& path);
 
-// The sum of the path's 3D segments.
-double PathLength(const std::vector<PathPoint>& path);
-
 // Returns the straightened path; the endpoints are kept exactly. Consecutive
 // input points must share a face (as QueryEngine::Path produces); runs that
 // do not are returned unchanged.
