@@ -188,7 +188,7 @@ absl::StatusOr<BuildReport> PlanTargetBuild(const mesh::RepairedMesh& repaired,
   state.cap = SampleCap(repaired.mesh, rounds);
   state.validation_sources = rounds.validation_sources;
   state.seed = rounds.build.seed;
-  state.refine = rounds.build.refine_long_edges;
+  state.split = rounds.build.split_long_edges;
   state.max_index_bytes = rounds.max_index_bytes;
   GEODEX_RETURN_IF_ERROR(SaveTargetState(state, workdir));
   BuildReport report;
@@ -236,7 +236,7 @@ absl::StatusOr<BuildReport> MergeTargetRound(const std::string& workdir, TargetS
   RoundsOptions rounds;
   rounds.build = options.build;
   rounds.build.seed = state.seed;
-  rounds.build.refine_long_edges = state.refine;
+  rounds.build.split_long_edges = state.split;
   rounds.target = state.target;
   rounds.max_samples = state.cap;
   rounds.validation_sources = state.validation_sources;
@@ -367,7 +367,7 @@ absl::StatusOr<BuildReport> BuildIndexFile(const std::string& mesh_path, const s
   if (options.target_error > 0) return BuildToTargetError(repaired, out, options, start);
   GEODEX_ASSIGN_OR_RETURN(const PreparedMesh prepared,
                           PrepareMesh(repaired.mesh, RecordRepair(repaired),
-                                      options.build.num_samples, options.build.refine_long_edges));
+                                      options.build.num_samples, options.build.split_long_edges));
   const mesh::Mesh& mesh = prepared.mesh;
   BuildOptions build = options.build;
   build.input_vertex_ids = InputVertexIds(prepared);
@@ -397,7 +397,7 @@ absl::StatusOr<BuildReport> PlanBuild(const std::string& mesh_path, const std::s
   GEODEX_RETURN_IF_ERROR(RemoveTargetState(workdir));
   GEODEX_ASSIGN_OR_RETURN(const PreparedMesh prepared,
                           PrepareMesh(repaired.mesh, RecordRepair(repaired),
-                                      options.build.num_samples, options.build.refine_long_edges));
+                                      options.build.num_samples, options.build.split_long_edges));
   const mesh::Mesh& mesh = prepared.mesh;
   BuildOptions build = options.build;
   build.input_vertex_ids = InputVertexIds(prepared);

@@ -126,9 +126,9 @@ int32_t SampleCap(const mesh::Mesh& coarse, const RoundsOptions& options) {
   // Samples are vertices: without the long-edge split the mesh's own
   // vertices bound m (by default half of them); with it, midpoints make room
   // for more.
-  const bool refine = options.build.refine_long_edges;
-  const int32_t bound = refine ? validation::kDefaultMaxSamples : referenced;
-  const int32_t default_cap = refine ? validation::kDefaultMaxSamples : std::max(3, referenced / 2);
+  const bool split = options.build.split_long_edges;
+  const int32_t bound = split ? validation::kDefaultMaxSamples : referenced;
+  const int32_t default_cap = split ? validation::kDefaultMaxSamples : std::max(3, referenced / 2);
   return std::min(bound, options.max_samples > 0
                              ? options.max_samples
                              : std::min(default_cap, validation::kDefaultMaxSamples));
@@ -148,7 +148,7 @@ absl::StatusOr<RoundPlan> PlanFirstRound(const mesh::Mesh& coarse, const RepairR
     BuildOptions build = options.build;
     build.num_samples = m;
     GEODEX_ASSIGN_OR_RETURN(PreparedMesh prepared,
-                            PrepareMesh(coarse, repair, m, build.refine_long_edges));
+                            PrepareMesh(coarse, repair, m, build.split_long_edges));
     build.input_vertex_ids = InputVertexIds(prepared);
     GEODEX_ASSIGN_OR_RETURN(Plan plan, MakePlan(prepared.mesh, build));
     return RoundPlan{std::move(prepared), std::move(plan), {}};
@@ -171,7 +171,7 @@ absl::StatusOr<RoundPlan> PlanNextRound(const mesh::Mesh& coarse, const RepairRe
     BuildOptions build = options.build;
     build.num_samples = n;
     GEODEX_ASSIGN_OR_RETURN(PreparedMesh prepared,
-                            PrepareMesh(coarse, repair, n, build.refine_long_edges));
+                            PrepareMesh(coarse, repair, n, build.split_long_edges));
     build.input_vertex_ids = InputVertexIds(prepared);
     if (!in_order || m > n || !KeepsVertices(previous.prepared.mesh, prepared.mesh)) {
       GEODEX_ASSIGN_OR_RETURN(Plan plan, MakePlan(prepared.mesh, build));
@@ -395,7 +395,7 @@ absl::Status SaveTargetState(const TargetState& state, const std::string& workdi
   w.Put(state.cap);
   w.Put(state.validation_sources);
   w.Put(state.seed);
-  w.Put<uint8_t>(state.refine ? 1 : 0);
+  w.Put<uint8_t>(state.split ? 1 : 0);
   w.Put(state.max_index_bytes);
   w.Put(state.round);
   w.PutVector(state.rounds);
@@ -408,18 +408,18 @@ absl::StatusOr<TargetState> LoadTargetState(const std::string& workdir) {
   GEODEX_ASSIGN_OR_RETURN(const std::string payload, LoadSealedFile(path, kTargetMagic));
   ByteReader r(payload, path);
   TargetState state;
-  uint8_t refine = 0;
+  uint8_t split = 0;
   GEODEX_RETURN_IF_ERROR(r.Get(&state.target));
   GEODEX_RETURN_IF_ERROR(r.Get(&state.cap));
   GEODEX_RETURN_IF_ERROR(r.Get(&state.validation_sources));
   GEODEX_RETURN_IF_ERROR(r.Get(&state.seed));
-  GEODEX_RETURN_IF_ERROR(r.Get(&refine));
+  GEODEX_RETURN_IF_ERROR(r.Get(&split));
   GEODEX_RETURN_IF_ERROR(r.Get(&state.max_index_bytes));
   GEODEX_RETURN_IF_ERROR(r.Get(&state.round));
   GEODEX_RETURN_IF_ERROR(r.GetVector(&state.rounds));
   GEODEX_RETURN_IF_ERROR(r.Get(&state.closest));
   if (!r.AtEnd()) return absl::DataLossError(absl::StrFormat("%s has trailing bytes", path));
-  state.refine = refine != 0;
+  state.split = split != 0;
   if (!(state.target > 0) || state.cap < 3 || state.validation_sources < 1 || state.round < 0 ||
       static_cast<int32_t>(state.rounds.size()) != state.round || state.max_index_bytes <= 0 ||
       state.closest < -1 || state.closest >= state.round) {

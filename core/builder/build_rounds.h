@@ -175,7 +175,7 @@ struct TargetState {
   int32_t cap = 0;
   int32_t validation_sources = 0;
   uint64_t seed = 0;
-  bool refine = true;
+  bool split = true;
   int64_t max_index_bytes = 0;
   int32_t round = 0;                              // the current round
   std::vector<validation::TargetFigures> rounds;  // the finished ones

@@ -189,7 +189,7 @@ TEST(BuildRoundsTest, TargetStateRoundTripsAndRefusesCorruption) {
   state.cap = 8000;
   state.validation_sources = 128;
   state.seed = 7;
-  state.refine = false;
+  state.split = false;
   state.max_index_bytes = 1 << 20;
   state.round = 1;
   state.closest = 0;
@@ -205,7 +205,7 @@ TEST(BuildRoundsTest, TargetStateRoundTripsAndRefusesCorruption) {
   ASSERT_TRUE(loaded.ok()) << loaded.status();
   EXPECT_EQ(loaded->target, 0.005);
   EXPECT_EQ(loaded->seed, 7u);
-  EXPECT_FALSE(loaded->refine);
+  EXPECT_FALSE(loaded->split);
   ASSERT_EQ(loaded->rounds.size(), 1u);
   EXPECT_EQ(loaded->rounds[0].samples, 512);
   EXPECT_EQ(loaded->rounds[0].upper[2], 0.25);

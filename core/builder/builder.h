@@ -50,7 +50,7 @@ struct BuildOptions {
   bool check_edges = true;
   // Split long mesh edges flat before sampling (PrepareMesh in
   // core/builder/mesh_arrays.h; geodex-build --no-split turns it off).
-  bool refine_long_edges = true;
+  bool split_long_edges = true;
   // Error-driven placement (core/validation/error_map.h): one weight per
   // vertex of the mesh being built; farthest-point sampling then spaces the
   // samples about 1 / weight apart relative to elsewhere. Empty: plain

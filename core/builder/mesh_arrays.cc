@@ -135,8 +135,8 @@ void AddSplitFaces(const mesh::Mesh& coarse, const mesh::LongEdgeSplit& split,
 }
 
 absl::StatusOr<PreparedMesh> PrepareMesh(const mesh::Mesh& coarse, RepairRecord repair,
-                                         int32_t num_samples, bool refine) {
-  if (!refine) return PreparedMesh{coarse, std::move(repair)};
+                                         int32_t num_samples, bool split_long_edges) {
+  if (!split_long_edges) return PreparedMesh{coarse, std::move(repair)};
   absl::StatusOr<mesh::LongEdgeSplit> split = SplitForSamples(coarse, num_samples);
   if (!split.ok()) return split.status();
   if (split->new_vertices == 0) return PreparedMesh{coarse, std::move(repair)};

@@ -62,14 +62,14 @@ void AddSplitFaces(const mesh::Mesh& coarse, const mesh::LongEdgeSplit& split,
 
 // The mesh the builder samples for `num_samples` samples and the record of
 // how it came from the input: `coarse` (the repaired input, whose repair is
-// `repair`), refined by SplitForSamples when `refine`. The index built from
+// `repair`), split by SplitForSamples when `split_long_edges`. The index built from
 // `mesh` takes AddRepair(record).
 struct PreparedMesh {
   mesh::Mesh mesh;
   RepairRecord record;
 };
 absl::StatusOr<PreparedMesh> PrepareMesh(const mesh::Mesh& coarse, RepairRecord repair,
-                                         int32_t num_samples, bool refine);
+                                         int32_t num_samples, bool split_long_edges);
 
 // The surface before the long-edge split, where an exact propagation is
 // several times cheaper than on the split mesh (homer_6k at m = 2,000:

@@ -446,7 +446,7 @@ TEST(ScanBuildTest, EveryRefusalOfTheBuildFitsOneShortLine) {
   tries.push_back({"zero samples", "builtin:sphere", zero});
   builder::PipelineOptions too_many = small;
   too_many.build.num_samples = 100000;
-  too_many.build.refine_long_edges = false;
+  too_many.build.split_long_edges = false;
   tries.push_back({"more samples than vertices",
                    write("tet.obj", obj(mt::RawOf(gen::Sphere(0, 1.0), "ico"))), too_many});
   builder::PipelineOptions rounds = small;

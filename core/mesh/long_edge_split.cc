@@ -34,14 +34,14 @@ struct ShorterFirst {
   }
 };
 
-// The mesh being refined, with its own half-edge bookkeeping: half-edge
+// The mesh being split, with its own half-edge bookkeeping: half-edge
 // 3f+i runs from faces[f][i] to faces[f][i+1], as in Mesh. An edge keeps its
 // id (and so its queue entry) while its half-edges move between faces; a
 // split edge is dead and never comes back, since every new edge has a new
 // vertex at one end.
-class Refiner {
+class LongEdgeSplitter {
  public:
-  explicit Refiner(const Mesh& mesh)
+  explicit LongEdgeSplitter(const Mesh& mesh)
       : positions_(mesh.positions()),
         faces_(mesh.faces()),
         he_edge_(mesh.num_halfedges(), kNone),
@@ -104,7 +104,7 @@ class Refiner {
   void Push(int32_t e) {
     const int32_t h = edge_he_[e][0];
     const int32_t a = Origin(h), b = Dest(h);
-    // The same expression as Mesh::Length, so that the refined mesh's
+    // The same expression as Mesh::Length, so that the split mesh's
     // lengths compare with max_edge_length exactly as they did here.
     const double length = (positions_[b] - positions_[a]).norm();
     queue_.push({length, std::min(a, b), std::max(a, b), e});
@@ -176,13 +176,13 @@ absl::StatusOr<LongEdgeSplit> SplitLongEdges(const Mesh& mesh, double max_edge_l
     return absl::InvalidArgumentError(
         absl::StrCat("SplitLongEdges: max_new_vertices must be >= 0, got ", max_new_vertices));
   }
-  Refiner refiner(mesh);
-  GEODEX_RETURN_IF_ERROR(refiner.Run(max_edge_length, max_new_vertices));
+  LongEdgeSplitter splitter(mesh);
+  GEODEX_RETURN_IF_ERROR(splitter.Run(max_edge_length, max_new_vertices));
   // Zero-area faces allowed: see the header.
-  GEODEX_ASSIGN_OR_RETURN(Mesh refined,
-                          Mesh::Create(std::move(refiner.positions()), std::move(refiner.faces()),
+  GEODEX_ASSIGN_OR_RETURN(Mesh split,
+                          Mesh::Create(std::move(splitter.positions()), std::move(splitter.faces()),
                                        mesh.name(), MeshOptions{.allow_zero_area_faces = true}));
-  return std::move(refiner).Finish(std::move(refined));
+  return std::move(splitter).Finish(std::move(split));
 }
 
 }  // namespace geodex::mesh

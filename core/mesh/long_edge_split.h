@@ -25,15 +25,15 @@
 namespace geodex::mesh {
 
 struct LongEdgeSplit {
-  // The refined mesh: the input's vertices (same ids, same order), then the
+  // The split mesh: the input's vertices (same ids, same order), then the
   // new midpoints; the input's name. Face f < input.num_faces() is what is
   // left of input face f (a part of it, or the whole face unsplit), so its
   // corners keep their orientation; later faces are appended pieces.
   Mesh mesh;
-  // Per refined face: the face of the input mesh it lies in, and where its
+  // Per split face: the face of the input mesh it lies in, and where its
   // corners are in that face, as barycentric weights of the parent's corners
   // in the parent's corner order (weights[f][i] = weights of corner i of
-  // refined face f; each sums to 1, as SurfacePoint::w). Unsplit faces:
+  // split face f; each sums to 1, as SurfacePoint::w). Unsplit faces:
   // parent = own id, identity weights.
   std::vector<int32_t> parent;
   std::vector<std::array<std::array<double, 3>, 3>> weights;
@@ -51,7 +51,7 @@ struct LongEdgeSplit {
 // Mesh::Create refuses by.
 //
 // Errors: InvalidArgument for a max_edge_length that is not positive and
-// finite, or a negative max_new_vertices; ResourceExhausted when the refined
+// finite, or a negative max_new_vertices; ResourceExhausted when the split
 // mesh would have more faces than int32 half-edge ids can number.
 absl::StatusOr<LongEdgeSplit> SplitLongEdges(const Mesh& mesh, double max_edge_length,
                                              int32_t max_new_vertices);

@@ -75,7 +75,7 @@ class Callbacks {
 // round's. max_samples 0: the default cap.
 std::string Build(const std::string& mesh_path, const std::string& out, int32_t samples,
                   double target_error, int32_t max_samples, uint64_t seed, int threads, bool strict,
-                  bool refine, bool calibrate, py::object progress, py::object log) {
+                  bool split, bool calibrate, py::object progress, py::object log) {
   auto callbacks = std::make_shared<Callbacks>(std::move(progress), std::move(log));
   builder::PipelineOptions options;
   if (samples > 0) options.build.num_samples = samples;
@@ -83,7 +83,7 @@ std::string Build(const std::string& mesh_path, const std::string& out, int32_t 
   options = builder::WithSampleDefaults(std::move(options), samples > 0);
   options.build.seed = seed;
   options.build.threads = threads;
-  options.build.refine_long_edges = refine;
+  options.build.split_long_edges = split;
   options.build.progress = [callbacks](const builder::Progress& p) { callbacks->Progress(p); };
   options.repair.strict = strict;
   options.calibrate = calibrate;
@@ -105,7 +105,7 @@ std::string Build(const std::string& mesh_path, const std::string& out, int32_t 
 void BindBuild(py::module_& m) {
   m.def("build", &Build, py::arg("mesh_path"), py::arg("out"), py::arg("samples"),
         py::arg("target_error"), py::arg("max_samples"), py::arg("seed"), py::arg("threads"),
-        py::arg("strict"), py::arg("refine"), py::arg("calibrate"), py::arg("progress"),
+        py::arg("strict"), py::arg("split"), py::arg("calibrate"), py::arg("progress"),
         py::arg("log"),
         "Builds an index file from a mesh file (geodex.build wraps it); returns the report.");
 }

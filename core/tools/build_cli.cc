@@ -106,7 +106,7 @@ BuildJob BuildCommandLine::job() const {
 
 builder::PipelineOptions BuildCommandLine::Options() const {
   builder::PipelineOptions o = args_.pipeline;
-  o.build.refine_long_edges = !args_.no_split;
+  o.build.split_long_edges = !args_.no_split;
   if (args_.max_index_mib > 0) {
     o.max_index_bytes = static_cast<int64_t>(args_.max_index_mib * 1048576.0);
   }

@@ -36,7 +36,7 @@ TEST(BuildCommandLineTest, WholeBuildDefaultsToTheErrorTarget) {
   EXPECT_EQ(o.build.num_samples, builder::kDefaultFirstRoundSamples);
   EXPECT_EQ(o.target_error, validation::kDefaultTargetError);
   EXPECT_TRUE(o.calibrate);
-  EXPECT_TRUE(o.build.refine_long_edges);
+  EXPECT_TRUE(o.build.split_long_edges);
   EXPECT_EQ(cli->MissingPathsMessage(), "");
 }
 
@@ -61,7 +61,7 @@ TEST(BuildCommandLineTest, WholeBuildFlags) {
   EXPECT_EQ(o.build.seed, 9u);
   EXPECT_EQ(o.build.threads, 3);
   EXPECT_EQ(o.edges_obj, "e.obj");
-  EXPECT_FALSE(o.build.refine_long_edges);
+  EXPECT_FALSE(o.build.split_long_edges);
   EXPECT_FALSE(o.calibrate);
   EXPECT_TRUE(o.repair.strict);
   EXPECT_DOUBLE_EQ(o.repair.read.weld_tolerance, 1e-6);
@@ -73,7 +73,7 @@ TEST(BuildCommandLineTest, Subcommands) {
   EXPECT_EQ(cli->args().workdir, "wd");
   EXPECT_EQ(cli->Options().build.num_samples, 30);
   EXPECT_EQ(cli->Options().target_error, 0);
-  EXPECT_FALSE(cli->Options().build.refine_long_edges);  // --no-refinement: --no-split's old name
+  EXPECT_FALSE(cli->Options().build.split_long_edges);  // --no-refinement: --no-split's old name
   EXPECT_EQ(Parsed("plan m.obj -o wd")->Options().target_error, validation::kDefaultTargetError);
 
   cli = Parsed("rows wd --shard 1/3 --threads 2");

@@ -72,7 +72,7 @@ def build(
     seed: int,
     threads: int,
     strict: bool,
-    refine: bool,
+    split: bool,
     calibrate: bool,
     progress: Optional[Callable[[str, int, int], None]],
     log: Optional[Callable[[str], None]],

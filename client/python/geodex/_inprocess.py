@@ -415,9 +415,10 @@ def build(
     seed: int = 1,
     threads: int = 0,
     strict: bool = False,
-    refine: bool = True,
+    split: bool = True,
     calibrate: bool = True,
     progress: Union[None, bool, Callable[[BuildProgress], Any]] = None,
+    refine: Optional[bool] = None,
 ) -> Index:
     """Builds an index, writes it to ``path`` and opens it.
 
@@ -447,7 +448,7 @@ def build(
         short of its target warns (``UserWarning``) with the report's
         verdict.
     max_samples : int, optional
-        With a target: the cap on m (default 8000; with ``refine=False``,
+        With a target: the cap on m (default 8000; with ``split=False``,
         at most half the mesh's vertices).
     seed : int
         The sampling seed: the same mesh and options give the same bytes.
@@ -457,9 +458,9 @@ def build(
         Refuse a mesh that needs repair (duplicate faces, non-manifold
         edges or vertices, inconsistent orientation) instead of repairing it;
         a repaired mesh keeps its ids in every answer.
-    refine : bool
+    split : bool
         Split edges longer than half the sample spacing flat first (the
-        surface is unchanged).
+        surface is unchanged; ``geodex-build --no-split`` is ``False``).
     calibrate : bool
         Measure the index against held-out exact propagations and store its
         error bounds (``bounds`` and ``tolerance`` need them).
@@ -468,6 +469,9 @@ def build(
         :class:`BuildProgress` now and then (from the building thread, with
         the GIL held; an exception it raises is raised by ``build`` once the
         build is over).
+    refine : bool, deprecated
+        The old name of ``split`` (a DeprecationWarning); "refine" names
+        the near pairs' refinement (``refine_below``).
 
     Returns
     -------
@@ -485,6 +489,10 @@ def build(
         No valid geodesic triangulation within the builder's limits.
     """
     core = _require_core()
+    if refine is not None:
+        warnings.warn("geodex.build: refine= is deprecated; it is split= (the long-edge split)",
+                      DeprecationWarning, stacklevel=2)
+        split = refine
     if path is None and faces is not None and is_pathlike(faces):
         faces, path = None, faces
     if path is None:
@@ -520,7 +528,7 @@ def build(
             int(seed),
             int(threads),
             bool(strict),
-            bool(refine),
+            bool(split),
             bool(calibrate),
             None if callback is None else report,
             _log.info,

@@ -164,6 +164,20 @@ def test_build_from_objects_and_files(tmp_path):
     assert d == pytest.approx([2.0], rel=1e-9)
 
 
+def test_split_is_the_long_edge_split_and_refine_its_deprecated_name(tmp_path):
+    require_in_process()
+    v = np.array([[0, 0, 0], [1, 0, 0], [2, 0, 0], [0, 1, 0], [1, 1, 0], [2, 1, 0]], float)
+    f = np.array([[0, 1, 4], [0, 4, 3], [1, 2, 5], [1, 5, 4]])
+    geodex.build(v, f, tmp_path / "split.gdx", samples=20, calibrate=False)
+    geodex.build(v, f, tmp_path / "whole.gdx", samples=5, split=False, calibrate=False)
+    with pytest.warns(DeprecationWarning, match="split="):
+        geodex.build(v, f, tmp_path / "old.gdx", samples=5, refine=False, calibrate=False)
+    assert (tmp_path / "old.gdx").read_bytes() == (tmp_path / "whole.gdx").read_bytes()
+    # Six vertices hold at most three samples unsplit; split, the strip takes 20.
+    assert geodex.Index(tmp_path / "split.gdx").num_samples == 20
+    assert geodex.Index(tmp_path / "whole.gdx").num_samples <= 6
+
+
 def test_build_refuses_bad_input(tmp_path):
     require_in_process()
     v = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0]], float)

@@ -1,6 +1,6 @@
 // The long-edge split on a coarse mesh, measured as users see it: pairs in
 // the input's ids, the O(1) answer against exact distances. Samples are
-// vertices, so without refinement a coarse mesh caps m at its vertex count
+// vertices, so without the split a coarse mesh caps m at its vertex count
 // and its geodesic triangles at its edge lengths; with it, the error keeps
 // falling as m grows past the vertex count.
 
@@ -20,15 +20,15 @@ namespace {
 
 struct Measured {
   int32_t samples = 0;    // after the triangulation's repair
-  int32_t midpoints = 0;  // added by the refinement
+  int32_t midpoints = 0;  // added by the split
   double rms = 0;         // relative, area-uniform pairs, pure O(1) answer
 };
 
-// Builds `coarse` for `m` samples as geodex-build does (refined or not) and
+// Builds `coarse` for `m` samples as geodex-build does (split or not) and
 // measures the pure O(1) answer on `pairs` (in `coarse`'s ids).
-Measured Measure(const mesh::Mesh& coarse, int32_t m, bool refine,
+Measured Measure(const mesh::Mesh& coarse, int32_t m, bool split,
                  const std::vector<ExactPair>& pairs) {
-  absl::StatusOr<builder::PreparedMesh> prepared = builder::PrepareMesh(coarse, {}, m, refine);
+  absl::StatusOr<builder::PreparedMesh> prepared = builder::PrepareMesh(coarse, {}, m, split);
   EXPECT_TRUE(prepared.ok()) << prepared.status();
   builder::BuildOptions options;
   options.num_samples = m;
@@ -55,30 +55,30 @@ Measured Measure(const mesh::Mesh& coarse, int32_t m, bool refine,
   return {(*index)->num_samples(), (*index)->split_vertices(), std::sqrt(sum / count)};
 }
 
-TEST(RefinementTest, ErrorFallsWithSamplesPastTheVertexCountOfACoarseMesh) {
+TEST(LongEdgeSplitAccuracyTest, ErrorFallsWithSamplesPastTheVertexCountOfACoarseMesh) {
   // A coarse torus: 128 vertices, edges 0.55 and 0.79 long.
   const mesh::Mesh torus = mesh::gen::Torus(16, 8, 2.0, 0.7);
   const std::vector<ExactPair> pairs = DrawPairs(
       torus, 100,
       {.num_sources = 8, .uniform_points = 200, .per_bin_points = 0, .seed = 5, .threads = 2});
-  std::vector<Measured> refined;
+  std::vector<Measured> split;
   for (int32_t m : {50, 100, 200, 400}) {
-    refined.push_back(Measure(torus, m, /*refine=*/true, pairs));
-    const Measured& r = refined.back();
-    std::printf("refined m=%d: %d samples, %d midpoints, relative RMS %.3f%%\n", m, r.samples,
+    split.push_back(Measure(torus, m, /*split=*/true, pairs));
+    const Measured& r = split.back();
+    std::printf("split m=%d: %d samples, %d midpoints, relative RMS %.3f%%\n", m, r.samples,
                 r.midpoints, 100 * r.rms);
   }
-  const Measured unrefined = Measure(torus, 100, /*refine=*/false, pairs);
-  std::printf("unrefined m=100: %d samples, relative RMS %.3f%%\n", unrefined.samples,
-              100 * unrefined.rms);
+  const Measured unsplit = Measure(torus, 100, /*split=*/false, pairs);
+  std::printf("unsplit m=100: %d samples, relative RMS %.3f%%\n", unsplit.samples,
+              100 * unsplit.rms);
   // The torus's own vertices cannot hold many more samples than this.
-  EXPECT_LE(unrefined.samples, torus.num_vertices());
-  EXPECT_GT(refined.back().samples, 2 * torus.num_vertices());
-  for (size_t i = 1; i < refined.size(); ++i) {
-    EXPECT_LT(refined[i].rms, 0.9 * refined[i - 1].rms) << i;
-    EXPECT_GT(refined[i].midpoints, refined[i - 1].midpoints) << i;
+  EXPECT_LE(unsplit.samples, torus.num_vertices());
+  EXPECT_GT(split.back().samples, 2 * torus.num_vertices());
+  for (size_t i = 1; i < split.size(); ++i) {
+    EXPECT_LT(split[i].rms, 0.9 * split[i - 1].rms) << i;
+    EXPECT_GT(split[i].midpoints, split[i - 1].midpoints) << i;
   }
-  EXPECT_LT(refined.back().rms, 0.5 * unrefined.rms);
+  EXPECT_LT(split.back().rms, 0.5 * unsplit.rms);
 }
 
 }  // namespace
