@@ -7,6 +7,7 @@
 #include <limits>
 #include <vector>
 
+#include "client/fake_geodex_service_testing.h"
 #include "geodex/client/client.h"
 #include "geodex/client/mocks/mock_geodex_connection.h"
 #include "gmock/gmock.h"
@@ -333,6 +334,24 @@ TEST(ClientExpMap, ServerErrorsPassThrough) {
   Client client(mock);
   EXPECT_EQ(client.ExpMap("x", {0, {1, 0, 0}}, WithinRadius(1)).status().code(),
             absl::StatusCode::kNotFound);
+}
+
+// Over the wire, against the fake server's closed form of the map.
+TEST(ClientExpMap, TheFakeServersMapOverTheWire) {
+  testing::FakeGeodexServer server;
+  absl::StatusOr<Client> client = Connect(server.address());
+  ASSERT_TRUE(client.ok()) << client.status();
+  absl::StatusOr<ExpMap> map = client->ExpMap("fake", {10, {1, 0, 0}}, WithinRadius(2));
+  ASSERT_TRUE(map.ok()) << map.status();
+  EXPECT_THAT(map->vertices, ElementsAre(8, 9, 10, 11, 12));
+  EXPECT_THAT(map->r, ElementsAre(2, 1, 0, 1, 2));
+  EXPECT_DOUBLE_EQ(map->u[4], 2 * std::cos(0.5));
+  // A vertex centre: vertex 12 is face 10 with weight 1 on its third corner.
+  map = client->ExpMap("fake", SurfacePoint::Vertex(12), WithinRadius(1));
+  ASSERT_TRUE(map.ok()) << map.status();
+  EXPECT_THAT(map->vertices, ElementsAre(9, 10, 11));
+  EXPECT_EQ(client->ExpMap("fake", {10, {1, 0, 0}}, WithinRadius(-1)).status().code(),
+            absl::StatusCode::kInvalidArgument);
 }
 
 }  // namespace

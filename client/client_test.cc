@@ -168,6 +168,32 @@ TEST(ClientDistance, OneBatchIsOneUnaryCall) {
   EXPECT_THAT(*d, ElementsAre(0.5, 1.5, 2.5));
 }
 
+// Vertex points go out as vertex ids: alone when every point of a side is a
+// vertex, beside the faces (-1 for a face point) when a side mixes both.
+TEST(ClientDistance, VertexPointsAreSentAsVertexIds) {
+  auto mock = std::make_shared<MockGeodexConnection>();
+  EXPECT_CALL(*mock, Distance).WillOnce([](const v1::DistanceRequest& r) {
+    EXPECT_THAT(r.a().vertices(), ElementsAre(4, 9));
+    EXPECT_TRUE(r.a().faces().empty());
+    EXPECT_TRUE(r.a().weights().empty());
+    EXPECT_THAT(r.b().vertices(), ElementsAre(-1, 12));
+    EXPECT_THAT(r.b().faces(), ElementsAre(3, 0));
+    EXPECT_EQ(r.b().weights_size(), 6);
+    EXPECT_EQ(r.b().weights(0), 0.2);
+    v1::DistanceResponse response;
+    response.add_distances(1);
+    response.add_distances(2);
+    return response;
+  });
+  Client client(mock, SmallBatches(8));
+  const std::vector<PointPair> pairs = {
+      {SurfacePoint::Vertex(4), SurfacePoint{3, {0.2, 0.3, 0.5}}},
+      {SurfacePoint::Vertex(9), SurfacePoint::Vertex(12)}};
+  absl::StatusOr<std::vector<double>> d = client.Distance(ModelRef("torus"), pairs);
+  ASSERT_TRUE(d.ok()) << d.status();
+  EXPECT_THAT(*d, ElementsAre(1, 2));
+}
+
 TEST(ClientDistance, ToleranceThresholdAndBoundsAreSentAndBoundsReturned) {
   auto mock = std::make_shared<MockGeodexConnection>();
   EXPECT_CALL(*mock, Distance).WillOnce([](const v1::DistanceRequest& r) {

@@ -1,16 +1,37 @@
 #include "client/convert.h"
 
+#include <algorithm>
+
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 
 namespace geodex::client {
 namespace {
 
-void AppendPoint(const SurfacePoint& p, v1::SurfacePoints* out) {
-  out->add_faces(p.face);
-  out->add_weights(p.w[0]);
-  out->add_weights(p.w[1]);
-  out->add_weights(p.w[2]);
+// Appends points at(begin) .. at(end - 1) to `out`: their faces and weights,
+// and their vertex ids when any is a vertex (SurfacePoint::Vertex); only the
+// ids when all are (geodex.proto's SurfacePoints).
+template <typename At>
+void AppendPoints(size_t begin, size_t end, At at, v1::SurfacePoints* out) {
+  bool any_vertex = false, all_vertices = true;
+  for (size_t i = begin; i < end; ++i) {
+    const bool vertex = at(i).vertex >= 0;
+    any_vertex |= vertex;
+    all_vertices &= vertex;
+  }
+  const int n = static_cast<int>(end - begin);
+  if (any_vertex) {
+    out->mutable_vertices()->Reserve(out->vertices_size() + n);
+    for (size_t i = begin; i < end; ++i) out->add_vertices(std::max(at(i).vertex, -1));
+    if (all_vertices) return;
+  }
+  out->mutable_faces()->Reserve(out->faces_size() + n);
+  out->mutable_weights()->Reserve(out->weights_size() + 3 * n);
+  for (size_t i = begin; i < end; ++i) {
+    const SurfacePoint& p = at(i);
+    out->add_faces(p.face);
+    for (double w : p.w) out->add_weights(w);
+  }
 }
 
 }  // namespace
@@ -38,23 +59,14 @@ v1::NearPairs ToProto(NearPairs mode) {
 
 v1::SurfacePoints ToProto(absl::Span<const SurfacePoint> points) {
   v1::SurfacePoints out;
-  out.mutable_faces()->Reserve(points.size());
-  out.mutable_weights()->Reserve(3 * points.size());
-  for (const SurfacePoint& p : points) AppendPoint(p, &out);
+  AppendPoints(0, points.size(), [&](size_t i) -> const SurfacePoint& { return points[i]; }, &out);
   return out;
 }
 
 void PairsToProto(absl::Span<const PointPair> pairs, size_t begin, size_t end, v1::SurfacePoints* a,
                   v1::SurfacePoints* b) {
-  const int n = static_cast<int>(end - begin);
-  a->mutable_faces()->Reserve(n);
-  a->mutable_weights()->Reserve(3 * n);
-  b->mutable_faces()->Reserve(n);
-  b->mutable_weights()->Reserve(3 * n);
-  for (size_t i = begin; i < end; ++i) {
-    AppendPoint(pairs[i].a, a);
-    AppendPoint(pairs[i].b, b);
-  }
+  AppendPoints(begin, end, [&](size_t i) -> const SurfacePoint& { return pairs[i].a; }, a);
+  AppendPoints(begin, end, [&](size_t i) -> const SurfacePoint& { return pairs[i].b; }, b);
 }
 
 absl::StatusOr<std::vector<SurfacePoint>> FromProto(const v1::SurfacePoints& points) {

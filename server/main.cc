@@ -1,5 +1,5 @@
 // geodex-server: serves geodex indexes over gRPC (server/server.h); its flags
-// are server/config/server_command_line.h.
+// are server/server_command_line.h.
 //
 //   geodex-server --models DIR --listen ADDR [--metrics ADDR] [--workers N]
 //                 [--poll-seconds S] [--tls-cert F --tls-key F [--tls-ca F]]
@@ -16,7 +16,7 @@
 #include <string>
 
 #include "CLI/CLI.hpp"
-#include "server/config/server_command_line.h"
+#include "server/server_command_line.h"
 #include "server/registry/mapped_files.h"
 #include "server/server.h"
 #include "spdlog/sinks/stdout_color_sinks.h"

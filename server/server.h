@@ -35,7 +35,7 @@
 #include "server/config/limits.h"
 #include "server/registry/model_registry.h"
 #include "server/service/auth.h"
-#include "server/service/geodex_service.h"
+#include "server/geodex_service.h"
 #include "server/service/metrics.h"
 #include "server/service/worker_pool.h"
 

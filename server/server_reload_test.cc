@@ -13,7 +13,7 @@
 #include "gmock/gmock.h"
 #include "grpcpp/create_channel.h"
 #include "gtest/gtest.h"
-#include "server/server_test_util.h"
+#include "server/server_testing.h"
 
 namespace geodex::server {
 namespace {

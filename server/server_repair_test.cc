@@ -9,13 +9,13 @@
 #include <utility>
 
 #include "core/builder/builder.h"
-#include "core/builder/mesh_arrays.h"
+#include "core/builder/prepared_mesh.h"
 #include "core/mesh/generators.h"
 #include "core/mesh/mesh_io.h"
 #include "core/mesh/mesh_repair.h"
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
-#include "server/server_test_util.h"
+#include "server/server_testing.h"
 
 namespace geodex::server {
 namespace {

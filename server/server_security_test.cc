@@ -12,7 +12,7 @@
 #include "grpcpp/create_channel.h"
 #include "grpcpp/security/credentials.h"
 #include "gtest/gtest.h"
-#include "server/server_test_util.h"
+#include "server/server_testing.h"
 
 namespace geodex::server {
 namespace {

@@ -14,10 +14,10 @@
 #include "core/mesh/generators.h"
 #include "core/query/exp_map.h"
 #include "core/query/input_queries.h"
-#include "core/query/query_types.h"
+#include "core/query/engine/query_types.h"
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
-#include "server/server_test_util.h"
+#include "server/server_testing.h"
 
 namespace geodex::server {
 namespace {

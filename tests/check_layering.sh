@@ -6,11 +6,13 @@
 #                 point locator); the face BVH it stores is in core/index;
 #   client/       nothing from core/ or server/;
 #   server/       not the client library;
-#   the parts of core/query (core/query/internal/) only from core/ and from
-#                 tests and benchmarks: the server, the offline tools and the
-#                 Python bindings use the public headers (those at the
-#                 top of core/query/: input_queries.h, query_types.h,
-#                 query_scratch.h and one for each query of its own).
+#   the engine's parts (core/query/engine/internal/) only from the engine and
+#                 from tests and benchmarks: the server, the offline tools
+#                 and the Python bindings use the public headers (the
+#                 queries at the top of core/query/, and the engine's face
+#                 at the top of core/query/engine/: query_engine.h,
+#                 query_types.h, query_scratch.h). tests/check_include_cycles.sh
+#                 checks the rest of core/ and the floors of every folder.
 # The Python package keeps the same direction: client/python/geodex imports
 # core only through the optional in-process module geodex._core, in
 # _inprocess.py alone and inside a try (the client works without it), and
@@ -36,9 +38,9 @@ fi
 
 # Production code outside core's libraries: server/ (but its tests), the tools'
 # mains and the Python bindings.
-if grep -rnE '#include\s*[<"]core/query/internal/' "$root/server" "$root/core/tools" "$root/core/python" \
-    2>/dev/null | grep -vE '_test\.cc:|/server_test_util\.(h|cc):'; then
-  echo "layering: only core/ and tests include core/query/internal/ (use core/query/input_queries.h)" >&2
+if grep -rnE '#include\s*[<"]core/query/engine/internal/' "$root/server" "$root/core/tools" "$root/core/python" \
+    2>/dev/null | grep -vE '_test\.cc:|/server_testing\.(h|cc):'; then
+  echo "layering: only core/ and tests include core/query/engine/internal/ (use core/query/input_queries.h)" >&2
   status=1
 fi
 

@@ -1,11 +1,11 @@
 #!/usr/bin/env bash
-# Fails when the "Adding a query" guide in core/README.md and the tree
+# Fails when the "Adding a query" guide in core/query/README.md and the tree
 # disagree on the files of the worked example, the exponential map.
 #
 # The tree's list: every tracked file but Markdown that names the map
 # (ExpMap, expmap, exp_map in any case), but this script. The guide's list: every path in
 # backquotes between the markers "<!-- query-files begin -->" and
-# "<!-- query-files end -->" of core/README.md, Markdown files left out.
+# "<!-- query-files end -->" of core/query/README.md, Markdown files left out.
 # Each path is written out in full there (no {h,cc}), so that both lists
 # are plain sets of paths.
 #
@@ -29,7 +29,7 @@ if ! git rev-parse --is-inside-work-tree >/dev/null 2>&1; then
   echo "check_query_guide: not a git tree; skipped" >&2
   exit 77
 fi
-guide=core/README.md
+guide=core/query/README.md
 # A ratchet on how many files a new query touches: lower it when a change
 # leaves fewer, never raise it to make room for one.
 max_files=25

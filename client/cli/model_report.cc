@@ -272,7 +272,7 @@ absl::StatusOr<std::string> ModelReportText(const ModelInfo& m) {
   }
   if (!f.ok) {
     return absl::InvalidArgumentError(
-        "the server's build report lacks fields this client reads (core/README.md)");
+        "the server's build report lacks fields this client reads (core/index/README.md)");
   }
   return out;
 }

@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstdint>
 #include <fstream>
+#include <initializer_list>
 #include <iostream>
 #include <iterator>
 #include <sstream>
@@ -78,15 +79,50 @@ absl::Status CheckCount(const std::vector<std::string_view>& fields, size_t expe
                                                     line, expected, format, fields.size()));
 }
 
-// Fields [first, first + 4) as a surface point.
-absl::Status ParsePoint(const std::vector<std::string_view>& fields, size_t first, int64_t line,
+// The surface point at fields[*next] ("v ID", a vertex id, or "f w0 w1 w2",
+// which the caller has counted); *next moves past it.
+absl::Status ParsePoint(const std::vector<std::string_view>& fields, size_t* next, int64_t line,
                         SurfacePoint* p) {
+  const size_t first = *next;
+  if (fields[first] == "v") {
+    *next = first + 2;
+    *p = SurfacePoint::Vertex(0);
+    if (ParseFace(fields[first + 1], line, first + 1, &p->vertex).ok()) return absl::OkStatus();
+    return absl::InvalidArgumentError(absl::StrFormat("line %d: field %d ('%s') is not a vertex id",
+                                                      line, first + 2,
+                                                      std::string(fields[first + 1])));
+  }
+  *next = first + 4;
   if (absl::Status s = ParseFace(fields[first], line, first, &p->face); !s.ok()) return s;
   for (size_t i = 0; i < 3; ++i) {
     if (absl::Status s = ParseDouble(fields[first + 1 + i], line, first + 1 + i, &p->w[i]);
         !s.ok()) {
       return s;
     }
+  }
+  return absl::OkStatus();
+}
+
+// All of `fields` as the surface points `points`, each "f w0 w1 w2" or
+// "v ID" (`format` names the first kind in messages).
+absl::Status ParsePointsOfLine(const std::vector<std::string_view>& fields, int64_t line,
+                               const char* format, std::initializer_list<SurfacePoint*> points) {
+  size_t expected = 0;
+  bool vertices = false;
+  for (size_t k = 0; k < points.size(); ++k) {
+    const bool vertex = expected < fields.size() && fields[expected] == "v";
+    vertices |= vertex;
+    expected += vertex ? 2 : 4;
+  }
+  if (expected != fields.size()) {
+    if (!vertices) return CheckCount(fields, expected, format, line);
+    return absl::InvalidArgumentError(absl::StrFormat(
+        "line %d: expected %d fields ('%s', a point 'v ID' for a vertex), found %d", line,
+        expected, format, fields.size()));
+  }
+  size_t next = 0;
+  for (SurfacePoint* p : points) {
+    if (absl::Status s = ParsePoint(fields, &next, line, p); !s.ok()) return s;
   }
   return absl::OkStatus();
 }
@@ -115,10 +151,12 @@ absl::StatusOr<std::string> ReadFileOrStdin(const std::string& path) {
 absl::StatusOr<ParsedPairs> ParsePairs(std::string_view text) {
   ParsedPairs out;
   absl::Status status = ForEachLine(text, [&](int64_t line, const auto& fields) {
-    if (absl::Status s = CheckCount(fields, 8, "fa a0 a1 a2 fb b0 b1 b2", line); !s.ok()) return s;
     PointPair pair;
-    if (absl::Status s = ParsePoint(fields, 0, line, &pair.a); !s.ok()) return s;
-    if (absl::Status s = ParsePoint(fields, 4, line, &pair.b); !s.ok()) return s;
+    if (absl::Status s =
+            ParsePointsOfLine(fields, line, "fa a0 a1 a2 fb b0 b1 b2", {&pair.a, &pair.b});
+        !s.ok()) {
+      return s;
+    }
     out.pairs.push_back(pair);
     out.lines.push_back(line);
     return absl::OkStatus();
@@ -146,9 +184,8 @@ absl::StatusOr<ParsedPositionPairs> ParsePositionPairs(std::string_view text) {
 absl::StatusOr<ParsedPoints> ParsePoints(std::string_view text) {
   ParsedPoints out;
   absl::Status status = ForEachLine(text, [&](int64_t line, const auto& fields) {
-    if (absl::Status s = CheckCount(fields, 4, "f w0 w1 w2", line); !s.ok()) return s;
     SurfacePoint p;
-    if (absl::Status s = ParsePoint(fields, 0, line, &p); !s.ok()) return s;
+    if (absl::Status s = ParsePointsOfLine(fields, line, "f w0 w1 w2", {&p}); !s.ok()) return s;
     out.points.push_back(p);
     out.lines.push_back(line);
     return absl::OkStatus();
@@ -172,6 +209,7 @@ absl::StatusOr<ParsedPositions> ParsePositions(std::string_view text) {
 }
 
 absl::Status CheckPoint(const SurfacePoint& p, int64_t num_faces, int64_t line) {
+  if (p.vertex >= 0) return absl::OkStatus();  // the server checks it against the mesh
   if (p.face >= num_faces) {
     return absl::OutOfRangeError(absl::StrFormat(
         "line %d: face %d is past the end (the model has %d faces)", line, p.face, num_faces));
@@ -203,6 +241,10 @@ std::string FormatDistance(double d) {
 std::string FormatPairs(const std::vector<PointPair>& pairs) {
   std::string out;
   auto point = [&out](const SurfacePoint& p) {
+    if (p.vertex >= 0) {
+      absl::StrAppend(&out, "v ", p.vertex);
+      return;
+    }
     absl::StrAppend(&out, p.face);
     for (double w : p.w) absl::StrAppend(&out, " ", FormatDistance(w));
   };

@@ -9,6 +9,10 @@
 //   points     f w0 w1 w2                (sources of `geodex field`)
 //   positions  x y z                     (`geodex locate`)
 //
+// In pairs and points, a point may be given as "v ID" instead, a vertex id
+// of the mesh file: "v 17 v 42" is the pair of vertices 17 and 42, and
+// "v 17 3 0.2 0.3 0.5" pairs vertex 17 with a point of face 3.
+//
 // Fields are separated by spaces, tabs or commas. Blank lines and lines
 // starting with '#' are skipped. Errors name the 1-based line.
 

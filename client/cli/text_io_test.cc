@@ -33,6 +33,31 @@ TEST(ParsePairs, ErrorsNameTheLine) {
   EXPECT_EQ(ParsePairs("0 1 0 0 5 0 0 1x").status().code(), absl::StatusCode::kInvalidArgument);
 }
 
+TEST(ParsePairs, VertexIdsStandForPoints) {
+  absl::StatusOr<ParsedPairs> parsed = ParsePairs(
+      "v 17 v 42\n"
+      "v 3 5 0.2 0.3 0.5\n"
+      "5 0.2 0.3 0.5 v 0\n");
+  ASSERT_TRUE(parsed.ok()) << parsed.status();
+  ASSERT_EQ(parsed->pairs.size(), 3u);
+  EXPECT_EQ(parsed->pairs[0].a, SurfacePoint::Vertex(17));
+  EXPECT_EQ(parsed->pairs[0].b, SurfacePoint::Vertex(42));
+  EXPECT_EQ(parsed->pairs[1].b, (SurfacePoint{5, {0.2, 0.3, 0.5}}));
+  EXPECT_EQ(parsed->pairs[2].b, SurfacePoint::Vertex(0));
+  EXPECT_EQ(FormatPairs(parsed->pairs),
+            "v 17 v 42\nv 3 5 0.2 0.3 0.5\n5 0.2 0.3 0.5 v 0\n");
+  EXPECT_TRUE(CheckPoint(SurfacePoint::Vertex(99999), 10, 1).ok());
+  EXPECT_EQ(ParsePairs("v 17 v\n").status(),
+            absl::InvalidArgumentError(
+                "line 1: expected 4 fields ('fa a0 a1 a2 fb b0 b1 b2', a point 'v ID' for a "
+                "vertex), found 3"));
+  EXPECT_EQ(ParsePairs("v -2 v 1\n").status(),
+            absl::InvalidArgumentError("line 1: field 2 ('-2') is not a vertex id"));
+  absl::StatusOr<ParsedPoints> points = ParsePoints("v 8\n");
+  ASSERT_TRUE(points.ok()) << points.status();
+  EXPECT_EQ(points->points[0], SurfacePoint::Vertex(8));
+}
+
 TEST(ParseOthers, PositionsPointsAndXyzPairs) {
   absl::StatusOr<ParsedPositionPairs> xyz = ParsePositionPairs("1 2 3 4 5 6\n");
   ASSERT_TRUE(xyz.ok());

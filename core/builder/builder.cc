@@ -12,6 +12,7 @@
 #include "absl/strings/str_format.h"
 #include "absl/strings/str_join.h"
 #include "core/builder/mesh_arrays.h"
+#include "core/builder/prepared_mesh.h"
 #include "core/builder/vertex_assignment.h"
 #include "core/common/status_macros.h"
 #include "core/common/threads.h"
@@ -242,7 +243,7 @@ class CarriedCellReach {
 // closed component needs 4 samples at least (a tetrahedron), and each handle
 // or boundary loop (2 - chi of its component, a scan's slits and tiny handles
 // among them) a ring of cells round it: 2 to 3.2 samples a non-manifold edge
-// cut on clustered scans (core/README.md#topology-the-samples-miss); 16 each
+// cut on clustered scans (core/mesh/README.md#topology-the-samples-miss); 16 each
 // leaves room.
 int64_t TopologyBudget(const Mesh& mesh) {
   std::vector<int64_t> chi(mesh.num_components(), 0);
@@ -376,7 +377,7 @@ absl::StatusOr<std::vector<SampleRow>> ComputeRows(const Mesh& mesh, const Plan&
                                                    std::span<const int32_t> sample_ids,
                                                    const BuildOptions& options,
                                                    std::span<SampleRow> carried,
-                                                   const CoarseSurface* coarse) {
+                                                   const index::CoarseSurface* coarse) {
   const int32_t m = plan.num_samples();
   for (int32_t id : sample_ids) {
     if (id < 0 || id >= m) {
@@ -406,7 +407,7 @@ absl::StatusOr<std::vector<SampleRow>> ComputeRows(const Mesh& mesh, const Plan&
     return absl::InvalidArgumentError("the coarse surface is not of this mesh");
   }
   // On a split mesh the rows propagate on the surface before the split
-  // (CoarseSurface): the same distances over several times fewer vertices,
+  // (index::CoarseSurface): the same distances over several times fewer vertices,
   // read at the samples and cell vertices as target points.
   std::vector<SurfacePoint> sample_points;
   if (coarse != nullptr) {
@@ -541,7 +542,7 @@ absl::StatusOr<index::IndexData> BuildIndex(const Mesh& mesh, const BuildOptions
 absl::StatusOr<index::IndexData> BuildIndexFromPlan(const Mesh& mesh, const Plan& plan,
                                                     const BuildOptions& options,
                                                     BuildSummary* summary,
-                                                    const CoarseSurface* coarse) {
+                                                    const index::CoarseSurface* coarse) {
   std::vector<int32_t> all(plan.num_samples());
   for (int32_t a = 0; a < plan.num_samples(); ++a) all[a] = a;
   const auto start = std::chrono::steady_clock::now();
@@ -556,7 +557,7 @@ absl::StatusOr<index::IndexData> BuildIndexFromPlan(const Mesh& mesh, const Plan
 absl::StatusOr<index::IndexData> BuildPreparedIndex(const PreparedMesh& prepared,
                                                     const BuildOptions& options,
                                                     BuildSummary* summary) {
-  GEODEX_ASSIGN_OR_RETURN(const std::optional<CoarseSurface> coarse,
+  GEODEX_ASSIGN_OR_RETURN(const std::optional<index::CoarseSurface> coarse,
                           CoarseSurfaceOf(prepared.mesh, prepared.record));
   GEODEX_ASSIGN_OR_RETURN(const Plan plan, MakePlan(prepared.mesh, options));
   GEODEX_ASSIGN_OR_RETURN(index::IndexData data,

@@ -25,7 +25,7 @@
 #include <vector>
 
 #include "absl/status/statusor.h"
-#include "core/builder/mesh_arrays.h"
+#include "core/builder/prepared_mesh.h"
 #include "core/builder/plan.h"
 #include "core/index/index.h"
 #include "core/mesh/mesh.h"
@@ -49,7 +49,7 @@ struct BuildOptions {
   // (triangulation::RepairOptions::check_edges).
   bool check_edges = true;
   // Split long mesh edges flat before sampling (PrepareMesh in
-  // core/builder/mesh_arrays.h; geodex-build --no-split turns it off).
+  // core/builder/prepared_mesh.h; geodex-build --no-split turns it off).
   bool split_long_edges = true;
   // Error-driven placement (core/validation/error_map.h): one weight per
   // vertex of the mesh being built; farthest-point sampling then spaces the
@@ -58,7 +58,7 @@ struct BuildOptions {
   std::vector<double> spacing_weight;
   // For refusal messages: the input file's id of each vertex of the mesh
   // being built (kNone for a midpoint of the long-edge split); empty when the
-  // mesh's ids are the file's (InputVertexIds in mesh_arrays.h).
+  // mesh's ids are the file's (InputVertexIds in prepared_mesh.h).
   std::vector<int32_t> input_vertex_ids;
   // Called from builder threads (serialised by the builder) as work advances.
   std::function<void(const Progress&)> progress;
@@ -126,7 +126,7 @@ struct BuildSummary {
 absl::StatusOr<Plan> MakePlan(const mesh::Mesh& mesh, const BuildOptions& options);
 
 // Phase 1 of a round that grows an earlier plan (a target-error build,
-// core/builder/build_rounds.h): the plan of options.num_samples samples on
+// core/build/build_rounds.h): the plan of options.num_samples samples on
 // `mesh` whose first samples are `previous` (vertex ids of `mesh`, e.g. an
 // earlier plan's samples on a mesh the split only added vertices to),
 // the others added by farthest-point sampling from them and then by the
@@ -171,7 +171,7 @@ absl::StatusOr<std::vector<SampleRow>> ComputeRows(const mesh::Mesh& mesh, const
                                                    std::span<const int32_t> sample_ids,
                                                    const BuildOptions& options,
                                                    std::span<SampleRow> carried = {},
-                                                   const CoarseSurface* coarse = nullptr);
+                                                   const index::CoarseSurface* coarse = nullptr);
 
 // Phase 3: assembles the index from the plan and the rows of every sample (any
 // order) and fills `summary` (vertex_assignment.h assigns the vertices).
@@ -202,7 +202,7 @@ absl::StatusOr<index::IndexData> BuildIndex(const mesh::Mesh& mesh, const BuildO
 absl::StatusOr<index::IndexData> BuildIndexFromPlan(const mesh::Mesh& mesh, const Plan& plan,
                                                     const BuildOptions& options,
                                                     BuildSummary* summary,
-                                                    const CoarseSurface* coarse = nullptr);
+                                                    const index::CoarseSurface* coarse = nullptr);
 
 // BuildIndex on `prepared.mesh` with `prepared.record` added (AddRepair): the
 // index a whole geodex-build makes, before its calibration.

@@ -311,7 +311,7 @@ TEST(BuilderTest, RowsOnTheCoarseSurfaceAreTheSplitMeshRows) {
   absl::StatusOr<PreparedMesh> prepared = PrepareMesh(coarse, {}, 60, true);
   ASSERT_TRUE(prepared.ok()) << prepared.status();
   const mesh::Mesh& m = prepared->mesh;
-  absl::StatusOr<std::optional<CoarseSurface>> surface = CoarseSurfaceOf(m, prepared->record);
+  absl::StatusOr<std::optional<index::CoarseSurface>> surface = CoarseSurfaceOf(m, prepared->record);
   ASSERT_TRUE(surface.ok()) << surface.status();
   ASSERT_TRUE(surface->has_value());
   ASSERT_EQ((*surface)->mesh.num_vertices(), coarse.num_vertices());
@@ -352,7 +352,7 @@ TEST(BuilderTest, RowsOnTheCoarseSurfaceAreTheSplitMeshRows) {
     }
   }
   // A coarse surface of another mesh is refused.
-  CoarseSurface other{coarse, {}};
+  index::CoarseSurface other{coarse, {}};
   EXPECT_EQ(ComputeRows(m, *plan, all, options, {}, &other).status().code(),
             absl::StatusCode::kInvalidArgument);
 }

@@ -10,6 +10,7 @@
 
 #include "absl/strings/str_format.h"
 #include "core/builder/mesh_arrays.h"
+#include "core/builder/prepared_mesh.h"
 #include "core/common/file_util.h"
 #include "core/common/status_macros.h"
 #include "core/mesh/mesh_io.h"

@@ -16,7 +16,7 @@
 
 #include "absl/status/statusor.h"
 #include "core/builder/builder.h"
-#include "core/builder/mesh_arrays.h"
+#include "core/builder/prepared_mesh.h"
 #include "core/mesh/mesh.h"
 
 namespace geodex::builder {
@@ -71,7 +71,7 @@ absl::Status RemoveRows(const std::string& workdir);
 //   carried.bin                     the rows the current plan carries from
 //                                   the round before (ComputeRows' carried)
 //   target.bin                      the target and the figures of the rounds
-//                                   so far (core/builder/build_rounds.h)
+//                                   so far (core/build/build_rounds.h)
 
 // Writes the coarse mesh and its repair record (RecordRepair), atomically,
 // into `workdir` (created if missing). Errors: as SavePlan's.

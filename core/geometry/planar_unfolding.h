@@ -5,7 +5,7 @@
 // trilaterated from its distances to the corners of a triangle, and the
 // barycentric coordinates of an unfolded point. Shared by the builder
 // (vertex -> triangle assignment), the query engine, the path tracer, the
-// path straightener and the far-pair kernel (core/query/internal/o1/unfold_kernel.h).
+// path straightener and the far-pair kernel (core/query/engine/internal/o1/unfold_kernel.h).
 //
 // The formulas are templates where the kernel evaluates them on a GCC
 // vector of doubles (four pairs at a time), so that its lanes round exactly

@@ -2,7 +2,7 @@
 
 // The face BVH of the index (SectionId::kFaceBvh, kBvhFaces): an axis-aligned
 // bounding-box hierarchy over the faces of the mesh. The builder fills it;
-// the query engine's point locator (core/query/internal/locate/point_locator.h) walks it in
+// the query engine's point locator (core/query/engine/internal/locate/point_locator.h) walks it in
 // place.
 //
 // Thread safety: BuildFaceBvh is a pure function of its inputs.

@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "core/index/index_test_util.h"
+#include "core/index/index_testing.h"
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
 

@@ -496,7 +496,7 @@ IndexReport MakeIndexReport(const Index& index) {
   r.index_vertices = index.num_vertices();
   r.index_faces = index.num_faces();
   r.split_midpoints = index.split_vertices();
-  // The mesh file's counts, as core/query/internal/input_ids.h reads them: the
+  // The mesh file's counts, as core/query/engine/input_ids.h reads them: the
   // midpoints and the copies of split vertices are the last vertices; faces
   // are the input records, else the faces before the split.
   r.vertices = r.index_vertices - r.split_midpoints -

@@ -9,7 +9,7 @@
 // target was met (and why not), and the relative error by distance.
 // IndexReportText renders it as a few lines and a table with units (%, MiB);
 // IndexReportJson as one JSON object whose keys are documented in
-// core/README.md ("The build report"). geodex-query --info, geodex-build's
+// core/index/README.md ("The build report"). geodex-query --info, geodex-build's
 // closing lines, the server's GetModel (ModelInfo.report_json), the viewer
 // and the Python package all show this one report.
 //
@@ -185,7 +185,7 @@ IndexReport MakeIndexReport(const Index& index);
 std::string IndexReportText(const IndexReport& report, std::string_view title);
 
 // One JSON object, pretty-printed with two-space indents (keys:
-// core/README.md). Numbers are the shortest decimals that read back to the
+// core/index/README.md). Numbers are the shortest decimals that read back to the
 // same double; a figure the index lacks is null.
 std::string IndexReportJson(const IndexReport& report);
 

@@ -6,7 +6,7 @@
 
 #include <cmath>
 
-#include "core/index/index_test_util.h"
+#include "core/index/index_testing.h"
 #include "core/validation/target_error.h"
 #include "gtest/gtest.h"
 

@@ -3,7 +3,7 @@
 #include <cmath>
 #include <string>
 
-#include "core/index/index_test_util.h"
+#include "core/index/index_testing.h"
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
 

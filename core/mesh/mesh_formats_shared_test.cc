@@ -29,13 +29,13 @@
 
 #include "absl/strings/str_format.h"
 #include "core/builder/builder.h"
-#include "core/builder/mesh_arrays.h"
+#include "core/builder/prepared_mesh.h"
 #include "core/common/file_util.h"
 #include "core/index/index.h"
 #include "core/mesh/mesh_io.h"
 #include "core/mesh/mesh_repair.h"
 #include "core/query/input_queries.h"
-#include "core/query/internal/query_engine.h"
+#include "core/query/engine/query_engine.h"
 #include "gtest/gtest.h"
 
 namespace geodex {

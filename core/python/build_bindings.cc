@@ -7,7 +7,7 @@
 #include <string>
 #include <utility>
 
-#include "core/builder/build_pipeline.h"
+#include "core/build/build_pipeline.h"
 #include "core/python/bindings.h"
 #include "core/python/python_status.h"
 #include "pybind11/pybind11.h"

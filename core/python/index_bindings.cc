@@ -29,7 +29,7 @@
 #include "core/python/python_status.h"
 #include "core/query/exp_map.h"
 #include "core/query/input_queries.h"
-#include "core/query/query_types.h"
+#include "core/query/engine/query_types.h"
 #include "pybind11/numpy.h"
 #include "pybind11/pybind11.h"
 #include "pybind11/stl.h"
@@ -345,6 +345,30 @@ class Index {
   }
 
   // (faces (N,), weights (N, 3), distances (N,)) of the closest points.
+  // Vertex ids as surface points (InputQueries::VertexPoint): (faces,
+  // weights), the errors naming "name[i]".
+  py::tuple VertexPoints(const Faces& ids, const std::string& name) const {
+    const int64_t n = ids.size();
+    py::array_t<int32_t> faces(n);
+    py::array_t<double> weights({n, int64_t{3}});
+    int32_t* f = faces.mutable_data();
+    double* w = weights.mutable_data();
+    const int32_t* v = ids.data();
+    {
+      py::gil_scoped_release release;
+      for (int64_t i = 0; i < n; ++i) {
+        absl::StatusOr<query::SurfacePoint> p = queries_->VertexPoint(v[i]);
+        if (!p.ok()) {
+          ThrowIfError(absl::Status(p.status().code(), absl::StrFormat("%s[%d]: %s", name, i,
+                                                                       p.status().message())));
+        }
+        f[i] = p->face;
+        for (int c = 0; c < 3; ++c) w[3 * i + c] = p->w[c];
+      }
+    }
+    return py::make_tuple(faces, weights);
+  }
+
   py::tuple Locate(const Weights& xyz) const {
     const int64_t n = xyz.size() / 3;
     py::array_t<int32_t> faces(n);
@@ -423,6 +447,7 @@ void BindIndex(py::module_& m) {
       .def("field_within", &Index::FieldWithin)
       .def("expmap", &Index::ExpMap)
       .def("locate", &Index::Locate)
+      .def("vertex_points", &Index::VertexPoints)
       .def("mesh", &Index::Mesh);
 }
 

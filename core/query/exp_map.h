@@ -5,7 +5,7 @@
 // the ids of the mesh file the index was built from. A query of its own over
 // InputQueries, which reads its centre and lends it the engine's distances
 // and the input ids: the options, the answer and the call are all here, and
-// the work is in internal/expmap/exp_map.cc.
+// the work is in exp_map.cc.
 //
 // r is the engine's distance from the centre (Distance with the options'
 // DistanceOptions: near pairs refined as usual). θ is the direction in which
@@ -29,7 +29,7 @@
 
 #include "absl/status/statusor.h"
 #include "core/mesh/mesh.h"
-#include "core/query/query_types.h"
+#include "core/query/engine/query_types.h"
 
 namespace geodex::query {
 

@@ -7,8 +7,8 @@
 
 #include "absl/strings/str_format.h"
 #include "core/common/status_macros.h"
-#include "core/query/internal/input_ids.h"
-#include "core/query/internal/query_engine.h"
+#include "core/query/engine/input_ids.h"
+#include "core/query/engine/query_engine.h"
 
 namespace geodex::query {
 
@@ -96,6 +96,73 @@ absl::Status InputQueries::Read(std::span<const int32_t> faces, std::span<const 
     out->points_[i] = *internal;
   }
   return absl::OkStatus();
+}
+
+absl::Status InputQueries::Read(std::span<const int32_t> faces, std::span<const double> weights,
+                                std::span<const int32_t> vertices, const PointName& name,
+                                EnginePoints* out) const {
+  if (vertices.empty()) return Read(faces, weights, name, out);
+  const bool mixed = !faces.empty() || !weights.empty();
+  if (mixed && (faces.size() != vertices.size() || weights.size() != 3 * vertices.size())) {
+    return absl::InvalidArgumentError(absl::StrFormat(
+        "%d vertex ids, %d faces and %d weights: give vertices alone, or one vertex id (-1: "
+        "none), one face and three weights a point",
+        vertices.size(), faces.size(), weights.size()));
+  }
+  std::vector<SurfacePoint> points(vertices.size());
+  for (size_t i = 0; i < vertices.size(); ++i) {
+    if (vertices[i] < 0 && mixed) {
+      points[i] = {faces[i], {weights[3 * i], weights[3 * i + 1], weights[3 * i + 2]}};
+      continue;
+    }
+    absl::StatusOr<SurfacePoint> vertex = VertexPoint(vertices[i]);
+    if (!vertex.ok()) return Prefixed(vertex.status(), name, i);
+    points[i] = *vertex;
+  }
+  return Read(points, name, out);
+}
+
+const std::vector<int32_t>& InputQueries::VertexFaces() const {
+  std::call_once(vertex_faces_once_, [this] {
+    const int32_t nv = num_vertices();
+    std::vector<int32_t> faces(nv, -1);
+    const double tolerance = engine_->options().weight_tolerance;
+    for (int32_t f = 0; f < num_faces(); ++f) {
+      const mesh::Triangle corners = InputFace(f);
+      for (int k = 0; k < 3; ++k) {
+        const int32_t v = corners[k];
+        if (v < 0 || v >= nv || faces[v] >= 0) continue;
+        // A face the repair dropped reads as no point: the vertex is then
+        // read in a later face that holds it.
+        SurfacePoint p{f, {0, 0, 0}};
+        p.w[k] = 1;
+        if (ids_->ToInternal(p, tolerance).ok()) faces[v] = f;
+      }
+    }
+    vertex_faces_ = std::move(faces);
+  });
+  return vertex_faces_;
+}
+
+absl::StatusOr<SurfacePoint> InputQueries::VertexPoint(int32_t v) const {
+  if (v < 0 || v >= num_vertices()) {
+    return absl::OutOfRangeError(
+        absl::StrFormat("vertex id %d out of range [0, %d)", v, num_vertices()));
+  }
+  const int32_t f = VertexFaces()[v];
+  if (f < 0) {
+    return absl::InvalidArgumentError(
+        absl::StrFormat("vertex %d lies on no face of the mesh", v));
+  }
+  const mesh::Triangle corners = InputFace(f);
+  SurfacePoint p{f, {0, 0, 0}};
+  for (int k = 0; k < 3; ++k) {
+    if (corners[k] == v) {
+      p.w[k] = 1;
+      break;
+    }
+  }
+  return p;
 }
 
 absl::Status InputQueries::DistanceBatch(const EnginePoints& a, const EnginePoints& b,

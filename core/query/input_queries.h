@@ -2,11 +2,11 @@
 
 // The queries of one index, in the ids of the mesh file it was built from:
 // the public face of core/query, with its value types (query_types.h) and
-// scratch space (query_scratch.h). Everything under core/query/internal/ is
+// scratch space (query_scratch.h). Everything under core/query/engine/internal/ is
 // a part behind it.
 //
 // The index's internal mesh differs from the file's when the builder
-// repaired it or split its long edges (internal/input_ids.h says how);
+// repaired it or split its long edges (engine/input_ids.h says how);
 // InputQueries is the one layer that speaks the file's ids: every caller
 // that takes points from a user or gives answers back (the server,
 // geodex-query, the accuracy harness, the Python bindings) goes through it,
@@ -16,7 +16,7 @@
 // them, translated, in an EnginePoints, which the queries take. Answers that
 // name faces or vertices (paths, located points, fields, the triangulation)
 // come back in input ids. A query that is a part of its own (a header of
-// its own beside this one: core/README.md, "Adding a query") takes an
+// its own beside this one: core/query/README.md, "Adding a query") takes an
 // InputQueries and its EnginePoints and answers in input ids too, through
 // engine() and ids(), with no method here.
 //
@@ -33,6 +33,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <mutex>
 #include <span>
 #include <string>
 #include <string_view>
@@ -41,13 +42,13 @@
 #include "absl/status/statusor.h"
 #include "core/index/index.h"
 #include "core/mesh/mesh.h"
-#include "core/query/query_scratch.h"
-#include "core/query/query_types.h"
+#include "core/query/engine/query_scratch.h"
+#include "core/query/engine/query_types.h"
 
 namespace geodex::query {
 
 class QueryEngine;
-class InputIds;  // internal/input_ids.h: kept out of this public header
+class InputIds;  // engine/input_ids.h: kept out of this public header
 
 // Points read by InputQueries::Read: validated, in the engine's ids. Only
 // InputQueries looks inside; callers keep them between calls (reusing one
@@ -91,8 +92,8 @@ class InputQueries {
   // Over a loaded index, sharing it. Errors: those of Open but the file's.
   static absl::StatusOr<std::shared_ptr<const InputQueries>> Create(
       std::shared_ptr<const index::Index> index, QueryOptions options = {});
-  // Over an engine (internal/query_engine.h), sharing it: for an engine made
-  // with test switches (internal/query_knobs.h). Errors: InvalidArgument for
+  // Over an engine (engine/query_engine.h), sharing it: for an engine made
+  // with test switches (engine/query_knobs.h). Errors: InvalidArgument for
   // a null engine.
   static absl::StatusOr<std::shared_ptr<const InputQueries>> Create(
       std::shared_ptr<const QueryEngine> engine);
@@ -107,8 +108,8 @@ class InputQueries {
   double scale_length() const;
 
   // What a query that is a part of its own is lent: the engine
-  // whose distances it takes (internal/query_engine.h), and the map between
-  // the file's ids and the engine's (internal/input_ids.h).
+  // whose distances it takes (engine/query_engine.h), and the map between
+  // the file's ids and the engine's (engine/input_ids.h).
   const QueryEngine& engine() const;
   const InputIds& ids() const;
 
@@ -132,6 +133,22 @@ class InputQueries {
   // a point). InvalidArgument when the lengths do not match.
   absl::Status Read(std::span<const int32_t> faces, std::span<const double> weights,
                     const PointName& name, EnginePoints* out) const;
+  // The same for points of which some or all are given as input vertex ids
+  // (VertexPoint): with `vertices` alone (faces and weights empty), point i
+  // is vertex vertices[i]; with all three, point i is vertex vertices[i]
+  // when that is >= 0, else faces[i] and its weights. Errors: Read's and
+  // VertexPoint's, prefixed by the point's name; InvalidArgument when the
+  // lengths do not match.
+  absl::Status Read(std::span<const int32_t> faces, std::span<const double> weights,
+                    std::span<const int32_t> vertices, const PointName& name,
+                    EnginePoints* out) const;
+  // Input vertex `v` as a surface point in input ids: weight 1 on it, in
+  // the lowest-numbered input face that holds it, so that a path or a field
+  // from a vertex starts at the vertex and names that face. The first call
+  // finds every vertex's face, in one pass over the faces. Errors:
+  // OutOfRange for an id outside [0, num_vertices()); InvalidArgument for a
+  // vertex that no face holds.
+  absl::StatusOr<SurfacePoint> VertexPoint(int32_t v) const;
 
   // Distances of pairs (a[i], b[i]) as QueryEngine::DistanceBatch, with its
   // errors (the points are valid already).
@@ -193,8 +210,14 @@ class InputQueries {
  private:
   explicit InputQueries(std::shared_ptr<const QueryEngine> engine);
 
+  // Per input vertex, the lowest input face that holds it (-1: none), made
+  // by the first VertexPoint.
+  const std::vector<int32_t>& VertexFaces() const;
+
   std::shared_ptr<const QueryEngine> engine_;
   std::unique_ptr<const InputIds> ids_;  // never null
+  mutable std::once_flag vertex_faces_once_;
+  mutable std::vector<int32_t> vertex_faces_;
 };
 
 }  // namespace geodex::query

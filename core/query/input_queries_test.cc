@@ -16,9 +16,9 @@
 #include "core/mesh/broken_meshes_testing.h"
 #include "core/mesh/generators.h"
 #include "core/mesh/mesh_repair.h"
-#include "core/query/internal/input_ids.h"
-#include "core/query/internal/query_engine.h"
-#include "core/validation/test_index.h"
+#include "core/query/engine/input_ids.h"
+#include "core/query/engine/query_engine.h"
+#include "core/build/build_testing.h"
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
 
@@ -377,6 +377,91 @@ TEST(InputQueriesTest, PointsAreCheckedWhereTheyEnter) {
 
   EnginePoints none;
   EXPECT_EQ((*queries)->Field(none).status().code(), absl::StatusCode::kInvalidArgument);
+}
+
+// Vertex ids as points: weight 1 on the vertex in the lowest face holding
+// it (after a face the repair dropped), the same answers as the vertex named
+// in any other face, mixed with face points, and refused with the point's
+// name when out of range or on no face.
+TEST(InputQueriesTest, VertexIdsReadAsTheVertexInItsLowestFace) {
+  const mesh::Mesh sphere = mesh::gen::Sphere(2, 1.0);
+  RawMesh raw = RawOf(sphere, "sphere");
+  // A duplicate of face 7 in front: input face 0, which the repair drops.
+  const mesh::Triangle dup = raw.triangles[7];
+  raw.triangles.insert(raw.triangles.begin(), dup);
+  raw.input_face.insert(raw.input_face.begin(), 0);
+  for (size_t t = 1; t < raw.input_face.size(); ++t) raw.input_face[t] = static_cast<int32_t>(t);
+  const int32_t lonely = mesh::testing::AddVertex(&raw, mesh::Vec3(0, 0, 3));
+  Built b = Build(raw, 40);
+  auto queries = InputQueries::Create(b.engine);
+  ASSERT_TRUE(queries.ok()) << queries.status();
+  const InputQueries& q = **queries;
+  ASSERT_EQ(q.num_vertices(), sphere.num_vertices() + 1);
+
+  EnginePoints any_face, by_id;
+  std::vector<SurfacePoint> named;
+  std::vector<int32_t> ids;
+  for (int32_t v = 0; v < sphere.num_vertices(); ++v) {
+    absl::StatusOr<SurfacePoint> p = q.VertexPoint(v);
+    ASSERT_TRUE(p.ok()) << p.status();
+    int32_t lowest = -1, highest = -1;
+    for (int32_t f = 0; f < q.num_faces(); ++f) {
+      const mesh::Triangle t = q.InputFace(f);
+      if (t[0] != v && t[1] != v && t[2] != v) continue;
+      if (lowest < 0) lowest = f;
+      highest = f;
+    }
+    // The lowest face but the dropped one, which reads as its twin.
+    EXPECT_TRUE(p->face == lowest || (lowest == 0 && p->face > 0)) << "vertex " << v;
+    const mesh::Triangle t = q.InputFace(p->face);
+    for (int k = 0; k < 3; ++k) EXPECT_EQ(p->w[k], t[k] == v ? 1.0 : 0.0) << "vertex " << v;
+    SurfacePoint other{highest, {0, 0, 0}};
+    const mesh::Triangle h = q.InputFace(highest);
+    for (int k = 0; k < 3; ++k) other.w[k] = h[k] == v ? 1.0 : 0.0;
+    named.push_back(other);
+    ids.push_back(v);
+  }
+  ASSERT_TRUE(q.Read(named, Named("a"), &any_face).ok());
+  ASSERT_TRUE(q.Read({}, {}, ids, Named("a"), &by_id).ok());
+  std::vector<int32_t> shifted(ids.begin() + 1, ids.end());
+  shifted.push_back(ids.front());
+  EnginePoints targets;
+  ASSERT_TRUE(q.Read({}, {}, shifted, Named("b"), &targets).ok());
+  std::vector<double> from_faces(ids.size()), from_ids(ids.size());
+  ASSERT_TRUE(q.DistanceBatch(any_face, targets, from_faces).ok());
+  ASSERT_TRUE(q.DistanceBatch(by_id, targets, from_ids).ok());
+  EXPECT_EQ(from_faces, from_ids);
+
+  // A path from a vertex starts at it, in the face VertexPoint chose.
+  absl::StatusOr<std::vector<PathPoint>> path = q.Path(by_id, 3, targets, 3, 0);
+  ASSERT_TRUE(path.ok()) << path.status();
+  EXPECT_EQ(path->front().point.face, q.VertexPoint(3)->face);
+  EXPECT_LT((path->front().position - sphere.position(3)).norm(), 1e-12);
+
+  // Mixed: vertex 5, then a face point.
+  const std::vector<int32_t> mixed_ids = {5, -1};
+  const std::vector<int32_t> faces = {0, 3};
+  const std::vector<double> weights = {0, 0, 0, 0.2, 0.3, 0.5};
+  EnginePoints mixed, alone;
+  ASSERT_TRUE(q.Read(faces, weights, mixed_ids, Named("m"), &mixed).ok());
+  const std::vector<SurfacePoint> both = {*q.VertexPoint(5), SurfacePoint{3, {0.2, 0.3, 0.5}}};
+  ASSERT_TRUE(q.Read(both, Named("m"), &alone).ok());
+  for (size_t i = 0; i < 2; ++i) {
+    EXPECT_EQ(mixed.engine_point(i).face, alone.engine_point(i).face);
+    EXPECT_EQ(mixed.engine_point(i).w, alone.engine_point(i).w);
+  }
+
+  EnginePoints bad;
+  absl::Status status = q.Read({}, {}, std::vector<int32_t>{0, q.num_vertices()}, Named("a"), &bad);
+  EXPECT_EQ(status.code(), absl::StatusCode::kOutOfRange);
+  EXPECT_THAT(std::string(status.message()), ::testing::StartsWith("a[1]: vertex id"));
+  status = q.Read({}, {}, std::vector<int32_t>{-1}, Named("a"), &bad);
+  EXPECT_EQ(status.code(), absl::StatusCode::kOutOfRange);
+  status = q.Read({}, {}, std::vector<int32_t>{lonely}, Named("a"), &bad);
+  EXPECT_EQ(status.code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(std::string(status.message()), ::testing::HasSubstr("on no face"));
+  status = q.Read(faces, weights, std::vector<int32_t>{5}, Named("m"), &bad);
+  EXPECT_EQ(status.code(), absl::StatusCode::kInvalidArgument);
 }
 
 // The field within a radius against the exact whole-mesh field (the

@@ -2,7 +2,7 @@
 
 // The geodex-build command line (core/tools/build_main.cc): its flags and
 // subcommands, the pipeline options they resolve to, and the job they run
-// (core/builder/build_pipeline.h).
+// (core/build/build_pipeline.h).
 //
 //   BuildCommandLine  the CLI11 app with the plan, rows, merge and calibrate
 //                     subcommands, its flags bound to a BuildToolArgs
@@ -15,7 +15,7 @@
 
 #include "CLI/CLI.hpp"
 #include "absl/status/statusor.h"
-#include "core/builder/build_pipeline.h"
+#include "core/build/build_pipeline.h"
 
 namespace geodex::tools {
 

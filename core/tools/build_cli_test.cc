@@ -4,7 +4,7 @@
 #include <memory>
 #include <string>
 
-#include "core/builder/build_rounds.h"
+#include "core/build/build_rounds.h"
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
 

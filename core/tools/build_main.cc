@@ -1,5 +1,5 @@
 // geodex-build: the offline builder job (mesh -> .gdx index); the pipeline is
-// core/builder/build_pipeline.h, the command line core/tools/build_cli.h.
+// core/build/build_pipeline.h, the command line core/tools/build_cli.h.
 //
 //   geodex-build MESH -o OUT.gdx [--target-error E] [--samples M0] [--max-samples CAP]
 //   geodex-build MESH -o OUT.gdx --samples M [--threads N] [--seed S] [--edges-obj FILE]

@@ -139,7 +139,10 @@ absl::StatusOr<std::vector<double>> ExactPairDistances(const mesh::Mesh& mesh,
 absl::StatusOr<std::string> PairDistancesText(const GeodesicToolArgs& args) {
   GEODEX_ASSIGN_OR_RETURN(const mesh::Mesh mesh, mesh::LoadMesh(args.mesh_path, args.read));
   GEODEX_ASSIGN_OR_RETURN(const std::string text, mesh::ReadFileOrStdin(args.pairs_path));
-  GEODEX_ASSIGN_OR_RETURN(const std::vector<mesh::PointPair> pairs, mesh::ParsePairs(text));
+  GEODEX_ASSIGN_OR_RETURN(std::vector<mesh::PointPair> pairs, mesh::ParsePairs(text));
+  const std::vector<mesh::SurfacePoint> lowest = mesh::LowestFacePoints(mesh);
+  GEODEX_RETURN_IF_ERROR(mesh::ResolveVertices(
+      [&](int32_t v) { return mesh::VertexPointOf(lowest, v); }, &pairs));
   GEODEX_RETURN_IF_ERROR(mesh::ValidatePairs(mesh, pairs));
   GEODEX_ASSIGN_OR_RETURN(const std::vector<double> distances,
                           ExactPairDistances(mesh, pairs, args.threads));

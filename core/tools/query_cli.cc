@@ -19,6 +19,8 @@ absl::StatusOr<std::vector<mesh::PointPair>> ReadPairs(const query::InputQueries
                                                        query::EnginePoints* b) {
   GEODEX_ASSIGN_OR_RETURN(const std::string text, mesh::ReadFileOrStdin(path));
   GEODEX_ASSIGN_OR_RETURN(std::vector<mesh::PointPair> pairs, mesh::ParsePairs(text));
+  GEODEX_RETURN_IF_ERROR(mesh::ResolveVertices(
+      [&](int32_t v) { return queries.VertexPoint(v); }, &pairs));
   // Both points of a line are checked before the next line's, as the
   // errors name lines.
   std::vector<mesh::SurfacePoint> both, pa, pb;

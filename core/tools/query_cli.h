@@ -16,7 +16,7 @@
 // --expmap prints "vertex u v" for every vertex within R of the centre (the
 // exponential map, core/query/exp_map.h), ascending by vertex id. Face and
 // vertex ids, in and out, are those of the mesh file the index was built
-// from, also when the builder repaired it (core/query/internal/input_ids.h). Output
+// from, also when the builder repaired it (core/query/engine/input_ids.h). Output
 // goes to standard output in input order; on a bad line nothing is printed and
 // the error names the line. Exit codes: 0 ok, 2 bad input, 1 other errors.
 //

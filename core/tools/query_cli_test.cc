@@ -13,7 +13,7 @@
 #include "core/common/file_util.h"
 #include "core/mesh/generators.h"
 #include "core/tools/cli_testing.h"
-#include "core/validation/test_index.h"
+#include "core/build/build_testing.h"
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
 

@@ -8,7 +8,7 @@
 #include "core/mesh/broken_meshes_testing.h"
 #include "core/mesh/generators.h"
 #include "core/triangulation/geodesic_triangulation.h"
-#include "core/triangulation/test_shapes.h"
+#include "core/triangulation/shapes_testing.h"
 #include "gtest/gtest.h"
 
 namespace geodex::triangulation {

@@ -4,7 +4,7 @@
 #include <string>
 
 #include "core/mesh/generators.h"
-#include "core/triangulation/test_shapes.h"
+#include "core/triangulation/shapes_testing.h"
 #include "gtest/gtest.h"
 
 namespace geodex::triangulation {

@@ -11,11 +11,11 @@
 #include <vector>
 
 #include "absl/strings/str_format.h"
-#include "core/builder/mesh_arrays.h"
 #include "core/common/status_macros.h"
 #include "core/common/threads.h"
-#include "core/query/internal/input_ids.h"
-#include "core/query/internal/query_engine.h"
+#include "core/index/coarse_surface.h"
+#include "core/query/engine/input_ids.h"
+#include "core/query/engine/query_engine.h"
 
 namespace geodex::validation {
 namespace {
@@ -185,8 +185,8 @@ absl::StatusOr<std::vector<ExactPair>> HeldOutPairs(const mesh::Mesh& mesh,
                                                     PairOptions options) {
   options.vertex_limit = index.num_vertices() - index.split_vertices();
   if (!index.split().split()) return DrawPairs(mesh, index.num_samples(), options);
-  GEODEX_ASSIGN_OR_RETURN(const std::optional<builder::CoarseSurface> surface,
-                          builder::CoarseSurfaceOf(mesh, index.split(), index.split_vertices()));
+  GEODEX_ASSIGN_OR_RETURN(const std::optional<index::CoarseSurface> surface,
+                          index::CoarseSurfaceOf(mesh, index.split(), index.split_vertices()));
   const mesh::Mesh& coarse = surface->mesh;
   std::vector<ExactPair> pairs = DrawPairs(coarse, index.num_samples(), options);
   const query::InputIds ids(index);

@@ -8,8 +8,8 @@
 // absolute errors that becomes every answer's error bound, with the relative
 // error of the default answer by scale.
 //
-// Lives above core/builder and core/query: it needs both an index and the
-// query engine that answers from it.
+// Lives above core/query and below core/build: it needs an index and the
+// query engine that answers from it, and the build's rounds read it.
 //
 // Thread safety: reentrant.
 

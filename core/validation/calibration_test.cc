@@ -4,11 +4,11 @@
 #include <cmath>
 
 #include "core/builder/builder.h"
-#include "core/builder/mesh_arrays.h"
+#include "core/builder/prepared_mesh.h"
 #include "core/geodesic/vertex_geodesic.h"
 #include "core/mesh/generators.h"
 #include "core/mesh/mesh_repair.h"
-#include "core/query/internal/query_engine.h"
+#include "core/query/engine/query_engine.h"
 #include "gtest/gtest.h"
 
 namespace geodex::validation {

@@ -9,7 +9,7 @@
 #include "core/common/status_macros.h"
 #include "core/common/threads.h"
 #include "core/geodesic/vertex_geodesic.h"
-#include "core/query/internal/query_engine.h"
+#include "core/query/engine/query_engine.h"
 #include "core/validation/pair_sampling.h"
 
 namespace geodex::validation {

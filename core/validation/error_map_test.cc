@@ -4,7 +4,7 @@
 
 #include "core/builder/builder.h"
 #include "core/mesh/generators.h"
-#include "core/validation/test_index.h"
+#include "core/build/build_testing.h"
 #include "gtest/gtest.h"
 
 namespace geodex::validation {

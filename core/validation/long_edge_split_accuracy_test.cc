@@ -8,10 +8,10 @@
 #include <vector>
 
 #include "core/builder/builder.h"
-#include "core/builder/mesh_arrays.h"
+#include "core/builder/prepared_mesh.h"
 #include "core/mesh/generators.h"
-#include "core/query/internal/input_ids.h"
-#include "core/query/internal/query_engine.h"
+#include "core/query/engine/input_ids.h"
+#include "core/query/engine/query_engine.h"
 #include "core/validation/pair_sampling.h"
 #include "gtest/gtest.h"
 

@@ -4,7 +4,7 @@
 #include <cmath>
 
 #include "absl/strings/str_format.h"
-#include "core/query/query_types.h"
+#include "core/query/engine/query_types.h"
 
 namespace geodex::validation {
 namespace {

@@ -3,7 +3,7 @@
 // What a target-error build asks of an index, how to tell from its
 // calibration whether the index meets it, and how many samples the next
 // round should have when it does not (the rounds themselves:
-// core/builder/build_rounds.h).
+// core/build/build_rounds.h).
 //
 // A target E asks of the default answer, on held-out pairs (calibration.h:
 // sources the build never sampled), in units fixed by the surface

@@ -3,7 +3,7 @@
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
 #include "server/config/limits.h"
-#include "server/test_util.h"
+#include "server/model_repository_testing.h"
 
 namespace geodex::server {
 namespace {

@@ -5,6 +5,7 @@
 #include <cassert>
 #include <cmath>
 #include <limits>
+#include <span>
 #include <vector>
 
 #include "absl/strings/ascii.h"
@@ -17,15 +18,18 @@ namespace geodex::server {
 
 absl::Status PointsFromProto(const v1::SurfacePoints& points, std::string_view name,
                              const query::InputQueries& queries, query::EnginePoints* out) {
-  const int64_t n = points.faces_size();
-  if (points.weights_size() != 3 * n) {
-    return absl::InvalidArgumentError(absl::StrFormat("%s: %d faces but %d weights (want %d)",
-                                                      std::string(name), n, points.weights_size(),
-                                                      3 * n));
+  const std::span<const int32_t> faces(points.faces().data(), points.faces_size());
+  const std::span<const double> weights(points.weights().data(), points.weights_size());
+  if (points.vertices_size() > 0) {
+    const std::span<const int32_t> vertices(points.vertices().data(), points.vertices_size());
+    return queries.Read(faces, weights, vertices, query::Named(name), out);
   }
-  return queries.Read({points.faces().data(), static_cast<size_t>(n)},
-                      {points.weights().data(), static_cast<size_t>(3 * n)}, query::Named(name),
-                      out);
+  if (weights.size() != 3 * faces.size()) {
+    return absl::InvalidArgumentError(absl::StrFormat("%s: %d faces but %d weights (want %d)",
+                                                      std::string(name), faces.size(),
+                                                      weights.size(), 3 * faces.size()));
+  }
+  return queries.Read(faces, weights, query::Named(name), out);
 }
 
 absl::Status CheckPairedUp(const v1::SurfacePoints& a, const v1::SurfacePoints& b) {

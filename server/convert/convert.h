@@ -13,7 +13,7 @@
 //
 // Ids. Requests and answers use the ids of the mesh file a model was built
 // from; when the builder repaired that mesh they differ from the index's
-// (core/query/internal/input_ids.h). Points are read into the index's ids here
+// (core/query/engine/input_ids.h). Points are read into the index's ids here
 // (PointsFromProto), and every answer that names faces or vertices is written
 // back in input ids (here: paths, located points, fields, the mesh, the
 // triangulation, the model's counts; InputQueries answers other calls in
@@ -31,23 +31,29 @@
 #include "core/index/index.h"
 #include "core/mesh/mesh.h"
 #include "core/query/input_queries.h"
-#include "core/query/query_types.h"
+#include "core/query/engine/query_types.h"
 #include "geodex/v1/geodex.pb.h"
 #include "server/registry/model_registry.h"
 
 namespace geodex::server {
 
-// Reads `points` (named `name` in messages, in input ids) into `out`, in the
-// index's ids, validating each point against the input mesh's face count and
-// the engine's weight tolerance. Errors: InvalidArgument if weights are not 3
-// per face ("a: 4 faces but 11 weights (want 12)"); OutOfRange for a face id
+// Reads `points` (named `name` in messages, in input ids; faces and weights,
+// vertex ids, or both mixed: geodex.proto's SurfacePoints) into `out`, in
+// the index's ids, validating each point against the input mesh's face and
+// vertex counts and the engine's weight tolerance. Errors: InvalidArgument
+// if weights are not 3 per face ("a: 4 faces but 11 weights (want 12)") or
+// the vertex ids do not pair up with them, and for a vertex no face holds;
+// OutOfRange for a face or vertex id
 // past the end and InvalidArgument for NaN, infinite or negative weights or
 // weights not summing to 1, both naming the point ("a[17]: ...").
 absl::Status PointsFromProto(const v1::SurfacePoints& points, std::string_view name,
                              const query::InputQueries& queries, query::EnginePoints* out);
 
-// Number of points in `points` (faces; weights are checked by PointsFromProto).
-inline int64_t PointCount(const v1::SurfacePoints& points) { return points.faces_size(); }
+// Number of points in `points`: its vertex ids when it has any, else its
+// faces (the rest is checked by PointsFromProto).
+inline int64_t PointCount(const v1::SurfacePoints& points) {
+  return points.vertices_size() > 0 ? points.vertices_size() : points.faces_size();
+}
 
 // OK when `a` and `b` hold as many points each (pairs a[i], b[i]). Errors:
 // InvalidArgument ("a has 3 points but b has 2; they must pair up").

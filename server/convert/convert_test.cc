@@ -8,7 +8,7 @@
 #include "core/index/index_report.h"
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
-#include "server/test_util.h"
+#include "server/model_repository_testing.h"
 
 namespace geodex::server {
 namespace {

@@ -9,7 +9,7 @@
 #include "core/mesh/generators.h"
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
-#include "server/test_util.h"
+#include "server/model_repository_testing.h"
 
 namespace geodex::server {
 namespace {

@@ -4,7 +4,7 @@
 #include <fstream>
 
 #include "gtest/gtest.h"
-#include "server/test_util.h"
+#include "server/model_repository_testing.h"
 
 namespace geodex::server {
 namespace {

@@ -3,7 +3,7 @@
 // What a call of the Geodex service needs of the service that runs it, and
 // nothing more: the models, the worker pool, the limits, metrics,
 // authentication and the set of running streams. The unary calls
-// (server/service/geodex_service.cc) and every stream reactor (server/streams/) see
+// (server/geodex_service.cc) and every stream reactor (server/streams/) see
 // the service through this struct alone.
 //
 // Ownership: GeodexService owns one; every pointer it holds outlives the

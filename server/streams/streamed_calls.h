@@ -2,7 +2,7 @@
 
 // The service's server-streaming calls, from the proto's list of calls
 // (geodex/v1/geodex_rpcs.h, generated from the service). GeodexService
-// (server/service/geodex_service.h) declares and defines its method for
+// (server/geodex_service.h) declares and defines its method for
 // every one, which only starts the call's reactor; so a new streamed call is
 // its rpc in geodex.proto and its reactor (server/streams/<call>_stream.*),
 // and neither this header nor the service's files change.

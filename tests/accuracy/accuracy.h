@@ -20,7 +20,7 @@
 
 #include "absl/status/statusor.h"
 #include "core/mesh/mesh.h"
-#include "core/query/internal/query_engine.h"
+#include "core/query/engine/query_engine.h"
 #include "core/validation/pair_sampling.h"
 
 namespace geodex::accuracy {

@@ -13,7 +13,7 @@
 
 #include "core/mesh/generators.h"
 #include "core/mesh/mesh_repair.h"
-#include "core/validation/test_index.h"
+#include "core/build/build_testing.h"
 #include "gtest/gtest.h"
 
 namespace geodex::accuracy {

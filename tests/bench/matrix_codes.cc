@@ -22,11 +22,11 @@
 
 #include "CLI/CLI.hpp"
 #include "core/builder/builder.h"
-#include "core/builder/mesh_arrays.h"
+#include "core/builder/prepared_mesh.h"
 #include "core/common/status_macros.h"
 #include "core/index/index.h"
 #include "core/mesh/mesh_repair.h"
-#include "core/query/internal/query_engine.h"
+#include "core/query/engine/query_engine.h"
 #include "core/validation/pair_sampling.h"
 
 namespace geodex {

@@ -18,8 +18,8 @@
 
 #include "CLI/CLI.hpp"
 #include "core/index/index.h"
-#include "core/query/internal/bounds/error_bounds.h"
-#include "core/query/internal/query_engine.h"
+#include "core/query/engine/internal/bounds/error_bounds.h"
+#include "core/query/engine/query_engine.h"
 #include "tests/bench/bench_timing.h"
 #include "tests/bench/refinement_accuracy.h"
 

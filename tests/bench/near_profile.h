@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "core/mesh/mesh.h"
-#include "core/query/internal/query_engine.h"
+#include "core/query/engine/query_engine.h"
 
 namespace geodex::bench {
 

@@ -12,9 +12,9 @@
 
 #include "absl/strings/str_split.h"
 #include "core/builder/builder.h"
-#include "core/builder/mesh_arrays.h"
+#include "core/builder/prepared_mesh.h"
 #include "core/mesh/generators.h"
-#include "core/validation/test_index.h"
+#include "core/build/build_testing.h"
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
 #include "tests/bench/bench_flags.h"

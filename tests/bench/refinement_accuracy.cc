@@ -9,8 +9,8 @@
 #include "absl/strings/str_format.h"
 #include "core/geodesic/exact_geodesic.h"
 #include "core/mesh/mesh.h"
-#include "core/query/internal/bounds/error_bounds.h"
-#include "core/query/internal/query_engine.h"
+#include "core/query/engine/internal/bounds/error_bounds.h"
+#include "core/query/engine/query_engine.h"
 #include "tests/bench/bench_table.h"
 #include "tests/bench/bench_timing.h"
 

@@ -6,7 +6,7 @@
 
 #include "absl/strings/str_format.h"
 #include "core/index/index.h"
-#include "core/query/internal/query_engine.h"
+#include "core/query/engine/query_engine.h"
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
 #include "tests/bench/bench_flags.h"

@@ -23,7 +23,7 @@
 #include <string>
 
 #include "core/builder/builder.h"
-#include "core/builder/mesh_arrays.h"
+#include "core/builder/prepared_mesh.h"
 #include "core/mesh/broken_meshes_testing.h"
 #include "core/mesh/generators.h"
 #include "core/mesh/mesh_repair.h"

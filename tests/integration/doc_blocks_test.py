@@ -166,6 +166,8 @@ class Stage:
                  "17 0.2 0.2 0.6 9000 0.3 0.3 0.4"]
         self.write("pairs.txt", pairs)
         self.write("path_pairs.txt", pairs[:1])
+        # Vertex ids ("v ID") in place of points, alone and mixed.
+        self.write("vertex_pairs.txt", ["v 0 v 4000", "v 17 100 0.2 0.3 0.5"])
         self.write("sources.txt", ["0 1 0 0", "100 0.2 0.3 0.5"])
         self.write("s.txt", ["0 1 0 0", "100 0.2 0.3 0.5"])
         self.write("t.txt", ["5 0.5 0.5 0", "4000 0.1 0.1 0.8", "9000 0.3 0.3 0.4"])

@@ -6,8 +6,8 @@
 #   e2e_test.sh --geodex BIN --server-bin BIN --build-bin BIN --query-bin BIN
 #   e2e_test.sh --fake --geodex BIN --server-bin geodex-fake-server
 #
-# --fake runs the CLI checks against client/testing's fake server (closed-form
-# answers, model "fake") and skips everything that needs the real geometry.
+# --fake runs the CLI checks against the fake server
+# (client/fake_geodex_service_testing.h: closed-form answers, model "fake") and skips everything that needs the real geometry.
 # Exit codes: 0 all passed, 1 a check failed, 77 the server binary is missing
 # (ctest reports the test as skipped).
 set -uo pipefail

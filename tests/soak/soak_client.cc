@@ -9,7 +9,7 @@
 #include "core/index/index.h"
 #include "core/query/exp_map.h"
 #include "core/query/input_queries.h"
-#include "core/query/internal/query_engine.h"
+#include "core/query/engine/query_engine.h"
 
 namespace geodex::soak {
 

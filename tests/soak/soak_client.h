@@ -18,7 +18,7 @@
 #include <string>
 #include <vector>
 
-#include "core/query/internal/query_engine.h"
+#include "core/query/engine/query_engine.h"
 #include "geodex/v1/geodex.grpc.pb.h"
 #include "grpcpp/channel.h"
 

@@ -12,7 +12,7 @@
 
 #include "CLI/CLI.hpp"
 #include "absl/status/statusor.h"
-#include "core/query/internal/query_engine.h"
+#include "core/query/engine/query_engine.h"
 #include "tests/soak/soak_client.h"
 
 namespace geodex::soak {

@@ -10,7 +10,7 @@
 #include "grpcpp/create_channel.h"
 #include "gtest/gtest.h"
 #include "server/server.h"
-#include "server/test_util.h"
+#include "server/model_repository_testing.h"
 #include "tests/bench/bench_flags.h"
 #include "tests/soak/soak_client.h"
 

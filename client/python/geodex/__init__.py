@@ -11,7 +11,8 @@ Two ways in, with the same methods and the same answers:
 
 A surface point is a face id of the mesh file the index was built from and
 the barycentric weights of that face's three vertices: points are
-``(faces, weights)`` arrays of shapes (N,) and (N, 3). Errors are
+``(faces, weights)`` arrays of shapes (N,) and (N, 3), or vertex ids of
+the mesh file, ``geodex.vertices(ids)``. Errors are
 :class:`Error` subclasses named after their status code
 (:class:`InvalidArgument`, :class:`NotFound`, ...).
 """
@@ -38,7 +39,7 @@ from .errors import (
     Unknown,
 )
 from . import errors as _errors
-from ._arrays import Located, Path, SurfacePoints
+from ._arrays import Located, Path, SurfacePoints, VertexPoints, vertices
 from ._inprocess import BuildProgress, Index, build, has_in_process
 from ._values import Model, Tls, Triangulation
 
@@ -79,6 +80,8 @@ __all__ = [
     "BuildProgress",
     "has_in_process",
     "SurfacePoints",
+    "VertexPoints",
+    "vertices",
     "Located",
     "Path",
     # the exception classes, one per status code

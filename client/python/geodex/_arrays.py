@@ -21,6 +21,10 @@ from .errors import InvalidArgument, OutOfRange
 
 __all__ = [
     "SurfacePoints",
+    "VertexPoints",
+    "Points",
+    "vertices",
+    "count",
     "Located",
     "Path",
     "as_points",
@@ -54,6 +58,73 @@ class SurfacePoints(NamedTuple):
         ``points.take(slice(0, 10))``. (Indexing the tuple itself picks its
         fields, as for any tuple.)"""
         return SurfacePoints(self.faces[index], self.weights[index])
+
+
+class VertexPoints(NamedTuple):
+    """Points given as vertex ids of the mesh file the index was built from
+    (made by :func:`geodex.vertices`): point i is vertex ``vertices[i]``,
+    read as weight 1 on it in the lowest-numbered face that holds it. Every
+    query takes them where it takes :class:`SurfacePoints`; a path or a field
+    from a vertex starts at it, and a path's first point names that face.
+
+    Attributes
+    ----------
+    vertices : numpy.ndarray
+        (N,) int32 vertex ids.
+    """
+
+    vertices: np.ndarray
+
+    def take(self, index: Any) -> "VertexPoints":
+        """The points at ``index`` (a slice, an integer array or a mask)."""
+        return VertexPoints(self.vertices[index])
+
+
+# What the queries take once the front has checked them.
+Points = Union[SurfacePoints, VertexPoints]
+
+
+def count(points: Points) -> int:
+    """The number of points."""
+    if isinstance(points, VertexPoints):
+        return int(points.vertices.shape[0])
+    return int(points.faces.shape[0])
+
+
+def vertices(ids: Any) -> VertexPoints:
+    """Vertices of the mesh file as points, for any query that takes points:
+    ``index.distance(geodex.vertices([0, 5]), geodex.vertices([17, 2]))``.
+
+    Parameters
+    ----------
+    ids : array_like
+        (N,) vertex ids (integers, or floats that are whole numbers), or one
+        id.
+
+    Raises
+    ------
+    InvalidArgument
+        Not a 1-D array of whole numbers, or a negative id (naming the first).
+    OutOfRange
+        An id beyond int32. An id past the model's vertex count is refused
+        by the query (OutOfRange, naming the point).
+    """
+    array = np.asarray(ids)
+    if array.ndim == 0:
+        array = array.reshape(1)
+    if array.ndim != 1:
+        raise InvalidArgument(f"vertices has shape {array.shape}, want (N,)")
+    if array.shape[0] > 0:
+        array = as_ids(array, "vertices")
+        negative = array < 0
+        if negative.any():
+            i = _first(negative)
+            raise InvalidArgument(f"vertices[{i}] is {int(array[i])}: vertex ids are >= 0")
+        large = array > _INT32_MAX
+        if large.any():
+            i = _first(large)
+            raise OutOfRange(f"vertices[{i}] is {int(array[i])}, past any vertex id (int32)")
+    return VertexPoints(np.ascontiguousarray(array, dtype=np.int32))
 
 
 class Located(NamedTuple):
@@ -134,7 +205,7 @@ def as_ids(ids: np.ndarray, name: str) -> np.ndarray:
     return np.clip(ids, -(2.0**62), 2.0**62).astype(np.int64)
 
 
-def as_points(points: PointsLike, name: str) -> SurfacePoints:
+def as_points(points: PointsLike, name: str) -> Points:
     """Validates surface points and returns them as C-contiguous arrays.
 
     Parameters
@@ -144,14 +215,16 @@ def as_points(points: PointsLike, name: str) -> SurfacePoints:
         float array of whole numbers) and weights
         a float array of shape (N, 3); or anything with ``.faces`` and
         ``.weights`` (a :class:`SurfacePoints`, a :class:`Located`). A single
-        point may be given as ``(face, (w0, w1, w2))``.
+        point may be given as ``(face, (w0, w1, w2))``. Vertex ids
+        (:class:`VertexPoints`, from :func:`geodex.vertices`) pass as they
+        are.
     name : str
         How error messages name the points ("a", "sources", ...).
 
     Returns
     -------
-    SurfacePoints
-        faces (N,) int32 and weights (N, 3) float64.
+    SurfacePoints or VertexPoints
+        faces (N,) int32 and weights (N, 3) float64; or the vertex ids.
 
     Raises
     ------
@@ -161,6 +234,8 @@ def as_points(points: PointsLike, name: str) -> SurfacePoints:
     OutOfRange
         A face id beyond int32 (no mesh has that many faces).
     """
+    if isinstance(points, VertexPoints):
+        return points  # checked by geodex.vertices
     if hasattr(points, "faces") and hasattr(points, "weights"):
         faces, weights = points.faces, points.weights
     elif isinstance(points, (tuple, list)) and len(points) == 2:

@@ -60,6 +60,9 @@ class Index:
         """(k,) int32 vertices and (k,) float64 r, theta, u, v."""
     def locate(self, xyz: _Weights, /) -> Tuple[_I32, _F64, _F64]:
         """(N,) int32 faces, (N, 3) float64 weights, (N,) float64 distances."""
+    def vertex_points(self, ids: _Faces, name: str, /) -> Tuple[_I32, _F64]:
+        """(N,) int32 faces and (N, 3) float64 weights of (N,) vertex ids:
+        weight 1 on each vertex in the lowest face that holds it."""
     def mesh(self) -> Tuple[_F64, _I32]:
         """(V, 3) float64 vertices and (F, 3) int32 faces."""
 

@@ -21,7 +21,8 @@ from typing import Any, Generic, List, Optional, Sequence, Tuple, TypeVar, Union
 
 import numpy as np
 
-from ._arrays import Located, Path, SurfacePoints, as_near_pairs, as_points, as_positions
+from ._arrays import Located, Path, Points, SurfacePoints, VertexPoints, as_near_pairs, as_points
+from ._arrays import as_positions, count
 from ._arrays import check_nonnegative, check_tolerance
 from .errors import InvalidArgument
 
@@ -44,40 +45,40 @@ class QueryFront(Generic[At]):
     # --- the back half, one method a query ---------------------------------
 
     def _run_distance(
-        self, at: At, a: SurfacePoints, b: SurfacePoints, near_pairs: int, tolerance: float,
+        self, at: At, a: Points, b: Points, near_pairs: int, tolerance: float,
         bounds: bool, refine_below: float,
     ) -> Tuple[np.ndarray, Optional[np.ndarray]]:
         """(N,) float64 distances, and (N,) bounds when ``bounds``."""
         raise NotImplementedError
 
     def _run_matrix(
-        self, at: At, sources: SurfacePoints, targets: SurfacePoints, near_pairs: int,
+        self, at: At, sources: Points, targets: Points, near_pairs: int,
         tolerance: float, bounds: bool, refine_below: float,
     ) -> Tuple[np.ndarray, Optional[np.ndarray]]:
         """(S, T) float64 distances, and (S, T) bounds when ``bounds``."""
         raise NotImplementedError
 
     def _run_path(
-        self, at: At, a: SurfacePoints, b: SurfacePoints, exact_corridor: int, batch_size: int
+        self, at: At, a: Points, b: Points, exact_corridor: int, batch_size: int
     ) -> List[Path]:
         raise NotImplementedError
 
     def _run_field(
-        self, at: At, sources: SurfacePoints, nearest: bool
+        self, at: At, sources: Points, nearest: bool
     ) -> Tuple[np.ndarray, Optional[np.ndarray]]:
         """(n,) float64 per vertex, and (n,) int32 nearest sources when
         ``nearest``."""
         raise NotImplementedError
 
     def _run_field_within(
-        self, at: At, sources: SurfacePoints, radius: float, nearest: bool
+        self, at: At, sources: Points, radius: float, nearest: bool
     ) -> Tuple[np.ndarray, np.ndarray, Optional[np.ndarray]]:
         """(k,) int32 vertices, (k,) float64 distances, and (k,) int32
         nearest sources when ``nearest``."""
         raise NotImplementedError
 
     def _run_expmap(
-        self, at: At, centre: SurfacePoints, radius: float, direction: Optional[np.ndarray],
+        self, at: At, centre: Points, radius: float, direction: Optional[np.ndarray],
         polar: bool, near_pairs: int, tolerance: float,
     ) -> Tuple[np.ndarray, np.ndarray]:
         """(k,) int32 vertices and (k, 2) float64 coordinates; ``direction``
@@ -93,24 +94,33 @@ class QueryFront(Generic[At]):
     def _run_mesh(self, at: At) -> Tuple[np.ndarray, np.ndarray]:
         raise NotImplementedError
 
+    def _run_vertices(self, at: At, points: VertexPoints, name: str) -> Points:
+        """Vertex ids as the backend answers them: an index reads them as
+        surface points here; a client sends the ids as they are."""
+        return points
+
     # --- the front half ----------------------------------------------------
 
     def _points(
         self, at: At, points: Sequence[Any], names: Sequence[str], xyz: bool
-    ) -> List[SurfacePoints]:
+    ) -> List[Points]:
         """Validated points; with xyz, every array is validated before the
         first is located (nothing is sent for input no index accepts)."""
         if not xyz:
-            return [as_points(p, name) for p, name in zip(points, names)]
+            checked = [as_points(p, name) for p, name in zip(points, names)]
+            return [
+                self._run_vertices(at, p, name) if isinstance(p, VertexPoints) else p
+                for p, name in zip(checked, names)
+            ]
         positions = [as_positions(p, name) for p, name in zip(points, names)]
         located = [self._run_locate(at, p, 65536) for p in positions]
         return [SurfacePoints(x.faces, x.weights) for x in located]
 
     @staticmethod
-    def _pair_up(a: SurfacePoints, b: SurfacePoints) -> None:
-        if a.faces.shape[0] != b.faces.shape[0]:
+    def _pair_up(a: Points, b: Points) -> None:
+        if count(a) != count(b):
             raise InvalidArgument(
-                f"a has {a.faces.shape[0]} points but b has {b.faces.shape[0]}; they must pair up"
+                f"a has {count(a)} points but b has {count(b)}; they must pair up"
             )
 
     def _distance(
@@ -169,8 +179,8 @@ class QueryFront(Generic[At]):
         check_tolerance(tolerance)
         as_near_pairs(near_pairs)
         (c,) = self._points(at, [centre], ("centre",), xyz)
-        if c.faces.shape[0] != 1:
-            raise InvalidArgument(f"centre must be one point, not {c.faces.shape[0]}")
+        if count(c) != 1:
+            raise InvalidArgument(f"centre must be one point, not {count(c)}")
         ref = None if direction is None else as_positions(direction, "direction")
         return self._run_expmap(
             at, c, float(radius), ref, bool(polar), NEAR_PAIRS[near_pairs], float(tolerance)

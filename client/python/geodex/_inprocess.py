@@ -21,7 +21,7 @@ from typing import Any, Callable, Dict, List, NamedTuple, Optional, Sequence, Tu
 
 import numpy as np
 
-from ._arrays import Located, Path, SurfacePoints, as_mesh, is_pathlike
+from ._arrays import Located, Path, Points, SurfacePoints, VertexPoints, as_mesh, is_pathlike
 from ._front import QueryFront
 from .errors import InvalidArgument
 
@@ -37,6 +37,13 @@ __all__ = ["Index", "build", "BuildProgress", "has_in_process"]
 
 # The builder's messages about the rounds of a target-error build.
 _log = logging.getLogger("geodex")
+
+
+def _read(points: Points) -> SurfacePoints:
+    """Points as the compiled module takes them: the front has read vertex
+    ids as surface points already (Index._run_vertices)."""
+    assert isinstance(points, SurfacePoints), "vertex ids reach the index as surface points"
+    return points
 
 
 def has_in_process() -> bool:
@@ -137,7 +144,7 @@ class Index(QueryFront[None]):
     def info(self) -> Dict[str, Any]:
         """The build report as a dict: mesh, repairs, samples, size by
         section, the error target (met, or why not) and the relative error by
-        distance (keys in core/README.md, "The build report"); relative
+        distance (keys in core/index/README.md, "The build report"); relative
         errors are fractions. Equal to ``Client.info`` of a server serving
         this file."""
         return json.loads(self._index.report_json)
@@ -326,19 +333,25 @@ class Index(QueryFront[None]):
 
     # --- the back half: geodex._core ----------------------------------------
 
+    def _run_vertices(self, at: None, points: VertexPoints, name: str) -> Points:
+        faces, weights = self._index.vertex_points(points.vertices, name)
+        return SurfacePoints(faces, weights)
+
     def _run_distance(
-        self, at: None, a: SurfacePoints, b: SurfacePoints, near_pairs: int, tolerance: float,
+        self, at: None, a: Points, b: Points, near_pairs: int, tolerance: float,
         bounds: bool, refine_below: float,
     ) -> Tuple[np.ndarray, Optional[np.ndarray]]:
+        a, b = _read(a), _read(b)
         d, bnd = self._index.distance(
             a.faces, a.weights, b.faces, b.weights, near_pairs, tolerance, bounds, refine_below
         )
         return d, (bnd if bounds else None)
 
     def _run_matrix(
-        self, at: None, sources: SurfacePoints, targets: SurfacePoints, near_pairs: int,
+        self, at: None, sources: Points, targets: Points, near_pairs: int,
         tolerance: float, bounds: bool, refine_below: float,
     ) -> Tuple[np.ndarray, Optional[np.ndarray]]:
+        sources, targets = _read(sources), _read(targets)
         m, bnd = self._index.matrix(
             sources.faces, sources.weights, targets.faces, targets.weights,
             near_pairs, tolerance, bounds, refine_below,
@@ -346,27 +359,31 @@ class Index(QueryFront[None]):
         return m, (bnd if bounds else None)
 
     def _run_path(
-        self, at: None, a: SurfacePoints, b: SurfacePoints, exact_corridor: int, batch_size: int
+        self, at: None, a: Points, b: Points, exact_corridor: int, batch_size: int
     ) -> List[Path]:
+        a, b = _read(a), _read(b)
         raw = self._index.path(a.faces, a.weights, b.faces, b.weights, exact_corridor)
         return [Path(*path) for path in raw]  # (positions, faces, weights, length)
 
     def _run_field(
-        self, at: None, sources: SurfacePoints, nearest: bool
+        self, at: None, sources: Points, nearest: bool
     ) -> Tuple[np.ndarray, Optional[np.ndarray]]:
+        sources = _read(sources)
         d, near = self._index.field(sources.faces, sources.weights)
         return d, (near if nearest else None)
 
     def _run_field_within(
-        self, at: None, sources: SurfacePoints, radius: float, nearest: bool
+        self, at: None, sources: Points, radius: float, nearest: bool
     ) -> Tuple[np.ndarray, np.ndarray, Optional[np.ndarray]]:
+        sources = _read(sources)
         ids, d, near = self._index.field_within(sources.faces, sources.weights, radius)
         return ids, d, (near if nearest else None)
 
     def _run_expmap(
-        self, at: None, centre: SurfacePoints, radius: float, direction: Optional[np.ndarray],
+        self, at: None, centre: Points, radius: float, direction: Optional[np.ndarray],
         polar: bool, near_pairs: int, tolerance: float,
     ) -> Tuple[np.ndarray, np.ndarray]:
+        centre = _read(centre)
         ref = None if direction is None else direction[0]
         vertices, r, theta, u, v = self._index.expmap(
             int(centre.faces[0]), centre.weights[0], radius, ref, near_pairs, tolerance

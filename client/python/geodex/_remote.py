@@ -9,21 +9,49 @@ would copy every number through a Python float.
 
 from __future__ import annotations
 
-from typing import Any, Iterator, List, Optional, Sequence, Tuple, Union, cast
+from typing import Any, Dict, Iterator, List, Optional, Sequence, Tuple, Union, cast
 
 import grpc
 import numpy as np
 
 from . import _wire
-from ._arrays import Located, Path, SurfacePoints
+from ._arrays import Located, Path, Points, VertexPoints
+from ._arrays import count as count_points
 from ._front import QueryFront
 from ._messages import _in_pairs, _model_ref, _path_of, _rpc_error
 from .errors import DataLoss, error_for_code
 from .v1 import geodex_pb2 as pb
 
-__all__ = ["At", "RemoteQueries"]
+__all__ = ["At", "RemoteQueries", "raw_calls"]
 
-_METHOD = "/geodex.v1.Geodex/"
+# gRPC's multicallable for each kind of call: (client streams, server streams).
+_KINDS = {
+    (False, False): "unary_unary",
+    (False, True): "unary_stream",
+    (True, False): "stream_unary",
+    (True, True): "stream_stream",
+}
+
+
+def raw_calls(channel: grpc.Channel) -> Dict[str, Any]:
+    """Every call of geodex.v1.Geodex, as the proto's descriptor lists them,
+    by name: a raw callable on the channel taking and returning serialised
+    bytes (the numeric arrays are encoded and decoded by _wire)."""
+    service = pb.DESCRIPTOR.services_by_name["Geodex"]
+    return {
+        m.name: getattr(channel, _KINDS[m.client_streaming, m.server_streaming])(
+            f"/{service.full_name}/{m.name}"
+        )
+        for m in service.methods
+    }
+
+
+def _points(points: Points) -> bytes:
+    """The geodex.v1.SurfacePoints message of `points`: faces and weights,
+    or vertex ids, which the server reads."""
+    if isinstance(points, VertexPoints):
+        return _wire.vertex_points(points.vertices)
+    return _wire.surface_points(points.faces, points.weights)
 
 
 class At:
@@ -56,15 +84,15 @@ class RemoteQueries(QueryFront[At]):
     _batch_size: int
 
     def _open_methods(self, channel: grpc.Channel) -> None:
-        raw = lambda kind, name: getattr(channel, kind)(_METHOD + name)  # noqa: E731
-        self._distance_call = raw("unary_unary", "Distance")
-        self._stream_distances = raw("stream_stream", "StreamDistances")
-        self._matrix_call = raw("unary_stream", "Matrix")
-        self._path_call = raw("unary_unary", "Path")
-        self._field_call = raw("unary_stream", "DistanceField")
-        self._expmap_call = raw("unary_stream", "ExpMap")
-        self._locate_call = raw("unary_unary", "Locate")
-        self._mesh_call = raw("unary_stream", "GetMesh")
+        calls = raw_calls(channel)
+        self._distance_call = calls["Distance"]
+        self._stream_distances = calls["StreamDistances"]
+        self._matrix_call = calls["Matrix"]
+        self._path_call = calls["Path"]
+        self._field_call = calls["DistanceField"]
+        self._expmap_call = calls["ExpMap"]
+        self._locate_call = calls["Locate"]
+        self._mesh_call = calls["GetMesh"]
 
     def distance(
         self,
@@ -128,10 +156,10 @@ class RemoteQueries(QueryFront[At]):
         )
 
     def _run_distance(
-        self, at: At, a: SurfacePoints, b: SurfacePoints, near_pairs: int, tolerance: float,
+        self, at: At, a: Points, b: Points, near_pairs: int, tolerance: float,
         bounds: bool, refine_below: float,
     ) -> Tuple[np.ndarray, Optional[np.ndarray]]:
-        n = a.faces.shape[0]
+        n = count_points(a)
         ref = at.ref()
         if n > self._batch_size:
             return self._stream(ref, a, b, bounds, tolerance, near_pairs, refine_below)
@@ -141,8 +169,8 @@ class RemoteQueries(QueryFront[At]):
         ).SerializeToString()
         request = (
             head
-            + _wire.length_delimited(2, _wire.surface_points(a.faces, a.weights))
-            + _wire.length_delimited(3, _wire.surface_points(b.faces, b.weights))
+            + _wire.length_delimited(2, _points(a))
+            + _wire.length_delimited(3, _points(b))
         )
         try:
             data = self._distance_call(request, timeout=self._timeout, metadata=self._metadata)
@@ -157,8 +185,8 @@ class RemoteQueries(QueryFront[At]):
     def _stream(
         self,
         ref: pb.ModelRef,
-        a: SurfacePoints,
-        b: SurfacePoints,
+        a: Points,
+        b: Points,
         bounds: bool,
         tolerance: float,
         near_pairs: int,
@@ -168,7 +196,7 @@ class RemoteQueries(QueryFront[At]):
         batch. gRPC's sending thread encodes a batch when the previous one
         has gone out, and the server reads a few batches ahead of its
         answers, so only a few batches are ever in memory at once."""
-        n = a.faces.shape[0]
+        n = count_points(a)
         size = self._batch_size
         num_batches = (n + size - 1) // size
         out = np.empty(n, dtype=np.float64)
@@ -186,10 +214,10 @@ class RemoteQueries(QueryFront[At]):
                 yield (
                     head.SerializeToString()
                     + _wire.length_delimited(
-                        3, _wire.surface_points(a.faces[lo:hi], a.weights[lo:hi])
+                        3, _points(a.take(slice(lo, hi)))
                     )
                     + _wire.length_delimited(
-                        4, _wire.surface_points(b.faces[lo:hi], b.weights[lo:hi])
+                        4, _points(b.take(slice(lo, hi)))
                     )
                 )
 
@@ -251,14 +279,14 @@ class RemoteQueries(QueryFront[At]):
         )
 
     def _run_matrix(
-        self, at: At, sources: SurfacePoints, targets: SurfacePoints, near_pairs: int,
+        self, at: At, sources: Points, targets: Points, near_pairs: int,
         tolerance: float, bounds: bool, refine_below: float,
     ) -> Tuple[np.ndarray, Optional[np.ndarray]]:
         src, tgt = sources, targets
-        s, t = src.faces.shape[0], tgt.faces.shape[0]
+        s, t = count_points(src), count_points(tgt)
         out = np.empty((s, t), dtype=np.float64)
         out_bounds = np.empty((s, t), dtype=np.float64) if bounds else None
-        targets_bytes = _wire.length_delimited(3, _wire.surface_points(tgt.faces, tgt.weights))
+        targets_bytes = _wire.length_delimited(3, _points(tgt))
         rows_per_call = max(1, (1 << 24) // max(t, 1))
         start = 0
         while True:
@@ -270,7 +298,7 @@ class RemoteQueries(QueryFront[At]):
             request = (
                 head
                 + _wire.length_delimited(
-                    2, _wire.surface_points(src.faces[start:stop], src.weights[start:stop])
+                    2, _points(src.take(slice(start, stop)))
                 )
                 + targets_bytes
             )
@@ -335,19 +363,19 @@ class RemoteQueries(QueryFront[At]):
         return self._path(At(model, version), a, b, exact_corridor, xyz, batch_size)
 
     def _run_path(
-        self, at: At, a: SurfacePoints, b: SurfacePoints, exact_corridor: int, batch_size: int
+        self, at: At, a: Points, b: Points, exact_corridor: int, batch_size: int
     ) -> List[Path]:
-        pa, pb_, n = a, b, a.faces.shape[0]
+        pa, pb_, n = a, b, count_points(a)
         paths: List[Path] = []
         for lo in range(0, max(n, 1), batch_size):
             hi = min(n, lo + batch_size)
             request = (
                 pb.PathRequest(model=at.ref(), exact_corridor=exact_corridor).SerializeToString()
                 + _wire.length_delimited(
-                    2, _wire.surface_points(pa.faces[lo:hi], pa.weights[lo:hi])
+                    2, _points(pa.take(slice(lo, hi)))
                 )
                 + _wire.length_delimited(
-                    3, _wire.surface_points(pb_.faces[lo:hi], pb_.weights[lo:hi])
+                    3, _points(pb_.take(slice(lo, hi)))
                 )
             )
             try:
@@ -405,16 +433,16 @@ class RemoteQueries(QueryFront[At]):
         """
         return self._field(At(model, version), sources, radius, nearest, xyz)
 
-    def _field_request(self, at: At, sources: SurfacePoints, radius: float, nearest: bool) -> bytes:
+    def _field_request(self, at: At, sources: Points, radius: float, nearest: bool) -> bytes:
         return (
             pb.DistanceFieldRequest(
                 model=at.ref(), with_nearest_source=nearest, radius=radius
             ).SerializeToString()
-            + _wire.length_delimited(2, _wire.surface_points(sources.faces, sources.weights))
+            + _wire.length_delimited(2, _points(sources))
         )
 
     def _run_field(
-        self, at: At, sources: SurfacePoints, nearest: bool
+        self, at: At, sources: Points, nearest: bool
     ) -> Tuple[np.ndarray, Optional[np.ndarray]]:
         request = self._field_request(at, sources, 0.0, nearest)
         out: Optional[np.ndarray] = None
@@ -448,7 +476,7 @@ class RemoteQueries(QueryFront[At]):
         return out, near
 
     def _run_field_within(
-        self, at: At, sources: SurfacePoints, radius: float, nearest: bool
+        self, at: At, sources: Points, radius: float, nearest: bool
     ) -> Tuple[np.ndarray, np.ndarray, Optional[np.ndarray]]:
         """The sparse chunks of a field within a radius, assembled."""
         request = self._field_request(at, sources, radius, nearest)
@@ -535,7 +563,7 @@ class RemoteQueries(QueryFront[At]):
         return self._expmap(at, centre, radius, direction, polar, near_pairs, tolerance, xyz)
 
     def _run_expmap(
-        self, at: At, centre: SurfacePoints, radius: float, direction: Optional[np.ndarray],
+        self, at: At, centre: Points, radius: float, direction: Optional[np.ndarray],
         polar: bool, near_pairs: int, tolerance: float,
     ) -> Tuple[np.ndarray, np.ndarray]:
         c = centre
@@ -545,7 +573,7 @@ class RemoteQueries(QueryFront[At]):
         if direction is not None:
             request.reference_direction.xyz.extend(direction.ravel().tolist())
         data = request.SerializeToString() + _wire.length_delimited(
-            2, _wire.surface_points(c.faces, c.weights)
+            2, _points(c)
         )
         vertices: List[np.ndarray] = []
         first: List[np.ndarray] = []

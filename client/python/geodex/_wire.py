@@ -24,6 +24,7 @@ __all__ = [
     "encode_varints",
     "decode_varints",
     "surface_points",
+    "vertex_points",
     "positions",
     "length_delimited",
     "read_fields",
@@ -107,6 +108,15 @@ def surface_points(faces: np.ndarray, weights: np.ndarray) -> bytes:
     return length_delimited(1, encode_varints(faces)) + length_delimited(
         2, np.ascontiguousarray(weights, dtype="<f8").tobytes()
     )
+
+
+def vertex_points(vertices: np.ndarray) -> bytes:
+    """A geodex.v1.SurfacePoints message of points given as vertex ids:
+    vertices (N,) non-negative int32 as field 3 (packed varints), no faces
+    and no weights."""
+    if vertices.shape[0] == 0:
+        return b""
+    return length_delimited(3, encode_varints(vertices))
 
 
 def positions(xyz: np.ndarray) -> bytes:

@@ -222,7 +222,7 @@ class Client(RemoteQueries):
         """The build report of a model (its newest version, or ``version``)
         as a dict: mesh, repairs, samples, size by section, the error target
         (met, or why not) and the relative error by distance (keys in
-        core/README.md, "The build report"); relative errors are fractions.
+        core/index/README.md, "The build report"); relative errors are fractions.
         Equal to ``geodex.Index(path).info()`` of the file served.
 
         Raises NotFound for an unknown model or version, FailedPrecondition

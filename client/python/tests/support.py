@@ -64,7 +64,8 @@ def build_index(mesh: str, out: Path, *args: str) -> Path:
 
 class Server:
     """A server process on 127.0.0.1, on a port the kernel chose: by default
-    geodex-server on `models` (the fake server of client/testing with
+    geodex-server on `models` (the fake server,
+    client/fake_geodex_service_testing.h, with
     binary="client/geodex-fake-server", which announces its port on stderr)."""
 
     def __init__(self, models: Path, log: Path, *args: str,

@@ -1,5 +1,5 @@
-"""The client against client/testing's fake server, whose answers are closed
-forms (client/testing/fake_geodex_service.h): how batches, streams and chunks
+"""The client against the fake server, whose answers are closed forms
+(client/fake_geodex_service_testing.h): how batches, streams and chunks
 are split and put back together, and how failures come back."""
 
 from pathlib import Path

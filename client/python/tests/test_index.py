@@ -105,6 +105,43 @@ def test_every_other_method_equals_the_server(index, client, num_faces, torus_me
         assert np.array_equal(ours, theirs) and ours.dtype == theirs.dtype
 
 
+def test_vertex_ids_are_points_in_process_and_on_the_server(index, client, num_faces, torus_mesh):
+    vertices, faces = torus_mesh
+    ids = np.arange(0, vertices.shape[0], 7)
+    a, b = geodex.vertices(ids), geodex.vertices(ids[::-1])
+    # The vertex in the lowest face holding it, weight 1 on it.
+    lowest = np.array([np.flatnonzero((faces == v).any(axis=1))[0] for v in ids])
+    corner = (faces[lowest] == ids[:, None]).argmax(axis=1)
+    explicit = (lowest, np.eye(3)[corner])
+    ours = index.distance(a, b)
+    assert np.array_equal(ours, client.distance(MODEL, a, b))
+    assert np.array_equal(ours, index.distance(explicit, b))
+    # Vertex ids mix with face points across the two sides of a pair.
+    g = random_points(num_faces, ids.shape[0], 49)
+    assert np.array_equal(index.distance(a, g), client.distance(MODEL, a, g))
+    for ours_p, theirs_p in zip(index.path(a.take(slice(3)), b.take(slice(3))),
+                                client.path(MODEL, a.take(slice(3)), b.take(slice(3)))):
+        assert np.array_equal(ours_p.positions, theirs_p.positions)
+        assert np.array_equal(ours_p.faces, theirs_p.faces)
+    first = index.path(a.take(slice(1)), b.take(slice(1)))[0]
+    assert np.allclose(first.positions[0], vertices[ids[0]], rtol=0, atol=1e-12)
+    assert first.faces[0] == lowest[0]
+    assert np.array_equal(index.field(a), client.field(MODEL, a))
+    # Whole floats are ids; the rest is refused before anything is sent.
+    assert np.array_equal(geodex.vertices(ids.astype(float)).vertices, ids)
+    with pytest.raises(geodex.InvalidArgument, match="vertices\\[1\\] is -2"):
+        geodex.vertices([0, -2])
+    with pytest.raises(geodex.InvalidArgument, match="vertices\\[0\\] is 1.5"):
+        geodex.vertices([1.5])
+    past = geodex.vertices([0, vertices.shape[0]])
+    with pytest.raises(geodex.OutOfRange) as ours_e:
+        index.distance(past, past)
+    with pytest.raises(geodex.OutOfRange) as theirs_e:
+        client.distance(MODEL, past, past)
+    assert ours_e.value.message == theirs_e.value.message
+    assert "a[1]: vertex id" in ours_e.value.message
+
+
 def test_the_same_exceptions_as_the_server(index, client, num_faces):
     g = random_points(num_faces, 10, 48)
     cases = [

@@ -15,7 +15,7 @@
 #include <vector>
 
 #include "absl/strings/str_format.h"
-#include "core/query/internal/query_engine.h"
+#include "core/query/engine/query_engine.h"
 #include "tests/bench/bench_table.h"
 #include "tests/bench/bench_timing.h"
 #include "tests/bench/query_bench_lib.h"

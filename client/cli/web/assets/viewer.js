@@ -301,7 +301,7 @@
   }
 
   // --- the build report -----------------------------------------------------------
-  // The server's report JSON (ModelInfo.reportJson; keys in core/README.md),
+  // The server's report JSON (ModelInfo.reportJson; keys in core/index/README.md),
   // laid out as geodex-query --info lays it out: the same figures, formatted
   // the same way (formatPercent is the core's FormatPercent).
 

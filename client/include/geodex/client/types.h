@@ -16,10 +16,21 @@ namespace geodex::client {
 // A point on the model's mesh: a face id (as in the source mesh file, polygons
 // fan-triangulated in order) and the barycentric weights of that face's three
 // vertices in file order. Weights must be finite, >= 0 and sum to 1 (the
-// server allows 1e-6 either way).
+// server allows 1e-6 either way). Or a vertex of the mesh file by its id,
+// SurfacePoint::Vertex(id): the server reads it as weight 1 on the vertex in
+// the lowest-numbered face holding it, and a path from it starts there.
 struct SurfacePoint {
   int32_t face = 0;
   std::array<double, 3> w = {1.0, 0.0, 0.0};
+  // >= 0: the point is this vertex, and face and w are not read.
+  int32_t vertex = -1;
+
+  // Vertex `id` of the mesh file as a point.
+  static SurfacePoint Vertex(int32_t id) {
+    SurfacePoint p;
+    p.vertex = id;
+    return p;
+  }
 
   friend bool operator==(const SurfacePoint&, const SurfacePoint&) = default;
 };
@@ -104,7 +115,7 @@ struct ModelInfo {
   std::map<std::string, std::string> build_report;  // the builder's "key = value" figures
   int64_t mapped_bytes = 0;
   uint64_t mesh_hash = 0;
-  // The build report as one JSON object (keys: core/README.md, "The build
+  // The build report as one JSON object (keys: core/index/README.md, "The build
   // report"); empty from a server that does not send it.
   std::string report_json;
 };
