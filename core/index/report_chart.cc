@@ -8,6 +8,7 @@
 #include <cstring>
 #include <memory>
 #include <utility>
+#include <vector>
 
 #include "absl/strings/str_format.h"
 #include "core/common/file_util.h"
@@ -111,56 +112,54 @@ Surface DrawSurface(const IndexReport& report, int width, int height) {
   cairo_set_line_cap(cr, CAIRO_LINE_CAP_BUTT);
 
   const ChartFrame f = MakeChartFrame(report, width, height);
-  Text(cr, f.left, 26, "relative error by distance", kTitleSize);
-  // The gridlines, labelled: errors, then distances (decades and 3L, the
-  // edge between the target's two limits).
+  const ChartLayout layout = MakeChartLayout(report);
+  Text(cr, f.left, 26, layout.title, kTitleSize);
+  // The gridlines, labelled: errors, then distances.
   for (int k = 0; k * f.error_step <= f.error_max * (1 + 1e-9); ++k) {
     const double e = k * f.error_step;
     HLine(cr, f.left, f.right, f.Y(e), 1, k == 0 ? kAxis : kGrid);
     Text(cr, f.left - 8, f.Y(e) + 4.5, TickLabel(e, f.error_step), kTickSize, Anchor::kEnd);
   }
-  const std::pair<double, const char*> ticks[] = {
-      {0.1, "0.1L"}, {1, "L"}, {3, "3L"}, {10, "10L"}, {100, "100L"}};
-  for (const auto& [l, label] : ticks) {
-    VLine(cr, f.X(l), f.top, f.bottom, 1, l == kChartMinL ? kAxis : kGrid);
+  for (const ChartTick& tick : layout.ticks) {
+    VLine(cr, f.X(tick.at), f.top, f.bottom, 1, tick.at == f.x_min ? kAxis : kGrid);
     // The last label ends at its line, inside the picture.
-    Text(cr, f.X(l) + 0.5, f.bottom + 20, label, kTickSize,
-         l == kChartMaxL ? Anchor::kEnd : Anchor::kMiddle);
+    Text(cr, f.X(tick.at) + 0.5, f.bottom + 20, tick.label, kTickSize,
+         tick.at == f.x_max ? Anchor::kEnd : Anchor::kMiddle);
   }
-  Text(cr, (f.left + f.right) / 2.0, f.bottom + 42, "distance / L (log scale)", kTickSize,
+  Text(cr, (f.left + f.right) / 2.0, f.bottom + 42, layout.axis_label, kTickSize,
        Anchor::kMiddle);
-  // The target's p99 limit: one dashed path over the bins, a step at 3L.
+  // The target's p99 limit: a dashed path over the ranges it judges, joined
+  // where they meet.
   SetColor(cr, kChartLimitColor);
   cairo_set_line_width(cr, 2);
   cairo_set_dash(cr, kDash, 2, 0);
-  for (const ReportBin& b : report.bins) {
-    const double from = std::max(b.from_l, kChartMinL), to = std::min(b.to_l, kChartMaxL);
-    const double y = Centre(f.Y(b.p99_limit), 2);
-    if (&b == &report.bins[0]) {
-      cairo_move_to(cr, f.X(from), y);
+  for (size_t i = 0; i < layout.limit.size(); ++i) {
+    const ChartStep& step = layout.limit[i];
+    const double y = Centre(f.Y(step.value), 2);
+    if (i > 0 && layout.limit[i - 1].to == step.from) {
+      cairo_line_to(cr, f.X(step.from), y);
     } else {
-      cairo_line_to(cr, f.X(from), y);
+      cairo_move_to(cr, f.X(step.from), y);
     }
-    cairo_line_to(cr, f.X(to) + 1, y);
+    cairo_line_to(cr, f.X(step.to) + 1, y);
   }
   cairo_stroke(cr);
-  // The series: RMS under p99; a step over each bin, a dot at its middle.
-  for (const auto& [rms, color] :
-       {std::make_pair(true, kChartRmsColor), std::make_pair(false, kChartP99Color)}) {
-    for (const ReportBin& b : report.bins) {
-      const double v = rms ? b.rms : b.p99;
-      if (!std::isfinite(v)) continue;
-      const double from = std::max(b.from_l, kChartMinL), to = std::min(b.to_l, kChartMaxL);
-      HLine(cr, f.X(from), f.X(to), f.Y(v), 3, color);
-      cairo_arc(cr, f.X(std::sqrt(from * to)) + 0.5, f.Y(v) + 0.5, 4.5, 0, 2 * M_PI);
+  // The series, the first drawn last (on top): a step over each range, a
+  // dot at its geometric middle.
+  for (auto series = layout.series.rbegin(); series != layout.series.rend(); ++series) {
+    SetColor(cr, series->color);
+    for (const ChartStep& step : series->steps) {
+      HLine(cr, f.X(step.from), f.X(step.to), f.Y(step.value), 3, series->color);
+      cairo_arc(cr, f.X(std::sqrt(step.from * step.to)) + 0.5, f.Y(step.value) + 0.5, 4.5, 0,
+                2 * M_PI);
       cairo_fill(cr);
     }
   }
   // The legend, top right, in the viewer's words.
-  const std::string limit =
-      absl::StrFormat("limit (target %s)", FormatPercent(report.target_error));
-  const std::pair<std::string, Rgb> legend[] = {
-      {"p99", kChartP99Color}, {"RMS", kChartRmsColor}, {limit, kChartLimitColor}};
+  std::vector<std::pair<std::string, Rgb>> legend;
+  for (const ChartSeries& series : layout.series) legend.emplace_back(series.label, series.color);
+  legend.emplace_back(absl::StrFormat("limit (target %s)", FormatPercent(report.target_error)),
+                      kChartLimitColor);
   double width_needed = 0;
   for (const auto& [label, color] : legend) width_needed += 24 + TextWidth(cr, label, kTickSize);
   double x = f.right - width_needed - 2 * 16;
@@ -227,10 +226,44 @@ cairo_status_t ReadFromView(void* closure, unsigned char* data, unsigned int len
 
 }  // namespace
 
-int ChartFrame::X(double l) const {
-  const double t =
-      (std::log10(l) - std::log10(kChartMinL)) / (std::log10(kChartMaxL) - std::log10(kChartMinL));
+int ChartFrame::X(double d) const {
+  const double t = (std::log10(d) - std::log10(x_min)) / (std::log10(x_max) - std::log10(x_min));
   return left + static_cast<int>(std::lround(t * (right - left)));
+}
+
+ChartLayout MakeChartLayout(const IndexReport& report) {
+  ChartLayout layout;
+  if (report.bands.empty()) {
+    // An index of a format before the L1000 bands: its bins by its own L.
+    layout.x_min = kChartMinL;
+    layout.x_max = kChartMaxL;
+    layout.ticks = {{0.1, "0.1L"}, {1, "L"}, {3, "3L"}, {10, "10L"}, {100, "100L"}};
+    layout.title = "relative error by distance";
+    layout.axis_label = "distance / L (log scale)";
+    layout.series = {{"p99", kChartP99Color, {}}, {"RMS", kChartRmsColor, {}}};
+    for (const ReportBin& b : report.bins) {
+      const double from = std::max(b.from_l, kChartMinL), to = std::min(b.to_l, kChartMaxL);
+      if (std::isfinite(b.p99)) layout.series[0].steps.push_back({from, to, b.p99});
+      if (std::isfinite(b.rms)) layout.series[1].steps.push_back({from, to, b.rms});
+      if (std::isfinite(b.p99_limit)) layout.limit.push_back({from, to, b.p99_limit});
+    }
+    return layout;
+  }
+  layout.x_min = kChartMinL1000;
+  layout.x_max = kChartMaxL1000;
+  layout.ticks = {{0.25, "0.25"}, {1, "1"}, {4, "4"}, {8, "8"}, {16, "16"}, {64, "64"}};
+  layout.axis_label = "distance / L1000 (log scale)";
+  layout.title = "p99 relative error by distance";
+  layout.series = {{"vertex", kChartVertexColor, {}}, {"interior", kChartInteriorColor, {}}};
+  for (const ReportBand& b : report.bands) {
+    const double from = std::max(b.from, kChartMinL1000), to = std::min(b.to, kChartMaxL1000);
+    for (int k = 0; k < 2; ++k) {
+      if (std::isfinite(b.p99[k])) layout.series[k].steps.push_back({from, to, b.p99[k]});
+    }
+    // Only the bands the target judges have a limit.
+    if (std::isfinite(b.p99_limit)) layout.limit.push_back({from, to, b.p99_limit});
+  }
+  return layout;
 }
 
 int ChartFrame::Y(double e) const {
@@ -239,11 +272,11 @@ int ChartFrame::Y(double e) const {
 
 double ChartErrorMax(const IndexReport& report, double* step) {
   double top = 0;
-  for (const ReportBin& b : report.bins) {
-    for (const double v : {b.p99, b.rms, b.p99_limit}) {
-      if (std::isfinite(v)) top = std::max(top, v);
-    }
+  const ChartLayout layout = MakeChartLayout(report);
+  for (const ChartSeries& series : layout.series) {
+    for (const ChartStep& s : series.steps) top = std::max(top, s.value);
   }
+  for (const ChartStep& s : layout.limit) top = std::max(top, s.value);
   top = top > 0 ? 1.1 * top : 0.01;
   // The smallest 1, 2, 5 x 10^k step that needs at most 7 lines.
   const double decade = std::pow(10.0, std::floor(std::log10(top / 7)));
@@ -263,6 +296,9 @@ ChartFrame MakeChartFrame(const IndexReport& report, int width, int height) {
   f.top = 48;
   f.bottom = height - 52;
   f.error_max = ChartErrorMax(report, &f.error_step);
+  const ChartLayout layout = MakeChartLayout(report);
+  f.x_min = layout.x_min;
+  f.x_max = layout.x_max;
   return f;
 }
 

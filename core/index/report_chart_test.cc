@@ -60,6 +60,56 @@ TEST(ReportChartTest, DrawsEachBinsFiguresAndTheTargetWhereTheFramePutsThem) {
   EXPECT_NE(image.At(f.X(mids[2]), f.Y(0.03)), kChartP99Color);
 }
 
+// A report of today's format: p99 by L1000 band, vertex and interior pairs,
+// the limit on the bands from 8 L1000 only.
+IndexReport BandsReport() {
+  IndexReport r = Report();
+  const double edges[8] = {0, 0.5, 1, 2, 4, 8, 16, INFINITY};
+  const double vertex[7] = {0, 0.0001, 0.002, 0.045, 0.03, 0.015, 0.012};
+  const double interior[7] = {0, 0, 0.001, 0.02, 0.025, 0.014, NAN};
+  for (int b = 0; b < 7; ++b) {
+    ReportBand band;
+    band.from = edges[b];
+    band.to = edges[b + 1];
+    band.p99[0] = vertex[b];
+    band.p99[1] = interior[b];
+    band.p99_limit = b >= 5 ? 4 * r.target_error : NAN;
+    r.bands.push_back(band);
+  }
+  return r;
+}
+
+TEST(ReportChartTest, BandsAreDrawnInL1000WithTheLimitOnlyWhereTheTargetJudges) {
+  const IndexReport r = BandsReport();
+  const ChartLayout layout = MakeChartLayout(r);
+  EXPECT_EQ(layout.x_min, kChartMinL1000);
+  EXPECT_EQ(layout.axis_label, "distance / L1000 (log scale)");
+  ASSERT_EQ(layout.series.size(), 2u);
+  EXPECT_EQ(layout.series[0].steps.size(), 7u);
+  EXPECT_EQ(layout.series[1].steps.size(), 6u);  // the last band's NaN is left out
+  ASSERT_EQ(layout.limit.size(), 2u);
+  EXPECT_EQ(layout.limit[0].from, 8);
+  EXPECT_EQ(layout.limit[1].to, kChartMaxL1000);
+  double step = 0;
+  EXPECT_DOUBLE_EQ(ChartErrorMax(r, &step), 0.05);  // 1.1 x 4.5% = 4.95%: 5 lines of 1%
+
+  const ChartImage image = DrawReportChart(r, 720, 420);
+  const ChartFrame f = MakeChartFrame(r, 720, 420);
+  for (int b = 2; b < 5; ++b) {
+    const double mid = std::sqrt(r.bands[b].from * r.bands[b].to);
+    EXPECT_EQ(image.At(f.X(mid), f.Y(r.bands[b].p99[0])), kChartVertexColor) << b;
+    if (std::abs(f.Y(r.bands[b].p99[0]) - f.Y(r.bands[b].p99[1])) > 6) {
+      EXPECT_EQ(image.At(f.X(mid), f.Y(r.bands[b].p99[1])), kChartInteriorColor) << b;
+    }
+  }
+  // The limit's row: dashed over 8-64, and nothing of it over 1-4.
+  int judged = 0, unjudged = 0;
+  for (int x = f.X(9); x < f.X(60); ++x) judged += image.At(x, f.Y(0.02)) == kChartLimitColor;
+  for (int x = f.X(1.1); x < f.X(3.9); ++x) unjudged += image.At(x, f.Y(0.02)) == kChartLimitColor;
+  EXPECT_GT(judged, 30);
+  EXPECT_EQ(unjudged, 0);
+}
+
 // The PNG is 8-bit RGB of the chart's size, and reads back to the same
 // pixels: nothing is lost on the way to the file.
 TEST(ReportChartTest, PngHoldsTheImage) {

@@ -86,8 +86,8 @@ void BuildCommandLine::AddSubcommandOptions() {
   }
   for (CLI::App* cmd : {&app_, merge_, calibrate_}) {
     cmd->add_option("--report-png", args_.pipeline.report_png,
-                    "Also draw the index's relative error by distance (p99, RMS, the target's "
-                    "limit) as a PNG here");
+                    "Also draw the index's p99 relative error by L1000 band (vertex and interior "
+                    "pairs, the target's limit where it judges) as a PNG here");
   }
   calibrate_->add_option("mesh", args_.mesh_path, "The mesh the index was built from")->required();
   calibrate_->add_option("index", args_.index_path, "Index file (.gdx)")->required();

@@ -355,7 +355,7 @@ return {broken, words, overflow: panel.scrollWidth - panel.clientWidth,
 CHART = """
 const svg = document.querySelector('#accuracy-chart svg');
 const frame = {};
-for (const k of ['error-max', 'plot-left', 'plot-right', 'plot-top', 'plot-bottom'])
+for (const k of ['error-max', 'plot-left', 'plot-right', 'plot-top', 'plot-bottom', 'axis-min', 'axis-max'])
   frame[k] = Number(svg.getAttribute('data-' + k));
 const series = Array.from(svg.querySelectorAll('line[data-series]')).map((e) => ({
   series: e.dataset.series, bin: e.dataset.bin, value: e.dataset.value,
@@ -365,9 +365,34 @@ return {frame, series, limit: limit.dataset.values, limitPath: limit.getAttribut
 """
 
 
-def chart_error_max(bins):
+def chart_steps(accuracy):
+    """What the chart draws (core/index/report_chart.h MakeChartLayout),
+    computed here apart: the axis, each series' steps by range key, and the
+    limit's steps. Bands by L1000 when the report has them, else bins by L."""
+    bands = accuracy.get("bands") or []
+    if bands:
+        lo, hi = 0.25, 64
+        rows = [(b["key"], b["from"], b["to"], {"p99-vertex": b["p99_vertex"],
+                                                 "p99-interior": b["p99_interior"]}, b["p99_limit"])
+                for b in bands]
+    else:
+        lo, hi = 0.1, 100
+        rows = [(b["key"], b["from_L"], b["to_L"], {"p99": b["p99"], "rms": b["rms"]}, b["p99_limit"])
+                for b in accuracy["bins"]]
+    series, limit = {}, []
+    for key, frm, to, values, lim in rows:
+        rng = (max(frm, lo), min(to if to is not None else math.inf, hi))
+        for name, v in values.items():
+            if v is not None:
+                series[(name, key)] = (rng, v)
+        if lim is not None:
+            limit.append((rng, lim))
+    return lo, hi, series, limit
+
+
+def chart_error_max(series, limit):
     """The chart's top (core/index/report_chart.h ChartErrorMax), computed here apart."""
-    top = max([v for b in bins for v in (b["p99"], b["rms"], b["p99_limit"]) if v is not None] + [0])
+    top = max([v for _, v in series.values()] + [v for _, v in limit] + [0])
     top = 1.1 * top if top > 0 else 0.01
     decade = 10 ** math.floor(math.log10(top / 7))
     for f in (1, 2, 5, 10):
@@ -375,6 +400,31 @@ def chart_error_max(bins):
         if top / step <= 7:
             break
     return math.ceil(top / step - 1e-9) * step
+
+
+def check_table(driver, report, text):
+    """The panel's accuracy table holds the report's values and shows the
+    text report's cells: its bands by L1000, or the bins of an index of a
+    format before them."""
+    from selenium.webdriver.common.by import By
+    rows = [line for line in text.splitlines() if line.startswith(" " * 18)]
+    bands = report["accuracy"].get("bands") or []
+    if bands:
+        for b in bands:
+            cells = driver.find_elements(By.CSS_SELECTOR, f"#accuracy-table tr[data-band='{b['key']}'] td")
+            check([float(c.get_attribute("data-value")) if c.get_attribute("data-value") != "null" else None
+                   for c in cells[1:3]] == [b["p99_vertex"], b["p99_interior"]],
+                  f"the panel's {b['label']} row holds other values than the report")
+            row = next((line for line in rows if line[18:].startswith(b["label"] + " ")), None)
+            check(row is not None, f"geodex-query --info has no row {b['label']}")
+            want = row[18 + len(b["label"]):].split()[:3]
+            got = [c.text for c in cells[1:4]]
+            check(got == want, f"the panel's {b['label']} row shows {got}, geodex-query --info {want}")
+        return
+    for b in report["accuracy"]["bins"]:
+        cells = driver.find_elements(By.CSS_SELECTOR, f"#accuracy-table tr[data-bin='{b['key']}'] td")
+        check([float(c.get_attribute("data-value")) for c in cells[1:4]] == [b["rms"], b["p99"], b["p99_limit"]],
+              f"the panel's {b['label']} row holds other values than the report")
 
 
 def check_report(driver, stack):
@@ -398,48 +448,38 @@ def check_report(driver, stack):
     cli_json = subprocess.run([stack.args.geodex, "info", "--server", stack.grpc, "--model", stack.name,
                                "--format", "json"], capture_output=True, text=True)
     check(json.loads(cli_json.stdout)["report"] == report, "geodex info --format json's report differs")
-    # The table: each bin's row holds the report's values, and shows the text
-    # report's cells where the text has the bin (indexes built before the
-    # bands by L1000; today's text gives the bands instead).
-    bins = report["accuracy"]["bins"]
-    rows = [line for line in text.splitlines() if line.startswith(" " * 18)]
-    for b in bins:
-        cells = driver.find_elements(By.CSS_SELECTOR, f"#accuracy-table tr[data-bin='{b['key']}'] td")
-        check([float(c.get_attribute("data-value")) for c in cells[1:4]] == [b["rms"], b["p99"], b["p99_limit"]],
-              f"the panel's {b['label']} row holds other values than the report")
-        row = next((line for line in rows if line[18:].startswith(b["label"] + " ")), None)
-        if row is None:
-            continue
-        want = row[18 + len(b["label"]):].split()[:3]
-        got = [c.text for c in cells[1:4]]
-        check(got == want, f"the panel's {b['label']} row shows {got}, geodex-query --info {want}")
-    # The chart: every bin's p99 and RMS, at the value and place the frame gives.
+    check_table(driver, report, text)
+    # The chart: every step at the value and place the frame gives, the
+    # limit over the judged ranges only.
+    lo, hi, series, limit = chart_steps(report["accuracy"])
     chart = driver.execute_script(CHART)
     frame = chart["frame"]
-    check(abs(frame["error-max"] - chart_error_max(bins)) < 1e-12,
-          f"the chart's error axis ends at {frame['error-max']}, not {chart_error_max(bins)}")
+    check((frame["axis-min"], frame["axis-max"]) == (lo, hi),
+          f"the chart's axis runs {frame['axis-min']}-{frame['axis-max']}, not {lo}-{hi}")
+    error_max = chart_error_max(series, limit)
+    check(abs(frame["error-max"] - error_max) < 1e-12,
+          f"the chart's error axis ends at {frame['error-max']}, not {error_max}")
 
-    def x(l):
-        return frame["plot-left"] + (math.log10(l) + 1) / 3 * (frame["plot-right"] - frame["plot-left"])
+    def x(d):
+        return frame["plot-left"] + (math.log10(d) - math.log10(lo)) / (math.log10(hi) - math.log10(lo)) * (
+            frame["plot-right"] - frame["plot-left"])
 
     def y(e):
         return frame["plot-bottom"] - e / frame["error-max"] * (frame["plot-bottom"] - frame["plot-top"])
 
     drawn = {(s["series"], s["bin"]): s for s in chart["series"]}
-    for b in bins:
-        lo, hi = max(b["from_L"], 0.1), min(b["to_L"] if b["to_L"] is not None else math.inf, 100)
-        for series in ("p99", "rms"):
-            s = drawn.get((series, b["key"]))
-            check(s is not None, f"the chart has no {series} of {b['label']}")
-            check(float(s["value"]) == b[series], f"the chart's {series} of {b['label']} is {s['value']}, "
-                  f"the report's {b[series]}")
-            check(abs(s["y"] - y(b[series])) < 0.01 and abs(s["x1"] - x(lo)) < 0.01 and abs(s["x2"] - x(hi)) < 0.01,
-                  f"the chart draws the {series} of {b['label']} at {s}, not at y {y(b[series])}")
-    check([float(v) for v in chart["limit"].split()] == [b["p99_limit"] for b in bins],
+    check(set(drawn) == set(series), f"the chart draws {sorted(drawn)}, the report has {sorted(series)}")
+    for (name, key), ((a, b), v) in series.items():
+        s = drawn[(name, key)]
+        check(float(s["value"]) == v, f"the chart's {name} of {key} is {s['value']}, the report's {v}")
+        check(abs(s["y"] - y(v)) < 0.01 and abs(s["x1"] - x(a)) < 0.01 and abs(s["x2"] - x(b)) < 0.01,
+              f"the chart draws the {name} of {key} at {s}, not at y {y(v)}")
+    check([float(v) for v in chart["limit"].split()] == [v for _, v in limit],
           f"the chart's target line is {chart['limit']}")
-    start = [float(v) for v in chart["limitPath"].lstrip("M").split()[:2]]
-    check(abs(start[0] - x(0.1)) < 0.01 and abs(start[1] - y(bins[0]["p99_limit"])) < 0.01,
-          f"the target line starts at {start}")
+    if limit:
+        start = [float(v) for v in chart["limitPath"].lstrip("M").split()[:2]]
+        check(abs(start[0] - x(limit[0][0][0])) < 0.01 and abs(start[1] - y(limit[0][1])) < 0.01,
+              f"the target line starts at {start}")
     print(f"web_test: the panel's table and chart show geodex-query --info's figures "
           f"({len(chart['series'])} steps, axis to {frame['error-max']:.4g})")
 

@@ -350,20 +350,43 @@
     }
     $('accuracy').hidden = false;
     const a = r.accuracy;
-    $('accuracy-note').textContent =
-      `Relative error of the default answer over ${a.pairs} held-out pairs; L = ${Number(a.scale_length.toPrecision(4))}.`;
     const head = accuracyTable.createTHead().insertRow();
-    for (const h of ['distance', 'RMS', 'p99', 'p99 limit']) head.appendChild(document.createElement('th')).textContent = h;
     const body = accuracyTable.createTBody();
-    for (const b of a.bins) {
-      const tr = body.insertRow();
-      tr.dataset.bin = b.key;
-      tr.insertCell().textContent = b.label;
-      for (const key of ['rms', 'p99', 'p99_limit']) {
-        const td = tr.insertCell();
-        td.textContent = formatPercent(b[key]);
-        td.dataset.value = String(b[key]);
-        if (key === 'p99' && b.p99 > b.p99_limit) td.className = 'over';
+    if (a.bands && a.bands.length > 0) {
+      // The text report's table: p99 by L1000 band, vertex and interior
+      // pairs, the bands the target judges, how the default mode answers.
+      $('accuracy-note').textContent =
+        `p99 relative error of the default answer over ${a.pairs} held-out pairs, by distance in ` +
+        `L1000 = ${Number(a.band_unit.toPrecision(4))} (the spacing of 1000 samples on this surface); ` +
+        `answers are walked or exact below ${Number(a.refined_below.toPrecision(3))} L1000, O(1) above.`;
+      for (const h of ['L1000', 'vertex', 'interior', 'target']) head.appendChild(document.createElement('th')).textContent = h;
+      for (const b of a.bands) {
+        const tr = body.insertRow();
+        tr.dataset.band = b.key;
+        tr.insertCell().textContent = b.label;
+        for (const key of ['p99_vertex', 'p99_interior']) {
+          const td = tr.insertCell();
+          td.textContent = formatPercent(b[key]);
+          td.dataset.value = String(b[key]);
+          if (b.p99_limit !== null && b[key] > b.p99_limit) td.className = 'over';
+        }
+        tr.insertCell().textContent = b.p99_limit === null ? '-' : 'judged';
+      }
+    } else {
+      // An index of a format before the bands: its bins by its own L.
+      $('accuracy-note').textContent =
+        `Relative error of the default answer over ${a.pairs} held-out pairs; L = ${Number(a.scale_length.toPrecision(4))}.`;
+      for (const h of ['distance', 'RMS', 'p99', 'p99 limit']) head.appendChild(document.createElement('th')).textContent = h;
+      for (const b of a.bins) {
+        const tr = body.insertRow();
+        tr.dataset.bin = b.key;
+        tr.insertCell().textContent = b.label;
+        for (const key of ['rms', 'p99', 'p99_limit']) {
+          const td = tr.insertCell();
+          td.textContent = formatPercent(b[key]);
+          td.dataset.value = String(b[key]);
+          if (key === 'p99' && b.p99 > b.p99_limit) td.className = 'over';
+        }
       }
     }
     drawChart(a, r.target);
