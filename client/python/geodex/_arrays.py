@@ -259,18 +259,17 @@ def as_points(points: PointsLike, name: str) -> Points:
         faces = as_ids(faces, f"{name}.faces")
     if weights.shape != (n, 3):
         raise InvalidArgument(f"{name}.weights has shape {weights.shape}, want ({n}, 3)")
+    # Each check is one pass over the array (min, max, a whole-array
+    # reduction); the offending index is looked for only once one fails.
     if n > 0:
-        negative = faces < 0
-        if negative.any():
-            i = _first(negative)
+        if faces.min() < 0:
+            i = _first(faces < 0)
             raise InvalidArgument(f"{name}.faces[{i}] is {int(faces[i])}: face ids are >= 0")
-        large = faces > _INT32_MAX
-        if large.any():
-            i = _first(large)
+        if np.iinfo(faces.dtype).max > _INT32_MAX and faces.max() > _INT32_MAX:
+            i = _first(faces > _INT32_MAX)
             raise OutOfRange(f"{name}.faces[{i}] is {int(faces[i])}, past any face id (int32)")
-        bad = ~np.isfinite(weights).all(axis=1)
-        if bad.any():
-            i = _first(bad)
+        if not np.isfinite(weights).all():
+            i = _first(~np.isfinite(weights).all(axis=1))
             raise InvalidArgument(
                 f"{name}.weights[{i}] is {weights[i].tolist()}: weights must be finite"
             )
