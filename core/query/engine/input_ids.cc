@@ -58,9 +58,10 @@ absl::StatusOr<mesh::SurfacePoint> InputIds::ToInternal(const mesh::SurfacePoint
 absl::StatusOr<mesh::SurfacePoint> InputIds::CoarseToInternal(
     const mesh::SurfacePoint& coarse) const {
   if (!split()) return coarse;
-  // The piece whose smallest weight of the point is the largest: the one
-  // holding it (on a shared edge either is right; rounding may leave the
-  // point a hair outside every piece).
+  // The first piece holding the point (no weight negative; on a shared edge
+  // either is right), else the one whose smallest weight is the largest:
+  // rounding may leave the point a hair outside every piece. Stopping at the
+  // first matters on a coarse face of many pieces.
   mesh::SurfacePoint best{mesh::kNone, {0, 0, 0}};
   double best_min = -std::numeric_limits<double>::infinity();
   for (int32_t k = piece_offset_[coarse.face]; k < piece_offset_[coarse.face + 1]; ++k) {
@@ -78,6 +79,7 @@ absl::StatusOr<mesh::SurfacePoint> InputIds::CoarseToInternal(
     if (smallest > best_min) {
       best_min = smallest;
       best = {pieces_[k], {a0, a1, a2}};
+      if (smallest >= 0) break;
     }
   }
   if (best.face == mesh::kNone) {
