@@ -31,17 +31,9 @@ from pathlib import Path
 import numpy as np
 
 import geodex
+from python_client_bench import area_uniform  # the same pairs as the client's bench
 
 REPO = Path(__file__).resolve().parents[2]
-
-
-def area_uniform(vertices: np.ndarray, faces: np.ndarray, n: int, seed: int):
-    rng = np.random.default_rng(seed)
-    p = vertices[faces]
-    area = 0.5 * np.linalg.norm(np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]), axis=1)
-    f = rng.choice(faces.shape[0], size=n, p=area / area.sum()).astype(np.int32)
-    r1, r2 = np.sqrt(rng.random(n)), rng.random(n)
-    return geodex.SurfacePoints(f, np.stack([1 - r1, r1 * (1 - r2), r1 * r2], axis=1))
 
 
 def digest(values: np.ndarray) -> int:
