@@ -8,6 +8,7 @@
 #include <tuple>
 
 #include "core/query/engine/internal/paths/chord_walk.h"
+#include "core/query/engine/internal/paths/cut_bound.h"
 
 namespace geodex::query {
 bool Refiner::MayBeNear(double unfolded, double below, const SurfacePoint& p,
@@ -78,14 +79,26 @@ double Refiner::Refine(const SurfacePoint& p_in, const SurfacePoint& q_in, const
     kind = path.wraps ? AnswerKind::kWrappedTrace : AnswerKind::kTrace;
     return true;
   };
-  // Every surface path, the geodesic too, is at least the chord |pq| long:
-  // a path within kCertifiedExcess of the chord errs less than that,
-  // whichever corridor it took. A longer straight walk may be a local
-  // geodesic round the wrong side of a sharp edge or a bump, which no
-  // calibrated bound sees (the shortest path crosses the feature elsewhere;
-  // tests/bench/accuracy.md, "Walks the chord certifies"): it is checked by
-  // an exact propagation, which its length prunes from the start.
-  auto certified = [&](double length) { return length <= (1 + kCertifiedExcess) * chord; };
+  // Every surface path, the geodesic too, is at least as long as a lower
+  // bound: first the chord |pq|, then, for a path the chord leaves
+  // uncertified, the two chords through the border of the faces nearer p
+  // (cut_bound.h), which follow a curved surface closer. A path within
+  // kCertifiedExcess of the bound errs less than that, whichever corridor
+  // it took. A longer walk may be a local geodesic round the wrong side of a
+  // sharp edge or a bump, which no calibrated bound sees (the shortest path
+  // crosses the feature elsewhere; tests/bench/accuracy.md, "Walks the chord
+  // certifies"): it is checked by an exact propagation, which its length
+  // prunes from the start. `floor`: the best lower bound known.
+  double floor = chord;
+  bool cut_tried = false;
+  auto certified = [&](double length) {
+    if (length <= (1 + kCertifiedExcess) * floor) return true;
+    if (cut_tried) return false;
+    cut_tried = true;
+    floor = std::max(floor, CutLowerBound(view_, from, to, kCutReach * length, kCutFaces,
+                                          &solvers.walks()));
+    return length <= (1 + kCertifiedExcess) * floor;
+  };
   // A pair refined only because the request raised the threshold past the
   // index's own (DistanceOptions::refine_below_l1000) is beyond the band
   // where the chord certifies walks: on a curved surface most of its walks
@@ -118,7 +131,13 @@ double Refiner::Refine(const SurfacePoint& p_in, const SurfacePoint& q_in, const
                                       .shoot = true},
                                      &solvers)
                       : WalkNearPair(view_, from, to, {.plausible = plausible()}, &solvers);
-      if (walk.path && (certified(walk.path->length) || raised_only)) return take(*walk.path);
+      if (walk.path && (raised_only || certified(walk.path->length))) return take(*walk.path);
+      // A doubted walk (bent at several saddles, or longer than is
+      // plausible) is a surface path all the same: within the bound's
+      // certificate it is taken.
+      if (!raised_only && !walk.path && walk.doubted && certified(*walk.doubted)) {
+        return take(NearPath{*walk.doubted, true});
+      }
       if (raised_only) {
         // The gradient trace finds the corridor where the chord's does not
         // (the chord leaves the surface over a curved band); a trace
@@ -138,7 +157,7 @@ double Refiner::Refine(const SurfacePoint& p_in, const SurfacePoint& q_in, const
       const bool solved = exact(upper, walk.corridor);
       ++stats.exact_solves;
       stats.exact_with_walk += walk.path || walk.doubted;
-      if (const auto& confined = solvers.solvers().confined) {
+      if (const auto* confined = solvers.solvers().last_confined) {
         stats.exact_rounds += confined->stats().rounds;
         stats.exact_region_faces += confined->stats().region_faces;
         stats.exact_windows += confined->stats().windows_created;
@@ -187,7 +206,7 @@ double Refiner::Refine(const SurfacePoint& p_in, const SurfacePoint& q_in, const
       // the O(1) bound wrong for this pair (it covers about 99% of them):
       // then only the chord is left to stand on.
       const double o1_floor = unfolded - bound_of(AnswerKind::kUnfold, unfolded);
-      const double below = raised_only && d >= o1_floor ? std::max(chord, o1_floor) : chord;
+      const double below = raised_only && d >= o1_floor ? std::max(floor, o1_floor) : floor;
       const double certificate = std::max(d - below, bound_of(AnswerKind::kExact, d));
       *bound = raised_only ? certificate : std::min(*bound, certificate);
     }

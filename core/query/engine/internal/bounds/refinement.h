@@ -31,6 +31,15 @@ namespace geodex::query {
 // surface (tests/bench/accuracy.md, "Walks the chord certifies").
 inline constexpr double kCertifiedExcess = 0.02;
 
+// The cut bound (cut_bound.h) that certifies a near pair's walk the chord
+// does not: its region reaches kCutReach x the walk's length round the
+// points, so that an edge on the region's rim, lower than `reach` by at most
+// the span of a face, seldom undercuts the walk's certificate; a region of
+// more than kCutFaces faces (a long or a wide pair) leaves the walk to the
+// exact check, whose own region is then of the same order.
+inline constexpr double kCutReach = 1.1;
+inline constexpr int kCutFaces = 4096;
+
 // A shot (chord_walk.h) of a pair refined only by a raised threshold, longer
 // than the O(1) answer by more than this share, is doubted, however wide the
 // answer's bound: where the secant wanders, a

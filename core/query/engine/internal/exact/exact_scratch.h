@@ -6,6 +6,7 @@
 // without including the solvers that use it.
 
 #include <memory>
+#include <vector>
 
 #include "core/geodesic/confined_geodesic.h"
 #include "core/geodesic/exact_geodesic.h"
@@ -13,14 +14,25 @@
 
 namespace geodex::query {
 
-// The working memory of LocalExact in a caller's QueryScratch: one exact
-// solver over the index's mesh, which the confined propagations borrow.
-struct ExactScratch {
+// One exact solver over a mesh, and the confined propagations that borrow
+// it.
+struct ExactSolvers {
   const mesh::Mesh* mesh = nullptr;  // the mesh `exact` was made for
   std::unique_ptr<geodesic::ExactGeodesicSolver> exact;
   // Over exact's mesh, propagating with `exact`; declared after it, so
   // destroyed before it.
   std::unique_ptr<geodesic::ConfinedGeodesicSolver> confined;
+};
+
+// The working memory of LocalExact in a caller's QueryScratch: solvers over
+// the index's mesh (fields name its vertices) and over the surface before
+// its long-edge split (a pair's distance, on fewer faces).
+struct ExactScratch {
+  ExactSolvers index_mesh;
+  ExactSolvers coarse;
+  std::vector<int32_t> coarse_seeds;  // a confined call's seeds on the coarse surface
+  // The confined solver of the last ConfinedDistance call, for its stats.
+  const geodesic::ConfinedGeodesicSolver* last_confined = nullptr;
 };
 
 }  // namespace geodex::query

@@ -39,40 +39,92 @@ const mesh::Mesh* LocalExact::ExactMesh() const {
   return mesh_.get();
 }
 
-geodesic::ExactGeodesicSolver* LocalExact::ExactSolver(QueryScratch& scratch) const {
-  const mesh::Mesh* m = ExactMesh();
-  if (m == nullptr) return nullptr;
-  ExactScratch& s = scratch.solvers();
-  if (s.exact == nullptr || s.mesh != m) {
+const index::CoarseSurface* LocalExact::Coarse() const {
+  std::call_once(coarse_once_, [this] {
+    const mesh::Mesh* m = ExactMesh();
+    if (m == nullptr || !index_->split().split()) return;
+    absl::StatusOr<std::optional<index::CoarseSurface>> coarse =
+        index::CoarseSurfaceOf(*m, index_->split(), index_->split_vertices());
+    // Index::Open checked the split: a failure here leaves the pairs'
+    // propagations on the index's mesh, where they give the same distances.
+    if (coarse.ok() && coarse->has_value()) {
+      coarse_ = std::make_unique<index::CoarseSurface>(**std::move(coarse));
+    }
+  });
+  return coarse_.get();
+}
+
+namespace {
+
+ExactSolvers* SolversOver(const mesh::Mesh& m, ExactSolvers& s) {
+  if (s.exact == nullptr || s.mesh != &m) {
     s.confined.reset();  // it borrows the solver replaced here
-    s.exact = std::make_unique<geodesic::ExactGeodesicSolver>(*m);
-    s.mesh = m;
+    s.exact = std::make_unique<geodesic::ExactGeodesicSolver>(m);
+    s.mesh = &m;
   }
-  return s.exact.get();
+  return &s;
+}
+
+}  // namespace
+
+ExactSolvers* LocalExact::Solvers(QueryScratch& scratch) const {
+  const mesh::Mesh* m = ExactMesh();
+  return m == nullptr ? nullptr : SolversOver(*m, scratch.solvers().index_mesh);
+}
+
+ExactSolvers* LocalExact::PairSolvers(QueryScratch& scratch, bool* coarse) const {
+  const index::CoarseSurface* c = Coarse();
+  *coarse = c != nullptr;
+  return c != nullptr ? SolversOver(c->mesh, scratch.solvers().coarse) : Solvers(scratch);
+}
+
+SurfacePoint LocalExact::ToCoarse(const SurfacePoint& p) const {
+  const index::SplitFaceRecord r = index_->split().Piece(p.face);
+  SurfacePoint coarse{r.coarse_face, {0, 0, 0}};
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) coarse.w[j] += p.w[i] * r.weight[i][j];
+  }
+  return coarse;
 }
 
 std::optional<double> LocalExact::NearDistance(const SurfacePoint& from, const SurfacePoint& to,
                                                QueryScratch* scratch) const {
   QueryScratch local;
-  geodesic::ExactGeodesicSolver* solver = ExactSolver(scratch != nullptr ? *scratch : local);
-  if (solver == nullptr) return std::nullopt;
+  bool coarse = false;
+  ExactSolvers* s = PairSolvers(scratch != nullptr ? *scratch : local, &coarse);
+  if (s == nullptr) return std::nullopt;
+  const SurfacePoint a = coarse ? ToCoarse(from) : from, b = coarse ? ToCoarse(to) : to;
   geodesic::GeodesicOptions options;
-  options.stop_points = {to};
-  if (!solver->Propagate({from}, options).ok()) return std::nullopt;
-  return solver->DistanceAt(to);
+  options.stop_points = {b};
+  if (!s->exact->Propagate({a}, options).ok()) return std::nullopt;
+  return s->exact->DistanceAt(b);
 }
 
 std::optional<double> LocalExact::ConfinedDistance(const SurfacePoint& from, const SurfacePoint& to,
                                                    std::span<const int32_t> seed_faces,
                                                    QueryScratch& scratch,
                                                    double upper_bound) const {
-  geodesic::ExactGeodesicSolver* solver = ExactSolver(scratch);
-  if (solver == nullptr) return std::nullopt;
-  std::unique_ptr<geodesic::ConfinedGeodesicSolver>& confined = scratch.solvers().confined;
-  if (confined == nullptr) confined = std::make_unique<geodesic::ConfinedGeodesicSolver>(*solver);
-  const absl::StatusOr<double> d = confined->Distance(from, to, seed_faces, upper_bound);
-  if (!d.ok()) return std::nullopt;
-  return *d;
+  bool coarse = false;
+  ExactSolvers* s = PairSolvers(scratch, &coarse);
+  if (s == nullptr) return std::nullopt;
+  if (s->confined == nullptr) {
+    s->confined = std::make_unique<geodesic::ConfinedGeodesicSolver>(*s->exact);
+  }
+  scratch.solvers().last_confined = s->confined.get();
+  if (!coarse) {
+    const absl::StatusOr<double> d = s->confined->Distance(from, to, seed_faces, upper_bound);
+    return d.ok() ? std::optional<double>(*d) : std::nullopt;
+  }
+  // The seeds' coarse faces, each once, in the order the seeds reach them.
+  std::vector<int32_t>& seeds = scratch.solvers().coarse_seeds;
+  seeds.clear();
+  for (const int32_t f : seed_faces) {
+    const int32_t c = index_->split().Piece(f).coarse_face;
+    if (std::find(seeds.begin(), seeds.end(), c) == seeds.end()) seeds.push_back(c);
+  }
+  const absl::StatusOr<double> d =
+      s->confined->Distance(ToCoarse(from), ToCoarse(to), seeds, upper_bound);
+  return d.ok() ? std::optional<double>(*d) : std::nullopt;
 }
 
 absl::StatusOr<std::span<const double>> LocalExact::Distances(const SurfacePoint& p, double radius,
@@ -80,7 +132,8 @@ absl::StatusOr<std::span<const double>> LocalExact::Distances(const SurfacePoint
   if (!(radius >= 0)) {
     return absl::InvalidArgumentError(absl::StrFormat("the radius must be >= 0, got %g", radius));
   }
-  geodesic::ExactGeodesicSolver* solver = ExactSolver(scratch);
+  ExactSolvers* solvers = Solvers(scratch);
+  geodesic::ExactGeodesicSolver* solver = solvers != nullptr ? solvers->exact.get() : nullptr;
   if (solver == nullptr) {
     return absl::InternalError("the index's mesh cannot be rebuilt for exact propagation");
   }
@@ -98,7 +151,8 @@ absl::StatusOr<RadiusField> LocalExact::DistancesWithin(std::span<const SurfaceP
         absl::StrFormat("the radius must be finite and > 0, got %g", radius));
   }
   if (sources.empty()) return absl::InvalidArgumentError("no sources given");
-  geodesic::ExactGeodesicSolver* solver = ExactSolver(scratch);
+  ExactSolvers* solvers = Solvers(scratch);
+  geodesic::ExactGeodesicSolver* solver = solvers != nullptr ? solvers->exact.get() : nullptr;
   if (solver == nullptr) {
     return absl::InternalError("the index's mesh cannot be rebuilt for exact propagation");
   }

@@ -20,6 +20,7 @@
 #include "absl/status/statusor.h"
 #include "core/geodesic/confined_geodesic.h"
 #include "core/geodesic/exact_geodesic.h"
+#include "core/index/coarse_surface.h"
 #include "core/index/index.h"
 #include "core/mesh/mesh.h"
 #include "core/query/engine/internal/exact/exact_scratch.h"
@@ -85,14 +86,24 @@ class LocalExact {
   // The mesh for exact propagations, made on first use; null when it cannot
   // be made.
   const mesh::Mesh* ExactMesh() const;
-  // The scratch's solver over ExactMesh(), made on first use; null when the
-  // mesh cannot be made.
-  geodesic::ExactGeodesicSolver* ExactSolver(QueryScratch& scratch) const;
+  // The surface before the long-edge split, made on first use; null when
+  // nothing was split or it cannot be made. The split is flat: a pair's
+  // distance is the same there, over up to several times fewer faces.
+  const index::CoarseSurface* Coarse() const;
+  // The scratch's solvers over ExactMesh(), made on first use; null when
+  // the mesh cannot be made.
+  ExactSolvers* Solvers(QueryScratch& scratch) const;
+  // The same over the coarse surface when there is one, else over
+  // ExactMesh(); `coarse` says which.
+  ExactSolvers* PairSolvers(QueryScratch& scratch, bool* coarse) const;
+  // A point of the index's mesh as the same point of the coarse surface.
+  SurfacePoint ToCoarse(const SurfacePoint& p) const;
 
   const index::Index* index_;
   MeshView view_;
-  mutable std::once_flag mesh_once_;
+  mutable std::once_flag mesh_once_, coarse_once_;
   mutable std::unique_ptr<mesh::Mesh> mesh_;
+  mutable std::unique_ptr<index::CoarseSurface> coarse_;
 };
 
 }  // namespace geodex::query

@@ -1,7 +1,10 @@
 #include "core/query/engine/internal/exact/local_exact.h"
 
 #include <cmath>
+#include <vector>
 
+#include "core/build/build_testing.h"
+#include "core/mesh/broken_meshes_testing.h"
 #include "core/mesh/generators.h"
 #include "core/query/engine/internal/paths/path_straightening.h"
 #include "core/query/engine/internal/query_parts_testing.h"
@@ -56,6 +59,40 @@ TEST(LocalExactTest, CorridorPathIsExactAndNeverLongerThanTheTrace) {
   EXPECT_LE(PathLength(*exact), PathLength(*raw) + 1e-12);
   EXPECT_NEAR((exact->front().position - mesh::PositionOf(sphere, a)).norm(), 0, 1e-9);
   EXPECT_NEAR((exact->back().position - mesh::PositionOf(sphere, b)).norm(), 0, 1e-9);
+}
+
+// On a split index a pair's propagation runs on the surface before the
+// split (flat, so the same distances on fewer faces): its answers to the
+// split mesh's vertices, midpoints too, are the split mesh's own.
+TEST(LocalExactTest, ASplitIndexsPairsAreTheSplitMeshsDistances) {
+  const auto split = geodex::testing::RepairedTestEngineOrThrow(
+      mesh::testing::RawOf(mesh::gen::Sphere(1, 1.0), "sphere"), 120, /*split=*/true);
+  const index::Index& ix = split.engine->index();
+  ASSERT_GT(ix.split_vertices(), 0);
+  const MeshView view{ix.positions(), ix.faces(), ix.twins()};
+  const LocalExact exact(ix, view);
+  QueryScratch scratch;
+  const int32_t first_midpoint = ix.num_vertices() - ix.split_vertices();
+  int midpoints = 0, checked = 0;
+  for (const int32_t f : {0, 17, 101}) {
+    const SurfacePoint p{f, {0.2, 0.3, 0.5}};
+    absl::StatusOr<std::span<const double>> field = exact.Distances(p, 10, scratch);
+    ASSERT_TRUE(field.ok()) << field.status();
+    const std::vector<double> want(field->begin(), field->end());
+    for (int32_t g = 0; g < ix.num_faces(); g += 5) {
+      const int32_t v = view.Vertex(g, 0);
+      const SurfacePoint q{g, {1, 0, 0}};
+      const std::optional<double> near = exact.NearDistance(p, q, &scratch);
+      const std::optional<double> confined = exact.ConfinedDistance(p, q, {}, scratch);
+      ASSERT_TRUE(near.has_value() && confined.has_value()) << "face " << g;
+      EXPECT_NEAR(*near, want[v], 1e-9 * (1 + want[v])) << "vertex " << v;
+      EXPECT_NEAR(*confined, want[v], 1e-9 * (1 + want[v])) << "vertex " << v;
+      midpoints += v >= first_midpoint;
+      ++checked;
+    }
+  }
+  EXPECT_GT(midpoints, 0);
+  EXPECT_GT(checked, 100);
 }
 
 }  // namespace

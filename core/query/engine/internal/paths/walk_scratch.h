@@ -23,6 +23,12 @@ struct WalkScratch {
   std::vector<Portal> portals;
   std::vector<int32_t> found_faces, doubted_faces;
   std::vector<int32_t> join;  // the chord's walk that joins a shot to its target
+  // The cut bound's region (cut_bound.h): the faces reached, and each
+  // face's mark, equal to `region_mark` when the current region holds it
+  // (a new region takes the next mark instead of clearing them).
+  std::vector<int32_t> region;
+  std::vector<uint32_t> region_marks;
+  uint32_t region_mark = 0;
 };
 
 }  // namespace geodex::query
