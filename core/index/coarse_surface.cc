@@ -8,20 +8,19 @@
 
 namespace geodex::index {
 
-absl::StatusOr<std::optional<CoarseSurface>> CoarseSurfaceOf(const mesh::Mesh& split,
-                                                             const SplitView& view,
-                                                             int32_t split_vertices) {
-  if (split_vertices == 0 && !view.split()) return std::nullopt;
-  const int32_t coarse_vertices = split.num_vertices() - split_vertices;
+absl::StatusOr<mesh::Mesh> CoarseMeshOf(std::span<const mesh::Vec3> positions,
+                                        const SplitView& view, int32_t split_vertices,
+                                        const std::string& name) {
+  const int32_t num_vertices = static_cast<int32_t>(positions.size());
+  const int32_t coarse_vertices = num_vertices - split_vertices;
   if (split_vertices <= 0 || coarse_vertices <= 0 || !view.split()) {
-    return absl::InvalidArgumentError(absl::StrFormat(
-        "the split (%d coarse faces, %d added vertices) is not of a mesh of %d vertices and %d "
-        "faces",
-        view.num_coarse_faces(), split_vertices, split.num_vertices(), split.num_faces()));
+    return absl::InvalidArgumentError(
+        absl::StrFormat("the split (%d coarse faces, %d added vertices) is not of a mesh of %d "
+                        "vertices",
+                        view.num_coarse_faces(), split_vertices, num_vertices));
   }
   const int32_t num_coarse_faces = view.num_coarse_faces();
-  std::vector<mesh::Vec3> positions(split.positions().begin(),
-                                    split.positions().begin() + coarse_vertices);
+  std::vector<mesh::Vec3> coarse_positions(positions.begin(), positions.begin() + coarse_vertices);
   std::vector<mesh::Triangle> faces(num_coarse_faces);
   for (int32_t f = 0; f < num_coarse_faces; ++f) {
     const std::array<int32_t, 3> corners = view.CoarseFace(f);
@@ -34,10 +33,17 @@ absl::StatusOr<std::optional<CoarseSurface>> CoarseSurfaceOf(const mesh::Mesh& s
     faces[f] = {corners[0], corners[1], corners[2]};
   }
   // The repaired input may keep faces of zero area.
-  GEODEX_ASSIGN_OR_RETURN(
-      mesh::Mesh coarse,
-      mesh::Mesh::Create(std::move(positions), std::move(faces), split.name(),
-                         mesh::MeshOptions{.allow_zero_area_faces = true}));
+  return mesh::Mesh::Create(std::move(coarse_positions), std::move(faces), name,
+                            mesh::MeshOptions{.allow_zero_area_faces = true});
+}
+
+absl::StatusOr<std::optional<CoarseSurface>> CoarseSurfaceOf(const mesh::Mesh& split,
+                                                             const SplitView& view,
+                                                             int32_t split_vertices) {
+  if (split_vertices == 0 && !view.split()) return std::nullopt;
+  GEODEX_ASSIGN_OR_RETURN(mesh::Mesh coarse,
+                          CoarseMeshOf(split.positions(), view, split_vertices, split.name()));
+  const int32_t num_coarse_faces = view.num_coarse_faces();
   std::vector<mesh::SurfacePoint> points(split.num_vertices());
   for (int32_t f = 0; f < split.num_faces(); ++f) {
     const SplitFaceRecord r = view.Piece(f);

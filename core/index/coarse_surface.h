@@ -6,6 +6,8 @@
 
 #include <cstdint>
 #include <optional>
+#include <span>
+#include <string>
 #include <vector>
 
 #include "absl/status/statusor.h"
@@ -24,6 +26,14 @@ struct CoarseSurface {
   // an unreferenced vertex).
   std::vector<mesh::SurfacePoint> points;
 };
+// The coarse faces alone over the first of `positions` (a split mesh's
+// vertices, the `split_vertices` added ones last): the mesh an exact
+// propagation between two points needs. Errors: InvalidArgument when the
+// split is not of these vertices.
+absl::StatusOr<mesh::Mesh> CoarseMeshOf(std::span<const mesh::Vec3> positions,
+                                        const SplitView& view, int32_t split_vertices,
+                                        const std::string& name);
+
 // The coarse surface of `split`, a mesh split as `view` says (a builder's
 // record, or an index's sections) after `split_vertices` added vertices;
 // nullopt when nothing was split. Errors: InvalidArgument when the split is

@@ -39,17 +39,17 @@ const mesh::Mesh* LocalExact::ExactMesh() const {
   return mesh_.get();
 }
 
-const index::CoarseSurface* LocalExact::Coarse() const {
+const mesh::Mesh* LocalExact::CoarseMesh() const {
   std::call_once(coarse_once_, [this] {
-    const mesh::Mesh* m = ExactMesh();
-    if (m == nullptr || !index_->split().split()) return;
-    absl::StatusOr<std::optional<index::CoarseSurface>> coarse =
-        index::CoarseSurfaceOf(*m, index_->split(), index_->split_vertices());
+    const index::Index& ix = *index_;
+    if (!ix.split().split()) return;
+    std::vector<mesh::Vec3> positions(ix.num_vertices());
+    for (int32_t v = 0; v < ix.num_vertices(); ++v) positions[v] = view_.Position(v);
+    absl::StatusOr<mesh::Mesh> coarse =
+        index::CoarseMeshOf(positions, ix.split(), ix.split_vertices(), "coarse");
     // Index::Open checked the split: a failure here leaves the pairs'
     // propagations on the index's mesh, where they give the same distances.
-    if (coarse.ok() && coarse->has_value()) {
-      coarse_ = std::make_unique<index::CoarseSurface>(**std::move(coarse));
-    }
+    if (coarse.ok()) coarse_ = std::make_unique<mesh::Mesh>(*std::move(coarse));
   });
   return coarse_.get();
 }
@@ -73,9 +73,9 @@ ExactSolvers* LocalExact::Solvers(QueryScratch& scratch) const {
 }
 
 ExactSolvers* LocalExact::PairSolvers(QueryScratch& scratch, bool* coarse) const {
-  const index::CoarseSurface* c = Coarse();
+  const mesh::Mesh* c = CoarseMesh();
   *coarse = c != nullptr;
-  return c != nullptr ? SolversOver(c->mesh, scratch.solvers().coarse) : Solvers(scratch);
+  return c != nullptr ? SolversOver(*c, scratch.solvers().coarse) : Solvers(scratch);
 }
 
 SurfacePoint LocalExact::ToCoarse(const SurfacePoint& p) const {

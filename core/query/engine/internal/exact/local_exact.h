@@ -86,10 +86,11 @@ class LocalExact {
   // The mesh for exact propagations, made on first use; null when it cannot
   // be made.
   const mesh::Mesh* ExactMesh() const;
-  // The surface before the long-edge split, made on first use; null when
-  // nothing was split or it cannot be made. The split is flat: a pair's
-  // distance is the same there, over up to several times fewer faces.
-  const index::CoarseSurface* Coarse() const;
+  // The surface before the long-edge split, made on first use (without
+  // ExactMesh(): fields alone need that); null when nothing was split or it
+  // cannot be made. The split is flat: a pair's distance is the same there,
+  // over up to several times fewer faces.
+  const mesh::Mesh* CoarseMesh() const;
   // The scratch's solvers over ExactMesh(), made on first use; null when
   // the mesh cannot be made.
   ExactSolvers* Solvers(QueryScratch& scratch) const;
@@ -103,7 +104,7 @@ class LocalExact {
   MeshView view_;
   mutable std::once_flag mesh_once_, coarse_once_;
   mutable std::unique_ptr<mesh::Mesh> mesh_;
-  mutable std::unique_ptr<index::CoarseSurface> coarse_;
+  mutable std::unique_ptr<mesh::Mesh> coarse_;
 };
 
 }  // namespace geodex::query
