@@ -36,6 +36,68 @@ const std::string& OtherSphereBytes() {
 
 // --- models changing while serving -----------------------------------------------------
 
+using DistanceStream = grpc::ClientReaderWriter<v1::DistanceBatch, v1::DistanceResult>;
+
+// What a stream of distance batches did: batches sent and read, answers by
+// version, batches that failed, answers out of order or wrong.
+struct StreamTally {
+  std::atomic<int> sent{0};
+  std::atomic<int> read{0};
+  std::map<int64_t, int> by_version;
+  int failed = 0, wrong = 0;
+};
+
+// Writes random sphere batches until `stop`, at most 32 in flight: the
+// swaps happen while the stream flows, and the backlog left at the end is
+// drained well within the deadline however slow the build (sanitizers).
+void WriteBatches(DistanceStream& stream, int32_t faces, const std::atomic<bool>& stop,
+                  StreamTally& tally) {
+  for (int k = 0; !stop; ++k) {
+    while (!stop && tally.sent - tally.read >= 32) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    }
+    if (stop) break;
+    if (!stream.Write(testing::RandomSphereBatch(k, faces, 50, k, 1000000))) break;
+    ++tally.sent;
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+  stream.WritesDone();
+}
+
+// Reads every answer and checks it against the engine of its version.
+void ReadAndCheck(DistanceStream& stream, int32_t faces,
+                  const std::shared_ptr<const query::QueryEngine>& v1_engine,
+                  const std::shared_ptr<const query::QueryEngine>& v2_engine, StreamTally& tally) {
+  v1::DistanceResult result;
+  while (stream.Read(&result)) {
+    const int k = static_cast<int>(result.batch_id());
+    if (k != tally.read) ++tally.wrong;
+    ++tally.read;
+    if (result.error_code() != 0) {
+      ++tally.failed;
+      ADD_FAILURE() << "batch " << k << ": " << result.error_message();
+      continue;
+    }
+    ++tally.by_version[result.version()];
+    auto a = testing::RandomPoints(faces, 50, k), b = testing::RandomPoints(faces, 50, k + 1000000);
+    std::vector<double> expected(50);
+    const auto& engine = result.version() == 1 ? v1_engine : v2_engine;
+    EXPECT_TRUE(engine->DistanceBatch(a, b, expected).ok());
+    for (int i = 0; i < 50; ++i) {
+      if (result.distances(i) != expected[i]) ++tally.wrong;
+    }
+  }
+}
+
+// Waits (10 s at most) until n more batches have been read.
+void WaitForBatches(const StreamTally& tally, int n) {
+  const int target = tally.read + n;
+  const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+  while (tally.read < target && std::chrono::steady_clock::now() < until) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  }
+}
+
 TEST(ServerTest, AddReplaceRemoveWhileStreamingFailsNoBatch) {
   TestServer ts;
   auto stub = v1::Geodex::NewStub(ts.TcpChannel());
@@ -47,71 +109,28 @@ TEST(ServerTest, AddReplaceRemoveWhileStreamingFailsNoBatch) {
   auto context = Context(60);
   auto stream = stub->StreamDistances(context.get());
   std::atomic<bool> stop{false};
-  std::atomic<int> sent{0};
-  std::atomic<int> read{0};
-  // At most 32 batches in flight: the swaps happen while the stream flows,
-  // and the backlog left at the end is drained well within the deadline
-  // however slow the build (sanitizers).
-  std::thread writer([&] {
-    for (int k = 0; !stop; ++k) {
-      while (!stop && sent - read >= 32) std::this_thread::sleep_for(std::chrono::milliseconds(1));
-      if (stop) break;
-      if (!stream->Write(testing::RandomSphereBatch(k, faces, 50, k, 1000000))) break;
-      ++sent;
-      std::this_thread::sleep_for(std::chrono::milliseconds(1));
-    }
-    stream->WritesDone();
-  });
-  std::map<int64_t, int> by_version;
-  int failed = 0, wrong = 0;
-  std::thread reader([&] {
-    v1::DistanceResult result;
-    while (stream->Read(&result)) {
-      const int k = static_cast<int>(result.batch_id());
-      if (k != read) ++wrong;
-      ++read;
-      if (result.error_code() != 0) {
-        ++failed;
-        ADD_FAILURE() << "batch " << k << ": " << result.error_message();
-        continue;
-      }
-      ++by_version[result.version()];
-      auto a = testing::RandomPoints(faces, 50, k),
-           b = testing::RandomPoints(faces, 50, k + 1000000);
-      std::vector<double> expected(50);
-      const auto& engine = result.version() == 1 ? v1_engine : v2_engine;
-      EXPECT_TRUE(engine->DistanceBatch(a, b, expected).ok());
-      for (int i = 0; i < 50; ++i) {
-        if (result.distances(i) != expected[i]) ++wrong;
-      }
-    }
-  });
-  auto wait_for_batches = [&](int n) {
-    const int target = read + n;
-    const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(10);
-    while (read < target && std::chrono::steady_clock::now() < until) {
-      std::this_thread::sleep_for(std::chrono::milliseconds(2));
-    }
-  };
-  wait_for_batches(20);
+  StreamTally tally;
+  std::thread writer([&] { WriteBatches(*stream, faces, stop, tally); });
+  std::thread reader([&] { ReadAndCheck(*stream, faces, v1_engine, v2_engine, tally); });
+  WaitForBatches(tally, 20);
   testing::WriteModelVersion(ts.root(), "added", 1, testing::TorusIndexBytes());  // add
   ts.Rescan();
-  wait_for_batches(20);
+  WaitForBatches(tally, 20);
   testing::WriteModelVersion(ts.root(), "sphere", 2, OtherSphereBytes());  // replace
   ts.Rescan();
-  wait_for_batches(20);
+  WaitForBatches(tally, 20);
   testing::RemoveModel(ts.root(), "torus");  // remove
   ts.Rescan();
-  wait_for_batches(20);
+  WaitForBatches(tally, 20);
   stop = true;
   writer.join();
   reader.join();
   EXPECT_TRUE(stream->Finish().ok());
-  EXPECT_EQ(read, sent.load());
-  EXPECT_EQ(failed, 0);
-  EXPECT_EQ(wrong, 0);
-  EXPECT_GT(by_version[1], 0);
-  EXPECT_GT(by_version[2], 0);
+  EXPECT_EQ(tally.read, tally.sent.load());
+  EXPECT_EQ(tally.failed, 0);
+  EXPECT_EQ(tally.wrong, 0);
+  EXPECT_GT(tally.by_version[1], 0);
+  EXPECT_GT(tally.by_version[2], 0);
 
   v1::ListModelsResponse list;
   auto c = Context();

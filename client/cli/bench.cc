@@ -267,45 +267,36 @@ double Percentile(const std::vector<double>& sorted, double q) {
   return sorted[i];
 }
 
-}  // namespace
-
-absl::StatusOr<BenchReport> RunBench(const Client& client, const BenchOptions& options) {
-  if (options.concurrency < 1 || options.batch < 1 || options.window < 1) {
-    return absl::InvalidArgumentError("concurrency, batch and window must be positive");
-  }
-  absl::StatusOr<ModelInfo> info = client.GetModel(options.model);
-  if (!info.ok()) return info.status();
-  if (info->num_faces <= 0) {
-    return absl::FailedPreconditionError(
-        absl::StrFormat("model %s has no faces (state %s)", info->name, StateName(info->state)));
-  }
-  BenchReport report;
-  std::vector<PointPair> pool;
+// The pool of pairs the workers send, in turn, drawn as options.pairs says
+// on the model `info` describes; sets report->scale_length for near pairs.
+absl::StatusOr<std::vector<PointPair>> DrawPool(const Client& client, const BenchOptions& options,
+                                                const ModelInfo& info, BenchReport* report) {
   // Area-uniform and near pairs are drawn on the mesh of the version
   // described.
   absl::StatusOr<Mesh> mesh = Mesh{};
   if (options.pairs != BenchOptions::Pairs::kUniform) {
-    mesh = client.GetMesh(ModelRef(options.model.name, info->version));
+    mesh = client.GetMesh(ModelRef(options.model.name, info.version));
     if (!mesh.ok()) return mesh.status();
   }
+  std::vector<PointPair> pool;
   if (options.pairs == BenchOptions::Pairs::kArea) {
     pool = AreaUniformPairs(*mesh, std::max<size_t>(65536, 4 * static_cast<size_t>(options.batch)),
                             options.seed);
     if (pool.empty()) {
       return absl::FailedPreconditionError(
-          absl::StrFormat("model %s: its mesh has no area", info->name));
+          absl::StrFormat("model %s: its mesh has no area", info.name));
     }
   } else if (options.pairs == BenchOptions::Pairs::kNear) {
-    report.scale_length = ScaleLength(*mesh, info->num_samples);
+    report->scale_length = ScaleLength(*mesh, info.num_samples);
     // Drawing walks the faces round each point: fewer pairs than the uniform
     // pool, used in turn.
     pool = DrawNearPairs(
-        *mesh, options.near_from * report.scale_length, options.near_to * report.scale_length,
+        *mesh, options.near_from * report->scale_length, options.near_to * report->scale_length,
         std::max<size_t>(4096, 4 * static_cast<size_t>(options.batch)), options.seed);
     if (pool.empty()) {
       return absl::FailedPreconditionError(
-          absl::StrFormat("model %s: no pairs %gL to %gL apart (L = %g)", info->name,
-                          options.near_from, options.near_to, report.scale_length));
+          absl::StrFormat("model %s: no pairs %gL to %gL apart (L = %g)", info.name,
+                          options.near_from, options.near_to, report->scale_length));
     }
     // Every batch is a slice of the pool.
     for (size_t i = 0; pool.size() < static_cast<size_t>(options.batch); ++i) {
@@ -313,16 +304,16 @@ absl::StatusOr<BenchReport> RunBench(const Client& client, const BenchOptions& o
     }
   } else {
     pool =
-        RandomPairs(info->num_faces,
-                    std::max<size_t>(65536, 4 * static_cast<size_t>(options.batch)), options.seed);
+        RandomPairs(info.num_faces, std::max<size_t>(65536, 4 * static_cast<size_t>(options.batch)),
+                    options.seed);
   }
+  return pool;
+}
 
-  if (!options.save_pairs.empty()) {
-    if (absl::Status saved = WriteFileOrStdout(options.save_pairs, FormatPairs(pool)); !saved.ok()) {
-      return saved;
-    }
-  }
-
+// options.concurrency workers sending from `pool` through the warm-up and
+// the measured time; what each measured.
+std::vector<WorkerStats> RunWorkers(const Client& client, const BenchOptions& options,
+                                    const std::vector<PointPair>& pool) {
   std::vector<WorkerStats> stats(options.concurrency);
   const absl::Time begin = absl::Now();
   const absl::Time measure_from = begin + options.warmup;
@@ -338,8 +329,12 @@ absl::StatusOr<BenchReport> RunBench(const Client& client, const BenchOptions& o
     });
   }
   for (std::thread& t : workers) t.join();
+  return stats;
+}
 
-  report.elapsed = options.duration;
+// The workers' figures merged into `report`; the first error when no call
+// succeeded.
+absl::Status Summarize(const std::vector<WorkerStats>& stats, BenchReport& report) {
   std::vector<double> latencies;
   absl::Status first_error;
   for (const WorkerStats& s : stats) {
@@ -359,6 +354,35 @@ absl::StatusOr<BenchReport> RunBench(const Client& client, const BenchOptions& o
   double sum = 0;
   for (double l : latencies) sum += l;
   report.mean_ms = latencies.empty() ? 0 : sum / latencies.size();
+  return absl::OkStatus();
+}
+
+}  // namespace
+
+absl::StatusOr<BenchReport> RunBench(const Client& client, const BenchOptions& options) {
+  if (options.concurrency < 1 || options.batch < 1 || options.window < 1) {
+    return absl::InvalidArgumentError("concurrency, batch and window must be positive");
+  }
+  absl::StatusOr<ModelInfo> info = client.GetModel(options.model);
+  if (!info.ok()) return info.status();
+  if (info->num_faces <= 0) {
+    return absl::FailedPreconditionError(
+        absl::StrFormat("model %s has no faces (state %s)", info->name, StateName(info->state)));
+  }
+  BenchReport report;
+  absl::StatusOr<std::vector<PointPair>> pool = DrawPool(client, options, *info, &report);
+  if (!pool.ok()) return pool.status();
+
+  if (!options.save_pairs.empty()) {
+    if (absl::Status saved = WriteFileOrStdout(options.save_pairs, FormatPairs(*pool));
+        !saved.ok()) {
+      return saved;
+    }
+  }
+
+  const std::vector<WorkerStats> stats = RunWorkers(client, options, *pool);
+  report.elapsed = options.duration;
+  if (absl::Status summarized = Summarize(stats, report); !summarized.ok()) return summarized;
   return report;
 }
 

@@ -227,13 +227,8 @@ absl::StatusOr<std::pair<RoundPlan, RoundResult>> FinishSavedRound(const std::st
   return std::make_pair(std::move(round), std::move(result));
 }
 
-// Merge of a target-error build's round: the index when the build is done
-// (the target met, or m can grow no more: the closest round's index),
-// otherwise the next round's plan.
-absl::StatusOr<BuildReport> MergeTargetRound(const std::string& workdir, TargetState state,
-                                             const std::string& out,
-                                             const PipelineOptions& options) {
-  const std::string dir = RoundDirectory(workdir, state.round);
+// The rounds' options a distributed target-error build saved in its state.
+RoundsOptions RoundsOfState(const TargetState& state, const PipelineOptions& options) {
   RoundsOptions rounds;
   rounds.build = options.build;
   rounds.build.seed = state.seed;
@@ -242,6 +237,54 @@ absl::StatusOr<BuildReport> MergeTargetRound(const std::string& workdir, TargetS
   rounds.max_samples = state.cap;
   rounds.validation_sources = state.validation_sources;
   rounds.max_index_bytes = state.max_index_bytes;
+  return rounds;
+}
+
+// The index of a finished target-error build: round next.keep's, `result`
+// when that is the round just merged, with the rounds' report.
+absl::StatusOr<BuildReport> WriteClosestRound(const std::string& workdir, const TargetState& state,
+                                              const NextStep& next, const RoundsOptions& rounds,
+                                              RoundResult result, const std::string& out,
+                                              const PipelineOptions& options) {
+  if (next.keep != state.round) {
+    // A later round came no closer: the closest one's index, made again
+    // from its directory (merge and calibration are deterministic).
+    std::vector<SampleRow> kept_rows;
+    GEODEX_ASSIGN_OR_RETURN(
+        auto kept, FinishSavedRound(RoundDirectory(workdir, next.keep), rounds, &kept_rows));
+    result = std::move(kept.second);
+  }
+  result.data.report += TargetReport(state.rounds, next, state.target, result.data.accuracy[0]);
+  if (!next.reached) {
+    Log(options, absl::StrFormat("the target error was not reached (%s); "
+                                 "writing the index of round %d (m = %d)",
+                                 next.stop, next.keep + 1, state.rounds[next.keep].samples));
+  }
+  result.summary.validation_seconds = result.validation_seconds;
+  BuildReport report;
+  GEODEX_RETURN_IF_ERROR(WriteAndReport(result.data, result.summary, out, options, std::nullopt,
+                                        state.max_index_bytes, &report));
+  return report;
+}
+
+// The next round's directory: its plan, repair record and carried rows, and
+// no rows yet.
+absl::Status SaveNextRound(const RoundPlan& following, const std::string& next_dir) {
+  GEODEX_RETURN_IF_ERROR(SavePlan(following.prepared.mesh, following.plan, next_dir));
+  GEODEX_RETURN_IF_ERROR(SaveRepair(following.prepared.record, following.plan, next_dir));
+  GEODEX_RETURN_IF_ERROR(RemoveRows(next_dir));
+  if (following.carried.empty()) return RemoveCarriedRows(next_dir);
+  return SaveCarriedRows(following.plan, following.carried, next_dir);
+}
+
+// Merge of a target-error build's round: the index when the build is done
+// (the target met, or m can grow no more: the closest round's index),
+// otherwise the next round's plan.
+absl::StatusOr<BuildReport> MergeTargetRound(const std::string& workdir, TargetState state,
+                                             const std::string& out,
+                                             const PipelineOptions& options) {
+  const std::string dir = RoundDirectory(workdir, state.round);
+  const RoundsOptions rounds = RoundsOfState(state, options);
   std::vector<SampleRow> rows;
   GEODEX_ASSIGN_OR_RETURN(auto finished, FinishSavedRound(dir, rounds, &rows));
   RoundPlan& round = finished.first;
@@ -263,38 +306,13 @@ absl::StatusOr<BuildReport> MergeTargetRound(const std::string& workdir, TargetS
       following = *std::move(planned);
     }
   }
-  BuildReport report;
   if (next.done) {
-    if (next.keep != state.round) {
-      // A later round came no closer: the closest one's index, made again
-      // from its directory (merge and calibration are deterministic).
-      std::vector<SampleRow> kept_rows;
-      GEODEX_ASSIGN_OR_RETURN(auto kept, FinishSavedRound(RoundDirectory(workdir, next.keep),
-                                                          rounds, &kept_rows));
-      result = std::move(kept.second);
-    }
-    result.data.report += TargetReport(state.rounds, next, state.target, result.data.accuracy[0]);
-    if (!next.reached) {
-      Log(options, absl::StrFormat("the target error was not reached (%s); "
-                                   "writing the index of round %d (m = %d)",
-                                   next.stop, next.keep + 1, state.rounds[next.keep].samples));
-    }
-    result.summary.validation_seconds = result.validation_seconds;
-    GEODEX_RETURN_IF_ERROR(WriteAndReport(result.data, result.summary, out, options, std::nullopt,
-                                          state.max_index_bytes, &report));
-    return report;
+    return WriteClosestRound(workdir, state, next, rounds, std::move(result), out, options);
   }
   // The next round's directory is complete before the state points at it:
   // a merge killed before that point is run again, from this round.
   const std::string next_dir = RoundDirectory(workdir, state.round + 1);
-  GEODEX_RETURN_IF_ERROR(SavePlan(following->prepared.mesh, following->plan, next_dir));
-  GEODEX_RETURN_IF_ERROR(SaveRepair(following->prepared.record, following->plan, next_dir));
-  GEODEX_RETURN_IF_ERROR(RemoveRows(next_dir));
-  if (following->carried.empty()) {
-    GEODEX_RETURN_IF_ERROR(RemoveCarriedRows(next_dir));
-  } else {
-    GEODEX_RETURN_IF_ERROR(SaveCarriedRows(following->plan, following->carried, next_dir));
-  }
+  GEODEX_RETURN_IF_ERROR(SaveNextRound(*following, next_dir));
   // Not done: this round is the closest so far (DecideNext stops at the
   // first that is not). Its directory is kept; the one it replaces is not.
   const int32_t replaced = state.closest;
@@ -305,6 +323,7 @@ absl::StatusOr<BuildReport> MergeTargetRound(const std::string& workdir, TargetS
     std::error_code ignored;
     std::filesystem::remove_all(RoundDirectory(workdir, replaced), ignored);
   }
+  BuildReport report;
   report.another_round = true;
   report.num_samples = following->plan.num_samples();
   report.text += absl::StrFormat(

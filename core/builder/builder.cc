@@ -373,12 +373,12 @@ absl::StatusOr<Plan> ExtendPlan(const Mesh& mesh, std::span<const int32_t> previ
   return plan;
 }
 
-absl::StatusOr<std::vector<SampleRow>> ComputeRows(const Mesh& mesh, const Plan& plan,
-                                                   std::span<const int32_t> sample_ids,
-                                                   const BuildOptions& options,
-                                                   std::span<SampleRow> carried,
-                                                   const index::CoarseSurface* coarse) {
-  const int32_t m = plan.num_samples();
+namespace {
+
+// The sample ids asked for and the carried rows, checked against a plan of
+// m samples.
+absl::Status CheckRowRequest(int32_t m, std::span<const int32_t> sample_ids,
+                             std::span<const SampleRow> carried) {
   for (int32_t id : sample_ids) {
     if (id < 0 || id >= m) {
       return absl::InvalidArgumentError(absl::StrFormat("sample %d out of range [0, %d)", id, m));
@@ -395,6 +395,124 @@ absl::StatusOr<std::vector<SampleRow>> ComputeRows(const Mesh& mesh, const Plan&
           absl::StrFormat("the carried row of sample %d has the wrong size", a));
     }
   }
+  return absl::OkStatus();
+}
+
+// What every thread of ComputeRows reads.
+struct RowContext {
+  const Mesh& mesh;
+  const Plan& plan;
+  const std::vector<std::vector<int32_t>>& neighbors;
+  const CarriedCellReach& reach;
+  std::span<SampleRow> carried;
+  const index::CoarseSurface* coarse;
+  // The samples as points of the coarse surface (empty without one).
+  const std::vector<SurfacePoint>& sample_points;
+};
+
+// One thread of ComputeRows: its propagation engine and scratch space.
+class RowWorker {
+ public:
+  // Rows need vertex distances only: the wavefront engine, whose memory
+  // follows the front rather than the whole propagation.
+  explicit RowWorker(const RowContext& c)
+      : c_(c), solver_(c.coarse != nullptr ? c.coarse->mesh : c.mesh) {}
+
+  // Fills `row`, sample a's.
+  absl::Status Row(int32_t a, SampleRow& row) {
+    row.sample = a;
+    const std::vector<int32_t> cell_vertices = CellVertices(c_.plan, c_.neighbors[a], a);
+    if (a < static_cast<int32_t>(c_.carried.size())) {
+      GEODEX_RETURN_IF_ERROR(CarriedRow(a, cell_vertices, row));
+    }
+    if (row.to_samples.empty() || row.to_cell_vertices.size() != cell_vertices.size()) {
+      GEODEX_RETURN_IF_ERROR(FullRow(a, cell_vertices, row));
+    }
+    return absl::OkStatus();
+  }
+
+ private:
+  // From sample a, with `targets_` laid out as `first_cell` points before
+  // the cell vertices' (coarse) or none (split mesh).
+  absl::Status Propagate(int32_t a, geodesic::VertexGeodesicOptions propagation) {
+    if (c_.coarse == nullptr) return solver_.Propagate({c_.plan.samples[a]}, propagation);
+    propagation.targets = targets_;
+    return solver_.Propagate({c_.sample_points[a]}, propagation);
+  }
+  // After Propagate: the distance to vertex v of `mesh`, target k of the
+  // coarse propagation; +inf where it did not reach.
+  double Distance(int32_t v, size_t k) const {
+    return c_.coarse == nullptr ? solver_.VertexDistance(v) : solver_.TargetDistance(k);
+  }
+  void CellTargets(std::span<const int32_t> cell_vertices, bool with_samples) {
+    targets_.clear();
+    if (c_.coarse == nullptr) return;
+    if (with_samples) targets_ = c_.sample_points;
+    for (int32_t v : cell_vertices) targets_.push_back(c_.coarse->points[v]);
+  }
+
+  // The carried row of sample a, and its cell vertices' distances when a
+  // propagation bounded by the reach of its cell gets to them all.
+  absl::Status CarriedRow(int32_t a, const std::vector<int32_t>& cell_vertices, SampleRow& row) {
+    // Exact below the cap (vertices the propagation did not reach
+    // sooner keep it: +inf at the targets, NearestSource kNone at
+    // vertices); a full propagation when a cell vertex lies beyond it
+    // after all.
+    const double radius = c_.reach.Radius(a);
+    row.to_samples = std::move(c_.carried[a].to_samples);
+    if (radius <= 0) return absl::OkStatus();
+    cap_.assign(solver_.mesh().num_vertices(), radius);
+    geodesic::VertexGeodesicOptions bounded;
+    bounded.initial_distance = cap_;
+    CellTargets(cell_vertices, false);
+    GEODEX_RETURN_IF_ERROR(Propagate(a, bounded));
+    bool reached = true;
+    for (size_t j = 0; j < cell_vertices.size(); ++j) {
+      reached &= c_.coarse == nullptr ? solver_.NearestSource(cell_vertices[j]) == 0
+                                      : std::isfinite(solver_.TargetDistance(j));
+    }
+    if (reached) {
+      for (size_t j = 0; j < cell_vertices.size(); ++j)
+        row.to_cell_vertices.push_back(Distance(cell_vertices[j], j));
+    }
+    return absl::OkStatus();
+  }
+
+  // The cell vertices' distances, and the samples' when the row has none,
+  // from one propagation without a bound.
+  absl::Status FullRow(int32_t a, const std::vector<int32_t>& cell_vertices, SampleRow& row) {
+    const int32_t m = c_.plan.num_samples();
+    row.to_cell_vertices.clear();
+    const bool with_samples = row.to_samples.empty();
+    CellTargets(cell_vertices, with_samples);
+    GEODEX_RETURN_IF_ERROR(Propagate(a, {}));
+    const size_t first_cell = c_.coarse != nullptr && with_samples ? m : 0;
+    if (with_samples) {
+      row.to_samples.resize(m);
+      for (int32_t b = 0; b < m; ++b) row.to_samples[b] = Distance(c_.plan.samples[b], b);
+      row.to_samples[a] = 0;  // a target at the source, whatever its rounding
+    }
+    for (size_t j = 0; j < cell_vertices.size(); ++j) {
+      row.to_cell_vertices.push_back(Distance(cell_vertices[j], first_cell + j));
+    }
+    return absl::OkStatus();
+  }
+
+  const RowContext& c_;
+  geodesic::VertexGeodesicSolver solver_;
+  std::vector<double> cap_;
+  std::vector<SurfacePoint> targets_;
+};
+
+}  // namespace
+
+absl::StatusOr<std::vector<SampleRow>> ComputeRows(const Mesh& mesh, const Plan& plan,
+                                                   std::span<const int32_t> sample_ids,
+                                                   const BuildOptions& options,
+                                                   std::span<SampleRow> carried,
+                                                   const index::CoarseSurface* coarse) {
+  const int32_t m = plan.num_samples();
+  GEODEX_RETURN_IF_ERROR(CheckRowRequest(m, sample_ids, carried));
   const std::vector<std::vector<int32_t>> neighbors = plan.SampleNeighbors();
   const CarriedCellReach reach(mesh, plan, neighbors, carried);
   std::vector<SampleRow> rows(sample_ids.size());
@@ -413,79 +531,13 @@ absl::StatusOr<std::vector<SampleRow>> ComputeRows(const Mesh& mesh, const Plan&
   if (coarse != nullptr) {
     for (int32_t b = 0; b < m; ++b) sample_points.push_back(coarse->points[plan.samples[b]]);
   }
+  const RowContext context{mesh, plan, neighbors, reach, carried, coarse, sample_points};
   auto worker = [&](int id) {
-    // Rows need vertex distances only: the wavefront engine, whose memory
-    // follows the front rather than the whole propagation.
-    geodesic::VertexGeodesicSolver solver(coarse != nullptr ? coarse->mesh : mesh);
-    std::vector<double> cap;
-    std::vector<SurfacePoint> targets;
-    // From sample a, with `targets` laid out as `first_cell` points before
-    // the cell vertices' (coarse) or none (split mesh).
-    auto propagate = [&](int32_t a, geodesic::VertexGeodesicOptions propagation) {
-      if (coarse == nullptr) return solver.Propagate({plan.samples[a]}, propagation);
-      propagation.targets = targets;
-      return solver.Propagate({sample_points[a]}, propagation);
-    };
-    // After propagate: the distance to vertex v of `mesh`, target k of the
-    // coarse propagation; +inf where it did not reach.
-    auto distance = [&](int32_t v, size_t k) {
-      return coarse == nullptr ? solver.VertexDistance(v) : solver.TargetDistance(k);
-    };
-    auto cell_targets = [&](std::span<const int32_t> cell_vertices, bool with_samples) {
-      targets.clear();
-      if (coarse == nullptr) return;
-      if (with_samples) targets = sample_points;
-      for (int32_t v : cell_vertices) targets.push_back(coarse->points[v]);
-    };
+    RowWorker row_worker(context);
     for (size_t k; (k = next.fetch_add(1)) < sample_ids.size();) {
-      const int32_t a = sample_ids[k];
-      SampleRow& row = rows[k];
-      row.sample = a;
-      const std::vector<int32_t> cell_vertices = CellVertices(plan, neighbors[a], a);
-      if (a < static_cast<int32_t>(carried.size())) {
-        // Exact below the cap (vertices the propagation did not reach
-        // sooner keep it: +inf at the targets, NearestSource kNone at
-        // vertices); a full propagation when a cell vertex lies beyond it
-        // after all.
-        const double radius = reach.Radius(a);
-        row.to_samples = std::move(carried[a].to_samples);
-        if (radius > 0) {
-          cap.assign(solver.mesh().num_vertices(), radius);
-          geodesic::VertexGeodesicOptions bounded;
-          bounded.initial_distance = cap;
-          cell_targets(cell_vertices, false);
-          if (absl::Status status = propagate(a, bounded); !status.ok()) {
-            errors[id] = status;
-            return;
-          }
-          bool reached = true;
-          for (size_t j = 0; j < cell_vertices.size(); ++j) {
-            reached &= coarse == nullptr ? solver.NearestSource(cell_vertices[j]) == 0
-                                         : std::isfinite(solver.TargetDistance(j));
-          }
-          if (reached) {
-            for (size_t j = 0; j < cell_vertices.size(); ++j)
-              row.to_cell_vertices.push_back(distance(cell_vertices[j], j));
-          }
-        }
-      }
-      if (row.to_samples.empty() || row.to_cell_vertices.size() != cell_vertices.size()) {
-        row.to_cell_vertices.clear();
-        const bool with_samples = row.to_samples.empty();
-        cell_targets(cell_vertices, with_samples);
-        if (absl::Status status = propagate(a, {}); !status.ok()) {
-          errors[id] = status;
-          return;
-        }
-        const size_t first_cell = coarse != nullptr && with_samples ? m : 0;
-        if (with_samples) {
-          row.to_samples.resize(m);
-          for (int32_t b = 0; b < m; ++b) row.to_samples[b] = distance(plan.samples[b], b);
-          row.to_samples[a] = 0;  // a target at the source, whatever its rounding
-        }
-        for (size_t j = 0; j < cell_vertices.size(); ++j) {
-          row.to_cell_vertices.push_back(distance(cell_vertices[j], first_cell + j));
-        }
+      if (absl::Status status = row_worker.Row(sample_ids[k], rows[k]); !status.ok()) {
+        errors[id] = status;
+        return;
       }
       const int64_t finished = ++done;
       if (options.progress) {

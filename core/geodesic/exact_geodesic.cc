@@ -17,6 +17,42 @@ using mesh::Vec3;
 // (pseudo-sources): it keeps flat vertices exact despite rounding.
 constexpr double kSaddleSlack = 1e-9;
 
+// The sources on the mesh and inside the face region, if there is one, and
+// the initial distances one per vertex.
+absl::Status CheckSources(const Mesh& mesh, std::span<const SurfacePoint> sources,
+                          const GeodesicOptions& options) {
+  for (const SurfacePoint& s : sources) {
+    GEODEX_RETURN_IF_ERROR(mesh::ValidateSurfacePoint(mesh, s));
+  }
+  GEODEX_RETURN_IF_ERROR(CheckInitialDistances(options.initial_distance, mesh.num_vertices()));
+  if (options.face_region.empty()) return absl::OkStatus();
+  if (options.face_region.size() != static_cast<size_t>(mesh.num_faces())) {
+    return absl::InvalidArgumentError(
+        absl::StrFormat("face_region has %d entries, the mesh %d faces", options.face_region.size(),
+                        mesh.num_faces()));
+  }
+  for (const SurfacePoint& s : sources) {
+    if (options.face_region[s.face] == 0) {
+      return absl::InvalidArgumentError(
+          absl::StrFormat("a source lies in face %d, outside the face region", s.face));
+    }
+  }
+  return absl::OkStatus();
+}
+
+// The stop points on the mesh, the stop vertices its vertices.
+absl::Status CheckStops(const Mesh& mesh, const GeodesicOptions& options) {
+  for (const SurfacePoint& p : options.stop_points) {
+    GEODEX_RETURN_IF_ERROR(mesh::ValidateSurfacePoint(mesh, p));
+  }
+  for (int32_t v : options.stop_vertices) {
+    if (v < 0 || v >= mesh.num_vertices()) {
+      return absl::OutOfRangeError(absl::StrFormat("stop vertex %d out of range", v));
+    }
+  }
+  return absl::OkStatus();
+}
+
 }  // namespace
 
 ExactGeodesicSolver::ExactGeodesicSolver(const Mesh& mesh)
@@ -72,23 +108,7 @@ absl::Status ExactGeodesicSolver::Propagate(std::span<const SurfacePoint> source
                                             const GeodesicOptions& options) {
   Reset();
   if (sources.empty()) return absl::InvalidArgumentError("no sources given");
-  for (const SurfacePoint& s : sources) {
-    GEODEX_RETURN_IF_ERROR(mesh::ValidateSurfacePoint(mesh_, s));
-  }
-  GEODEX_RETURN_IF_ERROR(CheckInitialDistances(options.initial_distance, mesh_.num_vertices()));
-  if (!options.face_region.empty()) {
-    if (options.face_region.size() != static_cast<size_t>(mesh_.num_faces())) {
-      return absl::InvalidArgumentError(
-          absl::StrFormat("face_region has %d entries, the mesh %d faces",
-                          options.face_region.size(), mesh_.num_faces()));
-    }
-    for (const SurfacePoint& s : sources) {
-      if (options.face_region[s.face] == 0) {
-        return absl::InvalidArgumentError(
-            absl::StrFormat("a source lies in face %d, outside the face region", s.face));
-      }
-    }
-  }
+  GEODEX_RETURN_IF_ERROR(CheckSources(mesh_, sources, options));
   if (!options.initial_distance.empty()) {
     // dist_ becomes finite where no propagation touches it.
     full_reset_ = true;
@@ -100,14 +120,7 @@ absl::Status ExactGeodesicSolver::Propagate(std::span<const SurfacePoint> source
       }
     }
   }
-  for (const SurfacePoint& p : options.stop_points) {
-    GEODEX_RETURN_IF_ERROR(mesh::ValidateSurfacePoint(mesh_, p));
-  }
-  for (int32_t v : options.stop_vertices) {
-    if (v < 0 || v >= mesh_.num_vertices()) {
-      return absl::OutOfRangeError(absl::StrFormat("stop vertex %d out of range", v));
-    }
-  }
+  GEODEX_RETURN_IF_ERROR(CheckStops(mesh_, options));
   region_ = options.face_region;
   stop_radius_ = options.stop_radius;
   // With slack for rounding: where the way on to the point is straight (a

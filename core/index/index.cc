@@ -298,6 +298,79 @@ absl::Status CheckPadding(const uint8_t* p, size_t n, std::vector<ByteRange> use
   return absl::OkStatus();
 }
 
+// The sections FindSections found in the image at `base`, as typed views
+// (empty when absent).
+struct FoundSections {
+  const uint8_t* base;
+  const std::optional<SectionEntry> (&found)[kNumSpecs];
+
+  const std::optional<SectionEntry>& Entry(SectionId id) const {
+    return found[SpecIndex(static_cast<uint32_t>(id))];
+  }
+  template <class T>
+  std::span<const T> View(SectionId id) const {
+    return SectionView<T>(base, Entry(id));
+  }
+  std::string_view Text(SectionId id) const {
+    const std::span<const char> text = View<char>(id);
+    return std::string_view(text.data(), text.size());
+  }
+};
+
+// The sample matrix in the layout of the file's format version, of m
+// samples.
+SampleMatrix MatrixOf(const FileHeader& h, const FoundSections& s, int32_t m) {
+  if (h.format_major >= kCodedFormatMajor) {
+    return SampleMatrix::Coded(s.View<PackedCode>(SectionId::kSampleDistancesCoded), m,
+                               s.View<DistanceCodeRecord>(SectionId::kDistanceCode)[0].scale);
+  }
+  if (h.format_major >= kPackedFormatMajor) {
+    return SampleMatrix::Lower(s.View<float>(SectionId::kSampleDistancesLower), m);
+  }
+  return SampleMatrix::Full(s.View<float>(SectionId::kSampleDistances), m);
+}
+
+// The split of `faces` from its sections, dense or sparse, as records or
+// codes, each only in the format versions that hold it.
+absl::StatusOr<SplitView> ReadSplit(const FileHeader& h, const FoundSections& s,
+                                    std::span<const int32_t> faces) {
+  const auto coarse_faces = s.View<int32_t>(SectionId::kCoarseFaces);
+  const auto split_faces = s.View<SplitFaceRecord>(SectionId::kSplitFaces);
+  const auto split_coarse = s.View<SplitCoarseRecord>(SectionId::kSplitCoarseFaces);
+  const auto split_pieces = s.View<SplitPieceRecord>(SectionId::kSplitPieces);
+  const auto split_face_codes = s.View<SplitFaceCode>(SectionId::kSplitFaceCodes);
+  const auto split_piece_codes = s.View<SplitPieceCode>(SectionId::kSplitPieceCodes);
+  const bool dense_split =
+      !split_faces.empty() || !coarse_faces.empty() || !split_face_codes.empty();
+  const bool sparse_split =
+      !split_coarse.empty() || !split_pieces.empty() || !split_piece_codes.empty();
+  if ((!split_faces.empty() && !split_face_codes.empty()) ||
+      (!split_pieces.empty() && !split_piece_codes.empty())) {
+    return absl::DataLossError("an index with both the records and the codes of its split");
+  }
+  if (dense_split && sparse_split) {
+    return absl::DataLossError("an index with both dense and sparse split sections");
+  }
+  if ((h.format_major < kSplitFormatMajor && (dense_split || h.params.split_vertices != 0)) ||
+      (h.format_major < kSparseSplitFormatMajor && sparse_split) ||
+      (h.format_major == kSparseSplitFormatMajor && dense_split)) {
+    return absl::DataLossError(absl::StrFormat("a format %d.%d index with %s split sections",
+                                               h.format_major, h.format_minor,
+                                               sparse_split ? "sparse" : "dense"));
+  }
+  if (!split_piece_codes.empty()) {
+    return SplitView::Sparse(faces, split_coarse, split_piece_codes, absl::StatusCode::kDataLoss);
+  }
+  if (sparse_split) {
+    return SplitView::Sparse(faces, split_coarse, split_pieces, absl::StatusCode::kDataLoss);
+  }
+  if (!split_face_codes.empty()) {
+    return SplitView::Dense(coarse_faces, split_face_codes, faces.size() / 3,
+                            absl::StatusCode::kDataLoss);
+  }
+  return SplitView::Dense(coarse_faces, split_faces, faces.size() / 3, absl::StatusCode::kDataLoss);
+}
+
 }  // namespace
 
 uint64_t MeshHash(std::span<const double> positions, std::span<const int32_t> faces) {
@@ -368,96 +441,48 @@ absl::Status Index::Validate() {
 
   // Sections are 64-byte aligned in a 64-byte aligned image: typed views are
   // properly aligned.
-  auto entry = [&found](SectionId id) -> const std::optional<SectionEntry>& {
-    return found[SpecIndex(static_cast<uint32_t>(id))];
-  };
+  const FoundSections s{p, found};
   header_ = reinterpret_cast<const FileHeader*>(p);
-  positions_ = SectionView<double>(p, entry(SectionId::kPositions));
-  faces_ = SectionView<int32_t>(p, entry(SectionId::kFaces));
-  twins_ = SectionView<int32_t>(p, entry(SectionId::kTwins));
-  samples_ = SectionView<int32_t>(p, entry(SectionId::kSamples));
-  sample_distances_ = SectionView<float>(p, entry(SectionId::kSampleDistances));
-  sample_distances_lower_ = SectionView<float>(p, entry(SectionId::kSampleDistancesLower));
-  sample_distances_coded_ = SectionView<PackedCode>(p, entry(SectionId::kSampleDistancesCoded));
-  const std::span<const DistanceCodeRecord> distance_code =
-      SectionView<DistanceCodeRecord>(p, entry(SectionId::kDistanceCode));
-  triangles_ = SectionView<GeodesicTriangle>(p, entry(SectionId::kTriangles));
+  positions_ = s.View<double>(SectionId::kPositions);
+  faces_ = s.View<int32_t>(SectionId::kFaces);
+  twins_ = s.View<int32_t>(SectionId::kTwins);
+  samples_ = s.View<int32_t>(SectionId::kSamples);
+  sample_distances_ = s.View<float>(SectionId::kSampleDistances);
+  sample_distances_lower_ = s.View<float>(SectionId::kSampleDistancesLower);
+  sample_distances_coded_ = s.View<PackedCode>(SectionId::kSampleDistancesCoded);
+  const auto distance_code = s.View<DistanceCodeRecord>(SectionId::kDistanceCode);
+  triangles_ = s.View<GeodesicTriangle>(SectionId::kTriangles);
   const bool derived_format = h.format_major >= kDerivedFormatMajor;
   std::span<const VertexRecordWithCorners> legacy_vertices;
   if (derived_format) {
-    vertices_ = SectionView<VertexRecord>(p, entry(SectionId::kCompactVertexRecords));
+    vertices_ = s.View<VertexRecord>(SectionId::kCompactVertexRecords);
   } else {
     // 1.x-5.x copied each record's corners in: checked against its
     // triangle's and left out, so that every version answers from one kind
     // of record.
-    legacy_vertices = SectionView<VertexRecordWithCorners>(p, entry(SectionId::kVertexRecords));
+    legacy_vertices = s.View<VertexRecordWithCorners>(SectionId::kVertexRecords);
     derived_vertices_ = internal::WithoutCorners(legacy_vertices);
     vertices_ = derived_vertices_;
   }
   // From 6.0 the twins and the BVH may be left out, to be derived here (the
   // BVH below, once the positions and faces it reads are checked).
-  const bool derive_twins = derived_format && !entry(SectionId::kTwins).has_value();
-  const bool derive_bvh = derived_format && !entry(SectionId::kFaceBvh).has_value();
-  if (derived_format && entry(SectionId::kFaceBvh).has_value() !=
-                            entry(SectionId::kBvhFaces).has_value()) {
+  const bool derive_bvh = derived_format && !s.Entry(SectionId::kFaceBvh).has_value();
+  if (derived_format &&
+      s.Entry(SectionId::kFaceBvh).has_value() != s.Entry(SectionId::kBvhFaces).has_value()) {
     return absl::DataLossError("a format 6 index with one of the two BVH sections");
   }
-  if (derive_twins) {
+  if (derived_format && !s.Entry(SectionId::kTwins).has_value()) {
     GEODEX_ASSIGN_OR_RETURN(derived_twins_, DeriveTwins(faces_, absl::StatusCode::kDataLoss));
     twins_ = derived_twins_;
   }
-  bvh_nodes_ = SectionView<BvhNode>(p, entry(SectionId::kFaceBvh));
-  bvh_faces_ = SectionView<int32_t>(p, entry(SectionId::kBvhFaces));
-  const std::span<const char> report = SectionView<char>(p, entry(SectionId::kReport));
-  report_ = std::string_view(report.data(), report.size());
-  accuracy_ = SectionView<AccuracyRecord>(p, entry(SectionId::kAccuracy));
-  input_faces_ = SectionView<InputFaceRecord>(p, entry(SectionId::kInputFaces));
-  vertex_copies_ = SectionView<int32_t>(p, entry(SectionId::kVertexCopies));
-  const std::span<const int32_t> coarse_faces =
-      SectionView<int32_t>(p, entry(SectionId::kCoarseFaces));
-  const std::span<const SplitFaceRecord> split_faces =
-      SectionView<SplitFaceRecord>(p, entry(SectionId::kSplitFaces));
-  const std::span<const SplitCoarseRecord> split_coarse =
-      SectionView<SplitCoarseRecord>(p, entry(SectionId::kSplitCoarseFaces));
-  const std::span<const SplitPieceRecord> split_pieces =
-      SectionView<SplitPieceRecord>(p, entry(SectionId::kSplitPieces));
-  spread_bounds_ = SectionView<SpreadBoundRecord>(p, entry(SectionId::kSpreadBounds));
-  const std::span<const SplitFaceCode> split_face_codes =
-      SectionView<SplitFaceCode>(p, entry(SectionId::kSplitFaceCodes));
-  const std::span<const SplitPieceCode> split_piece_codes =
-      SectionView<SplitPieceCode>(p, entry(SectionId::kSplitPieceCodes));
-  const bool dense_split =
-      !split_faces.empty() || !coarse_faces.empty() || !split_face_codes.empty();
-  const bool sparse_split =
-      !split_coarse.empty() || !split_pieces.empty() || !split_piece_codes.empty();
-  if ((!split_faces.empty() && !split_face_codes.empty()) ||
-      (!split_pieces.empty() && !split_piece_codes.empty())) {
-    return absl::DataLossError("an index with both the records and the codes of its split");
-  }
-  if (dense_split && sparse_split) {
-    return absl::DataLossError("an index with both dense and sparse split sections");
-  }
-  if ((h.format_major < kSplitFormatMajor && (dense_split || h.params.split_vertices != 0)) ||
-      (h.format_major < kSparseSplitFormatMajor && sparse_split) ||
-      (h.format_major == kSparseSplitFormatMajor && dense_split)) {
-    return absl::DataLossError(absl::StrFormat("a format %d.%d index with %s split sections",
-                                               h.format_major, h.format_minor,
-                                               sparse_split ? "sparse" : "dense"));
-  }
-  if (!split_piece_codes.empty()) {
-    GEODEX_ASSIGN_OR_RETURN(split_, SplitView::Sparse(faces_, split_coarse, split_piece_codes,
-                                                      absl::StatusCode::kDataLoss));
-  } else if (sparse_split) {
-    GEODEX_ASSIGN_OR_RETURN(
-        split_, SplitView::Sparse(faces_, split_coarse, split_pieces, absl::StatusCode::kDataLoss));
-  } else if (!split_face_codes.empty()) {
-    GEODEX_ASSIGN_OR_RETURN(split_,
-                            SplitView::Dense(coarse_faces, split_face_codes, faces_.size() / 3,
-                                             absl::StatusCode::kDataLoss));
-  } else {
-    GEODEX_ASSIGN_OR_RETURN(split_, SplitView::Dense(coarse_faces, split_faces, faces_.size() / 3,
-                                                     absl::StatusCode::kDataLoss));
-  }
+  bvh_nodes_ = s.View<BvhNode>(SectionId::kFaceBvh);
+  bvh_faces_ = s.View<int32_t>(SectionId::kBvhFaces);
+  report_ = s.Text(SectionId::kReport);
+  accuracy_ = s.View<AccuracyRecord>(SectionId::kAccuracy);
+  input_faces_ = s.View<InputFaceRecord>(SectionId::kInputFaces);
+  vertex_copies_ = s.View<int32_t>(SectionId::kVertexCopies);
+  spread_bounds_ = s.View<SpreadBoundRecord>(SectionId::kSpreadBounds);
+  GEODEX_ASSIGN_OR_RETURN(split_, ReadSplit(h, s, faces_));
   GEODEX_RETURN_IF_ERROR(CheckAccuracy(accuracy_, absl::StatusCode::kDataLoss));
   GEODEX_RETURN_IF_ERROR(
       CheckSpreadBounds(spread_bounds_, accuracy_.size(), absl::StatusCode::kDataLoss));
@@ -481,14 +506,7 @@ absl::Status Index::Validate() {
     bvh_nodes_ = derived_bvh_nodes_;
     bvh_faces_ = derived_bvh_faces_;
   }
-  const int32_t m = num_samples();
-  if (h.format_major >= kCodedFormatMajor) {
-    matrix_ = SampleMatrix::Coded(sample_distances_coded_, m, distance_code[0].scale);
-  } else if (h.format_major >= kPackedFormatMajor) {
-    matrix_ = SampleMatrix::Lower(sample_distances_lower_, m);
-  } else {
-    matrix_ = SampleMatrix::Full(sample_distances_, m);
-  }
+  matrix_ = MatrixOf(h, s, num_samples());
   return absl::OkStatus();
 }
 

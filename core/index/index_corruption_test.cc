@@ -173,15 +173,24 @@ void ExpectDataLoss(const std::string& bytes, const std::vector<Case>& cases) {
   }
 }
 
-TEST(IndexTest, SemanticCorruptionWithValidChecksumsIsDataLoss) {
-  const IndexData d = MakeSphereIndex();
-  const std::string bytes = Serialize(d);
-  const int32_t nv = static_cast<int32_t>(d.positions.size() / 3);
-  const int32_t nf = static_cast<int32_t>(d.faces.size() / 3);
-  const int32_t m = static_cast<int32_t>(d.samples.size());
-  const int32_t nt = static_cast<int32_t>(d.triangles.size());
-  const int32_t nb = static_cast<int32_t>(d.bvh_nodes.size());
-  const float kNaN = std::numeric_limits<float>::quiet_NaN();
+// The sphere index with valid checksums, and its counts, for the semantic
+// corruptions below.
+struct SphereFile {
+  IndexData d = MakeSphereIndex();
+  std::string bytes = Serialize(d);
+  int32_t nv = static_cast<int32_t>(d.positions.size() / 3);
+  int32_t nf = static_cast<int32_t>(d.faces.size() / 3);
+  int32_t m = static_cast<int32_t>(d.samples.size());
+  int32_t nt = static_cast<int32_t>(d.triangles.size());
+  int32_t nb = static_cast<int32_t>(d.bvh_nodes.size());
+};
+
+constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
+
+TEST(IndexTest, SemanticCorruptionOfTheMeshIsDataLoss) {
+  const SphereFile f;
+  const int32_t nv = f.nv;
+  const int32_t nf = f.nf;
   const std::vector<Case> cases = {
       {"face vertex out of range", [&](Image& i) { i.Set<int32_t>(SectionId::kFaces, 7, nv); },
        "face 2"},
@@ -199,11 +208,29 @@ TEST(IndexTest, SemanticCorruptionWithValidChecksumsIsDataLoss) {
          i.Set<double>(SectionId::kPositions, 4, std::numeric_limits<double>::infinity());
        },
        "vertex 1"},
+  };
+  ExpectDataLoss(f.bytes, cases);
+}
+
+TEST(IndexTest, SemanticCorruptionOfSampleDistancesIsDataLoss) {
+  const SphereFile f;
+  const int32_t m = f.m;
+  const std::vector<Case> cases = {
       {"NaN sample distance", [&](Image& i) { i.Set<float>(SectionId::kSampleDistances, 1, kNaN); },
        "sample distance"},
       {"negative sample distance",
        [&](Image& i) { i.Set<float>(SectionId::kSampleDistances, m + 2, -0.5f); },
        "sample distance (1, 2)"},
+  };
+  ExpectDataLoss(f.bytes, cases);
+}
+
+TEST(IndexTest, SemanticCorruptionOfVertexRecordsIsDataLoss) {
+  const SphereFile f;
+  const int32_t nv = f.nv;
+  const int32_t m = f.m;
+  const int32_t nt = f.nt;
+  const std::vector<Case> cases = {
       {"vertex triangle out of range",
        [&](Image& i) {
          VertexRecordWithCorners r = i.Get<VertexRecordWithCorners>(SectionId::kVertexRecords, 9);
@@ -239,6 +266,14 @@ TEST(IndexTest, SemanticCorruptionWithValidChecksumsIsDataLoss) {
          i.Set(SectionId::kVertexRecords, 9, r);
        },
        "vertex record 9"},
+  };
+  ExpectDataLoss(f.bytes, cases);
+}
+
+TEST(IndexTest, SemanticCorruptionOfTrianglesIsDataLoss) {
+  const SphereFile f;
+  const int32_t nt = f.nt;
+  const std::vector<Case> cases = {
       {"triangle corner out of range",
        [&](Image& i) {
          GeodesicTriangle g = i.Get<GeodesicTriangle>(SectionId::kTriangles, 4);
@@ -253,6 +288,15 @@ TEST(IndexTest, SemanticCorruptionWithValidChecksumsIsDataLoss) {
          i.Set(SectionId::kTriangles, 4, g);
        },
        "geodesic triangle 4"},
+  };
+  ExpectDataLoss(f.bytes, cases);
+}
+
+TEST(IndexTest, SemanticCorruptionOfTheBvhIsDataLoss) {
+  const SphereFile f;
+  const int32_t nf = f.nf;
+  const int32_t nb = f.nb;
+  const std::vector<Case> cases = {
       {"BVH child out of range",
        [&](Image& i) {
          BvhNode n = i.Get<BvhNode>(SectionId::kFaceBvh, 0);
@@ -297,7 +341,7 @@ TEST(IndexTest, SemanticCorruptionWithValidChecksumsIsDataLoss) {
        },
        "BVH face 1"},
   };
-  ExpectDataLoss(bytes, cases);
+  ExpectDataLoss(f.bytes, cases);
 }
 
 // The sphere index as if it were refined (format 2.0): every face its own
@@ -615,14 +659,27 @@ TEST(IndexTest, SpreadBoundCorruptionWithValidChecksumsIsDataLoss) {
   ExpectDataLoss(bytes, cases);
 }
 
-TEST(IndexTest, StructuralCorruptionWithValidChecksumsIsDataLoss) {
+// A corruption of the file's structure: the file it makes of the sphere
+// index's image, and the message its DataLoss names.
+struct StructuralCase {
+  std::string name;
+  std::function<std::string(Image&)> corrupt;
+  std::string message;
+};
+
+void ExpectStructuralDataLoss(const std::vector<StructuralCase>& cases) {
   const std::string bytes = Serialize(MakeSphereIndex());
-  struct Case {
-    std::string name;
-    std::function<std::string(Image&)> corrupt;
-    std::string message;
-  };
-  const std::vector<Case> cases = {
+  for (const StructuralCase& c : cases) {
+    Image image = Image::Parse(bytes);
+    const std::string corrupt = c.corrupt(image);
+    const absl::Status status = Index::FromBytes(corrupt).status();
+    EXPECT_EQ(status.code(), absl::StatusCode::kDataLoss) << c.name << ": " << status;
+    EXPECT_THAT(status.message(), HasSubstr(c.message)) << c.name;
+  }
+}
+
+TEST(IndexTest, StructuralCorruptionOfTheSectionsIsDataLoss) {
+  const std::vector<StructuralCase> cases = {
       {"missing required section",
        [](Image& i) {
          i.Remove(SectionId::kTriangles);
@@ -660,6 +717,18 @@ TEST(IndexTest, StructuralCorruptionWithValidChecksumsIsDataLoss) {
          return i.Layout();
        },
        "element size"},
+      {"params disagree with counts",
+       [](Image& i) {
+         ++i.header.params.num_samples;
+         return i.Layout();
+       },
+       "num_samples"},
+  };
+  ExpectStructuralDataLoss(cases);
+}
+
+TEST(IndexTest, StructuralCorruptionOfTheLayoutIsDataLoss) {
+  const std::vector<StructuralCase> cases = {
       {"misaligned section",
        [](Image& i) {
          std::string out = i.Layout();
@@ -714,20 +783,8 @@ TEST(IndexTest, StructuralCorruptionWithValidChecksumsIsDataLoss) {
          return out;
        },
        "non-zero padding"},
-      {"params disagree with counts",
-       [](Image& i) {
-         ++i.header.params.num_samples;
-         return i.Layout();
-       },
-       "num_samples"},
   };
-  for (const Case& c : cases) {
-    Image image = Image::Parse(bytes);
-    const std::string corrupt = c.corrupt(image);
-    const absl::Status status = Index::FromBytes(corrupt).status();
-    EXPECT_EQ(status.code(), absl::StatusCode::kDataLoss) << c.name << ": " << status;
-    EXPECT_THAT(status.message(), HasSubstr(c.message)) << c.name;
-  }
+  ExpectStructuralDataLoss(cases);
 }
 
 }  // namespace

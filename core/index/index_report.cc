@@ -607,48 +607,58 @@ std::string IndexReportText(const IndexReport& r, std::string_view title) {
   return out;
 }
 
-std::string IndexReportJson(const IndexReport& r) {
-  std::string out = "{\n";
-  absl::StrAppend(&out, "  \"format\": ", JsonString(r.format), ",\n");
-  absl::StrAppend(&out, "  \"builder\": ", JsonString(r.builder), ",\n");
-  absl::StrAppend(&out, "  \"mesh\": {\n    \"vertices\": ", r.vertices,
+namespace {
+
+// The input mesh, the mesh indexed and its repairs.
+void AppendMeshJson(const IndexReport& r, std::string* out) {
+  absl::StrAppend(out, "  \"mesh\": {\n    \"vertices\": ", r.vertices,
                   ",\n    \"faces\": ", r.faces, ",\n    \"index_vertices\": ", r.index_vertices,
                   ",\n    \"index_faces\": ", r.index_faces,
                   ",\n    \"split_midpoints\": ", r.split_midpoints,
                   ",\n    \"repairs\": ", JsonString(r.repairs), ",\n    \"repair_counts\": {");
   for (size_t i = 0; i < r.repair_counts.size(); ++i) {
-    absl::StrAppend(&out, i ? ", " : "", JsonString(r.repair_counts[i].first), ": ",
+    absl::StrAppend(out, i ? ", " : "", JsonString(r.repair_counts[i].first), ": ",
                     JsonNumber(r.repair_counts[i].second));
   }
-  absl::StrAppend(&out, "}\n  },\n");
-  absl::StrAppend(&out, "  \"samples\": {\"requested\": ", r.requested_samples,
+  absl::StrAppend(out, "}\n  },\n");
+}
+
+// The samples asked for and made, and those added for the topology.
+void AppendSamplesJson(const IndexReport& r, std::string* out) {
+  absl::StrAppend(out, "  \"samples\": {\"requested\": ", r.requested_samples,
                   ", \"final\": ", r.samples, ", \"added_by_repair\": ", r.samples_added_by_repair,
                   ", \"repair\": ", JsonString(r.sample_repair),
                   ", \"added_for_topology\": ", r.euler_samples, ", \"topology_places\": [");
   for (size_t i = 0; i < r.euler_sample_places.size(); ++i) {
     const PlacedSample& p = r.euler_sample_places[i];
-    absl::StrAppend(&out, i ? ", " : "", "{\"sample\": ", p.sample,
+    absl::StrAppend(out, i ? ", " : "", "{\"sample\": ", p.sample,
                     ", \"vertex\": ", p.midpoint ? std::string("null") : absl::StrCat(p.vertex),
                     ", \"copy\": ", p.copy ? "true" : "false", ", \"position\": [",
                     JsonNumber(p.position[0]), ", ", JsonNumber(p.position[1]), ", ",
                     JsonNumber(p.position[2]), "]}");
   }
-  absl::StrAppend(&out, "]},\n");
-  absl::StrAppend(&out, "  \"triangles\": ", r.triangles, ",\n");
-  absl::StrAppend(&out, "  \"size\": {\"bytes\": ", r.bytes, ", \"sections\": [");
+  absl::StrAppend(out, "]},\n");
+}
+
+// The file's size by section, and what the reader derives.
+void AppendSizeJson(const IndexReport& r, std::string* out) {
+  absl::StrAppend(out, "  \"size\": {\"bytes\": ", r.bytes, ", \"sections\": [");
   for (size_t i = 0; i < r.sections.size(); ++i) {
-    absl::StrAppend(&out, i ? ",\n" : "\n", "    {\"key\": ", JsonString(r.sections[i].key),
+    absl::StrAppend(out, i ? ",\n" : "\n", "    {\"key\": ", JsonString(r.sections[i].key),
                     ", \"label\": ", JsonString(r.sections[i].label),
                     ", \"bytes\": ", r.sections[i].bytes, "}");
   }
-  absl::StrAppend(&out, "], \"derived_at_load\": [");
+  absl::StrAppend(out, "], \"derived_at_load\": [");
   for (size_t i = 0; i < r.derived_at_load.size(); ++i) {
-    absl::StrAppend(&out, i ? ", " : "", JsonString(r.derived_at_load[i]));
+    absl::StrAppend(out, i ? ", " : "", JsonString(r.derived_at_load[i]));
   }
-  absl::StrAppend(&out, "]},\n");
-  absl::StrAppend(&out, "  \"error_bounds\": ", r.error_bounds ? "true" : "false", ",\n");
+  absl::StrAppend(out, "]},\n");
+}
+
+// The target error and how the rounds went.
+void AppendTargetJson(const IndexReport& r, std::string* out) {
   absl::StrAppend(
-      &out, "  \"target\": {\n    \"error\": ", JsonNumber(r.target_error),
+      out, "  \"target\": {\n    \"error\": ", JsonNumber(r.target_error),
       ",\n    \"asked\": ", r.target_asked ? "true" : "false",
       ",\n    \"met\": ", r.target_asked ? (r.target_met ? "true" : "false") : "null",
       ",\n    \"stop\": ", JsonString(r.target_stop), ",\n    \"rounds\": [",
@@ -658,45 +668,69 @@ std::string IndexReportJson(const IndexReport& r) {
       ",\n    \"closest_limit\": ", r.closest_check.empty() ? "null" : JsonNumber(r.closest_limit),
       ",\n    \"checks\": [", ChecksJson(r.checks), "]",
       ",\n    \"verdict\": ", JsonString(r.target_verdict), "\n  },\n");
-  if (r.has_accuracy) {
-    absl::StrAppend(&out, "  \"accuracy\": {\n    \"sources\": ", r.accuracy_sources,
-                    ",\n    \"pairs\": ", r.accuracy_pairs,
-                    ",\n    \"scale_length\": ", JsonNumber(r.scale_length),
-                    ",\n    \"uniform_rms\": ", JsonNumber(r.uniform_rms),
-                    ",\n    \"uniform_far_p99\": ", JsonNumber(r.uniform_far_p99),
-                    ",\n    \"bins\": [");
-    for (size_t b = 0; b < r.bins.size(); ++b) {
-      const ReportBin& bin = r.bins[b];
-      absl::StrAppend(
-          &out, b ? ",\n" : "\n", "      {\"key\": ", JsonString(bin.key),
-          ", \"label\": ", JsonString(bin.label), ", \"from_L\": ", JsonNumber(bin.from_l),
-          ", \"to_L\": ", JsonNumber(bin.to_l), ", \"rms\": ", JsonNumber(bin.rms),
-          ", \"p99\": ", JsonNumber(bin.p99), ", \"p99_limit\": ", JsonNumber(bin.p99_limit), "}");
-    }
-    absl::StrAppend(&out, "\n    ],\n    \"band_unit\": ",
-                    r.bands.empty() ? "null" : JsonNumber(r.band_unit),
-                    ",\n    \"refined_below\": ",
-                    r.bands.empty() ? "null" : JsonNumber(r.refined_below), ",\n    \"bands\": [");
-    for (size_t b = 0; b < r.bands.size(); ++b) {
-      const ReportBand& band = r.bands[b];
-      absl::StrAppend(&out, b ? ",\n" : "\n", "      {\"key\": ", JsonString(band.key),
-                      ", \"label\": ", JsonString(band.label), ", \"from\": ", JsonNumber(band.from),
-                      ", \"to\": ", JsonNumber(band.to), ", \"p99_vertex\": ", JsonNumber(band.p99[0]),
-                      ", \"p99_interior\": ", JsonNumber(band.p99[1]),
-                      ", \"pairs_vertex\": ", band.pairs[0], ", \"pairs_interior\": ", band.pairs[1],
-                      ", \"p99_limit\": ", JsonNumber(band.p99_limit),
-                      ", \"answer\": ", JsonString(band.answer), "}");
-    }
-    absl::StrAppend(&out, r.bands.empty() ? "]\n  },\n" : "\n    ]\n  },\n");
-  } else {
-    absl::StrAppend(&out, "  \"accuracy\": null,\n");
+}
+
+// The calibration's figures by scale bin and fixed band; null without one.
+void AppendAccuracyJson(const IndexReport& r, std::string* out) {
+  if (!r.has_accuracy) {
+    absl::StrAppend(out, "  \"accuracy\": null,\n");
+    return;
   }
-  absl::StrAppend(&out, "  \"build_report\": {");
+  absl::StrAppend(out, "  \"accuracy\": {\n    \"sources\": ", r.accuracy_sources,
+                  ",\n    \"pairs\": ", r.accuracy_pairs,
+                  ",\n    \"scale_length\": ", JsonNumber(r.scale_length),
+                  ",\n    \"uniform_rms\": ", JsonNumber(r.uniform_rms),
+                  ",\n    \"uniform_far_p99\": ", JsonNumber(r.uniform_far_p99),
+                  ",\n    \"bins\": [");
+  for (size_t b = 0; b < r.bins.size(); ++b) {
+    const ReportBin& bin = r.bins[b];
+    absl::StrAppend(out, b ? ",\n" : "\n", "      {\"key\": ", JsonString(bin.key),
+                    ", \"label\": ", JsonString(bin.label),
+                    ", \"from_L\": ", JsonNumber(bin.from_l), ", \"to_L\": ", JsonNumber(bin.to_l),
+                    ", \"rms\": ", JsonNumber(bin.rms), ", \"p99\": ", JsonNumber(bin.p99),
+                    ", \"p99_limit\": ", JsonNumber(bin.p99_limit), "}");
+  }
+  absl::StrAppend(
+      out, "\n    ],\n    \"band_unit\": ", r.bands.empty() ? "null" : JsonNumber(r.band_unit),
+      ",\n    \"refined_below\": ", r.bands.empty() ? "null" : JsonNumber(r.refined_below),
+      ",\n    \"bands\": [");
+  for (size_t b = 0; b < r.bands.size(); ++b) {
+    const ReportBand& band = r.bands[b];
+    absl::StrAppend(
+        out, b ? ",\n" : "\n", "      {\"key\": ", JsonString(band.key),
+        ", \"label\": ", JsonString(band.label), ", \"from\": ", JsonNumber(band.from),
+        ", \"to\": ", JsonNumber(band.to), ", \"p99_vertex\": ", JsonNumber(band.p99[0]),
+        ", \"p99_interior\": ", JsonNumber(band.p99[1]), ", \"pairs_vertex\": ", band.pairs[0],
+        ", \"pairs_interior\": ", band.pairs[1], ", \"p99_limit\": ", JsonNumber(band.p99_limit),
+        ", \"answer\": ", JsonString(band.answer), "}");
+  }
+  absl::StrAppend(out, r.bands.empty() ? "]\n  },\n" : "\n    ]\n  },\n");
+}
+
+// The build report's entries, and the closing brace of the document.
+void AppendBuildReportJson(const IndexReport& r, std::string* out) {
+  absl::StrAppend(out, "  \"build_report\": {");
   for (size_t i = 0; i < r.entries.size(); ++i) {
-    absl::StrAppend(&out, i ? ",\n" : "\n", "    ", JsonString(r.entries[i].first), ": ",
+    absl::StrAppend(out, i ? ",\n" : "\n", "    ", JsonString(r.entries[i].first), ": ",
                     JsonString(r.entries[i].second));
   }
-  absl::StrAppend(&out, r.entries.empty() ? "}\n" : "\n  }\n", "}\n");
+  absl::StrAppend(out, r.entries.empty() ? "}\n" : "\n  }\n", "}\n");
+}
+
+}  // namespace
+
+std::string IndexReportJson(const IndexReport& r) {
+  std::string out = "{\n";
+  absl::StrAppend(&out, "  \"format\": ", JsonString(r.format), ",\n");
+  absl::StrAppend(&out, "  \"builder\": ", JsonString(r.builder), ",\n");
+  AppendMeshJson(r, &out);
+  AppendSamplesJson(r, &out);
+  absl::StrAppend(&out, "  \"triangles\": ", r.triangles, ",\n");
+  AppendSizeJson(r, &out);
+  absl::StrAppend(&out, "  \"error_bounds\": ", r.error_bounds ? "true" : "false", ",\n");
+  AppendTargetJson(r, &out);
+  AppendAccuracyJson(r, &out);
+  AppendBuildReportJson(r, &out);
   return out;
 }
 

@@ -134,133 +134,184 @@ absl::Status CheckSpreadBounds(std::span<const SpreadBoundRecord> records, size_
   return absl::OkStatus();
 }
 
-absl::Status CheckContents(const Contents& c, absl::StatusCode code) {
-  auto fail = [code](std::string message) { return absl::Status(code, message); };
+namespace {
+
+absl::Status Fail(absl::StatusCode code, std::string message) {
+  return absl::Status(code, message);
+}
+
+// The mesh's coordinates finite, and the faces', twins' and samples' ids in
+// range.
+absl::Status CheckMeshIds(const Contents& c, absl::StatusCode code) {
   const int64_t nv = static_cast<int64_t>(c.counts.num_vertices);
   const int64_t nf = static_cast<int64_t>(c.counts.num_faces);
-  const int64_t m = static_cast<int64_t>(c.counts.num_samples);
-  const int64_t nt = static_cast<int64_t>(c.counts.num_triangles);
-  const int64_t nb = static_cast<int64_t>(c.bvh_nodes.size());
-
   for (size_t i = 0; i < c.positions.size(); ++i) {
     if (!std::isfinite(c.positions[i])) {
-      return fail(absl::StrFormat("vertex %d: coordinate %d is not finite (%g)", i / 3, i % 3,
-                                  c.positions[i]));
+      return Fail(code, absl::StrFormat("vertex %d: coordinate %d is not finite (%g)", i / 3, i % 3,
+                                        c.positions[i]));
     }
   }
   for (size_t i = 0; i < c.faces.size(); ++i) {
     if (!InRange(c.faces[i], 0, nv)) {
-      return fail(
-          absl::StrFormat("face %d: vertex id %d out of range [0, %d)", i / 3, c.faces[i], nv));
+      return Fail(code, absl::StrFormat("face %d: vertex id %d out of range [0, %d)", i / 3,
+                                        c.faces[i], nv));
     }
   }
   for (size_t i = 0; i < c.twins.size(); ++i) {
     if (!InRange(c.twins[i], -1, 3 * nf)) {
-      return fail(
-          absl::StrFormat("half-edge %d: twin %d out of range [-1, %d)", i, c.twins[i], 3 * nf));
+      return Fail(code, absl::StrFormat("half-edge %d: twin %d out of range [-1, %d)", i,
+                                        c.twins[i], 3 * nf));
     }
   }
   for (size_t i = 0; i < c.samples.size(); ++i) {
     if (!InRange(c.samples[i], 0, nv)) {
-      return fail(
-          absl::StrFormat("sample %d: vertex id %d out of range [0, %d)", i, c.samples[i], nv));
+      return Fail(code, absl::StrFormat("sample %d: vertex id %d out of range [0, %d)", i,
+                                        c.samples[i], nv));
     }
   }
+  return absl::OkStatus();
+}
+
+// The sample matrix in whichever layout it is given.
+absl::Status CheckSampleMatrix(const Contents& c, absl::StatusCode code) {
+  const int64_t m = static_cast<int64_t>(c.counts.num_samples);
   // +inf is a legitimate distance between samples on different components.
   for (size_t i = 0; i < c.sample_distances.size(); ++i) {
     if (!NonNegative(c.sample_distances[i])) {
-      return fail(absl::StrFormat("sample distance (%d, %d) is negative or NaN (%g)", i / m, i % m,
-                                  c.sample_distances[i]));
+      return Fail(code, absl::StrFormat("sample distance (%d, %d) is negative or NaN (%g)", i / m,
+                                        i % m, c.sample_distances[i]));
     }
   }
   for (size_t i = 0; i < c.sample_distances_lower.size(); ++i) {
     if (!NonNegative(c.sample_distances_lower[i])) {
-      return fail(
-          absl::StrFormat("sample distance %d of the lower triangle is negative or NaN (%g)", i,
-                          c.sample_distances_lower[i]));
+      return Fail(
+          code, absl::StrFormat("sample distance %d of the lower triangle is negative or NaN (%g)",
+                                i, c.sample_distances_lower[i]));
     }
   }
   // Every code is a distance; only the scale can be wrong.
   if (c.distance_code.size() > 1 ||
       (!c.distance_code.empty() &&
        !(c.distance_code[0].scale > 0 && std::isfinite(c.distance_code[0].scale)))) {
-    return fail(absl::StrFormat("distance code: %d records, or a scale that is not finite and > 0",
+    return Fail(code,
+                absl::StrFormat("distance code: %d records, or a scale that is not finite and > 0",
                                 c.distance_code.size()));
   }
+  return absl::OkStatus();
+}
+
+absl::Status CheckVertexRecords(const Contents& c, absl::StatusCode code) {
+  const int64_t nt = static_cast<int64_t>(c.counts.num_triangles);
   for (size_t v = 0; v < c.vertices.size(); ++v) {
     const VertexRecord& r = c.vertices[v];
     if (!InRange(r.triangle, -1, nt)) {
-      return fail(absl::StrFormat("vertex record %d: geodesic triangle %d out of range [-1, %d)", v,
-                                  r.triangle, nt));
+      return Fail(code, absl::StrFormat("vertex record %d: geodesic triangle %d out of range "
+                                        "[-1, %d)",
+                                        v, r.triangle, nt));
     }
     for (int k = 0; k < 3; ++k) {
       // Vertices without a triangle may carry +inf; the others need real values.
       const bool ok = r.triangle == -1 ? NonNegative(r.distance[k])
                                        : std::isfinite(r.distance[k]) && r.distance[k] >= 0;
       if (!ok) {
-        return fail(
-            absl::StrFormat("vertex record %d: distance %d is invalid (%g)", v, k, r.distance[k]));
+        return Fail(code, absl::StrFormat("vertex record %d: distance %d is invalid (%g)", v, k,
+                                          r.distance[k]));
       }
     }
   }
+  return absl::OkStatus();
+}
+
+absl::Status CheckTriangles(const Contents& c, absl::StatusCode code) {
+  const int64_t m = static_cast<int64_t>(c.counts.num_samples);
+  const int64_t nt = static_cast<int64_t>(c.counts.num_triangles);
   for (size_t t = 0; t < c.triangles.size(); ++t) {
     const GeodesicTriangle& g = c.triangles[t];
     for (int k = 0; k < 3; ++k) {
       if (!InRange(g.corner[k], 0, m)) {
-        return fail(absl::StrFormat("geodesic triangle %d: corner %d is %d, out of range [0, %d)",
-                                    t, k, g.corner[k], m));
+        return Fail(
+            code, absl::StrFormat("geodesic triangle %d: corner %d is %d, out of range [0, %d)", t,
+                                  k, g.corner[k], m));
       }
       if (!InRange(g.neighbor[k], -1, nt)) {
-        return fail(
-            absl::StrFormat("geodesic triangle %d: neighbour %d is %d, out of range [-1, %d)", t, k,
-                            g.neighbor[k], nt));
+        return Fail(
+            code, absl::StrFormat("geodesic triangle %d: neighbour %d is %d, out of range [-1, %d)",
+                                  t, k, g.neighbor[k], nt));
       }
     }
   }
+  return absl::OkStatus();
+}
+
+// The corners a 1.x-5.x vertex record copied in: its triangle's.
+absl::Status CheckRecordCorners(const Contents& c, absl::StatusCode code) {
   for (size_t v = 0; v < c.vertices_with_corners.size(); ++v) {
     const VertexRecordWithCorners& r = c.vertices_with_corners[v];
     for (int k = 0; k < 3; ++k) {
       const int32_t expected = r.triangle == -1 ? -1 : c.triangles[r.triangle].corner[k];
       if (r.corner[k] != expected) {
-        return fail(absl::StrFormat("vertex record %d: corner %d is %d, expected %d (%s)", v, k,
-                                    r.corner[k], expected,
-                                    r.triangle == -1 ? "no triangle" : "its triangle's"));
+        return Fail(code, absl::StrFormat("vertex record %d: corner %d is %d, expected %d (%s)", v,
+                                          k, r.corner[k], expected,
+                                          r.triangle == -1 ? "no triangle" : "its triangle's"));
       }
     }
   }
+  return absl::OkStatus();
+}
+
+absl::Status CheckBvhNodes(const Contents& c, absl::StatusCode code) {
+  const int64_t nf = static_cast<int64_t>(c.counts.num_faces);
+  const int64_t nb = static_cast<int64_t>(c.bvh_nodes.size());
   // Children after their parent: every traversal terminates.
   for (int64_t i = 0; i < nb; ++i) {
     const BvhNode& b = c.bvh_nodes[i];
     for (int k = 0; k < 3; ++k) {
       if (!(b.lo[k] <= b.hi[k])) {
-        return fail(
-            absl::StrFormat("BVH node %d: bad box on axis %d [%g, %g]", i, k, b.lo[k], b.hi[k]));
+        return Fail(code, absl::StrFormat("BVH node %d: bad box on axis %d [%g, %g]", i, k, b.lo[k],
+                                          b.hi[k]));
       }
     }
     const bool ok = b.count > 0 ? b.first >= 0 && int64_t{b.first} + b.count <= nf
                                 : b.count == 0 && b.first > i && int64_t{b.first} + 1 < nb;
     if (!ok) {
-      return fail(
-          absl::StrFormat("BVH node %d: first %d, count %d out of range (%d nodes, %d "
-                          "faces)",
-                          i, b.first, b.count, nb, nf));
-    }
-  }
-  GEODEX_RETURN_IF_ERROR(CheckInputIds(
-      {nv, nf, c.input_faces, c.vertex_copies, c.split, c.split_vertices},
-      code));
-  if (!c.bvh_faces.empty()) {
-    std::vector<bool> seen(nf, false);
-    for (size_t i = 0; i < c.bvh_faces.size(); ++i) {
-      const int32_t f = c.bvh_faces[i];
-      if (!InRange(f, 0, nf) || seen[f]) {
-        return fail(
-            absl::StrFormat("BVH face %d: face %d out of range [0, %d) or repeated", i, f, nf));
-      }
-      seen[f] = true;
+      return Fail(code, absl::StrFormat("BVH node %d: first %d, count %d out of range (%d nodes, "
+                                        "%d faces)",
+                                        i, b.first, b.count, nb, nf));
     }
   }
   return absl::OkStatus();
+}
+
+// The BVH's faces: each face once, when there is a BVH.
+absl::Status CheckBvhFaces(const Contents& c, absl::StatusCode code) {
+  const int64_t nf = static_cast<int64_t>(c.counts.num_faces);
+  if (c.bvh_faces.empty()) return absl::OkStatus();
+  std::vector<bool> seen(nf, false);
+  for (size_t i = 0; i < c.bvh_faces.size(); ++i) {
+    const int32_t f = c.bvh_faces[i];
+    if (!InRange(f, 0, nf) || seen[f]) {
+      return Fail(
+          code, absl::StrFormat("BVH face %d: face %d out of range [0, %d) or repeated", i, f, nf));
+    }
+    seen[f] = true;
+  }
+  return absl::OkStatus();
+}
+
+}  // namespace
+
+absl::Status CheckContents(const Contents& c, absl::StatusCode code) {
+  const int64_t nv = static_cast<int64_t>(c.counts.num_vertices);
+  const int64_t nf = static_cast<int64_t>(c.counts.num_faces);
+  GEODEX_RETURN_IF_ERROR(CheckMeshIds(c, code));
+  GEODEX_RETURN_IF_ERROR(CheckSampleMatrix(c, code));
+  GEODEX_RETURN_IF_ERROR(CheckVertexRecords(c, code));
+  GEODEX_RETURN_IF_ERROR(CheckTriangles(c, code));
+  GEODEX_RETURN_IF_ERROR(CheckRecordCorners(c, code));
+  GEODEX_RETURN_IF_ERROR(CheckBvhNodes(c, code));
+  GEODEX_RETURN_IF_ERROR(
+      CheckInputIds({nv, nf, c.input_faces, c.vertex_copies, c.split, c.split_vertices}, code));
+  return CheckBvhFaces(c, code);
 }
 
 }  // namespace geodex::index::internal

@@ -231,13 +231,18 @@ uint64_t PredictIndexBytes(const IndexData& d) {
   return FileSize(pieces, layout, Compact(d), derivable);
 }
 
-absl::StatusOr<std::string> SerializeIndex(const IndexData& d) {
-  auto bad = [](std::string message) { return absl::InvalidArgumentError(message); };
+namespace {
+
+absl::Status Bad(std::string message) { return absl::InvalidArgumentError(message); }
+
+// The element counts of `d`, checked to fit int32 ids and against the
+// arrays whose sizes they fix first.
+absl::StatusOr<Counts> CountsOf(const IndexData& d) {
   if (d.positions.size() % 3 != 0) {
-    return bad(absl::StrFormat("positions: %d values, not a multiple of 3", d.positions.size()));
+    return Bad(absl::StrFormat("positions: %d values, not a multiple of 3", d.positions.size()));
   }
   if (d.faces.size() % 3 != 0) {
-    return bad(absl::StrFormat("faces: %d values, not a multiple of 3", d.faces.size()));
+    return Bad(absl::StrFormat("faces: %d values, not a multiple of 3", d.faces.size()));
   }
   Counts counts;
   counts.num_vertices = d.positions.size() / 3;
@@ -248,138 +253,156 @@ absl::StatusOr<std::string> SerializeIndex(const IndexData& d) {
   if (counts.num_vertices > kInt32Max || 3 * counts.num_faces > kInt32Max ||
       counts.num_samples > kInt32Max || counts.num_triangles > kInt32Max ||
       counts.num_bvh_nodes > kInt32Max) {
-    return bad("too many vertices, faces, samples, triangles or BVH nodes for int32 ids");
+    return Bad("too many vertices, faces, samples, triangles or BVH nodes for int32 ids");
   }
   if (d.twins.size() != d.faces.size()) {
-    return bad(absl::StrFormat("twins: %d values, expected %d (3 per face)", d.twins.size(),
+    return Bad(absl::StrFormat("twins: %d values, expected %d (3 per face)", d.twins.size(),
                                d.faces.size()));
   }
   if (d.sample_distances.size() != counts.num_samples * counts.num_samples) {
-    return bad(absl::StrFormat("sample_distances: %d values, expected %d (num_samples^2)",
+    return Bad(absl::StrFormat("sample_distances: %d values, expected %d (num_samples^2)",
                                d.sample_distances.size(), counts.num_samples * counts.num_samples));
   }
-  // The matrix stored once (3.0, 4.0): its lower triangle, checked
-  // symmetric, as floats or codes.
-  const MatrixLayout layout = d.sample_matrix;
+  return counts;
+}
+
+// The lower triangle of the m x m matrix `full`, row by row, checked
+// symmetric with a zero diagonal.
+absl::StatusOr<std::vector<float>> LowerTriangle(const std::vector<float>& full, size_t m) {
+  std::vector<float> lower;
+  lower.reserve(m * (m - std::min<size_t>(m, 1)) / 2);
+  for (size_t a = 0; a < m; ++a) {
+    if (full[a * m + a] != 0) {
+      return Bad(absl::StrFormat("sample_distances: (%d, %d) is not 0", a, a));
+    }
+    for (size_t b = 0; b < a; ++b) {
+      const float x = full[a * m + b];
+      if (!(x == full[b * m + a]) && !(std::isnan(x))) {
+        return Bad(absl::StrFormat("sample_distances: (%d, %d) and (%d, %d) differ", a, b, b, a));
+      }
+      lower.push_back(x);
+    }
+  }
+  return lower;
+}
+
+// The matrix stored once (3.0, 4.0): its lower triangle, checked
+// symmetric, as floats (`lower`) or codes (`coded` with its `code`); all
+// empty for the full matrix.
+struct StoredMatrix {
   std::vector<float> lower;
   std::vector<PackedCode> coded;
   std::vector<DistanceCodeRecord> code;
-  if (layout != MatrixLayout::kFull) {
-    const size_t m = counts.num_samples;
-    lower.reserve(m * (m - std::min<size_t>(m, 1)) / 2);
-    for (size_t a = 0; a < m; ++a) {
-      if (d.sample_distances[a * m + a] != 0) {
-        return bad(absl::StrFormat("sample_distances: (%d, %d) is not 0", a, a));
-      }
-      for (size_t b = 0; b < a; ++b) {
-        const float x = d.sample_distances[a * m + b];
-        if (!(x == d.sample_distances[b * m + a]) && !(std::isnan(x))) {
-          return bad(absl::StrFormat("sample_distances: (%d, %d) and (%d, %d) differ", a, b, b, a));
-        }
-        lower.push_back(x);
-      }
+};
+
+absl::StatusOr<StoredMatrix> StoreMatrix(const IndexData& d, size_t num_samples) {
+  StoredMatrix out;
+  if (d.sample_matrix == MatrixLayout::kFull) return out;
+  GEODEX_ASSIGN_OR_RETURN(out.lower, LowerTriangle(d.sample_distances, num_samples));
+  if (d.sample_matrix != MatrixLayout::kCoded) return out;
+  // Checked as floats first: a NaN has no code.
+  Contents floats;
+  floats.sample_distances_lower = out.lower;
+  GEODEX_RETURN_IF_ERROR(CheckContents(floats, absl::StatusCode::kInvalidArgument));
+  double scale = d.sample_distance_scale;
+  if (scale == 0) {
+    double largest = 0;
+    for (float x : out.lower) {
+      if (std::isfinite(x)) largest = std::max(largest, static_cast<double>(x));
     }
+    scale = DistanceCode::ScaleFor(largest);
   }
-  if (layout == MatrixLayout::kCoded) {
-    // Checked as floats first: a NaN has no code.
-    Contents floats;
-    floats.sample_distances_lower = lower;
-    GEODEX_RETURN_IF_ERROR(CheckContents(floats, absl::StatusCode::kInvalidArgument));
-    double scale = d.sample_distance_scale;
-    if (scale == 0) {
-      double largest = 0;
-      for (float x : lower) {
-        if (std::isfinite(x)) largest = std::max(largest, static_cast<double>(x));
-      }
-      scale = DistanceCode::ScaleFor(largest);
-    }
-    code = {DistanceCodeRecord{scale}};
-    coded.reserve(lower.size());
-    for (float x : lower) coded.push_back(DistanceCode::Pack(DistanceCode::Encode(x, scale)));
-    lower.clear();
-  }
-  const std::span<const float> full_matrix = layout == MatrixLayout::kFull
-                                                 ? std::span<const float>(d.sample_distances)
-                                                 : std::span<const float>();
+  out.code = {DistanceCodeRecord{scale}};
+  out.coded.reserve(out.lower.size());
+  for (float x : out.lower) out.coded.push_back(DistanceCode::Pack(DistanceCode::Encode(x, scale)));
+  out.lower.clear();
+  return out;
+}
+
+// The records whose number the counts fix, and the builder's version,
+// which must fit the header.
+absl::Status CheckRecordCounts(const IndexData& d, const Counts& counts) {
   if (d.vertices.size() != counts.num_vertices) {
-    return bad(absl::StrFormat("vertices: %d records, expected %d (one per vertex)",
+    return Bad(absl::StrFormat("vertices: %d records, expected %d (one per vertex)",
                                d.vertices.size(), counts.num_vertices));
   }
   const uint64_t expected_bvh_faces = counts.num_bvh_nodes > 0 ? counts.num_faces : 0;
   if (d.bvh_faces.size() != expected_bvh_faces) {
-    return bad(absl::StrFormat("bvh_faces: %d values, expected %d", d.bvh_faces.size(),
+    return Bad(absl::StrFormat("bvh_faces: %d values, expected %d", d.bvh_faces.size(),
                                expected_bvh_faces));
   }
   if (d.params.num_samples != counts.num_samples) {
-    return bad(absl::StrFormat("params.num_samples is %d but there are %d samples",
+    return Bad(absl::StrFormat("params.num_samples is %d but there are %d samples",
                                d.params.num_samples, counts.num_samples));
   }
   if (d.builder_version.size() >= sizeof(FileHeader::builder_version) ||
       d.builder_version.find('\0') != std::string::npos) {
-    return bad(absl::StrFormat("builder_version must be under %d bytes without NULs: \"%s\"",
+    return Bad(absl::StrFormat("builder_version must be under %d bytes without NULs: \"%s\"",
                                sizeof(FileHeader::builder_version), d.builder_version));
   }
+  return absl::OkStatus();
+}
+
+// The arrays' contents, checked as the reader checks them.
+absl::Status CheckArrays(const IndexData& d, const Counts& counts,
+                         std::span<const float> full_matrix, const StoredMatrix& matrix) {
   GEODEX_ASSIGN_OR_RETURN(const SplitView split_view,
                           SplitView::Dense(d.coarse_faces, d.split_faces, counts.num_faces,
                                            absl::StatusCode::kInvalidArgument));
-  GEODEX_RETURN_IF_ERROR(CheckContents(
-      Contents{counts, d.positions, d.faces, d.twins, d.samples, full_matrix, lower, code,
-               d.vertices, d.triangles, d.bvh_nodes, d.bvh_faces, d.input_faces, d.vertex_copies,
-               split_view, d.params.split_vertices},
-      absl::StatusCode::kInvalidArgument));
-  GEODEX_ASSIGN_OR_RETURN(const SplitLayout split, SplitLayoutOf(d));
-  GEODEX_RETURN_IF_ERROR(CheckAccuracy(d.accuracy, absl::StatusCode::kInvalidArgument));
-  GEODEX_RETURN_IF_ERROR(
-      CheckSpreadBounds(d.spread_bounds, d.accuracy.size(), absl::StatusCode::kInvalidArgument));
+  return CheckContents(
+      Contents{counts, d.positions, d.faces, d.twins, d.samples, full_matrix, matrix.lower,
+               matrix.code, d.vertices, d.triangles, d.bvh_nodes, d.bvh_faces, d.input_faces,
+               d.vertex_copies, split_view, d.params.split_vertices},
+      absl::StatusCode::kInvalidArgument);
+}
 
-  const Piece matrix[4] = {
-      {full_matrix.data(), full_matrix.size() * sizeof(float)},
-      {lower.data(), lower.size() * sizeof(float)},
-      {coded.data(), coded.size() * sizeof(PackedCode)},
-      {code.data(), code.size() * sizeof(DistanceCodeRecord)},
-  };
-  const Derivable derivable = DerivableOf(d);
-  const bool compact = Compact(d);
-  const std::vector<VertexRecordWithCorners> with_corners =
-      compact ? std::vector<VertexRecordWithCorners>()
-              : internal::WithCorners(d.vertices, d.triangles);
-  Piece pieces[kNumSpecs];
-  LayOut(d, matrix, split, derivable, with_corners, pieces);
-  auto written = [&](size_t i) { return Written(i, pieces, layout, compact, derivable); };
-  const bool refined = !d.split_faces.empty();
-  size_t num_sections = 0;
-  for (size_t i = 0; i < kNumSpecs; ++i) num_sections += written(i) ? 1 : 0;
+// The section table: an entry for each written section, in kSpecs order,
+// each aligned after the header and the table; piece_of[e] is the piece
+// entry e describes.
+struct SectionTable {
   SectionEntry entries[kNumSpecs];
-  std::memset(entries, 0, sizeof(entries));
-  const uint64_t table_offset = sizeof(FileHeader);
-  const uint64_t table_bytes = num_sections * sizeof(SectionEntry);
-  uint64_t cursor = table_offset + table_bytes;
   size_t piece_of[kNumSpecs];
+  size_t num_sections = 0;
+  uint64_t file_size = 0;
+
+  uint64_t offset() const { return sizeof(FileHeader); }
+  uint64_t bytes() const { return num_sections * sizeof(SectionEntry); }
+};
+
+SectionTable TableOf(const Piece (&pieces)[kNumSpecs], MatrixLayout layout, bool compact,
+                     const Derivable& derivable) {
+  auto written = [&](size_t i) { return Written(i, pieces, layout, compact, derivable); };
+  SectionTable t;
+  for (size_t i = 0; i < kNumSpecs; ++i) t.num_sections += written(i) ? 1 : 0;
+  std::memset(t.entries, 0, sizeof(t.entries));
+  uint64_t cursor = t.offset() + t.bytes();
   for (size_t i = 0, e = 0; i < kNumSpecs; ++i) {
     if (!written(i)) continue;
     cursor = AlignUp(cursor);
-    piece_of[e] = i;
-    entries[e].id = static_cast<uint32_t>(kSpecs[i].id);
-    entries[e].element_size = kSpecs[i].element_size;
-    entries[e].offset = cursor;
-    entries[e].size = pieces[i].size;
-    entries[e].checksum = Checksum(pieces[i].data, pieces[i].size);
+    t.piece_of[e] = i;
+    t.entries[e].id = static_cast<uint32_t>(kSpecs[i].id);
+    t.entries[e].element_size = kSpecs[i].element_size;
+    t.entries[e].offset = cursor;
+    t.entries[e].size = pieces[i].size;
+    t.entries[e].checksum = Checksum(pieces[i].data, pieces[i].size);
     cursor += pieces[i].size;
     ++e;
   }
-  const uint64_t file_size = cursor;
+  t.file_size = cursor;
+  return t;
+}
 
-  FileHeader h;
-  std::memset(static_cast<void*>(&h), 0, sizeof(h));  // padding included
-  std::memcpy(h.magic, kMagic, sizeof(kMagic));
-  switch (layout) {
+// The format version a file of `d` is written in.
+void SetFormatVersion(const IndexData& d, bool sparse_split, FileHeader& h) {
+  const bool refined = !d.split_faces.empty();
+  switch (d.sample_matrix) {
     case MatrixLayout::kCoded:
-      if (compact) {
+      if (Compact(d)) {
         h.format_major = kDerivedFormatMajor;
         h.format_minor = kDerivedFormatMinor;
       } else {
-        h.format_major = split.sparse ? kSparseSplitFormatMajor : kCodedFormatMajor;
-        h.format_minor = split.sparse ? kSparseSplitFormatMinor : kCodedFormatMinor;
+        h.format_major = sparse_split ? kSparseSplitFormatMajor : kCodedFormatMajor;
+        h.format_minor = sparse_split ? kSparseSplitFormatMinor : kCodedFormatMinor;
       }
       break;
     case MatrixLayout::kLower:
@@ -391,6 +414,16 @@ absl::StatusOr<std::string> SerializeIndex(const IndexData& d) {
       h.format_minor = refined ? kRefinedFormatMinor : kFormatMinor;
       break;
   }
+}
+
+// The file: header, section table and the written pieces, zero padding
+// everywhere.
+std::string FileBytes(const IndexData& d, const Counts& counts, bool sparse_split,
+                      const Piece (&pieces)[kNumSpecs], const SectionTable& table) {
+  FileHeader h;
+  std::memset(static_cast<void*>(&h), 0, sizeof(h));  // padding included
+  std::memcpy(h.magic, kMagic, sizeof(kMagic));
+  SetFormatVersion(d, sparse_split, h);
   h.byte_order_mark = kByteOrderMark;
   h.header_size = sizeof(FileHeader);
   std::memcpy(h.builder_version, d.builder_version.data(), d.builder_version.size());
@@ -401,21 +434,54 @@ absl::StatusOr<std::string> SerializeIndex(const IndexData& d) {
   h.num_samples = static_cast<uint32_t>(counts.num_samples);
   h.num_triangles = static_cast<uint32_t>(counts.num_triangles);
   h.num_bvh_nodes = static_cast<uint32_t>(counts.num_bvh_nodes);
-  h.num_sections = static_cast<uint32_t>(num_sections);
-  h.section_table_offset = table_offset;
-  h.file_size = file_size;
-  h.table_checksum = Checksum(entries, table_bytes);
+  h.num_sections = static_cast<uint32_t>(table.num_sections);
+  h.section_table_offset = table.offset();
+  h.file_size = table.file_size;
+  h.table_checksum = Checksum(table.entries, table.bytes());
   h.header_checksum = 0;
   h.header_checksum = HeaderChecksum(reinterpret_cast<const uint8_t*>(&h), sizeof(h));
 
-  std::string out(file_size, '\0');  // zero padding everywhere
+  std::string out(table.file_size, '\0');  // zero padding everywhere
   std::memcpy(out.data(), &h, sizeof(h));
-  std::memcpy(out.data() + table_offset, entries, table_bytes);
-  for (size_t e = 0; e < num_sections; ++e) {
-    const Piece& piece = pieces[piece_of[e]];
-    if (piece.size > 0) std::memcpy(out.data() + entries[e].offset, piece.data, piece.size);
+  std::memcpy(out.data() + table.offset(), table.entries, table.bytes());
+  for (size_t e = 0; e < table.num_sections; ++e) {
+    const Piece& piece = pieces[table.piece_of[e]];
+    if (piece.size > 0) std::memcpy(out.data() + table.entries[e].offset, piece.data, piece.size);
   }
   return out;
+}
+
+}  // namespace
+
+absl::StatusOr<std::string> SerializeIndex(const IndexData& d) {
+  GEODEX_ASSIGN_OR_RETURN(const Counts counts, CountsOf(d));
+  GEODEX_ASSIGN_OR_RETURN(const StoredMatrix stored, StoreMatrix(d, counts.num_samples));
+  const MatrixLayout layout = d.sample_matrix;
+  const std::span<const float> full_matrix = layout == MatrixLayout::kFull
+                                                 ? std::span<const float>(d.sample_distances)
+                                                 : std::span<const float>();
+  GEODEX_RETURN_IF_ERROR(CheckRecordCounts(d, counts));
+  GEODEX_RETURN_IF_ERROR(CheckArrays(d, counts, full_matrix, stored));
+  GEODEX_ASSIGN_OR_RETURN(const SplitLayout split, SplitLayoutOf(d));
+  GEODEX_RETURN_IF_ERROR(CheckAccuracy(d.accuracy, absl::StatusCode::kInvalidArgument));
+  GEODEX_RETURN_IF_ERROR(
+      CheckSpreadBounds(d.spread_bounds, d.accuracy.size(), absl::StatusCode::kInvalidArgument));
+
+  const Piece matrix[4] = {
+      {full_matrix.data(), full_matrix.size() * sizeof(float)},
+      {stored.lower.data(), stored.lower.size() * sizeof(float)},
+      {stored.coded.data(), stored.coded.size() * sizeof(PackedCode)},
+      {stored.code.data(), stored.code.size() * sizeof(DistanceCodeRecord)},
+  };
+  const Derivable derivable = DerivableOf(d);
+  const bool compact = Compact(d);
+  const std::vector<VertexRecordWithCorners> with_corners =
+      compact ? std::vector<VertexRecordWithCorners>()
+              : internal::WithCorners(d.vertices, d.triangles);
+  Piece pieces[kNumSpecs];
+  LayOut(d, matrix, split, derivable, with_corners, pieces);
+  const SectionTable table = TableOf(pieces, layout, compact, derivable);
+  return FileBytes(d, counts, split.sparse, pieces, table);
 }
 
 absl::Status WriteIndexFile(const IndexData& data, const std::string& path) {

@@ -99,110 +99,159 @@ absl::StatusOr<Mesh> Mesh::Create(std::vector<Vec3> positions, std::vector<Trian
   return mesh;
 }
 
-absl::Status Mesh::BuildAdjacency() {
-  const int32_t nv = num_vertices();
-  const int32_t nf = num_faces();
-  const int32_t nh = 3 * nf;
+namespace {
 
-  length_.resize(nh);
-  for (int32_t h = 0; h < nh; ++h) length_[h] = (position(Dest(h)) - position(Origin(h))).norm();
-
-  // Pair half-edges by their undirected edge.
-  twin_.assign(nh, kNone);
-  num_boundary_edges_ = 0;
-  auto ends = [&](int32_t h) { return std::pair<int32_t, int32_t>(Origin(h), Dest(h)); };
+// Pairs `mesh`'s half-edges by their undirected edge into `twin` (kNone on
+// the boundary); returns the number of boundary edges.
+absl::StatusOr<int32_t> PairTwins(const Mesh& mesh, const std::string& name,
+                                  std::vector<int32_t>& twin) {
+  const int32_t nh = 3 * mesh.num_faces();
+  twin.assign(nh, kNone);
+  int32_t num_boundary_edges = 0;
+  auto ends = [&](int32_t h) { return std::pair<int32_t, int32_t>(mesh.Origin(h), mesh.Dest(h)); };
   GEODEX_RETURN_IF_ERROR(
       ForEachEdge(nh, ends, [&](std::span<const int32_t> group, int64_t a, int64_t b) {
         if (group.size() > 2) {
           std::string list;
           for (size_t k = 0; k < group.size(); ++k)
-            absl::StrAppend(&list, k > 0 ? ", " : "", FaceOf(group[k]));
+            absl::StrAppend(&list, k > 0 ? ", " : "", Mesh::FaceOf(group[k]));
           return absl::InvalidArgumentError(
-              absl::StrFormat("%s: non-manifold edge (%d, %d) is shared by %d faces (%s)", name_, a,
+              absl::StrFormat("%s: non-manifold edge (%d, %d) is shared by %d faces (%s)", name, a,
                               b, group.size(), list));
         }
         if (group.size() == 2) {
           const int32_t h0 = group[0], h1 = group[1];
-          if (Origin(h0) == Origin(h1)) {
+          if (mesh.Origin(h0) == mesh.Origin(h1)) {
             return absl::InvalidArgumentError(absl::StrFormat(
                 "%s: faces %d and %d traverse edge (%d, %d) in the same direction (inconsistent "
                 "orientation or a non-orientable surface)",
-                name_, FaceOf(h0), FaceOf(h1), a, b));
+                name, Mesh::FaceOf(h0), Mesh::FaceOf(h1), a, b));
           }
-          twin_[h0] = h1;
-          twin_[h1] = h0;
+          twin[h0] = h1;
+          twin[h1] = h0;
         } else {
-          ++num_boundary_edges_;
+          ++num_boundary_edges;
         }
         return absl::OkStatus();
       }));
+  return num_boundary_edges;
+}
 
-  // Outgoing half-edges per vertex, then order each fan counter-clockwise.
-  outgoing_offset_.assign(nv + 1, 0);
-  for (int32_t h = 0; h < nh; ++h) ++outgoing_offset_[Origin(h) + 1];
-  for (int32_t v = 0; v < nv; ++v) outgoing_offset_[v + 1] += outgoing_offset_[v];
+// The outgoing half-edges of each vertex v, outgoing[offset[v], offset[v +
+// 1]), in counter-clockwise order round v; whether v is on the boundary;
+// the sum of its corners' angles.
+struct Fans {
+  std::vector<int32_t> offset;
+  std::vector<int32_t> outgoing;
+  std::vector<uint8_t> is_boundary;
+  std::vector<double> angle_sum;
+};
+
+// Orders the fan of vertex v, whose outgoing half-edges are `unordered`
+// [begin, end), into `fans` (its twins paired).
+absl::Status OrderFan(const Mesh& mesh, const std::string& name,
+                      const std::vector<int32_t>& unordered, int32_t v, Fans& fans) {
+  const int32_t begin = fans.offset[v], end = fans.offset[v + 1];
+  if (begin == end) return absl::OkStatus();
+  // Start at a half-edge with no clockwise neighbour (a boundary), if any.
+  int32_t start = unordered[begin];
+  for (int32_t k = begin; k < end; ++k) {
+    if (mesh.Twin(unordered[k]) == kNone) {
+      start = unordered[k];
+      fans.is_boundary[v] = 1;
+      break;
+    }
+  }
+  int32_t count = 0;
+  int32_t h = start;
+  do {
+    fans.outgoing[begin + count++] = h;
+    const int32_t back = mesh.Twin(Mesh::Prev(h));  // counter-clockwise neighbour
+    if (back == kNone) {
+      fans.is_boundary[v] = 1;
+      break;
+    }
+    h = back;
+  } while (h != start && count < end - begin);
+  if (count != end - begin) {
+    return absl::InvalidArgumentError(absl::StrFormat(
+        "%s: non-manifold vertex %d: its %d faces form more than one fan", name, v, end - begin));
+  }
+  for (int32_t k = begin; k < end; ++k) {
+    const int32_t o = fans.outgoing[k];
+    fans.angle_sum[v] +=
+        CornerAngle(mesh.position(v), mesh.position(mesh.Dest(o)), mesh.position(mesh.Opposite(o)));
+  }
+  return absl::OkStatus();
+}
+
+// Outgoing half-edges per vertex, then each fan ordered counter-clockwise.
+absl::StatusOr<Fans> OrderFans(const Mesh& mesh, const std::string& name) {
+  const int32_t nv = mesh.num_vertices();
+  const int32_t nh = 3 * mesh.num_faces();
+  Fans fans;
+  fans.offset.assign(nv + 1, 0);
+  for (int32_t h = 0; h < nh; ++h) ++fans.offset[mesh.Origin(h) + 1];
+  for (int32_t v = 0; v < nv; ++v) fans.offset[v + 1] += fans.offset[v];
   std::vector<int32_t> unordered(nh);
   {
-    std::vector<int32_t> fill(outgoing_offset_.begin(), outgoing_offset_.end() - 1);
-    for (int32_t h = 0; h < nh; ++h) unordered[fill[Origin(h)]++] = h;
+    std::vector<int32_t> fill(fans.offset.begin(), fans.offset.end() - 1);
+    for (int32_t h = 0; h < nh; ++h) unordered[fill[mesh.Origin(h)]++] = h;
   }
-  outgoing_.assign(nh, kNone);
-  is_boundary_.assign(nv, 0);
-  angle_sum_.assign(nv, 0.0);
+  fans.outgoing.assign(nh, kNone);
+  fans.is_boundary.assign(nv, 0);
+  fans.angle_sum.assign(nv, 0.0);
   for (int32_t v = 0; v < nv; ++v) {
-    const int32_t begin = outgoing_offset_[v], end = outgoing_offset_[v + 1];
-    if (begin == end) continue;
-    // Start at a half-edge with no clockwise neighbour (a boundary), if any.
-    int32_t start = unordered[begin];
-    for (int32_t k = begin; k < end; ++k) {
-      if (twin_[unordered[k]] == kNone) {
-        start = unordered[k];
-        is_boundary_[v] = 1;
-        break;
-      }
-    }
-    int32_t count = 0;
-    int32_t h = start;
-    do {
-      outgoing_[begin + count++] = h;
-      const int32_t back = twin_[Prev(h)];  // counter-clockwise neighbour
-      if (back == kNone) {
-        is_boundary_[v] = 1;
-        break;
-      }
-      h = back;
-    } while (h != start && count < end - begin);
-    if (count != end - begin) {
-      return absl::InvalidArgumentError(
-          absl::StrFormat("%s: non-manifold vertex %d: its %d faces form more than one fan", name_,
-                          v, end - begin));
-    }
-    for (int32_t k = begin; k < end; ++k) {
-      const int32_t o = outgoing_[k];
-      angle_sum_[v] += CornerAngle(position(v), position(Dest(o)), position(Opposite(o)));
-    }
+    GEODEX_RETURN_IF_ERROR(OrderFan(mesh, name, unordered, v, fans));
   }
+  return fans;
+}
 
-  // Connected components over faces.
+// Labels the connected components over faces, in order of their first
+// face, in `face_component` and `vertex_component`; returns their number.
+int32_t LabelComponents(const Mesh& mesh, std::vector<int32_t>& face_component,
+                        std::vector<int32_t>& vertex_component) {
+  const int32_t nf = mesh.num_faces();
+  const int32_t nh = 3 * nf;
   std::vector<int32_t> parent(nf);
   std::iota(parent.begin(), parent.end(), 0);
   for (int32_t h = 0; h < nh; ++h) {
-    if (twin_[h] == kNone) continue;
-    const int32_t a = FindRoot(parent, FaceOf(h)), b = FindRoot(parent, FaceOf(twin_[h]));
+    if (mesh.Twin(h) == kNone) continue;
+    const int32_t a = FindRoot(parent, Mesh::FaceOf(h));
+    const int32_t b = FindRoot(parent, Mesh::FaceOf(mesh.Twin(h)));
     if (a != b) parent[std::max(a, b)] = std::min(a, b);
   }
-  face_component_.assign(nf, kNone);
+  face_component.assign(nf, kNone);
   std::vector<int32_t> root_id(nf, kNone);
-  num_components_ = 0;
+  int32_t num_components = 0;
   for (int32_t f = 0; f < nf; ++f) {
     const int32_t r = FindRoot(parent, f);
-    if (root_id[r] == kNone) root_id[r] = num_components_++;
-    face_component_[f] = root_id[r];
+    if (root_id[r] == kNone) root_id[r] = num_components++;
+    face_component[f] = root_id[r];
   }
-  vertex_component_.assign(nv, kNone);
+  vertex_component.assign(mesh.num_vertices(), kNone);
   for (int32_t f = 0; f < nf; ++f) {
-    for (int32_t v : faces_[f]) vertex_component_[v] = face_component_[f];
+    for (int32_t v : mesh.face(f)) vertex_component[v] = face_component[f];
   }
+  return num_components;
+}
+
+}  // namespace
+
+absl::Status Mesh::BuildAdjacency() {
+  const int32_t nh = 3 * num_faces();
+  length_.resize(nh);
+  for (int32_t h = 0; h < nh; ++h) length_[h] = (position(Dest(h)) - position(Origin(h))).norm();
+
+  // Pair half-edges by their undirected edge.
+  GEODEX_ASSIGN_OR_RETURN(num_boundary_edges_, PairTwins(*this, name_, twin_));
+  GEODEX_ASSIGN_OR_RETURN(Fans fans, OrderFans(*this, name_));
+  outgoing_offset_ = std::move(fans.offset);
+  outgoing_ = std::move(fans.outgoing);
+  is_boundary_ = std::move(fans.is_boundary);
+  angle_sum_ = std::move(fans.angle_sum);
+  // Connected components over faces.
+  num_components_ = LabelComponents(*this, face_component_, vertex_component_);
   return absl::OkStatus();
 }
 

@@ -143,6 +143,54 @@ std::vector<double> Answers(const query::InputQueries& queries, const std::vecto
   return d;
 }
 
+// Samples per build: GEODEX_FORMATS_SAMPLES, else 200.
+int32_t SamplesFromEnvironment() {
+  int32_t samples = 200;
+  if (const char* env = std::getenv("GEODEX_FORMATS_SAMPLES"); env != nullptr) {
+    samples = std::atoi(env);
+  }
+  return samples;
+}
+
+// 2000 random pairs of points of `m`'s faces (the same in every format).
+void RandomPairs(const Mesh& m, std::vector<SurfacePoint>* a, std::vector<SurfacePoint>* b) {
+  std::mt19937_64 rng(17);
+  std::uniform_real_distribution<double> unit(0, 1);
+  std::uniform_int_distribution<int32_t> face(0, m.num_faces() - 1);
+  a->assign(2000, SurfacePoint{});
+  b->assign(2000, SurfacePoint{});
+  for (size_t i = 0; i < a->size(); ++i) {
+    for (SurfacePoint* p : {&(*a)[i], &(*b)[i]}) {
+      double u = unit(rng), v = unit(rng);
+      if (u + v > 1) u = 1 - u, v = 1 - v;
+      p->face = face(rng);
+      // Every tenth point at a vertex, every tenth on an edge.
+      p->w = i % 10 == 0   ? std::array<double, 3>{1, 0, 0}
+             : i % 10 == 1 ? std::array<double, 3>{1 - u, u, 0}
+                           : std::array<double, 3>{1 - u - v, u, v};
+    }
+  }
+}
+
+// The largest difference of `answers` to `reference`, relative to the
+// reference's; every answer must be finite.
+void ExpectFiniteAndClose(const std::vector<double>& answers, const std::vector<double>& reference,
+                          const std::string& format, double* worst) {
+  *worst = 0;
+  for (size_t i = 0; i < answers.size(); ++i) {
+    ASSERT_TRUE(std::isfinite(answers[i])) << format << " pair " << i;
+    *worst = std::max(
+        *worst, std::abs(answers[i] - reference[i]) / std::max(std::abs(reference[i]), 1e-300));
+  }
+}
+
+struct FormatCase {
+  std::string format;
+  std::string file;
+  std::string bytes;
+  bool round;
+};
+
 class MeshFormatsSharedTest : public ::testing::TestWithParam<std::string> {};
 
 TEST_P(MeshFormatsSharedTest, StlAndGlbAnswerAsTheObjOfTheirPositions) {
@@ -156,44 +204,22 @@ TEST_P(MeshFormatsSharedTest, StlAndGlbAnswerAsTheObjOfTheirPositions) {
     GTEST_SKIP() << GetParam() << " has " << m->num_vertices()
                  << " vertices; set GEODEX_LARGE_TESTS=1 to include it";
   }
-  int32_t samples = 200;
-  if (const char* env = std::getenv("GEODEX_FORMATS_SAMPLES"); env != nullptr) {
-    samples = std::atoi(env);
-  }
+  const int32_t samples = SamplesFromEnvironment();
   const std::string dir =
       (std::filesystem::temp_directory_path() / ("geodex_formats_" + GetParam())).string();
   std::filesystem::create_directories(dir);
 
   // The pairs, in the file's faces (the same in every format).
-  std::mt19937_64 rng(17);
-  std::uniform_real_distribution<double> unit(0, 1);
-  std::uniform_int_distribution<int32_t> face(0, m->num_faces() - 1);
-  std::vector<SurfacePoint> a(2000), b(2000);
-  for (size_t i = 0; i < a.size(); ++i) {
-    for (SurfacePoint* p : {&a[i], &b[i]}) {
-      double u = unit(rng), v = unit(rng);
-      if (u + v > 1) u = 1 - u, v = 1 - v;
-      p->face = face(rng);
-      // Every tenth point at a vertex, every tenth on an edge.
-      p->w = i % 10 == 0   ? std::array<double, 3>{1, 0, 0}
-             : i % 10 == 1 ? std::array<double, 3>{1 - u, u, 0}
-                           : std::array<double, 3>{1 - u - v, u, v};
-    }
-  }
+  std::vector<SurfacePoint> a, b;
+  RandomPairs(*m, &a, &b);
 
-  struct Case {
-    std::string format;
-    std::string file;
-    std::string bytes;
-    bool round;
-  };
-  const std::vector<Case> cases = {
+  const std::vector<FormatCase> cases = {
       {"binary STL", "mesh_binary.stl", mesh::StlBytes(*m, /*binary=*/true), true},
       {"ASCII STL", "mesh_ascii.stl", mesh::StlBytes(*m, /*binary=*/false), false},
       {"GLB", "mesh.glb", mesh::GlbBytes(*m), true},
   };
   std::map<bool, std::pair<Built, std::vector<double>>> reference;  // by `round`
-  for (const Case& c : cases) {
+  for (const FormatCase& c : cases) {
     if (reference.count(c.round) == 0) {
       const std::string obj = dir + (c.round ? "/reference_float32.obj" : "/reference.obj");
       ASSERT_TRUE(AtomicWriteFile(obj, ObjText(WeldedReference(*m, c.round))).ok());
@@ -212,11 +238,7 @@ TEST_P(MeshFormatsSharedTest, StlAndGlbAnswerAsTheObjOfTheirPositions) {
     EXPECT_EQ(built.queries->index().header().mesh_hash, ref.queries->index().header().mesh_hash);
     const std::vector<double> answers = Answers(*built.queries, a, b);
     double worst = 0;
-    for (size_t i = 0; i < answers.size(); ++i) {
-      ASSERT_TRUE(std::isfinite(answers[i])) << c.format << " pair " << i;
-      worst = std::max(worst, std::abs(answers[i] - ref_answers[i]) /
-                                  std::max(std::abs(ref_answers[i]), 1e-300));
-    }
+    ASSERT_NO_FATAL_FAILURE(ExpectFiniteAndClose(answers, ref_answers, c.format, &worst));
     std::printf(
         "%s %s: %d faces, %d vertices, %lld corners welded, %zu pairs, worst relative "
         "difference to the OBJ %.3g; build %.1f s (OBJ %.1f s)\n",

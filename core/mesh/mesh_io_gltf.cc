@@ -13,6 +13,7 @@
 #include <cstring>
 #include <exception>
 #include <limits>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -340,6 +341,27 @@ class SceneReader {
     return values;
   }
 
+  // The little-endian component at `p`, of `component_type`; nullopt for a
+  // type no accessor geodex reads has.
+  static std::optional<double> DecodeComponent(const unsigned char* p, int component_type) {
+    switch (component_type) {
+      case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE:
+        return p[0];
+      case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT:
+        return static_cast<uint16_t>(p[0] | p[1] << 8);
+      case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT:
+        return LittleEndianU32(reinterpret_cast<const char*>(p));
+      case TINYGLTF_COMPONENT_TYPE_FLOAT: {
+        const uint32_t bits = LittleEndianU32(reinterpret_cast<const char*>(p));
+        float f;
+        std::memcpy(&f, &bits, sizeof(f));
+        return f;
+      }
+      default:
+        return std::nullopt;
+    }
+  }
+
   // `count` elements of `components` components of `component_type` from
   // buffer view `view` at `offset`, with the view's stride (none when
   // `packed`, as sparse arrays are), bounds checked.
@@ -397,29 +419,10 @@ class SceneReader {
     for (size_t e = 0; e < count; ++e) {
       const unsigned char* element = base + stride * e;
       for (int c = 0; c < components; ++c) {
-        const unsigned char* p = element + component_bytes * c;
-        double value = 0;
-        switch (component_type) {
-          case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE:
-            value = p[0];
-            break;
-          case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT:
-            value = static_cast<uint16_t>(p[0] | p[1] << 8);
-            break;
-          case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT:
-            value = LittleEndianU32(reinterpret_cast<const char*>(p));
-            break;
-          case TINYGLTF_COMPONENT_TYPE_FLOAT: {
-            const uint32_t bits = LittleEndianU32(reinterpret_cast<const char*>(p));
-            float f;
-            std::memcpy(&f, &bits, sizeof(f));
-            value = f;
-            break;
-          }
-          default:
-            return Error(absl::StrFormat("%s: component type %d", where, component_type));
-        }
-        (*out)[e * components + c] = value;
+        const std::optional<double> value =
+            DecodeComponent(element + component_bytes * c, component_type);
+        if (!value) return Error(absl::StrFormat("%s: component type %d", where, component_type));
+        (*out)[e * components + c] = *value;
       }
     }
     return absl::OkStatus();

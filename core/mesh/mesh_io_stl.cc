@@ -131,18 +131,86 @@ class WordReader {
   int64_t word_line_ = 1;
 };
 
+// The next word, `word` (`what` says where in the facet it belongs).
+absl::Status Expect(WordReader& words, const std::string& name, std::string_view word,
+                    std::string_view what) {
+  const std::string_view got = words.Next();
+  if (Is(got, word)) return absl::OkStatus();
+  return LineError(name, words.line(),
+                   got.empty() ? absl::StrCat("file ends where '", std::string(word), "' ",
+                                              std::string(what), " was expected (truncated?)")
+                               : absl::StrCat("expected '", std::string(word), "' ",
+                                              std::string(what), ", found ", Quote(got)));
+}
+
+// The three coordinates after 'vertex'.
+absl::StatusOr<Vec3> ParseAsciiVertex(WordReader& words, const std::string& name) {
+  Vec3 p;
+  for (int i = 0; i < 3; ++i) {
+    const std::string_view x = words.Next();
+    if (!ParseDouble(x, &p[i])) {
+      return LineError(name, words.line(),
+                       x.empty() ? std::string("file ends inside a facet (truncated?)")
+                                 : absl::StrCat("coordinate ", Quote(x), " is not a number"));
+    }
+    if (!std::isfinite(p[i])) {
+      return LineError(name, words.line(), absl::StrCat("coordinate ", Quote(x), " is not finite"));
+    }
+  }
+  return p;
+}
+
+// Facet number `facet` after its 'facet' keyword, up to its 'endfacet';
+// appends its three corners to `corners`.
+absl::Status ParseAsciiFacet(WordReader& words, const std::string& name, int64_t facet,
+                             std::vector<Vec3>& corners) {
+  // "facet normal nx ny nz": the normal is not used (the corners' order
+  // says the orientation), and some writers leave it out.
+  std::string_view next = words.Next();
+  if (Is(next, "normal")) {
+    for (int i = 0; i < 3; ++i) {
+      double unused;
+      const std::string_view n = words.Next();
+      if (!ParseDouble(n, &unused)) {
+        return LineError(
+            name, words.line(),
+            absl::StrCat("facet ", facet, ": normal component ", Quote(n), " is not a number"));
+      }
+    }
+    next = words.Next();
+  }
+  if (!Is(next, "outer")) {
+    return LineError(name, words.line(),
+                     next.empty() ? std::string("file ends inside a facet (truncated?)")
+                                  : absl::StrCat("facet ", facet, ": expected 'outer loop', found ",
+                                                 Quote(next)));
+  }
+  GEODEX_RETURN_IF_ERROR(Expect(words, name, "loop", "(after 'outer')"));
+  int vertices = 0;
+  for (;;) {
+    const std::string_view v = words.Next();
+    if (Is(v, "endloop")) break;
+    if (!Is(v, "vertex")) {
+      return LineError(name, words.line(),
+                       v.empty()
+                           ? std::string("file ends inside a facet (truncated?)")
+                           : absl::StrCat("facet ", facet,
+                                          ": expected 'vertex' or 'endloop', found ", Quote(v)));
+    }
+    GEODEX_ASSIGN_OR_RETURN(const Vec3 p, ParseAsciiVertex(words, name));
+    if (++vertices <= 3) corners.push_back(p);
+  }
+  if (vertices != 3) {
+    return LineError(
+        name, words.line(),
+        absl::StrFormat("facet %d has %d vertices (STL facets are triangles)", facet, vertices));
+  }
+  return Expect(words, name, "endfacet", "(after 'endloop')");
+}
+
 absl::StatusOr<std::vector<Vec3>> ParseAscii(std::string_view contents, const std::string& name) {
   WordReader words(contents);
   std::vector<Vec3> corners;
-  auto expect = [&](std::string_view word, std::string_view what) -> absl::Status {
-    const std::string_view got = words.Next();
-    if (Is(got, word)) return absl::OkStatus();
-    return LineError(name, words.line(),
-                     got.empty() ? absl::StrCat("file ends where '", std::string(word), "' ",
-                                                std::string(what), " was expected (truncated?)")
-                                 : absl::StrCat("expected '", std::string(word), "' ",
-                                                std::string(what), ", found ", Quote(got)));
-  };
   int64_t facet = 0;
   bool in_solid = false;
   for (;;) {
@@ -170,60 +238,7 @@ absl::StatusOr<std::vector<Vec3>> ParseAscii(std::string_view contents, const st
       return LineError(name, words.line(),
                        absl::StrCat("expected 'facet' or 'endsolid', found ", Quote(word)));
     }
-    // "facet normal nx ny nz": the normal is not used (the corners' order
-    // says the orientation), and some writers leave it out.
-    std::string_view next = words.Next();
-    if (Is(next, "normal")) {
-      for (int i = 0; i < 3; ++i) {
-        double unused;
-        const std::string_view n = words.Next();
-        if (!ParseDouble(n, &unused)) {
-          return LineError(
-              name, words.line(),
-              absl::StrCat("facet ", facet, ": normal component ", Quote(n), " is not a number"));
-        }
-      }
-      next = words.Next();
-    }
-    if (!Is(next, "outer")) {
-      return LineError(name, words.line(),
-                       next.empty() ? std::string("file ends inside a facet (truncated?)")
-                                    : absl::StrCat("facet ", facet,
-                                                   ": expected 'outer loop', found ", Quote(next)));
-    }
-    GEODEX_RETURN_IF_ERROR(expect("loop", "(after 'outer')"));
-    int vertices = 0;
-    for (;;) {
-      const std::string_view v = words.Next();
-      if (Is(v, "endloop")) break;
-      if (!Is(v, "vertex")) {
-        return LineError(name, words.line(),
-                         v.empty()
-                             ? std::string("file ends inside a facet (truncated?)")
-                             : absl::StrCat("facet ", facet,
-                                            ": expected 'vertex' or 'endloop', found ", Quote(v)));
-      }
-      Vec3 p;
-      for (int i = 0; i < 3; ++i) {
-        const std::string_view x = words.Next();
-        if (!ParseDouble(x, &p[i])) {
-          return LineError(name, words.line(),
-                           x.empty() ? std::string("file ends inside a facet (truncated?)")
-                                     : absl::StrCat("coordinate ", Quote(x), " is not a number"));
-        }
-        if (!std::isfinite(p[i])) {
-          return LineError(name, words.line(),
-                           absl::StrCat("coordinate ", Quote(x), " is not finite"));
-        }
-      }
-      if (++vertices <= 3) corners.push_back(p);
-    }
-    if (vertices != 3) {
-      return LineError(
-          name, words.line(),
-          absl::StrFormat("facet %d has %d vertices (STL facets are triangles)", facet, vertices));
-    }
-    GEODEX_RETURN_IF_ERROR(expect("endfacet", "(after 'endloop')"));
+    GEODEX_RETURN_IF_ERROR(ParseAsciiFacet(words, name, facet, corners));
     ++facet;
   }
   return corners;

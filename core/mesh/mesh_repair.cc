@@ -385,31 +385,29 @@ std::string RepairReport::ToText() const {
   return out;
 }
 
-absl::StatusOr<RepairedMesh> RepairMesh(RawMesh raw, const RepairOptions& options) {
-  const int32_t num_input_vertices = static_cast<int32_t>(raw.positions.size());
-  auto count_unreferenced = [&](const std::vector<Triangle>& faces) {
-    std::vector<uint8_t> used(num_input_vertices, 0);
-    for (const Triangle& t : faces) {
-      for (int32_t v : t) used[v] = 1;
-    }
-    return static_cast<int32_t>(std::count(used.begin(), used.end(), 0));
-  };
-  if (options.strict) {
-    const WeldReport weld = raw.weld;
-    GEODEX_ASSIGN_OR_RETURN(LoadedMesh loaded, CreateLoadedMesh(std::move(raw)));
-    RepairedMesh out = WithoutRepairs(std::move(loaded.mesh));
-    out.report.weld = weld;
-    return out;
+namespace {
+
+// The oriented faces. Flipping (a, b, c) to (a, c, b) turns input corner i
+// into corner kFlipCorner[i].
+constexpr std::array<uint8_t, 3> kSameCorner = {0, 1, 2}, kFlipCorner = {0, 2, 1};
+
+// Input vertices no face of `faces` uses, of `num_input_vertices`.
+int32_t CountUnreferenced(int32_t num_input_vertices, const std::vector<Triangle>& faces) {
+  std::vector<uint8_t> used(num_input_vertices, 0);
+  for (const Triangle& t : faces) {
+    for (int32_t v : t) used[v] = 1;
   }
-  RepairReport report;
-  GEODEX_RETURN_IF_ERROR(CheckUnrepairable(raw, &report));
-  report.unreferenced_vertices = count_unreferenced(raw.triangles);
+  return static_cast<int32_t>(std::count(used.begin(), used.end(), 0));
+}
 
-  report.weld = raw.weld;
+// The soup's half-edges paired (`mate`, kNone on the boundary) and its
+// faces' orientation (`flip`: 1 where a kept face is reversed).
+struct OrientedSoup {
+  std::vector<int32_t> mate;
+  std::vector<uint8_t> flip;
+};
 
-  Soup soup{&raw, {}};
-  std::vector<int32_t> group_keeper;
-  DropDuplicates(raw, &soup, &group_keeper, &report);
+absl::StatusOr<OrientedSoup> OrientAndPair(const Soup& soup, RepairReport* report) {
   // Orientation first, from the edges of two faces only: what is refused is
   // a surface not orientable once its non-manifold edges are cut. The pairs
   // made round non-manifold edges then follow that orientation.
@@ -427,26 +425,26 @@ absl::StatusOr<RepairedMesh> RepairMesh(RawMesh raw, const RepairOptions& option
                                             final_flip.status().message()));
   }
   flip = *std::move(final_flip);
-  report.nonmanifold_edges = static_cast<int32_t>(nonmanifold.size());
+  report->nonmanifold_edges = static_cast<int32_t>(nonmanifold.size());
   for (const std::vector<int32_t>& halfedges : nonmanifold) {
-    for (int32_t h : halfedges) report.edge_copies += mate[h] == kNone || mate[h] > h ? 1 : 0;
+    for (int32_t h : halfedges) report->edge_copies += mate[h] == kNone || mate[h] > h ? 1 : 0;
   }
   const int32_t nk = static_cast<int32_t>(soup.kept.size());
-  for (int32_t k = 0; k < nk; ++k) report.reoriented_faces += flip[k];
+  for (int32_t k = 0; k < nk; ++k) report->reoriented_faces += flip[k];
+  return OrientedSoup{std::move(mate), std::move(flip)};
+}
 
-  // The oriented faces. Flipping (a, b, c) to (a, c, b) turns input corner i
-  // into corner kFlipCorner[i].
-  constexpr std::array<uint8_t, 3> kSameCorner = {0, 1, 2}, kFlipCorner = {0, 2, 1};
+// The oriented faces, with one vertex per fan; the fan of a vertex's first
+// corner (in face order) keeps its id, the others' are copies appended to
+// `positions` (and `maps`).
+std::vector<Triangle> FacesByFan(const Soup& soup, const OrientedSoup& oriented,
+                                 std::vector<Vec3>& positions, RepairMaps& maps,
+                                 RepairReport& report) {
+  const int32_t nk = static_cast<int32_t>(soup.kept.size());
   std::vector<Triangle> faces(nk);
-
-  // One vertex per fan; the fan of a vertex's first corner (in face order)
-  // keeps its id.
-  DisjointSets fans = Fans(soup, mate);
-  std::vector<Vec3> positions = std::move(raw.positions);
+  DisjointSets fans = Fans(soup, oriented.mate);
   std::vector<int32_t> fan_vertex(3 * nk, kNone);
-  std::vector<int32_t> fans_of(num_input_vertices, 0);
-  RepairMaps maps;
-  maps.num_input_vertices = num_input_vertices;
+  std::vector<int32_t> fans_of(maps.num_input_vertices, 0);
   for (int32_t x = 0; x < 3 * nk; ++x) {
     if (fans.Find(x) != x) continue;  // not the first corner of its fan
     const int32_t v = soup.tri(x / 3)[x % 3];
@@ -461,7 +459,7 @@ absl::StatusOr<RepairedMesh> RepairMesh(RawMesh raw, const RepairOptions& option
   }
   for (int32_t x = 0; x < 3 * nk; ++x) {
     const int32_t k = x / 3;
-    faces[k][flip[k] ? kFlipCorner[x % 3] : x % 3] = fan_vertex[fans.Find(x)];
+    faces[k][oriented.flip[k] ? kFlipCorner[x % 3] : x % 3] = fan_vertex[fans.Find(x)];
   }
   for (int32_t count : fans_of) {
     if (count > 1) {
@@ -469,33 +467,70 @@ absl::StatusOr<RepairedMesh> RepairMesh(RawMesh raw, const RepairOptions& option
       report.vertex_copies += count;
     }
   }
+  return faces;
+}
 
-  // Where each input triangle went.
-  if (report.duplicate_faces > 0 || report.reoriented_faces > 0) {
-    const int32_t nf = static_cast<int32_t>(raw.triangles.size());
-    std::vector<int32_t> internal_of(nf, kNone);
-    for (int32_t k = 0; k < nk; ++k) internal_of[soup.kept[k]] = k;
-    maps.faces.resize(nf);
-    for (int32_t f = 0; f < nf; ++f) {
-      InputFace& out = maps.faces[f];
-      const int32_t keeper = group_keeper[f];
-      out.face = internal_of[keeper];
-      out.dropped = keeper != f;
-      out.reoriented = !out.dropped && flip[out.face];
-      if (!out.dropped) {
-        out.corner = flip[out.face] ? kFlipCorner : kSameCorner;
-        continue;
-      }
-      // The duplicate's corners among its keeper's (the same vertex set).
-      const Triangle& kept_corners = raw.triangles[keeper];
-      const std::array<uint8_t, 3> kept_to_internal = flip[out.face] ? kFlipCorner : kSameCorner;
-      for (int i = 0; i < 3; ++i) {
-        const int j = static_cast<int>(
-            std::find(kept_corners.begin(), kept_corners.end(), raw.triangles[f][i]) -
-            kept_corners.begin());
-        out.corner[i] = kept_to_internal[j];
-      }
+// Where each input triangle went: its kept face (its keeper's for a
+// duplicate) and its corners there.
+std::vector<InputFace> InputFaces(const RawMesh& raw, const Soup& soup,
+                                  const std::vector<int32_t>& group_keeper,
+                                  const std::vector<uint8_t>& flip) {
+  const int32_t nk = static_cast<int32_t>(soup.kept.size());
+  const int32_t nf = static_cast<int32_t>(raw.triangles.size());
+  std::vector<int32_t> internal_of(nf, kNone);
+  for (int32_t k = 0; k < nk; ++k) internal_of[soup.kept[k]] = k;
+  std::vector<InputFace> faces(nf);
+  for (int32_t f = 0; f < nf; ++f) {
+    InputFace& out = faces[f];
+    const int32_t keeper = group_keeper[f];
+    out.face = internal_of[keeper];
+    out.dropped = keeper != f;
+    out.reoriented = !out.dropped && flip[out.face];
+    if (!out.dropped) {
+      out.corner = flip[out.face] ? kFlipCorner : kSameCorner;
+      continue;
     }
+    // The duplicate's corners among its keeper's (the same vertex set).
+    const Triangle& kept_corners = raw.triangles[keeper];
+    const std::array<uint8_t, 3> kept_to_internal = flip[out.face] ? kFlipCorner : kSameCorner;
+    for (int i = 0; i < 3; ++i) {
+      const int j = static_cast<int>(
+          std::find(kept_corners.begin(), kept_corners.end(), raw.triangles[f][i]) -
+          kept_corners.begin());
+      out.corner[i] = kept_to_internal[j];
+    }
+  }
+  return faces;
+}
+
+}  // namespace
+
+absl::StatusOr<RepairedMesh> RepairMesh(RawMesh raw, const RepairOptions& options) {
+  const int32_t num_input_vertices = static_cast<int32_t>(raw.positions.size());
+  if (options.strict) {
+    const WeldReport weld = raw.weld;
+    GEODEX_ASSIGN_OR_RETURN(LoadedMesh loaded, CreateLoadedMesh(std::move(raw)));
+    RepairedMesh out = WithoutRepairs(std::move(loaded.mesh));
+    out.report.weld = weld;
+    return out;
+  }
+  RepairReport report;
+  GEODEX_RETURN_IF_ERROR(CheckUnrepairable(raw, &report));
+  report.unreferenced_vertices = CountUnreferenced(num_input_vertices, raw.triangles);
+
+  report.weld = raw.weld;
+
+  Soup soup{&raw, {}};
+  std::vector<int32_t> group_keeper;
+  DropDuplicates(raw, &soup, &group_keeper, &report);
+  GEODEX_ASSIGN_OR_RETURN(const OrientedSoup oriented, OrientAndPair(soup, &report));
+
+  std::vector<Vec3> positions = std::move(raw.positions);
+  RepairMaps maps;
+  maps.num_input_vertices = num_input_vertices;
+  std::vector<Triangle> faces = FacesByFan(soup, oriented, positions, maps, report);
+  if (report.duplicate_faces > 0 || report.reoriented_faces > 0) {
+    maps.faces = InputFaces(raw, soup, group_keeper, oriented.flip);
   }
 
   MeshOptions mesh_options;

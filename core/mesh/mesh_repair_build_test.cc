@@ -44,21 +44,16 @@ Vec3 PositionOf(const RawMesh& raw, const SurfacePoint& p) {
   return p.w[0] * raw.positions[t[0]] + p.w[1] * raw.positions[t[1]] + p.w[2] * raw.positions[t[2]];
 }
 
-TEST(CrossingSheetsBuildTest, ScanCrossingItselfBuildsAndAnswers) {
-  const int n = 8;
-  const RawMesh raw = mesh::testing::TwoSheetsCrossingAlongAnEdge(n);
-  const int32_t faces_per_sheet = static_cast<int32_t>(raw.triangles.size()) / 2;
-  const std::string path =
-      (std::filesystem::temp_directory_path() / "geodex_crossing_sheets.obj").string();
-  ASSERT_TRUE(AtomicWriteFile(path, ObjText(raw)).ok());
-
-  // geodex-build's steps: repair, refine, build.
+// geodex-build's steps on the mesh file at `path`: repair, refine, build,
+// with the float32 matrix, whose straight answers are exact to its
+// rounding; the index's queries in the file's ids.
+void BuildAsGeodexBuild(const std::string& path, int32_t samples,
+                        std::shared_ptr<const query::InputQueries>* out) {
   absl::StatusOr<mesh::RepairedMesh> repaired = mesh::LoadAndRepairMesh(path);
   ASSERT_TRUE(repaired.ok()) << repaired.status();
   EXPECT_EQ(repaired->report.nonmanifold_edges, 1);
   EXPECT_EQ(repaired->report.edge_copies, 2);
   EXPECT_EQ(repaired->mesh.num_components(), 2);
-  const int32_t samples = 60;
   absl::StatusOr<builder::PreparedMesh> prepared = builder::PrepareMesh(
       repaired->mesh, builder::RecordRepair(*repaired), samples, /*refine=*/true);
   ASSERT_TRUE(prepared.ok()) << prepared.status();
@@ -82,26 +77,39 @@ TEST(CrossingSheetsBuildTest, ScanCrossingItselfBuildsAndAnswers) {
   absl::StatusOr<std::shared_ptr<const query::InputQueries>> queries =
       query::InputQueries::Create(*engine);
   ASSERT_TRUE(queries.ok()) << queries.status();
-  EXPECT_EQ((*queries)->num_faces(), static_cast<int32_t>(raw.triangles.size()));
+  *out = *std::move(queries);
+}
 
-  // Pairs within each flat square sheet, in the file's face ids, including
-  // points on the shared edge's ends: the answer is the straight line.
-  std::mt19937_64 rng(5);
-  std::uniform_real_distribution<double> unit(0, 1);
-  auto random_point = [&](int sheet) {
+// Random points of one sheet (faces [sheet, sheet + 1) * faces_per_sheet),
+// in a face drawn uniformly, area-uniform in it.
+class SheetPoints {
+ public:
+  explicit SheetPoints(int32_t faces_per_sheet) : faces_per_sheet_(faces_per_sheet) {}
+
+  SurfacePoint operator()(int sheet) {
     SurfacePoint p;
-    p.face = sheet * faces_per_sheet +
-             std::uniform_int_distribution<int32_t>(0, faces_per_sheet - 1)(rng);
-    double u = unit(rng), v = unit(rng);
+    p.face = sheet * faces_per_sheet_ +
+             std::uniform_int_distribution<int32_t>(0, faces_per_sheet_ - 1)(rng_);
+    double u = unit_(rng_), v = unit_(rng_);
     if (u + v > 1) u = 1 - u, v = 1 - v;
     p.w = {1 - u - v, u, v};
     return p;
-  };
-  std::vector<SurfacePoint> a, b;
+  }
+
+ private:
+  int32_t faces_per_sheet_;
+  std::mt19937_64 rng_{5};
+  std::uniform_real_distribution<double> unit_{0, 1};
+};
+
+// Pairs within each flat square sheet, in the file's face ids, including
+// points on the shared edge's ends: the answer is the straight line.
+void SheetPairs(const RawMesh& raw, int32_t faces_per_sheet, SheetPoints& random_point,
+                std::vector<SurfacePoint>* a, std::vector<SurfacePoint>* b) {
   for (int sheet = 0; sheet < 2; ++sheet) {
     for (int k = 0; k < 200; ++k) {
-      a.push_back(random_point(sheet));
-      b.push_back(random_point(sheet));
+      a->push_back(random_point(sheet));
+      b->push_back(random_point(sheet));
     }
     // From the shared edge's end a (vertex 0), in every face of this sheet
     // round it.
@@ -112,17 +120,34 @@ TEST(CrossingSheetsBuildTest, ScanCrossingItselfBuildsAndAnswers) {
         SurfacePoint at_a{f, {0, 0, 0}};
         at_a.w[i] = 1;
         for (int k = 0; k < 10; ++k) {
-          a.push_back(at_a);
-          b.push_back(random_point(sheet));
+          a->push_back(at_a);
+          b->push_back(random_point(sheet));
         }
       }
     }
   }
+}
+
+TEST(CrossingSheetsBuildTest, ScanCrossingItselfBuildsAndAnswers) {
+  const int n = 8;
+  const RawMesh raw = mesh::testing::TwoSheetsCrossingAlongAnEdge(n);
+  const int32_t faces_per_sheet = static_cast<int32_t>(raw.triangles.size()) / 2;
+  const std::string path =
+      (std::filesystem::temp_directory_path() / "geodex_crossing_sheets.obj").string();
+  ASSERT_TRUE(AtomicWriteFile(path, ObjText(raw)).ok());
+
+  std::shared_ptr<const query::InputQueries> queries;
+  ASSERT_NO_FATAL_FAILURE(BuildAsGeodexBuild(path, /*samples=*/60, &queries));
+  EXPECT_EQ(queries->num_faces(), static_cast<int32_t>(raw.triangles.size()));
+
+  SheetPoints random_point(faces_per_sheet);
+  std::vector<SurfacePoint> a, b;
+  SheetPairs(raw, faces_per_sheet, random_point, &a, &b);
   query::EnginePoints ea, eb;
-  ASSERT_TRUE((*queries)->Read(a, query::Named("a"), &ea).ok());
-  ASSERT_TRUE((*queries)->Read(b, query::Named("b"), &eb).ok());
+  ASSERT_TRUE(queries->Read(a, query::Named("a"), &ea).ok());
+  ASSERT_TRUE(queries->Read(b, query::Named("b"), &eb).ok());
   std::vector<double> d(a.size());
-  ASSERT_TRUE((*queries)->DistanceBatch(ea, eb, d).ok());
+  ASSERT_TRUE(queries->DistanceBatch(ea, eb, d).ok());
   double worst = 0;
   for (size_t i = 0; i < a.size(); ++i) {
     const double straight = (PositionOf(raw, a[i]) - PositionOf(raw, b[i])).norm();
@@ -135,9 +160,9 @@ TEST(CrossingSheetsBuildTest, ScanCrossingItselfBuildsAndAnswers) {
 
   // The sheets no longer touch: no path leads from one to the other.
   const std::vector<SurfacePoint> on_a = {random_point(0)}, on_b = {random_point(1)};
-  ASSERT_TRUE((*queries)->Read(on_a, query::Named("a"), &ea).ok());
-  ASSERT_TRUE((*queries)->Read(on_b, query::Named("b"), &eb).ok());
-  const absl::StatusOr<double> across = (*queries)->Distance(ea, 0, eb, 0);
+  ASSERT_TRUE(queries->Read(on_a, query::Named("a"), &ea).ok());
+  ASSERT_TRUE(queries->Read(on_b, query::Named("b"), &eb).ok());
+  const absl::StatusOr<double> across = queries->Distance(ea, 0, eb, 0);
   EXPECT_TRUE(!across.ok() || !std::isfinite(*across)) << *across;
   std::filesystem::remove(path);
 }

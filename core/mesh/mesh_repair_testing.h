@@ -81,29 +81,36 @@ inline bool OrientableOnceCut(const RawMesh& raw) {
   return true;
 }
 
-// "" when `result` is what RepairMesh promises for `raw`, else what is wrong.
-inline std::string CheckRepair(const RawMesh& raw, const absl::StatusOr<RepairedMesh>& result) {
-  const int32_t nv = static_cast<int32_t>(raw.positions.size());
-  const int32_t nf = static_cast<int32_t>(raw.triangles.size());
-  if (!result.ok()) {
-    if (result.status().code() != absl::StatusCode::kInvalidArgument) {
-      return absl::StrCat("refused with a code other than InvalidArgument: ",
-                          result.status().ToString());
-    }
-    const std::string message(result.status().message());
-    for (const char* reason : {"non-finite coordinate", "repeats a vertex", "repeats vertex",
-                               "mesh has no faces", "out of range", "mesh too large"}) {
-      if (message.find(reason) != std::string::npos) return "";
-    }
-    if (message.find("not orientable") != std::string::npos) {
-      if (OrientableOnceCut(raw)) {
-        return absl::StrCat("refused as not orientable, but it is once cut: ", message);
-      }
-      return "";
-    }
-    return absl::StrCat("refused for a reason the repair does not list: ", message);
+// CheckRepair of a refusal: InvalidArgument for a documented reason, and
+// "not orientable" only when the surface is not, once cut.
+inline std::string CheckRefusal(const RawMesh& raw, const absl::Status& status) {
+  if (status.code() != absl::StatusCode::kInvalidArgument) {
+    return absl::StrCat("refused with a code other than InvalidArgument: ", status.ToString());
   }
-  const RepairedMesh& r = *result;
+  const std::string message(status.message());
+  for (const char* reason : {"non-finite coordinate", "repeats a vertex", "repeats vertex",
+                             "mesh has no faces", "out of range", "mesh too large"}) {
+    if (message.find(reason) != std::string::npos) return "";
+  }
+  if (message.find("not orientable") != std::string::npos) {
+    if (OrientableOnceCut(raw)) {
+      return absl::StrCat("refused as not orientable, but it is once cut: ", message);
+    }
+    return "";
+  }
+  return absl::StrCat("refused for a reason the repair does not list: ", message);
+}
+
+// The input vertex that vertex v of the repaired mesh is or copies.
+inline int32_t InputVertexOf(const RawMesh& raw, const RepairedMesh& r, int32_t v) {
+  const int32_t nv = static_cast<int32_t>(raw.positions.size());
+  return v < nv ? v : r.maps.vertex_copies[v - nv];
+}
+
+// CheckRepair of an accepted surface's mesh and vertices: a valid mesh of
+// the input's vertices, unmoved, and of copies of them.
+inline std::string CheckRepairedVertices(const RawMesh& raw, const RepairedMesh& r) {
+  const int32_t nv = static_cast<int32_t>(raw.positions.size());
   const Mesh& m = r.mesh;
   // Valid: Mesh::Create takes the arrays again.
   MeshOptions options;
@@ -116,7 +123,6 @@ inline std::string CheckRepair(const RawMesh& raw, const absl::StatusOr<Repaired
   if (r.maps.num_input_vertices != nv) return "num_input_vertices is not the input's";
   const int32_t copies = static_cast<int32_t>(r.maps.vertex_copies.size());
   if (m.num_vertices() != nv + copies) return "vertex count is not input vertices + copies";
-  auto input_vertex = [&](int32_t v) { return v < nv ? v : r.maps.vertex_copies[v - nv]; };
   for (int32_t k = 0; k < copies; ++k) {
     const int32_t original = r.maps.vertex_copies[k];
     if (original < 0 || original >= nv) return "a vertex copy of no input vertex";
@@ -125,30 +131,61 @@ inline std::string CheckRepair(const RawMesh& raw, const absl::StatusOr<Repaired
   for (int32_t v = 0; v < nv; ++v) {
     if (m.position(v) != raw.positions[v]) return absl::StrCat("input vertex ", v, " moved");
   }
-  // One internal face per distinct vertex set, the first of each in input
-  // order, in input order.
+  return "";
+}
+
+// For each input face, the first input face with its vertex set (itself
+// when it is the first); `distinct` is the number of vertex sets.
+inline std::vector<int32_t> FirstOfVertexSet(const RawMesh& raw, int32_t* distinct) {
+  const int32_t nf = static_cast<int32_t>(raw.triangles.size());
   std::map<std::array<int32_t, 3>, int32_t> first;
   std::vector<int32_t> keeper(nf);
-  int32_t distinct = 0;
+  *distinct = 0;
   for (int32_t f = 0; f < nf; ++f) {
     std::array<int32_t, 3> key = raw.triangles[f];
     std::sort(key.begin(), key.end());
     const auto [it, inserted] = first.emplace(key, f);
     keeper[f] = it->second;
-    distinct += inserted ? 1 : 0;
+    *distinct += inserted ? 1 : 0;
   }
-  if (m.num_faces() != distinct) {
-    return absl::StrFormat("%d internal faces for %d distinct input faces", m.num_faces(),
-                           distinct);
+  return keeper;
+}
+
+// Input face f's corners, mapped by `in`: a permutation onto its internal
+// face's corners, each its input vertex, unmoved.
+inline std::string CheckInputCorners(const RawMesh& raw, const RepairedMesh& r, int32_t f,
+                                     const InputFace& in) {
+  std::array<bool, 3> used = {false, false, false};
+  for (int i = 0; i < 3; ++i) {
+    const int c = in.corner[i];
+    if (c > 2 || used[c]) return absl::StrCat("input face ", f, ": not a corner permutation");
+    used[c] = true;
+    const int32_t v = r.mesh.face(in.face)[c];
+    if (InputVertexOf(raw, r, v) != raw.triangles[f][i]) {
+      return absl::StrCat("input face ", f, " corner ", i, " is not its input vertex");
+    }
+    if (r.mesh.position(v) != raw.positions[raw.triangles[f][i]]) {
+      return absl::StrCat("input face ", f, " corner ", i, " moved");
+    }
   }
-  if (!r.maps.faces.empty() && static_cast<int32_t>(r.maps.faces.size()) != nf) {
-    return "a face map that is not one entry per input face";
-  }
+  return "";
+}
+
+// CheckRepair of the face map: each input face kept in input order, or
+// dropped as a duplicate answering for its keeper's face, with its corners;
+// the counts as reported. Fills `internal_of`, the internal face of each
+// kept input face.
+inline std::string CheckFaceMap(const RawMesh& raw, const RepairedMesh& r,
+                                const std::vector<int32_t>& keeper,
+                                std::vector<int32_t>* internal_of) {
+  const int32_t nf = static_cast<int32_t>(raw.triangles.size());
   int32_t dropped = 0, reoriented = 0, next_internal = 0;
-  std::vector<int32_t> internal_of(nf, kNone);
+  internal_of->assign(nf, kNone);
   for (int32_t f = 0; f < nf; ++f) {
     const InputFace in = r.maps.faces.empty() ? InputFace{f} : r.maps.faces[f];
-    if (in.face < 0 || in.face >= m.num_faces()) return absl::StrCat("input face ", f, " lost");
+    if (in.face < 0 || in.face >= r.mesh.num_faces()) {
+      return absl::StrCat("input face ", f, " lost");
+    }
     if (in.dropped != (keeper[f] != f)) {
       return absl::StrCat(
           "input face ", f,
@@ -156,45 +193,38 @@ inline std::string CheckRepair(const RawMesh& raw, const absl::StatusOr<Repaired
     }
     if (in.dropped) {
       ++dropped;
-      if (in.face != internal_of[keeper[f]]) {
+      if (in.face != (*internal_of)[keeper[f]]) {
         return absl::StrCat("duplicate ", f, " answers for another face than its twin's");
       }
     } else {
       if (in.face != next_internal++) return "kept faces out of input order";
-      internal_of[f] = in.face;
+      (*internal_of)[f] = in.face;
       reoriented += in.reoriented ? 1 : 0;
       const std::array<uint8_t, 3> expected =
           in.reoriented ? std::array<uint8_t, 3>{0, 2, 1} : std::array<uint8_t, 3>{0, 1, 2};
       if (in.corner != expected) return absl::StrCat("input face ", f, ": corner map");
     }
-    std::array<bool, 3> used = {false, false, false};
-    for (int i = 0; i < 3; ++i) {
-      const int c = in.corner[i];
-      if (c > 2 || used[c]) return absl::StrCat("input face ", f, ": not a corner permutation");
-      used[c] = true;
-      const int32_t v = m.face(in.face)[c];
-      if (input_vertex(v) != raw.triangles[f][i]) {
-        return absl::StrCat("input face ", f, " corner ", i, " is not its input vertex");
-      }
-      if (m.position(v) != raw.positions[raw.triangles[f][i]]) {
-        return absl::StrCat("input face ", f, " corner ", i, " moved");
-      }
-    }
+    if (std::string wrong = CheckInputCorners(raw, r, f, in); !wrong.empty()) return wrong;
   }
   if (dropped != r.report.duplicate_faces) return "duplicate count differs from the report";
   if (reoriented != r.report.reoriented_faces) return "re-oriented count differs from the report";
-  if (r.report.vertex_copies - r.report.nonmanifold_vertices != copies) {
-    return "vertex copies differ from the report";
-  }
-  // Every input edge of exactly two (kept) faces stays joined: cuts are made
-  // only where more than two faces meet.
+  return "";
+}
+
+// Every input edge of exactly two (kept) faces stays joined: cuts are made
+// only where more than two faces meet; the cuts as reported.
+inline std::string CheckEdgesJoined(const RawMesh& raw, const RepairedMesh& r,
+                                    const std::vector<int32_t>& keeper,
+                                    const std::vector<int32_t>& internal_of) {
+  const int32_t nf = static_cast<int32_t>(raw.triangles.size());
+  const Mesh& m = r.mesh;
   std::map<std::pair<int32_t, int32_t>, std::vector<int32_t>> edge_halfedges;
   for (int32_t f = 0; f < nf; ++f) {
     if (keeper[f] != f) continue;
     const int32_t k = internal_of[f];
     for (int i = 0; i < 3; ++i) {
       const int32_t h = 3 * k + i;
-      const int32_t a = input_vertex(m.Origin(h)), b = input_vertex(m.Dest(h));
+      const int32_t a = InputVertexOf(raw, r, m.Origin(h)), b = InputVertexOf(raw, r, m.Dest(h));
       edge_halfedges[{std::min(a, b), std::max(a, b)}].push_back(h);
     }
   }
@@ -212,6 +242,32 @@ inline std::string CheckRepair(const RawMesh& raw, const absl::StatusOr<Repaired
     return "non-manifold edge counts differ from the report";
   }
   return "";
+}
+
+// "" when `result` is what RepairMesh promises for `raw`, else what is wrong.
+inline std::string CheckRepair(const RawMesh& raw, const absl::StatusOr<RepairedMesh>& result) {
+  const int32_t nf = static_cast<int32_t>(raw.triangles.size());
+  if (!result.ok()) return CheckRefusal(raw, result.status());
+  const RepairedMesh& r = *result;
+  if (std::string wrong = CheckRepairedVertices(raw, r); !wrong.empty()) return wrong;
+  // One internal face per distinct vertex set, the first of each in input
+  // order, in input order.
+  int32_t distinct = 0;
+  const std::vector<int32_t> keeper = FirstOfVertexSet(raw, &distinct);
+  if (r.mesh.num_faces() != distinct) {
+    return absl::StrFormat("%d internal faces for %d distinct input faces", r.mesh.num_faces(),
+                           distinct);
+  }
+  if (!r.maps.faces.empty() && static_cast<int32_t>(r.maps.faces.size()) != nf) {
+    return "a face map that is not one entry per input face";
+  }
+  std::vector<int32_t> internal_of;
+  if (std::string wrong = CheckFaceMap(raw, r, keeper, &internal_of); !wrong.empty()) return wrong;
+  const int32_t copies = static_cast<int32_t>(r.maps.vertex_copies.size());
+  if (r.report.vertex_copies - r.report.nonmanifold_vertices != copies) {
+    return "vertex copies differ from the report";
+  }
+  return CheckEdgesJoined(raw, r, keeper, internal_of);
 }
 
 // Whether two repairs of one input made the same mesh and maps.

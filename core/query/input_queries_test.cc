@@ -224,6 +224,60 @@ mesh::Vec3 PointOf(std::span<const double> positions, const mesh::Triangle& t,
   return x;
 }
 
+// Points of each of the 80 input faces of `coarse` (in `points`): the same
+// point of space in the internal ids, and back to the same input
+// description.
+void ExpectSamePointsInBothIds(const QueryEngine& e, const InputIds& ids, const mesh::Mesh& coarse,
+                               std::vector<SurfacePoint>* points) {
+  const std::span<const double> x = e.index().positions();
+  const std::span<const int32_t> faces = e.index().faces();
+  auto internal_face = [&](int32_t f) {
+    return mesh::Triangle{faces[3 * f], faces[3 * f + 1], faces[3 * f + 2]};
+  };
+  for (int32_t f = 0; f < 80; ++f) {
+    EXPECT_EQ(ids.InputFace(f), coarse.face(f));
+    for (const mesh::Vec3& w : {mesh::Vec3(0.2, 0.3, 0.5), mesh::Vec3(1, 0, 0),
+                                mesh::Vec3(0.5, 0.5, 0), mesh::Vec3(0.05, 0.05, 0.9)}) {
+      const SurfacePoint p{f, {w.x(), w.y(), w.z()}};
+      absl::StatusOr<SurfacePoint> in = ids.ToInternal(p);
+      ASSERT_TRUE(in.ok()) << in.status();
+      // The same point of space, and back to the same input description.
+      EXPECT_LT((PointOf(x, internal_face(in->face), *in) - PointOf(x, coarse.face(f), p)).norm(),
+                1e-9);
+      const SurfacePoint back = ids.ToInput(*in);
+      EXPECT_EQ(back.face, f);
+      for (int i = 0; i < 3; ++i) EXPECT_NEAR(back.w[i], p.w[i], 1e-6);
+      points->push_back(p);
+    }
+  }
+}
+
+// The surface is the same: exact distances from an input point, on the
+// refined mesh, equal those on the coarse one at every input vertex; the
+// O(1) answers are close to them.
+void ExpectTheSameSurface(const QueryEngine& e, const InputIds& ids, const mesh::Mesh& coarse,
+                          const std::vector<SurfacePoint>& points) {
+  geodesic::ExactGeodesicSolver exact(coarse);
+  QueryScratch scratch;
+  int checked = 0;
+  for (size_t i = 0; i < points.size(); i += 37) {
+    ASSERT_TRUE(exact.Propagate({points[i]}).ok());
+    absl::StatusOr<SurfacePoint> internal = ids.ToInternal(points[i]);
+    ASSERT_TRUE(internal.ok());
+    absl::StatusOr<std::span<const double>> local = e.LocalExactDistances(*internal, 10, scratch);
+    ASSERT_TRUE(local.ok()) << local.status();
+    for (int32_t v = 0; v < 42; ++v) EXPECT_NEAR((*local)[v], exact.VertexDistance(v), 1e-9);
+    for (size_t j = 5; j < points.size(); j += 23) {
+      const double truth = exact.DistanceAt(points[j]);
+      if (truth < 0.3) continue;
+      EXPECT_NEAR(InputDistance(e, points[i], points[j], NearPairs::kUnfold), truth, 0.06 * truth)
+          << i << " " << j;
+      ++checked;
+    }
+  }
+  EXPECT_GT(checked, 20);
+}
+
 // A coarse sphere (42 vertices, edges about 0.6) sampled more finely than it
 // has vertices: only the long-edge split makes room for the samples, and
 // every answer still speaks of the input's faces and vertices.
@@ -244,49 +298,10 @@ TEST(InputIdsTest, SplitIndexAnswersInTheInputIds) {
   EXPECT_THAT(std::string(e.index().report()), ::testing::HasSubstr("mesh_split = "));
 
   const std::span<const double> x = e.index().positions();
-  const std::span<const int32_t> faces = e.index().faces();
-  auto internal_face = [&](int32_t f) {
-    return mesh::Triangle{faces[3 * f], faces[3 * f + 1], faces[3 * f + 2]};
-  };
   std::vector<SurfacePoint> points;
-  for (int32_t f = 0; f < 80; ++f) {
-    EXPECT_EQ(ids.InputFace(f), coarse.face(f));
-    for (const mesh::Vec3& w : {mesh::Vec3(0.2, 0.3, 0.5), mesh::Vec3(1, 0, 0),
-                                mesh::Vec3(0.5, 0.5, 0), mesh::Vec3(0.05, 0.05, 0.9)}) {
-      const SurfacePoint p{f, {w.x(), w.y(), w.z()}};
-      absl::StatusOr<SurfacePoint> in = ids.ToInternal(p);
-      ASSERT_TRUE(in.ok()) << in.status();
-      // The same point of space, and back to the same input description.
-      EXPECT_LT((PointOf(x, internal_face(in->face), *in) - PointOf(x, coarse.face(f), p)).norm(),
-                1e-9);
-      const SurfacePoint back = ids.ToInput(*in);
-      EXPECT_EQ(back.face, f);
-      for (int i = 0; i < 3; ++i) EXPECT_NEAR(back.w[i], p.w[i], 1e-6);
-      points.push_back(p);
-    }
-  }
-  // The surface is the same: exact distances from an input point, on the
-  // refined mesh, equal those on the coarse one at every input vertex; the
-  // O(1) answers are close to them.
+  ASSERT_NO_FATAL_FAILURE(ExpectSamePointsInBothIds(e, ids, coarse, &points));
+  ASSERT_NO_FATAL_FAILURE(ExpectTheSameSurface(e, ids, coarse, points));
   geodesic::ExactGeodesicSolver exact(coarse);
-  QueryScratch scratch;
-  int checked = 0;
-  for (size_t i = 0; i < points.size(); i += 37) {
-    ASSERT_TRUE(exact.Propagate({points[i]}).ok());
-    absl::StatusOr<SurfacePoint> internal = ids.ToInternal(points[i]);
-    ASSERT_TRUE(internal.ok());
-    absl::StatusOr<std::span<const double>> local = e.LocalExactDistances(*internal, 10, scratch);
-    ASSERT_TRUE(local.ok()) << local.status();
-    for (int32_t v = 0; v < 42; ++v) EXPECT_NEAR((*local)[v], exact.VertexDistance(v), 1e-9);
-    for (size_t j = 5; j < points.size(); j += 23) {
-      const double truth = exact.DistanceAt(points[j]);
-      if (truth < 0.3) continue;
-      EXPECT_NEAR(InputDistance(e, points[i], points[j], NearPairs::kUnfold), truth, 0.06 * truth)
-          << i << " " << j;
-      ++checked;
-    }
-  }
-  EXPECT_GT(checked, 20);
   // Per-vertex answers cover the input's vertices only; midpoints have no
   // input vertex.
   EXPECT_EQ(ids.InputVertex(41), 41);

@@ -279,9 +279,11 @@ std::vector<std::pair<int32_t, int32_t>> DelaunayEdges(
   return out;
 }
 
-absl::StatusOr<std::vector<GeodesicEdge>> TraceEdges(
-    const Mesh& mesh, std::span<const int32_t> samples,
-    std::span<const std::array<int32_t, 3>> triangles, int threads) {
+namespace {
+
+// The samples on referenced mesh vertices, the triangles' corners samples.
+absl::Status CheckTraceInput(const Mesh& mesh, std::span<const int32_t> samples,
+                             std::span<const std::array<int32_t, 3>> triangles) {
   const int32_t m = static_cast<int32_t>(samples.size());
   for (int32_t a = 0; a < m; ++a) {
     if (samples[a] < 0 || samples[a] >= mesh.num_vertices() || !mesh.IsReferenced(samples[a])) {
@@ -297,6 +299,66 @@ absl::StatusOr<std::vector<GeodesicEdge>> TraceEdges(
       }
     }
   }
+  return absl::OkStatus();
+}
+
+// Sets `edge`'s path to the one `solver` propagated from its a to `target`,
+// its b, and its length to that path's.
+absl::Status BacktrackPath(const Mesh& mesh, const geodesic::ExactGeodesicSolver& solver,
+                           const SurfacePoint& target, GeodesicEdge& edge) {
+  GEODEX_ASSIGN_OR_RETURN(std::vector<SurfacePoint> back, solver.PathTo(target));
+  // PathTo runs from b back to a and may give one place twice (a
+  // vertex, then the same vertex as the end of a window's interval):
+  // keep it once, but measure the length along every point.
+  Vec3 last = Vec3::Zero();
+  Location last_at;
+  for (auto it = back.rbegin(); it != back.rend(); ++it) {
+    const Vec3 x = mesh::PositionOf(mesh, *it);
+    const Location x_at = Locate(mesh, *it);
+    if (!edge.path.empty()) edge.length += (x - last).norm();
+    if (edge.path.empty() || !SameLocation(x_at, last_at)) edge.path.push_back(*it);
+    last = x;
+    last_at = x_at;
+  }
+  // The last point kept must be b itself.
+  edge.path.back() = target;
+  return absl::OkStatus();
+}
+
+// The edges pairs[i] for i in [begin, end), which all start at one sample,
+// from one propagation.
+absl::Status TraceFromSource(const Mesh& mesh, std::span<const int32_t> samples,
+                             const std::vector<std::pair<int32_t, int32_t>>& pairs, size_t begin,
+                             size_t end, geodesic::ExactGeodesicSolver& solver,
+                             geodesic::GeodesicOptions& options, std::vector<GeodesicEdge>& edges) {
+  const int32_t a = pairs[begin].first;
+  options.stop_vertices.clear();
+  for (size_t i = begin; i < end; ++i) options.stop_vertices.push_back(samples[pairs[i].second]);
+  GEODEX_ASSIGN_OR_RETURN(const SurfacePoint source, mesh::VertexPoint(mesh, samples[a]));
+  GEODEX_RETURN_IF_ERROR(solver.Propagate({source}, options));
+  for (size_t i = begin; i < end; ++i) {
+    const int32_t b = pairs[i].second;
+    GeodesicEdge& edge = edges[i];
+    edge.a = a;
+    edge.b = b;
+    edge.distance = solver.VertexDistance(samples[b]);
+    if (!(edge.distance < geodesic::kInfinity)) {
+      return absl::NotFoundError(
+          absl::StrFormat("adjacent samples %d and %d are not connected on the surface", a, b));
+    }
+    if (MeshEdgePath(mesh, samples[a], samples[b], edge.distance, &edge)) continue;
+    GEODEX_ASSIGN_OR_RETURN(const SurfacePoint target, mesh::VertexPoint(mesh, samples[b]));
+    GEODEX_RETURN_IF_ERROR(BacktrackPath(mesh, solver, target, edge));
+  }
+  return absl::OkStatus();
+}
+
+}  // namespace
+
+absl::StatusOr<std::vector<GeodesicEdge>> TraceEdges(
+    const Mesh& mesh, std::span<const int32_t> samples,
+    std::span<const std::array<int32_t, 3>> triangles, int threads) {
+  GEODEX_RETURN_IF_ERROR(CheckTraceInput(mesh, samples, triangles));
   const std::vector<std::pair<int32_t, int32_t>> pairs = DelaunayEdges(triangles);
   // Pairs are sorted by a: each sample with larger neighbours owns a range.
   std::vector<size_t> begin;
@@ -313,45 +375,8 @@ absl::StatusOr<std::vector<GeodesicEdge>> TraceEdges(
     geodesic::ExactGeodesicSolver solver(mesh);
     geodesic::GeodesicOptions options;
     for (size_t k; (k = next.fetch_add(1)) < num_sources;) {
-      errors[k] = [&]() -> absl::Status {
-        const int32_t a = pairs[begin[k]].first;
-        options.stop_vertices.clear();
-        for (size_t i = begin[k]; i < begin[k + 1]; ++i) {
-          options.stop_vertices.push_back(samples[pairs[i].second]);
-        }
-        GEODEX_ASSIGN_OR_RETURN(const SurfacePoint source, mesh::VertexPoint(mesh, samples[a]));
-        GEODEX_RETURN_IF_ERROR(solver.Propagate({source}, options));
-        for (size_t i = begin[k]; i < begin[k + 1]; ++i) {
-          const int32_t b = pairs[i].second;
-          GeodesicEdge& edge = edges[i];
-          edge.a = a;
-          edge.b = b;
-          edge.distance = solver.VertexDistance(samples[b]);
-          if (!(edge.distance < geodesic::kInfinity)) {
-            return absl::NotFoundError(absl::StrFormat(
-                "adjacent samples %d and %d are not connected on the surface", a, b));
-          }
-          if (MeshEdgePath(mesh, samples[a], samples[b], edge.distance, &edge)) continue;
-          GEODEX_ASSIGN_OR_RETURN(const SurfacePoint target, mesh::VertexPoint(mesh, samples[b]));
-          GEODEX_ASSIGN_OR_RETURN(std::vector<SurfacePoint> back, solver.PathTo(target));
-          // PathTo runs from b back to a and may give one place twice (a
-          // vertex, then the same vertex as the end of a window's interval):
-          // keep it once, but measure the length along every point.
-          Vec3 last = Vec3::Zero();
-          Location last_at;
-          for (auto it = back.rbegin(); it != back.rend(); ++it) {
-            const Vec3 x = mesh::PositionOf(mesh, *it);
-            const Location x_at = Locate(mesh, *it);
-            if (!edge.path.empty()) edge.length += (x - last).norm();
-            if (edge.path.empty() || !SameLocation(x_at, last_at)) edge.path.push_back(*it);
-            last = x;
-            last_at = x_at;
-          }
-          // The last point kept must be b itself.
-          edge.path.back() = target;
-        }
-        return absl::OkStatus();
-      }();
+      errors[k] =
+          TraceFromSource(mesh, samples, pairs, begin[k], begin[k + 1], solver, options, edges);
     }
   };
   const int count = std::min<int>(common::ThreadCount(threads), std::max<size_t>(1, num_sources));
@@ -362,120 +387,158 @@ absl::StatusOr<std::vector<GeodesicEdge>> TraceEdges(
   return edges;
 }
 
-absl::StatusOr<std::vector<EdgeCrossing>> FindCrossings(const Mesh& mesh,
-                                                        std::span<const int32_t> samples,
-                                                        std::span<const GeodesicEdge> edges) {
-  const int32_t m = static_cast<int32_t>(samples.size());
-  // 1. Cut every path into per-face pieces.
-  std::vector<Piece> pieces;
+namespace {
+
+int32_t VertexOf(const Location& x) { return x.kind == Location::Kind::kVertex ? x.id : kNone; }
+
+// The distinct places along `edge`'s path, each point checked on the mesh.
+absl::StatusOr<std::vector<Location>> PathLocations(const Mesh& mesh, const GeodesicEdge& edge) {
   std::vector<Location> at;
+  for (const SurfacePoint& p : edge.path) {
+    GEODEX_RETURN_IF_ERROR(mesh::ValidateSurfacePoint(mesh, p));
+    const Location x = Locate(mesh, p);
+    if (at.empty() || !SameLocation(at.back(), x)) at.push_back(x);
+  }
+  return at;
+}
+
+// Appends the per-face pieces of the path of edge `e`, whose distinct places
+// are `at`: a piece per segment and face it runs in, and a point piece per
+// face that a point on a mesh edge or vertex touches without a segment.
+absl::Status CutPath(const Mesh& mesh, int32_t e, const GeodesicEdge& edge,
+                     const std::vector<Location>& at, std::vector<Piece>& pieces) {
   std::vector<int32_t> faces_x, faces_y, common;
-  std::vector<std::vector<int32_t>> segment_faces;  // per point: faces of its segments
+  std::vector<std::vector<int32_t>> segment_faces(at.size());  // per point: faces of its segments
+  for (size_t i = 0; i + 1 < at.size(); ++i) {
+    faces_x.clear();
+    faces_y.clear();
+    FacesOf(mesh, at[i], &faces_x);
+    FacesOf(mesh, at[i + 1], &faces_y);
+    std::sort(faces_x.begin(), faces_x.end());
+    std::sort(faces_y.begin(), faces_y.end());
+    common.clear();
+    std::set_intersection(faces_x.begin(), faces_x.end(), faces_y.begin(), faces_y.end(),
+                          std::back_inserter(common));
+    if (common.empty()) {
+      return absl::InvalidArgumentError(absl::StrFormat(
+          "path of edge (%d, %d): points %d and %d share no face", edge.a, edge.b, i, i + 1));
+    }
+    // Usually one face; both faces of a mesh edge the path runs along.
+    for (const int32_t f : common) {
+      pieces.push_back({f, e, WeightsIn(mesh, at[i], f), WeightsIn(mesh, at[i + 1], f),
+                        VertexOf(at[i]), VertexOf(at[i + 1])});
+      segment_faces[i].push_back(f);
+      segment_faces[i + 1].push_back(f);
+    }
+  }
+  // A point on a mesh edge or vertex also touches the faces around it that
+  // its own segments do not enter.
+  for (size_t i = 0; i < at.size(); ++i) {
+    if (at[i].kind == Location::Kind::kFace) continue;
+    faces_x.clear();
+    FacesOf(mesh, at[i], &faces_x);
+    for (const int32_t f : faces_x) {
+      const auto& used = segment_faces[i];
+      if (std::find(used.begin(), used.end(), f) != used.end()) continue;
+      const auto w = WeightsIn(mesh, at[i], f);
+      pieces.push_back({f, e, w, w, VertexOf(at[i]), VertexOf(at[i])});
+    }
+  }
+  return absl::OkStatus();
+}
+
+// Every path cut into per-face pieces, by face.
+absl::StatusOr<std::vector<Piece>> PiecesOf(const Mesh& mesh, int32_t num_samples,
+                                            std::span<const GeodesicEdge> edges) {
+  const int32_t m = num_samples;
+  std::vector<Piece> pieces;
   for (int32_t e = 0; e < static_cast<int32_t>(edges.size()); ++e) {
     const GeodesicEdge& edge = edges[e];
     if (edge.a < 0 || edge.a >= m || edge.b < 0 || edge.b >= m) {
       return absl::InvalidArgumentError(
           absl::StrFormat("edge (%d, %d) has a sample out of range [0, %d)", edge.a, edge.b, m));
     }
-    at.clear();
-    for (const SurfacePoint& p : edge.path) {
-      GEODEX_RETURN_IF_ERROR(mesh::ValidateSurfacePoint(mesh, p));
-      const Location x = Locate(mesh, p);
-      if (at.empty() || !SameLocation(at.back(), x)) at.push_back(x);
-    }
-    auto vertex_of = [](const Location& x) {
-      return x.kind == Location::Kind::kVertex ? x.id : kNone;
-    };
-    segment_faces.assign(at.size(), {});
-    for (size_t i = 0; i + 1 < at.size(); ++i) {
-      faces_x.clear();
-      faces_y.clear();
-      FacesOf(mesh, at[i], &faces_x);
-      FacesOf(mesh, at[i + 1], &faces_y);
-      std::sort(faces_x.begin(), faces_x.end());
-      std::sort(faces_y.begin(), faces_y.end());
-      common.clear();
-      std::set_intersection(faces_x.begin(), faces_x.end(), faces_y.begin(), faces_y.end(),
-                            std::back_inserter(common));
-      if (common.empty()) {
-        return absl::InvalidArgumentError(absl::StrFormat(
-            "path of edge (%d, %d): points %d and %d share no face", edge.a, edge.b, i, i + 1));
-      }
-      // Usually one face; both faces of a mesh edge the path runs along.
-      for (const int32_t f : common) {
-        pieces.push_back({f, e, WeightsIn(mesh, at[i], f), WeightsIn(mesh, at[i + 1], f),
-                          vertex_of(at[i]), vertex_of(at[i + 1])});
-        segment_faces[i].push_back(f);
-        segment_faces[i + 1].push_back(f);
-      }
-    }
-    // A point on a mesh edge or vertex also touches the faces around it that
-    // its own segments do not enter.
-    for (size_t i = 0; i < at.size(); ++i) {
-      if (at[i].kind == Location::Kind::kFace) continue;
-      faces_x.clear();
-      FacesOf(mesh, at[i], &faces_x);
-      for (const int32_t f : faces_x) {
-        const auto& used = segment_faces[i];
-        if (std::find(used.begin(), used.end(), f) != used.end()) continue;
-        const auto w = WeightsIn(mesh, at[i], f);
-        pieces.push_back({f, e, w, w, vertex_of(at[i]), vertex_of(at[i])});
-      }
-    }
+    GEODEX_ASSIGN_OR_RETURN(const std::vector<Location> at, PathLocations(mesh, edge));
+    GEODEX_RETURN_IF_ERROR(CutPath(mesh, e, edge, at, pieces));
   }
   std::stable_sort(pieces.begin(), pieces.end(),
                    [](const Piece& x, const Piece& y) { return x.face < y.face; });
+  return pieces;
+}
+
+// Whether two pieces in one face, x0-x1 and y0-y1 in its frame, touch
+// closer than `eps`, and where (`meet`); `vs` is the mesh vertex of the
+// sample their edges share, or kNone.
+bool PiecesTouch(const Piece& px, const Piece& py, const Vec2& x0, const Vec2& x1, const Vec2& y0,
+                 const Vec2& y1, int32_t vs, double eps, Vec2* meet) {
+  if (vs != kNone && (px.vp == vs || px.vq == vs) && (py.vp == vs || py.vq == vs)) {
+    // Both pieces start at the common sample: straight pieces from one
+    // point meet again only if they leave it in the same direction, and
+    // then the far end of one lies on the other.
+    const Vec2 s = px.vp == vs ? x0 : x1;
+    const Vec2 xf = px.vp == vs ? x1 : x0;
+    const Vec2 yf = py.vp == vs ? y1 : y0;
+    if ((xf - s).norm() > eps && (xf - Nearest(xf, y0, y1)).norm() < eps) {
+      *meet = xf;
+      return true;
+    }
+    if ((yf - s).norm() > eps && (yf - Nearest(yf, x0, x1)).norm() < eps) {
+      *meet = yf;
+      return true;
+    }
+    return false;
+  }
+  return SegmentsTouch(x0, x1, y0, y1, eps, meet);
+}
+
+// Appends to `found` (crossing, order found) where the pieces [i, j) of
+// one face, of different edges, touch.
+void CrossingsInFace(const Mesh& mesh, std::span<const int32_t> samples,
+                     std::span<const GeodesicEdge> edges, std::span<const Piece> pieces,
+                     std::vector<std::pair<EdgeCrossing, int64_t>>& found) {
+  const int32_t f = pieces.front().face;
+  const FaceFrame frame(mesh, f);
+  const double eps = kTouchTolerance * frame.size;
+  for (size_t x = 0; x < pieces.size(); ++x) {
+    const Piece& px = pieces[x];
+    const Vec2 x0 = frame.Map(px.p), x1 = frame.Map(px.q);
+    for (size_t y = x + 1; y < pieces.size(); ++y) {
+      const Piece& py = pieces[y];
+      if (py.edge == px.edge) continue;
+      const Vec2 y0 = frame.Map(py.p), y1 = frame.Map(py.q);
+      const GeodesicEdge& ex = edges[px.edge];
+      const GeodesicEdge& ey = edges[py.edge];
+      int32_t shared = kNone;
+      if (ex.a == ey.a || ex.a == ey.b) shared = ex.a;
+      if (ex.b == ey.a || ex.b == ey.b) shared = ex.b;
+      const int32_t vs = shared == kNone ? kNone : samples[shared];
+      Vec2 meet;
+      if (PiecesTouch(px, py, x0, x1, y0, y1, vs, eps, &meet)) {
+        EdgeCrossing c;
+        c.first = std::min(px.edge, py.edge);
+        c.second = std::max(px.edge, py.edge);
+        c.point = frame.Unmap(f, meet);
+        found.push_back({c, static_cast<int64_t>(found.size())});
+      }
+    }
+  }
+}
+
+}  // namespace
+
+absl::StatusOr<std::vector<EdgeCrossing>> FindCrossings(const Mesh& mesh,
+                                                        std::span<const int32_t> samples,
+                                                        std::span<const GeodesicEdge> edges) {
+  // 1. Cut every path into per-face pieces.
+  GEODEX_ASSIGN_OR_RETURN(const std::vector<Piece> pieces,
+                          PiecesOf(mesh, static_cast<int32_t>(samples.size()), edges));
 
   // 2. Compare the pieces of different edges face by face.
   std::vector<std::pair<EdgeCrossing, int64_t>> found;  // (crossing, order found)
   for (size_t i = 0; i < pieces.size();) {
     size_t j = i;
     while (j < pieces.size() && pieces[j].face == pieces[i].face) ++j;
-    const int32_t f = pieces[i].face;
-    const FaceFrame frame(mesh, f);
-    const double eps = kTouchTolerance * frame.size;
-    for (size_t x = i; x < j; ++x) {
-      const Piece& px = pieces[x];
-      const Vec2 x0 = frame.Map(px.p), x1 = frame.Map(px.q);
-      for (size_t y = x + 1; y < j; ++y) {
-        const Piece& py = pieces[y];
-        if (py.edge == px.edge) continue;
-        const Vec2 y0 = frame.Map(py.p), y1 = frame.Map(py.q);
-        const GeodesicEdge& ex = edges[px.edge];
-        const GeodesicEdge& ey = edges[py.edge];
-        int32_t shared = kNone;
-        if (ex.a == ey.a || ex.a == ey.b) shared = ex.a;
-        if (ex.b == ey.a || ex.b == ey.b) shared = ex.b;
-        const int32_t vs = shared == kNone ? kNone : samples[shared];
-        Vec2 meet;
-        bool touch;
-        if (vs != kNone && (px.vp == vs || px.vq == vs) && (py.vp == vs || py.vq == vs)) {
-          // Both pieces start at the common sample: straight pieces from one
-          // point meet again only if they leave it in the same direction, and
-          // then the far end of one lies on the other.
-          const Vec2 s = px.vp == vs ? x0 : x1;
-          const Vec2 xf = px.vp == vs ? x1 : x0;
-          const Vec2 yf = py.vp == vs ? y1 : y0;
-          touch = false;
-          if ((xf - s).norm() > eps && (xf - Nearest(xf, y0, y1)).norm() < eps) {
-            touch = true;
-            meet = xf;
-          } else if ((yf - s).norm() > eps && (yf - Nearest(yf, x0, x1)).norm() < eps) {
-            touch = true;
-            meet = yf;
-          }
-        } else {
-          touch = SegmentsTouch(x0, x1, y0, y1, eps, &meet);
-        }
-        if (touch) {
-          EdgeCrossing c;
-          c.first = std::min(px.edge, py.edge);
-          c.second = std::max(px.edge, py.edge);
-          c.point = frame.Unmap(f, meet);
-          found.push_back({c, static_cast<int64_t>(found.size())});
-        }
-      }
-    }
+    CrossingsInFace(mesh, samples, edges, std::span<const Piece>(pieces).subspan(i, j - i), found);
     i = j;
   }
   // One crossing per pair: the first found (the lowest face).

@@ -250,6 +250,135 @@ struct Answers {
   double spread = 0;
 };
 
+// Fills the answers of the uncalibrated `engine` to pairs [known, size) of
+// `pairs`, each in its own slot: the calibration does not depend on the
+// thread count.
+void AnswerUncalibrated(const query::QueryEngine& engine, const std::vector<ExactPair>& pairs,
+                        int threads, size_t known, std::vector<Answers>& answers) {
+  const query::DistanceOptions pure{.near_pairs = query::NearPairs::kUnfold};
+  ForEachPair(pairs.size() - known, threads, [&](size_t j) {
+    const size_t k = known + j;
+    Answers& a = answers[k];
+    a.unfolded = engine.Distance(pairs[k].p, pairs[k].q, pure);
+    a.walked = engine.WalkedDistance(pairs[k].p, pairs[k].q, &a.wraps);
+    if (a.unfolded.ok()) a.spread = engine.UnfoldingSpread(pairs[k].p, pairs[k].q);
+  });
+}
+
+// The errors of the uncalibrated answers, by answer bin, that the bounds
+// are fitted on.
+struct UncalibratedErrors {
+  std::vector<double> unfold[2][index::kAccuracyBins], trace[4][index::kAccuracyBins];
+  std::vector<SpreadSample> spread[2][index::kAccuracyBins];
+  double largest_answer = 0;  // of the last, open answer bin
+};
+
+UncalibratedErrors UncalibratedErrorsOf(const std::vector<ExactPair>& pairs,
+                                        const std::vector<Answers>& answers, double scale) {
+  UncalibratedErrors out;
+  for (size_t k = 0; k < pairs.size(); ++k) {
+    const ExactPair& pair = pairs[k];
+    const absl::StatusOr<double>& u = answers[k].unfolded;
+    const bool wraps = answers[k].wraps;
+    const absl::StatusOr<double>& t = answers[k].walked;
+    if (!u.ok()) continue;
+    if (std::isfinite(*u)) out.largest_answer = std::max(out.largest_answer, *u);
+    if (t.ok() && std::isfinite(*t)) out.largest_answer = std::max(out.largest_answer, *t);
+    const int bin = AccuracyBinOf(*u, scale);
+    out.unfold[pair.vertices ? 0 : 1][bin].push_back(std::abs(*u - pair.exact));
+    out.spread[pair.vertices ? 0 : 1][bin].push_back(
+        {std::abs(*u - pair.exact), answers[k].spread, *u});
+    if (t.ok()) {
+      out.trace[2 * pair.vertices + wraps][AccuracyBinOf(*t, scale)].push_back(
+          std::abs(*t - pair.exact));
+    }
+  }
+  return out;
+}
+
+// The default answer to every pair, from an engine that has the bounds
+// (the default mode uses them to doubt a trace).
+absl::StatusOr<std::vector<absl::StatusOr<double>>> DefaultAnswers(
+    const index::Index& index, const index::AccuracyRecord& r,
+    const index::SpreadBoundRecord& spread, const std::vector<ExactPair>& pairs, int threads) {
+  index::IndexData data = index::ToIndexData(index);
+  data.accuracy = {r};
+  data.spread_bounds = {spread};
+  GEODEX_ASSIGN_OR_RETURN(std::string bytes, index::SerializeIndex(data));
+  GEODEX_ASSIGN_OR_RETURN(auto calibrated, index::Index::FromBytes(std::move(bytes)));
+  GEODEX_ASSIGN_OR_RETURN(auto engine, query::QueryEngine::Create(std::move(calibrated)));
+  std::vector<absl::StatusOr<double>> defaults(pairs.size(), absl::UnknownError(""));
+  ForEachPair(pairs.size(), threads,
+              [&](size_t k) { defaults[k] = engine->Distance(pairs[k].p, pairs[k].q); });
+  return defaults;
+}
+
+// The relative errors of the default answers, by scale bin, by fixed band
+// and over the area-uniform pairs.
+struct DefaultErrors {
+  std::vector<double> relative[kNumScaleBins], uniform, uniform_far;
+  std::vector<double> by_kind[2][kNumScaleBins];  // |relative error|, BinConfidence's kinds
+  std::vector<int32_t> uniform_source;
+  std::vector<double> band_errors[2][kNumFixedBins], far_errors[2];
+};
+
+DefaultErrors DefaultErrorsOf(const std::vector<ExactPair>& pairs,
+                              const std::vector<absl::StatusOr<double>>& defaults, double unit) {
+  DefaultErrors out;
+  for (size_t k = 0; k < pairs.size(); ++k) {
+    const ExactPair& pair = pairs[k];
+    const absl::StatusOr<double>& d = defaults[k];
+    if (!d.ok()) continue;
+    const double e = (*d - pair.exact) / pair.exact;
+    const int kind = pair.vertices ? BinConfidence::kVertex : BinConfidence::kInterior;
+    out.band_errors[kind][FixedBinOf(pair.exact, unit)].push_back(std::abs(e));
+    if (pair.uniform && pair.exact >= FixedBinLower(FixedBands::kFarBin) * unit) {
+      out.far_errors[kind].push_back(std::abs(e));
+    }
+    out.relative[pair.bin].push_back(e);
+    out.by_kind[pair.vertices ? BinConfidence::kVertex : BinConfidence::kInterior][pair.bin]
+        .push_back(std::abs(e));
+    if (pair.uniform && !pair.vertices) {
+      out.uniform.push_back(e);
+      out.uniform_source.push_back(pair.source);
+      if (pair.bin == kNumScaleBins - 1) out.uniform_far.push_back(std::abs(e));
+    }
+  }
+  return out;
+}
+
+// The figures of the default answers: the record's RMS and p99 by scale
+// bin, the confidence limits, the bins' and the fixed bands' p99.
+void FillFigures(const DefaultErrors& e, index::AccuracyRecord& r, Calibration& result) {
+  for (int b = 0; b < kNumScaleBins; ++b) {
+    r.rms[b] = static_cast<float>(Rms(e.relative[b]));
+    std::vector<double> abs = e.relative[b];
+    for (double& x : abs) x = std::abs(x);
+    r.p99[b] = e.relative[b].empty() ? 0 : static_cast<float>(Quantile(abs, 0.99));
+  }
+  r.uniform_rms = static_cast<float>(Rms(e.uniform));
+  r.uniform_far_p99 = e.uniform_far.empty() ? 0 : static_cast<float>(Quantile(e.uniform_far, 0.99));
+  result.confidence = UniformConfidenceOf(e.uniform, e.uniform_source, e.uniform_far);
+  for (int k = 0; k < 2; ++k) {
+    for (int b = 0; b < kNumScaleBins; ++b) {
+      const std::vector<double>& x = e.by_kind[k][b];
+      result.bins.pairs[k][b] = static_cast<int32_t>(x.size());
+      result.bins.p99[k][b] = x.empty() ? 0 : Quantile(x, 0.99);
+      result.bins.p99_upper[k][b] = P99UpperLimit(x);
+    }
+  }
+  FixedBands& bands = result.bands;
+  for (int k = 0; k < 2; ++k) {
+    for (int b = 0; b < kNumFixedBins; ++b) {
+      bands.pairs[k][b] = static_cast<int32_t>(e.band_errors[k][b].size());
+      bands.p99[k][b] = e.band_errors[k][b].empty() ? 0 : Quantile(e.band_errors[k][b], 0.99);
+    }
+    bands.far_pairs[k] = static_cast<int32_t>(e.far_errors[k].size());
+    bands.far_p99[k] = e.far_errors[k].empty() ? 0 : Quantile(e.far_errors[k], 0.99);
+    bands.far_p99_upper[k] = P99UpperLimit(e.far_errors[k]);
+  }
+}
+
 // Calibrate on `pairs` (HeldOutPairs of options.pairs' sources);
 // `uncalibrated` holds the answers of a prefix of them, and gets all.
 absl::StatusOr<Calibration> CalibrateOn(const mesh::Mesh& mesh,
@@ -259,118 +388,34 @@ absl::StatusOr<Calibration> CalibrateOn(const mesh::Mesh& mesh,
                                         std::vector<Answers>* uncalibrated) {
   GEODEX_ASSIGN_OR_RETURN(auto engine, query::QueryEngine::Create(index));
   const double scale = engine->scale_length();
-  std::vector<double> unfold[2][index::kAccuracyBins], trace[4][index::kAccuracyBins];
-  std::vector<SpreadSample> spread[2][index::kAccuracyBins];
-  std::vector<double> relative[kNumScaleBins], uniform, uniform_far;
-  std::vector<double> by_kind[2][kNumScaleBins];  // |relative error|, BinConfidence's kinds
-  std::vector<int32_t> uniform_source;
-  const query::DistanceOptions pure{.near_pairs = query::NearPairs::kUnfold};
-  // Each pair's answers in its own slot, gathered in order below: the
-  // calibration does not depend on the thread count. Those of the pairs
-  // measured before (a sequential calibration's earlier sources) are kept.
+  // Those of the pairs measured before (a sequential calibration's earlier
+  // sources) are kept.
   std::vector<Answers>& answers = *uncalibrated;
   const size_t known = answers.size();
   answers.resize(pairs.size());
-  ForEachPair(pairs.size() - known, options.pairs.threads, [&](size_t j) {
-    const size_t k = known + j;
-    Answers& a = answers[k];
-    a.unfolded = engine->Distance(pairs[k].p, pairs[k].q, pure);
-    a.walked = engine->WalkedDistance(pairs[k].p, pairs[k].q, &a.wraps);
-    if (a.unfolded.ok()) a.spread = engine->UnfoldingSpread(pairs[k].p, pairs[k].q);
-  });
-  double largest_answer = 0;  // of the last, open answer bin
-  for (size_t k = 0; k < pairs.size(); ++k) {
-    const ExactPair& pair = pairs[k];
-    const absl::StatusOr<double>& u = answers[k].unfolded;
-    const bool wraps = answers[k].wraps;
-    const absl::StatusOr<double>& t = answers[k].walked;
-    if (!u.ok()) continue;
-    if (std::isfinite(*u)) largest_answer = std::max(largest_answer, *u);
-    if (t.ok() && std::isfinite(*t)) largest_answer = std::max(largest_answer, *t);
-    const int bin = AccuracyBinOf(*u, scale);
-    unfold[pair.vertices ? 0 : 1][bin].push_back(std::abs(*u - pair.exact));
-    spread[pair.vertices ? 0 : 1][bin].push_back(
-        {std::abs(*u - pair.exact), answers[k].spread, *u});
-    if (t.ok()) {
-      trace[2 * pair.vertices + wraps][AccuracyBinOf(*t, scale)].push_back(
-          std::abs(*t - pair.exact));
-    }
-  }
+  AnswerUncalibrated(*engine, pairs, options.pairs.threads, known, answers);
+  const UncalibratedErrors u = UncalibratedErrorsOf(pairs, answers, scale);
   index::AccuracyRecord r{};
   r.scale_length = static_cast<float>(scale);
   r.num_sources = options.pairs.num_sources;
   r.num_pairs = static_cast<uint32_t>(pairs.size());
   r.bound_quantile_permille = static_cast<uint32_t>(std::lround(1000 * options.quantile));
-  FillBounds(unfold[0], options.quantile, scale, largest_answer, r.unfold_bound[0]);
-  FillBounds(unfold[1], options.quantile, scale, largest_answer, r.unfold_bound[1]);
+  FillBounds(u.unfold[0], options.quantile, scale, u.largest_answer, r.unfold_bound[0]);
+  FillBounds(u.unfold[1], options.quantile, scale, u.largest_answer, r.unfold_bound[1]);
   for (int k = 0; k < 4; ++k) {
-    FillBounds(trace[k], options.quantile, scale, largest_answer, r.trace_bound[k]);
+    FillBounds(u.trace[k], options.quantile, scale, u.largest_answer, r.trace_bound[k]);
   }
   Calibration result;
   for (int k = 0; k < 2; ++k) {
-    FitSpreadBounds(spread[k], options.quantile, r.unfold_bound[k], result.spread.epsilon[k],
+    FitSpreadBounds(u.spread[k], options.quantile, r.unfold_bound[k], result.spread.epsilon[k],
                     result.spread.factor[k]);
   }
-  // The default answer's figures, from an engine that has the bounds (the
-  // default mode uses them to doubt a trace).
-  index::IndexData data = index::ToIndexData(*index);
-  data.accuracy = {r};
-  data.spread_bounds = {result.spread};
-  GEODEX_ASSIGN_OR_RETURN(std::string bytes, index::SerializeIndex(data));
-  GEODEX_ASSIGN_OR_RETURN(auto calibrated, index::Index::FromBytes(std::move(bytes)));
-  GEODEX_ASSIGN_OR_RETURN(engine, query::QueryEngine::Create(std::move(calibrated)));
-  std::vector<absl::StatusOr<double>> defaults(pairs.size(), absl::UnknownError(""));
-  ForEachPair(pairs.size(), options.pairs.threads,
-              [&](size_t k) { defaults[k] = engine->Distance(pairs[k].p, pairs[k].q); });
-  FixedBands& bands = result.bands;
-  bands.unit = ScaleLength(mesh.TotalArea(), kFixedUnitSamples);
-  std::vector<double> band_errors[2][kNumFixedBins], far_errors[2];
-  for (size_t k = 0; k < pairs.size(); ++k) {
-    const ExactPair& pair = pairs[k];
-    const absl::StatusOr<double>& d = defaults[k];
-    if (!d.ok()) continue;
-    const double e = (*d - pair.exact) / pair.exact;
-    const int kind = pair.vertices ? BinConfidence::kVertex : BinConfidence::kInterior;
-    band_errors[kind][FixedBinOf(pair.exact, bands.unit)].push_back(std::abs(e));
-    if (pair.uniform && pair.exact >= FixedBinLower(FixedBands::kFarBin) * bands.unit) {
-      far_errors[kind].push_back(std::abs(e));
-    }
-    relative[pair.bin].push_back(e);
-    by_kind[pair.vertices ? BinConfidence::kVertex : BinConfidence::kInterior][pair.bin].push_back(
-        std::abs(e));
-    if (pair.uniform && !pair.vertices) {
-      uniform.push_back(e);
-      uniform_source.push_back(pair.source);
-      if (pair.bin == kNumScaleBins - 1) uniform_far.push_back(std::abs(e));
-    }
-  }
-  if (uniform.empty()) return absl::InternalError("calibration: no pair could be measured");
-  for (int b = 0; b < kNumScaleBins; ++b) {
-    r.rms[b] = static_cast<float>(Rms(relative[b]));
-    std::vector<double> abs = relative[b];
-    for (double& x : abs) x = std::abs(x);
-    r.p99[b] = relative[b].empty() ? 0 : static_cast<float>(Quantile(abs, 0.99));
-  }
-  r.uniform_rms = static_cast<float>(Rms(uniform));
-  r.uniform_far_p99 = uniform_far.empty() ? 0 : static_cast<float>(Quantile(uniform_far, 0.99));
-  result.confidence = UniformConfidenceOf(uniform, uniform_source, uniform_far);
-  for (int k = 0; k < 2; ++k) {
-    for (int b = 0; b < kNumScaleBins; ++b) {
-      const std::vector<double>& x = by_kind[k][b];
-      result.bins.pairs[k][b] = static_cast<int32_t>(x.size());
-      result.bins.p99[k][b] = x.empty() ? 0 : Quantile(x, 0.99);
-      result.bins.p99_upper[k][b] = P99UpperLimit(x);
-    }
-  }
-  for (int k = 0; k < 2; ++k) {
-    for (int b = 0; b < kNumFixedBins; ++b) {
-      bands.pairs[k][b] = static_cast<int32_t>(band_errors[k][b].size());
-      bands.p99[k][b] = band_errors[k][b].empty() ? 0 : Quantile(band_errors[k][b], 0.99);
-    }
-    bands.far_pairs[k] = static_cast<int32_t>(far_errors[k].size());
-    bands.far_p99[k] = far_errors[k].empty() ? 0 : Quantile(far_errors[k], 0.99);
-    bands.far_p99_upper[k] = P99UpperLimit(far_errors[k]);
-  }
+  GEODEX_ASSIGN_OR_RETURN(const std::vector<absl::StatusOr<double>> defaults,
+                          DefaultAnswers(*index, r, result.spread, pairs, options.pairs.threads));
+  result.bands.unit = ScaleLength(mesh.TotalArea(), kFixedUnitSamples);
+  const DefaultErrors errors = DefaultErrorsOf(pairs, defaults, result.bands.unit);
+  if (errors.uniform.empty()) return absl::InternalError("calibration: no pair could be measured");
+  FillFigures(errors, r, result);
   result.record = r;
   return result;
 }

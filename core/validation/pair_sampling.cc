@@ -63,49 +63,95 @@ std::mt19937_64 SourceGenerator(uint64_t seed, int32_t s) {
   return std::mt19937_64(seq);
 }
 
-// The pairs of source `s`: a vertex paired with vertices for even s, a point
-// inside a face paired with such points for odd s. Empty when the source's
-// propagation fails.
-std::vector<ExactPair> PairsOfSource(const PairContext& c, geodesic::VertexGeodesicSolver& solver,
-                                     int32_t s) {
-  const mesh::Mesh& mesh = c.mesh;
-  const PairOptions& options = c.options;
-  std::mt19937_64 rng = SourceGenerator(options.seed, s);
-  std::uniform_int_distribution<size_t> any_vertex(0, c.referenced.size() - 1);
+// The pairs of source `s` as they are drawn.
+struct SourcePairs {
+  const PairContext& c;
+  int32_t s;
   std::vector<ExactPair> pairs;
-  auto add = [&](const mesh::SurfacePoint& p, const mesh::SurfacePoint& q, double exact,
-                 bool vertices, bool uniform) {
+
+  // Adds (p, q) at distance `exact` unless it is too close or infinite;
+  // returns whether it did.
+  bool Add(const mesh::SurfacePoint& p, const mesh::SurfacePoint& q, double exact, bool vertices,
+           bool uniform) {
     if (!(exact > c.tiny) || !std::isfinite(exact)) return false;
     pairs.push_back({p, q, exact, vertices, uniform, ScaleBinOf(exact, c.scale), s});
     return true;
-  };
-  if (s % 2 == 0) {
-    const int32_t v = c.referenced[any_vertex(rng)];
-    const mesh::SurfacePoint source = AtVertex(mesh, v);
-    if (!solver.Propagate({v}).ok()) return {};
-    const std::vector<double>& dist = solver.VertexDistances();
-    for (int32_t k = 0; k < options.uniform_points; ++k) {
-      const int32_t u = c.referenced[any_vertex(rng)];
-      add(source, AtVertex(mesh, u), dist[u], true, true);
-    }
-    for (int b = 0; b < kNumScaleBins; ++b) {
-      const double lo = kBinEdges[b] * c.scale, hi = kBinEdges[b + 1] * c.scale;
-      std::vector<int32_t> in_bin;
-      for (int32_t u : c.referenced) {
-        if (dist[u] >= lo && dist[u] < hi) in_bin.push_back(u);
-      }
-      if (in_bin.empty()) continue;
-      std::uniform_int_distribution<size_t> pick(0, in_bin.size() - 1);
-      for (int32_t k = 0; k < options.per_bin_points; ++k) {
-        const int32_t u = in_bin[pick(rng)];
-        add(source, AtVertex(mesh, u), dist[u], true, false);
-      }
-    }
-    return pairs;
   }
-  // A source inside a face: one propagation for the vertex distances and
-  // the uniform points, a second for the candidates of every bin, drawn on
-  // the faces that reach into it (the first says which those are).
+};
+
+// A vertex paired with vertices: area-uniform ones, then in each bin.
+std::vector<ExactPair> VertexSourcePairs(const PairContext& c,
+                                         geodesic::VertexGeodesicSolver& solver, int32_t s,
+                                         std::mt19937_64& rng) {
+  const mesh::Mesh& mesh = c.mesh;
+  const PairOptions& options = c.options;
+  std::uniform_int_distribution<size_t> any_vertex(0, c.referenced.size() - 1);
+  SourcePairs out{c, s, {}};
+  const int32_t v = c.referenced[any_vertex(rng)];
+  const mesh::SurfacePoint source = AtVertex(mesh, v);
+  if (!solver.Propagate({v}).ok()) return {};
+  const std::vector<double>& dist = solver.VertexDistances();
+  for (int32_t k = 0; k < options.uniform_points; ++k) {
+    const int32_t u = c.referenced[any_vertex(rng)];
+    out.Add(source, AtVertex(mesh, u), dist[u], true, true);
+  }
+  for (int b = 0; b < kNumScaleBins; ++b) {
+    const double lo = kBinEdges[b] * c.scale, hi = kBinEdges[b + 1] * c.scale;
+    std::vector<int32_t> in_bin;
+    for (int32_t u : c.referenced) {
+      if (dist[u] >= lo && dist[u] < hi) in_bin.push_back(u);
+    }
+    if (in_bin.empty()) continue;
+    std::uniform_int_distribution<size_t> pick(0, in_bin.size() - 1);
+    for (int32_t k = 0; k < options.per_bin_points; ++k) {
+      const int32_t u = in_bin[pick(rng)];
+      out.Add(source, AtVertex(mesh, u), dist[u], true, false);
+    }
+  }
+  return std::move(out.pairs);
+}
+
+// Candidate points of every bin for a source in face `source_face`, whose
+// vertex distances are `dist`: drawn area-uniformly on the faces that reach
+// into the bin.
+struct Candidates {
+  std::vector<mesh::SurfacePoint> points;
+  std::vector<int> bin;
+};
+
+Candidates BinCandidates(const PairContext& c, int32_t source_face, const std::vector<double>& dist,
+                         std::mt19937_64& rng) {
+  const mesh::Mesh& mesh = c.mesh;
+  Candidates out;
+  for (int b = 0; b < kNumScaleBins; ++b) {
+    const double lo = kBinEdges[b] * c.scale, hi = kBinEdges[b + 1] * c.scale;
+    std::vector<int32_t> faces;
+    for (int32_t f = 0; f < mesh.num_faces(); ++f) {
+      const mesh::Triangle& t = mesh.face(f);
+      const double d0 = dist[t[0]], d1 = dist[t[1]], d2 = dist[t[2]];
+      if (f == source_face || (std::min({d0, d1, d2}) < hi && std::max({d0, d1, d2}) >= lo)) {
+        faces.push_back(f);
+      }
+    }
+    if (faces.empty()) continue;
+    const std::vector<double> cumulative = Cumulative(mesh, faces);
+    if (!(cumulative.back() > 0)) continue;
+    for (int32_t k = 0; k < 8 * c.options.per_bin_points; ++k) {
+      out.points.push_back(PointOnFaces(faces, cumulative, rng));
+      out.bin.push_back(b);
+    }
+  }
+  return out;
+}
+
+// A point inside a face paired with such points: one propagation for the
+// vertex distances and the uniform points, a second for the candidates of
+// every bin, drawn on the faces that reach into it (the first says which
+// those are).
+std::vector<ExactPair> FaceSourcePairs(const PairContext& c, geodesic::VertexGeodesicSolver& solver,
+                                       int32_t s, std::mt19937_64& rng) {
+  const PairOptions& options = c.options;
+  SourcePairs out{c, s, {}};
   const mesh::SurfacePoint source = PointOnFaces(c.all_faces, c.all_cumulative, rng);
   std::vector<mesh::SurfacePoint> uniform(options.uniform_points);
   for (mesh::SurfacePoint& q : uniform) q = PointOnFaces(c.all_faces, c.all_cumulative, rng);
@@ -113,42 +159,36 @@ std::vector<ExactPair> PairsOfSource(const PairContext& c, geodesic::VertexGeode
   first.targets = uniform;
   if (!solver.Propagate({source}, first).ok()) return {};
   for (size_t k = 0; k < uniform.size(); ++k) {
-    add(source, uniform[k], solver.TargetDistance(k), false, true);
+    out.Add(source, uniform[k], solver.TargetDistance(k), false, true);
   }
   const std::vector<double> dist = solver.VertexDistances();
-  std::vector<mesh::SurfacePoint> candidates;
-  std::vector<int> candidate_bin;
-  for (int b = 0; b < kNumScaleBins; ++b) {
-    const double lo = kBinEdges[b] * c.scale, hi = kBinEdges[b + 1] * c.scale;
-    std::vector<int32_t> faces;
-    for (int32_t f = 0; f < mesh.num_faces(); ++f) {
-      const mesh::Triangle& t = mesh.face(f);
-      const double d0 = dist[t[0]], d1 = dist[t[1]], d2 = dist[t[2]];
-      if (f == source.face || (std::min({d0, d1, d2}) < hi && std::max({d0, d1, d2}) >= lo)) {
-        faces.push_back(f);
-      }
-    }
-    if (faces.empty()) continue;
-    const std::vector<double> cumulative = Cumulative(mesh, faces);
-    if (!(cumulative.back() > 0)) continue;
-    for (int32_t k = 0; k < 8 * options.per_bin_points; ++k) {
-      candidates.push_back(PointOnFaces(faces, cumulative, rng));
-      candidate_bin.push_back(b);
-    }
-  }
+  const Candidates candidates = BinCandidates(c, source.face, dist, rng);
   geodesic::VertexGeodesicOptions second;
-  second.targets = candidates;
-  if (candidates.empty() || !solver.Propagate({source}, second).ok()) return pairs;
+  second.targets = candidates.points;
+  if (candidates.points.empty() || !solver.Propagate({source}, second).ok()) {
+    return std::move(out.pairs);
+  }
   std::vector<int32_t> found(kNumScaleBins, 0);
-  for (size_t k = 0; k < candidates.size(); ++k) {
-    const int b = candidate_bin[k];
+  for (size_t k = 0; k < candidates.points.size(); ++k) {
+    const int b = candidates.bin[k];
     const double exact = solver.TargetDistance(k);
     if (found[b] < options.per_bin_points && exact >= kBinEdges[b] * c.scale &&
-        exact < kBinEdges[b + 1] * c.scale && add(source, candidates[k], exact, false, false)) {
+        exact < kBinEdges[b + 1] * c.scale &&
+        out.Add(source, candidates.points[k], exact, false, false)) {
       ++found[b];
     }
   }
-  return pairs;
+  return std::move(out.pairs);
+}
+
+// The pairs of source `s`: a vertex paired with vertices for even s, a point
+// inside a face paired with such points for odd s. Empty when the source's
+// propagation fails.
+std::vector<ExactPair> PairsOfSource(const PairContext& c, geodesic::VertexGeodesicSolver& solver,
+                                     int32_t s) {
+  std::mt19937_64 rng = SourceGenerator(c.options.seed, s);
+  if (s % 2 == 0) return VertexSourcePairs(c, solver, s, rng);
+  return FaceSourcePairs(c, solver, s, rng);
 }
 
 }  // namespace

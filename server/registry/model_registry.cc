@@ -212,25 +212,26 @@ void ModelRegistry::Scan() {
   Publish(initial_scan_done_);
 }
 
-void ModelRegistry::ScanModel(ModelEntry& entry, const std::string& dir) {
-  // The configuration, re-read when its file changes.
+void ModelRegistry::ReloadConfig(ModelEntry& entry, const std::string& dir) {
   const std::string config_path = (fs::path(dir) / kModelConfigFile).string();
   const FileId config_id = StatRegularFile(config_path).value_or(FileId{});
-  if ((!entry.config_loaded && entry.config_error.empty()) || config_id != entry.config_file) {
-    entry.config_file = config_id;
-    absl::StatusOr<ModelConfig> config = LoadModelConfig(config_path);
-    if (config.ok()) {
-      entry.config = *std::move(config);
-      entry.config_loaded = true;
-      entry.config_error.clear();
-    } else {
-      entry.config_error = std::string(config.status().message());
-      spdlog::warn("model {}: {}{}", entry.name, entry.config_error,
-                   entry.config_loaded ? "; keeping the previous configuration" : "");
-    }
+  if ((entry.config_loaded || !entry.config_error.empty()) && config_id == entry.config_file) {
+    return;
   }
+  entry.config_file = config_id;
+  absl::StatusOr<ModelConfig> config = LoadModelConfig(config_path);
+  if (config.ok()) {
+    entry.config = *std::move(config);
+    entry.config_loaded = true;
+    entry.config_error.clear();
+  } else {
+    entry.config_error = std::string(config.status().message());
+    spdlog::warn("model {}: {}{}", entry.name, entry.config_error,
+                 entry.config_loaded ? "; keeping the previous configuration" : "");
+  }
+}
 
-  // The versions on disk.
+std::map<int64_t, FileId> ModelRegistry::ScanVersions(ModelEntry& entry, const std::string& dir) {
   std::map<int64_t, FileId> disk;
   std::error_code ec;
   for (fs::directory_iterator it(dir, ec); !ec && it != fs::directory_iterator();
@@ -266,88 +267,101 @@ void ModelRegistry::ScanModel(ModelEntry& entry, const std::string& dir) {
       ve.served.reset();
     }
   }
+  return disk;
+}
 
-  // Which versions should be served: the newest keep_versions ones on disk
-  // that are not known to be broken (a broken file whose previous contents
-  // are still served counts as served).
+// Which versions should be served: the newest keep_versions ones on disk
+// that are not known to be broken (a broken file whose previous contents
+// are still served counts as served).
+std::vector<int64_t> ModelRegistry::DesiredVersions(ModelEntry& entry,
+                                                    const std::map<int64_t, FileId>& disk) {
   const size_t keep = std::max<int32_t>(1, entry.config.keep_versions());
-  auto desired = [&] {
-    std::vector<int64_t> out;
-    for (auto v = disk.rbegin(); v != disk.rend() && out.size() < keep; ++v) {
-      const VersionEntry& ve = entry.versions[v->first];
-      if (ve.failed() && ve.served == nullptr) continue;
-      out.push_back(v->first);
-    }
-    return out;
-  };
-  // Publishes the served set: the desired versions that are loaded; if none
-  // is, the newest version served so far keeps serving.
-  auto update_served = [&](bool final) {
-    std::map<int64_t, std::shared_ptr<const ServedVersion>> served;
-    for (int64_t v : desired()) {
-      if (entry.versions[v].served) served[v] = entry.versions[v].served;
-    }
-    if (served.empty()) {
-      for (auto v = entry.versions.rbegin(); v != entry.versions.rend(); ++v) {
-        if (v->second.served) {
-          served[v->first] = v->second.served;
-          break;
-        }
-      }
-    }
-    if (final) {
-      for (auto v = entry.versions.begin(); v != entry.versions.end();) {
-        if (served.count(v->first) == 0 && v->second.served) {
-          spdlog::info("model {} version {} retired", entry.name, v->first);
-          v->second.served.reset();  // freed when the last request using it ends
-        }
-        if (v->second.served == nullptr && v->second.disk.size < 0) {
-          v = entry.versions.erase(v);
-        } else {
-          ++v;
-        }
-      }
-    }
-    entry.served = std::move(served);
-  };
+  std::vector<int64_t> out;
+  for (auto v = disk.rbegin(); v != disk.rend() && out.size() < keep; ++v) {
+    const VersionEntry& ve = entry.versions[v->first];
+    if (ve.failed() && ve.served == nullptr) continue;
+    out.push_back(v->first);
+  }
+  return out;
+}
 
+// Publishes the served set: the desired versions that are loaded; if none
+// is, the newest version served so far keeps serving.
+void ModelRegistry::UpdateServed(ModelEntry& entry, const std::map<int64_t, FileId>& disk,
+                                 bool final) {
+  std::map<int64_t, std::shared_ptr<const ServedVersion>> served;
+  for (int64_t v : DesiredVersions(entry, disk)) {
+    if (entry.versions[v].served) served[v] = entry.versions[v].served;
+  }
+  if (served.empty()) {
+    for (auto v = entry.versions.rbegin(); v != entry.versions.rend(); ++v) {
+      if (v->second.served) {
+        served[v->first] = v->second.served;
+        break;
+      }
+    }
+  }
+  if (final) {
+    for (auto v = entry.versions.begin(); v != entry.versions.end();) {
+      if (served.count(v->first) == 0 && v->second.served) {
+        spdlog::info("model {} version {} retired", entry.name, v->first);
+        v->second.served.reset();  // freed when the last request using it ends
+      }
+      if (v->second.served == nullptr && v->second.disk.size < 0) {
+        v = entry.versions.erase(v);
+      } else {
+        ++v;
+      }
+    }
+  }
+  entry.served = std::move(served);
+}
+
+void ModelRegistry::LoadVersion(ModelEntry& entry, int64_t version, const std::string& dir) {
+  VersionEntry& ve = entry.versions[version];
+  const std::string path = (fs::path(dir) / std::to_string(version) / kIndexFileName).string();
+  entry.loading_version = version;
+  Publish(initial_scan_done_);
+  if (options_.before_load) options_.before_load(path);
+  const auto start = std::chrono::steady_clock::now();
+  auto loaded = ServedVersion::Load(version, path, ve.disk);
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  entry.loading_version = 0;
+  if (loaded.ok()) {
+    spdlog::info("model {} version {} loaded: {} vertices, {} samples, {} bytes mapped, {:.3f}s",
+                 entry.name, version, (*loaded)->index().num_vertices(),
+                 (*loaded)->index().num_samples(), (*loaded)->mapped_bytes(), seconds);
+    ve.served = *std::move(loaded);
+    ve.failed_reason.clear();
+  } else {
+    ve.failed_file = ve.disk;
+    ve.failed_reason = loaded.status().ToString();
+    spdlog::error("model {} version {} failed to load: {}", entry.name, version, ve.failed_reason);
+  }
+}
+
+void ModelRegistry::ScanModel(ModelEntry& entry, const std::string& dir) {
+  // The configuration, re-read when its file changes.
+  ReloadConfig(entry, dir);
+  // The versions on disk.
+  const std::map<int64_t, FileId> disk = ScanVersions(entry, dir);
   if (entry.config_loaded) {
     for (;;) {
       int64_t next = 0;
-      for (int64_t v : desired()) {
+      for (int64_t v : DesiredVersions(entry, disk)) {
         if (entry.versions[v].needs_load()) {
           next = v;
           break;
         }
       }
       if (next == 0) break;
-      VersionEntry& ve = entry.versions[next];
-      const std::string path = (fs::path(dir) / std::to_string(next) / kIndexFileName).string();
-      entry.loading_version = next;
-      Publish(initial_scan_done_);
-      if (options_.before_load) options_.before_load(path);
-      const auto start = std::chrono::steady_clock::now();
-      auto loaded = ServedVersion::Load(next, path, ve.disk);
-      const double seconds =
-          std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-      entry.loading_version = 0;
-      if (loaded.ok()) {
-        spdlog::info(
-            "model {} version {} loaded: {} vertices, {} samples, {} bytes mapped, {:.3f}s",
-            entry.name, next, (*loaded)->index().num_vertices(), (*loaded)->index().num_samples(),
-            (*loaded)->mapped_bytes(), seconds);
-        ve.served = *std::move(loaded);
-        ve.failed_reason.clear();
-      } else {
-        ve.failed_file = ve.disk;
-        ve.failed_reason = loaded.status().ToString();
-        spdlog::error("model {} version {} failed to load: {}", entry.name, next, ve.failed_reason);
-      }
-      update_served(/*final=*/false);
+      LoadVersion(entry, next, dir);
+      UpdateServed(entry, disk, /*final=*/false);
       Publish(initial_scan_done_);
     }
   }
-  update_served(/*final=*/true);
+  UpdateServed(entry, disk, /*final=*/true);
 }
 
 std::shared_ptr<const ModelSnapshot> ModelRegistry::MakeModelSnapshot(

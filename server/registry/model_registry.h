@@ -216,6 +216,16 @@ class ModelRegistry {
   void Run();
   void Scan();
   void ScanModel(ModelEntry& entry, const std::string& dir);
+  // ScanModel's steps: the configuration, re-read when its file changed;
+  // the versions on disk (version -> index file), entry.versions made to
+  // agree; the versions that should be served; the served set published
+  // (`final`: versions no longer served retired); one version loaded.
+  static void ReloadConfig(ModelEntry& entry, const std::string& dir);
+  static std::map<int64_t, FileId> ScanVersions(ModelEntry& entry, const std::string& dir);
+  static std::vector<int64_t> DesiredVersions(ModelEntry& entry,
+                                              const std::map<int64_t, FileId>& disk);
+  static void UpdateServed(ModelEntry& entry, const std::map<int64_t, FileId>& disk, bool final);
+  void LoadVersion(ModelEntry& entry, int64_t version, const std::string& dir);
   void Publish(bool initial_scan_done);
   std::shared_ptr<const ModelSnapshot> MakeModelSnapshot(const ModelEntry& entry) const;
 

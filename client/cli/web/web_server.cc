@@ -43,18 +43,11 @@ absl::StatusOr<HostPort> ParseListen(const std::string& listen) {
   return out;
 }
 
-}  // namespace
-
-absl::Status ServeWeb(const WebGateway& gateway, const WebServerOptions& options) {
-  absl::StatusOr<HostPort> address = ParseListen(options.listen);
-  if (!address.ok()) return address.status();
-
-  httplib::Server server;
-  server.set_payload_max_length(gateway.max_body_bytes());
-  // httplib compresses answers with brotli when the client accepts it, at
-  // brotli's slowest quality: ten seconds for the JSON of a 100K-vertex mesh
-  // that gzip compresses in a fraction of one. Offer it gzip only. (The
-  // request is httplib's own mutable object, handed to us as const.)
+// httplib compresses answers with brotli when the client accepts it, at
+// brotli's slowest quality: ten seconds for the JSON of a 100K-vertex mesh
+// that gzip compresses in a fraction of one. Offer it gzip only. (The
+// request is httplib's own mutable object, handed to us as const.)
+void OfferGzipOnly(httplib::Server& server) {
   server.set_pre_routing_handler([](const httplib::Request& req, httplib::Response&) {
     auto& headers = const_cast<httplib::Request&>(req).headers;
     auto it = headers.find("Accept-Encoding");
@@ -65,6 +58,10 @@ absl::Status ServeWeb(const WebGateway& gateway, const WebServerOptions& options
     }
     return httplib::Server::HandlerResponse::Unhandled;
   });
+}
+
+// Every method on every path goes to the gateway.
+void RouteToGateway(httplib::Server& server, const WebGateway& gateway) {
   auto handle = [&gateway](const httplib::Request& req, httplib::Response& res) {
     HttpRequest request;
     request.method = req.method;
@@ -89,9 +86,12 @@ absl::Status ServeWeb(const WebGateway& gateway, const WebServerOptions& options
     server.Patch(pattern, handle);
     server.Delete(pattern, handle);
   }
-  // Rejections made by httplib itself (413 over --max-body, 400 for a
-  // malformed request, 404 for a method it has no route for) get the same JSON
-  // error body as the gateway's.
+}
+
+// Rejections made by httplib itself (413 over --max-body, 400 for a
+// malformed request, 404 for a method it has no route for) get the same JSON
+// error body as the gateway's.
+void AnswerRejectionsAsJson(httplib::Server& server) {
   server.set_error_handler([](const httplib::Request&, httplib::Response& res) {
     if (!res.body.empty()) return;
     const absl::StatusCode code = res.status == 413   ? absl::StatusCode::kResourceExhausted
@@ -110,24 +110,46 @@ absl::Status ServeWeb(const WebGateway& gateway, const WebServerOptions& options
         res.status = error.status;
         res.set_content(error.body, error.content_type.c_str());
       });
+}
 
-  int port = address->port;
+// The port bound at `address` (any free one for port 0); 0 when none is.
+int Bind(httplib::Server& server, const HostPort& address) {
+  int port = address.port;
   if (port == 0) {
-    port = server.bind_to_any_port(address->host);
+    port = server.bind_to_any_port(address.host);
     if (port < 0) port = 0;
-  } else if (!server.bind_to_port(address->host, port)) {
+  } else if (!server.bind_to_port(address.host, port)) {
     port = 0;
   }
-  if (port == 0) {
-    return absl::UnavailableError(absl::StrCat("cannot listen on ", options.listen));
-  }
+  return port;
+}
 
+void InstallStopHandlers() {
   stop_requested = false;
   struct sigaction action = {};
   action.sa_handler = OnStopSignal;
   sigemptyset(&action.sa_mask);
   sigaction(SIGINT, &action, nullptr);
   sigaction(SIGTERM, &action, nullptr);
+}
+
+}  // namespace
+
+absl::Status ServeWeb(const WebGateway& gateway, const WebServerOptions& options) {
+  absl::StatusOr<HostPort> address = ParseListen(options.listen);
+  if (!address.ok()) return address.status();
+
+  httplib::Server server;
+  server.set_payload_max_length(gateway.max_body_bytes());
+  OfferGzipOnly(server);
+  RouteToGateway(server, gateway);
+  AnswerRejectionsAsJson(server);
+  const int port = Bind(server, *address);
+  if (port == 0) {
+    return absl::UnavailableError(absl::StrCat("cannot listen on ", options.listen));
+  }
+
+  InstallStopHandlers();
   // A signal handler may not call stop(); a watcher thread does.
   std::thread watcher([&server] {
     while (!stop_requested) std::this_thread::sleep_for(std::chrono::milliseconds(100));
