@@ -93,6 +93,8 @@ class Refiner {
                 QueryScratch* scratch, double* bound) const;
 
  private:
+  class Pair;  // one pair's refinement (refinement.cc)
+
   MeshView view_;
   const LiftedUnfolding& unfolding_;
   const ErrorBounds& bounds_;
